@@ -1,0 +1,21 @@
+//! railwear: wear of missile-launcher rails and missile shoes in captive carry.
+//!
+//! The pipeline follows the data (see ARCHITECTURE.md):
+//! config -> geometry and bodies -> time integration with contacts -> contact tracks
+//! -> wear -> reports (service life) -> storage -> HTTP.
+//!
+//! Units: SI inside the engine (m, kg, s, N, Pa). See [`units`] for the
+//! conversions from the thesis' ADAMS units (mm, kg, s, N).
+
+pub mod analysis;
+pub mod config;
+pub mod contact_models;
+pub mod excitation;
+pub mod geometry;
+pub mod http;
+pub mod jobs;
+pub mod models;
+pub mod physics;
+pub mod store;
+pub mod units;
+pub mod wear;
