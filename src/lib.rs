@@ -16,6 +16,7 @@ pub mod http;
 pub mod jobs;
 pub mod models;
 pub mod physics;
+pub mod pipeline;
 pub mod store;
 pub mod units;
 pub mod wear;

@@ -1,4 +1,6 @@
 //! Rigid multibody dynamics: bodies, force elements, contact and friction laws, integrators.
 
 pub mod friction;
+pub mod impact;
 pub mod step;
+pub mod track;

@@ -1,0 +1,134 @@
+//! ADAMS IMPACT normal contact force, thesis eq. 2.1-2.3.
+//!
+//! `F = max(0, k w^e + c_max STEP(w, 0, 0, d, 1) wdot)` for `w > 0`, zero otherwise, with `w` the
+//! penetration and `wdot` its rate (positive while approaching). The damping always resists
+//! approach. Eq. 2.2 as printed (`- c_max wdot STEP`) uses the gap coordinate's rate; read with
+//! `wdot` as the penetration rate its sign is reversed (an erratum, see docs/errata.md).
+
+use super::step::StepKind;
+use serde::{Deserialize, Serialize};
+
+/// IMPACT parameters in SI (N/m^e, N·s/m, m).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ImpactParams {
+    /// Stiffness k, N/m^e. Thesis Table 5.2: 1000 N/mm² = 1e9 N/m².
+    pub stiffness: f64,
+    /// Force exponent e (dimensionless). Thesis Table 5.2: 2.0.
+    pub exponent: f64,
+    /// Maximum damping c_max, N·s/m. Thesis Table 5.2: 500 N·s/mm = 5e5 N·s/m.
+    pub max_damping: f64,
+    /// Penetration d at which full damping is reached, m. Thesis Table 5.2: 0.01 mm.
+    pub full_damping_depth: f64,
+    /// Shape of the damping ramp (eq. 2.4 cycloidal by default).
+    #[serde(default)]
+    pub step: StepKind,
+}
+
+impl ImpactParams {
+    /// Builds from the thesis' ADAMS units: k in N/mm^e, c in N·s/mm, d in mm.
+    pub fn from_adams_units(k_n_per_mm_e: f64, exponent: f64, c_ns_per_mm: f64, d_mm: f64) -> Self {
+        Self {
+            stiffness: crate::units::impact_stiffness_si(k_n_per_mm_e, exponent),
+            exponent,
+            max_damping: crate::units::damping_si(c_ns_per_mm),
+            full_damping_depth: crate::units::mm(d_mm),
+            step: StepKind::Cycloidal,
+        }
+    }
+
+    /// Thesis Table 5.2 / 4.1 / 6.2 default: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
+    pub fn thesis_table_5_2() -> Self {
+        Self::from_adams_units(1000.0, 2.0, 500.0, 0.01)
+    }
+
+    /// Checks the rules on each field; returns (field, rule) for the first violation.
+    pub fn validate(&self) -> Result<(), (&'static str, &'static str)> {
+        if !(self.stiffness.is_finite() && self.stiffness > 0.0) {
+            return Err(("stiffness", "must be a finite number > 0"));
+        }
+        if !(self.exponent.is_finite() && self.exponent >= 1.0) {
+            return Err(("exponent", "must be a finite number >= 1"));
+        }
+        if !(self.max_damping.is_finite() && self.max_damping >= 0.0) {
+            return Err(("max_damping", "must be a finite number >= 0"));
+        }
+        if !(self.full_damping_depth.is_finite() && self.full_damping_depth >= 0.0) {
+            return Err(("full_damping_depth", "must be a finite number >= 0"));
+        }
+        Ok(())
+    }
+
+    /// Damping coefficient at penetration `w`: `c_max STEP(w, 0, 0, d, 1)`.
+    #[inline]
+    pub fn damping_at(&self, w: f64) -> f64 {
+        if w <= 0.0 {
+            0.0
+        } else if w >= self.full_damping_depth {
+            self.max_damping
+        } else {
+            self.max_damping * self.step.eval(w, 0.0, 0.0, self.full_damping_depth, 1.0)
+        }
+    }
+
+    /// Normal force magnitude (N) for penetration `w` (m) and penetration rate `wdot` (m/s,
+    /// positive approaching), clamped at zero (eq. 2.1-2.3).
+    #[inline]
+    pub fn force(&self, w: f64, wdot: f64) -> f64 {
+        if w <= 0.0 {
+            return 0.0;
+        }
+        (self.stiffness * w.powf(self.exponent) + self.damping_at(w) * wdot).max(0.0)
+    }
+
+    /// Partial derivatives (dF/dw, dF/dwdot) of [`ImpactParams::force`], zero where clamped.
+    #[inline]
+    pub fn force_gradient(&self, w: f64, wdot: f64) -> (f64, f64) {
+        if w <= 0.0 || self.force(w, wdot) <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let dstep = if w < self.full_damping_depth {
+            self.max_damping * self.step.derivative(w, 0.0, 0.0, self.full_damping_depth, 1.0)
+        } else {
+            0.0
+        };
+        (
+            self.exponent * self.stiffness * w.powf(self.exponent - 1.0) + dstep * wdot,
+            self.damping_at(w),
+        )
+    }
+
+    /// Static penetration under a steady load `f` (N): `(f/k)^(1/e)`.
+    pub fn static_penetration(&self, f: f64) -> f64 {
+        (f.max(0.0) / self.stiffness).powf(1.0 / self.exponent)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spring_part_and_clamp() {
+        let p = ImpactParams::thesis_table_5_2();
+        // 0.02 mm with no rate: 1000 N/mm² * (0.02 mm)² = 0.4 N.
+        assert!((p.force(2e-5, 0.0) - 0.4).abs() < 1e-9);
+        // Separating fast: the damping would pull, the clamp keeps it at zero.
+        assert_eq!(p.force(2e-5, -1.0), 0.0);
+        assert_eq!(p.force(-1e-6, 1.0), 0.0);
+    }
+
+    #[test]
+    fn damping_resists_approach() {
+        let p = ImpactParams::thesis_table_5_2();
+        // Beyond d the full 5e5 N·s/m acts: 0.1 m/s approach adds 5e4 N.
+        let f = p.force(2e-5, 0.1);
+        assert!((f - (0.4 + 5e4)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn static_penetration_inverts_the_spring() {
+        let p = ImpactParams::thesis_table_5_2();
+        let w = p.static_penetration(0.45);
+        assert!((p.force(w, 0.0) - 0.45).abs() < 1e-12);
+    }
+}
