@@ -1,1 +1,4 @@
 //! analysis
+pub mod spectra;
+pub mod svg;
+pub mod vdv;
