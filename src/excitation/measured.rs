@@ -272,7 +272,7 @@ impl SpectralOps {
             a[k] *= -w * w;
         }
         let norm = 1.0 / (2 * self.n) as f64;
-        let mut real = |buf: &mut Vec<Complex<f64>>| -> Vec<f64> {
+        let real = |buf: &mut Vec<Complex<f64>>| -> Vec<f64> {
             self.ifft.process(buf);
             buf[..self.n].iter().map(|z| z.re * norm).collect()
         };

@@ -18,6 +18,8 @@ mod motion;
 pub mod profile;
 mod random;
 mod sine;
+#[cfg(test)]
+mod tests;
 
 pub use hermite::{MotionSample, SampledRecord};
 pub use measured::{parse_acceleration_csv, AccelerationRecord};

@@ -26,7 +26,8 @@ pub struct MotionState {
 ///
 /// Motion is `w(tau) * m(tau)` with `tau = t - settle_s`, `m` the sum of exact tones and a
 /// sampled record, and `w` the ramp window (0 before, cycloidal step of eq. 2.4 over `ramp_s`,
-/// then 1). Velocity and acceleration are the exact time derivatives of that product, so the
+/// then 1; a measured record also ramps out over `ramp_s` before its end and is zero after
+/// it). Velocity and acceleration are the exact time derivatives of that product, so the
 /// three outputs are consistent everywhere, ramp included.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BaseMotion {
@@ -34,6 +35,9 @@ pub struct BaseMotion {
     record: Option<SampledRecord>,
     settle_s: f64,
     ramp_s: f64,
+    /// Excitation time at which a finite (measured) record ends, s: the motion ramps out over
+    /// the `ramp_s` before it and is zero after it.
+    end_s: Option<f64>,
 }
 
 impl BaseMotion {
@@ -44,6 +48,7 @@ impl BaseMotion {
             record: None,
             settle_s: 0.0,
             ramp_s: 0.0,
+            end_s: None,
         }
     }
 
@@ -120,7 +125,11 @@ impl BaseMotion {
                     }
                 };
                 let motion = record.integrate(*highpass_hz)?;
-                Self::assemble(Vec::new(), Some(motion), *settle_s, *ramp, *highpass_hz)
+                let end_s = (motion.samples().len() - 1) as f64 * motion.dt_s();
+                let mut built =
+                    Self::assemble(Vec::new(), Some(motion), *settle_s, *ramp, *highpass_hz)?;
+                built.end_s = Some(end_s);
+                Ok(built)
             }
         }
     }
@@ -151,6 +160,7 @@ impl BaseMotion {
             record,
             settle_s,
             ramp_s,
+            end_s: None,
         })
     }
 
@@ -164,9 +174,18 @@ impl BaseMotion {
         self.ramp_s
     }
 
-    /// Period after which the sampled part repeats, s (`None` for pure tones or no motion).
+    /// Period after which the sampled part repeats, s (`None` for pure tones, no motion, or a
+    /// measured record, which does not repeat).
     pub fn record_period_s(&self) -> Option<f64> {
-        self.record.as_ref().map(SampledRecord::period_s)
+        match self.end_s {
+            Some(_) => None,
+            None => self.record.as_ref().map(SampledRecord::period_s),
+        }
+    }
+
+    /// Simulation time after which the motion is zero (measured records only), s.
+    pub fn end_time_s(&self) -> Option<f64> {
+        self.end_s.map(|e| e + self.settle_s)
     }
 
     /// Displacement, velocity and acceleration at simulation time `t_s`. O(1), no allocation.
@@ -178,7 +197,10 @@ impl BaseMotion {
             velocity_m_s: Vector3::zeros(),
             acceleration_m_s2: Vector3::zeros(),
         };
-        if tau <= 0.0 || (self.tones.is_empty() && self.record.is_none()) {
+        if tau <= 0.0
+            || (self.tones.is_empty() && self.record.is_none())
+            || self.end_s.is_some_and(|end| tau >= end)
+        {
             return zero;
         }
         let mut x = [0.0; 3];
@@ -196,7 +218,13 @@ impl BaseMotion {
             v[tone.axis] += tv;
             a[tone.axis] += ta;
         }
-        let (w, dw, ddw) = ramp_window(tau, self.ramp_s);
+        let (mut w, mut dw, mut ddw) = ramp_window(tau, self.ramp_s);
+        if let Some(end) = self.end_s {
+            // Ramp-out: the mirror image of the ramp-in, ending at `end`; product rule.
+            let (wo, dwo, ddwo) = ramp_window(end - tau, self.ramp_s);
+            let (dwo, ddwo) = (-dwo, ddwo);
+            (w, dw, ddw) = (w * wo, dw * wo + w * dwo, ddw * wo + 2.0 * dw * dwo + w * ddwo);
+        }
         let mut out = zero;
         for c in 0..3 {
             out.displacement_m[c] = w * x[c];
