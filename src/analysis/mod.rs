@@ -1,3 +1,7 @@
-//! analysis
+//! Analysis: spectra, vibration dose value, calibration fits, rattle space, service-life
+//! penalization, SVG plots.
 
 pub mod calibration;
+pub mod spectra;
+pub mod svg;
+pub mod vdv;
