@@ -1,7 +1,7 @@
 //! Adapts an excitation [`BaseMotion`] to the engine's [`KinematicMotion`]: the driven body
 //! (shaker fixture, rail) translates by the prescribed base displacement from a reference pose.
 
-use crate::excitation::motion::BaseMotion;
+use crate::excitation::BaseMotion;
 use crate::physics::body::KinematicMotion;
 use nalgebra::{Isometry3, Translation3, Vector3};
 
