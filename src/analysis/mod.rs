@@ -1,1 +1,4 @@
 //! analysis
+
+pub mod penalization;
+pub mod rattle_space;
