@@ -1683,6 +1683,19 @@ mod tests {
             "launcher"
         );
 
+        let pc = std::fs::read_to_string(configs_dir().join("persistent-contact.toml")).unwrap();
+        let e = CaseSpec::from_toml_str(&pc.replacen(
+            "frequency_hz = 1.0",
+            "frequency_hz = 1.0\nphase_deg = 3.0",
+            1,
+        ))
+        .unwrap_err();
+        assert_eq!(e.field, "toml");
+        let e =
+            CaseSpec::from_toml_str(&pc.replace("mean_radius_m = 0.020", "mean_radius_m = 0.024"))
+                .unwrap_err();
+        assert_eq!(e.field, "persistent_contact.coupon_side_m");
+
         let rb = std::fs::read_to_string(configs_dir().join("rattle-box-c.toml")).unwrap();
         let e = CaseSpec::from_toml_str(
             &rb.replace("tube_inner_side_m = 0.031750", "tube_inner_side_m = 0.0200"),
