@@ -2,6 +2,8 @@
 //! penalization, SVG plots.
 
 pub mod calibration;
+pub mod penalization;
+pub mod rattle_space;
 pub mod spectra;
 pub mod svg;
 pub mod vdv;

@@ -3,3 +3,4 @@
 
 pub mod motion;
 pub mod run;
+pub mod specs;
