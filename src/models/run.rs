@@ -119,6 +119,8 @@ pub struct RunReport {
     pub response_rate_hz: f64,
     /// Base (drive) acceleration at the same instants, m/s².
     pub base_acceleration: Vec<[f64; 3]>,
+    /// Cumulative wear volume per contact versus time: (time s, volume m³ per contact).
+    pub wear_history: Vec<(f64, Vec<f64>)>,
 }
 
 /// Why a run failed.
@@ -168,6 +170,9 @@ pub fn run_model(
         BodyKind::Kinematic(_) => None,
     };
     let law = options.wear_law;
+    let mut wear_history: Vec<(f64, Vec<f64>)> = Vec::new();
+    let history_dt = (model.end_time_s - t0) / 200.0;
+    let mut next_history = t0;
     let mut observer = |v: &StepView| {
         if v.t < t0 {
             return;
@@ -221,6 +226,14 @@ pub fn run_model(
                     a.open = true; // closed once; further zeros are harmless but skip them
                 }
             }
+        }
+        if v.t >= next_history {
+            next_history = v.t + history_dt;
+            let vols = accs
+                .iter()
+                .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
+                .collect();
+            wear_history.push((v.t, vols));
         }
         // Track samples for export.
         if options.record_interval_s >= 0.0 && v.t >= next_record {
@@ -327,6 +340,7 @@ pub fn run_model(
         response_acceleration,
         response_rate_hz: options.response_rate_hz,
         base_acceleration,
+        wear_history,
     })
 }
 

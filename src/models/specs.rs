@@ -1367,6 +1367,31 @@ pub struct CaseSpec {
     pub launcher: Option<LauncherSpec>,
     /// Base excitation, kept untyped here (its schema belongs to `crate::excitation`).
     pub excitation: serde_json::Value,
+    /// Wear law and the split of wear volume between the bodies of a contact.
+    #[serde(default)]
+    pub wear: WearSpec,
+}
+
+/// The `[wear]` table: wear law (default thesis Table 4.3 with the eq. 3.11 cutoff 2 S_y) and
+/// how each contact's volume is split between its two bodies (default inverse hardness).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WearSpec {
+    /// Wear law (tagged by `kind`: `archard`, `modified`, `legacy_appendix`).
+    #[serde(default = "crate::wear::law::WearLaw::table_4_3")]
+    pub law: crate::wear::law::WearLaw,
+    /// Volume split between the two bodies of each contact.
+    #[serde(default)]
+    pub volume_split: crate::wear::allocation::VolumeSplit,
+}
+
+impl Default for WearSpec {
+    fn default() -> Self {
+        Self {
+            law: crate::wear::law::WearLaw::table_4_3(),
+            volume_split: crate::wear::allocation::VolumeSplit::default(),
+        }
+    }
 }
 
 impl CaseSpec {
