@@ -56,6 +56,10 @@ impl Poly2 {
 
     /// Area (m²) and first moment (m³, about the origin) of this polygon ∩ the disk of
     /// radius `rho` centred at the origin.
+    ///
+    /// Green's theorem along the boundary of the intersection: polygon chords inside the circle
+    /// give triangles (centre, chord); each run of the polygon outside the circle is replaced
+    /// by one counter-clockwise arc from the exit to the next entry point (one `atan2` per arc).
     #[inline]
     pub(crate) fn disk_intersection(&self, rho: f64) -> (f64, V2) {
         let mut area = 0.0;
@@ -63,11 +67,73 @@ impl Poly2 {
         if self.n < 3 || rho <= 0.0 {
             return (area, moment);
         }
-        for k in 0..self.n {
-            let (a, m) = disk_triangle(self.v[k], self.v[(k + 1) % self.n], rho);
-            area += a;
+        let rho2 = rho * rho;
+        let mut add = |(ar, m): (f64, V2)| {
+            area += ar;
             moment[0] += m[0];
             moment[1] += m[1];
+        };
+        let mut exit: Option<V2> = None;
+        let mut first_entry: Option<V2> = None;
+        let mut any_event = false;
+        let mut all_inside = true;
+        for k in 0..self.n {
+            let a = self.v[k];
+            let b = self.v[(k + 1) % self.n];
+            if a[0] * a[0] + a[1] * a[1] > rho2 {
+                all_inside = false;
+            }
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let qa = d[0] * d[0] + d[1] * d[1];
+            if qa == 0.0 {
+                continue;
+            }
+            let qb = a[0] * d[0] + a[1] * d[1];
+            let qc = a[0] * a[0] + a[1] * a[1] - rho2;
+            let disc = qb * qb - qa * qc;
+            if disc <= 0.0 {
+                continue;
+            }
+            let sq = disc.sqrt();
+            let t1 = (-qb - sq) / qa;
+            let t2 = (-qb + sq) / qa;
+            let (s1, s2) = (t1.max(0.0), t2.min(1.0));
+            if s1 > s2 {
+                continue;
+            }
+            let p1 = lerp(a, b, s1);
+            let p2 = lerp(a, b, s2);
+            if t1 > 0.0 {
+                any_event = true;
+                match exit.take() {
+                    Some(q) => add(arc(q, p1, rho)),
+                    None => {
+                        if first_entry.is_none() {
+                            first_entry = Some(p1);
+                        }
+                    }
+                }
+            }
+            if s2 > s1 {
+                add(triangle(p1, p2));
+            }
+            if t2 < 1.0 {
+                any_event = true;
+                exit = Some(p2);
+            }
+        }
+        if let (Some(q), Some(p)) = (exit, first_entry) {
+            add(arc(q, p, rho));
+        }
+        if !any_event && !all_inside {
+            // No crossing and a vertex outside: the disk is inside the polygon iff its centre
+            // is (counter-clockwise polygon: centre left of every edge), else they are apart.
+            let centre_inside =
+                (0..self.n).all(|k| cross(self.v[k], self.v[(k + 1) % self.n]) >= 0.0);
+            if centre_inside {
+                return (std::f64::consts::PI * rho2, [0.0; 2]);
+            }
+            return (0.0, [0.0; 2]);
         }
         (area, moment)
     }
@@ -90,62 +156,20 @@ fn triangle(p: V2, q: V2) -> (f64, V2) {
     (a, [a * (p[0] + q[0]) / 3.0, a * (p[1] + q[1]) / 3.0])
 }
 
-/// Signed area and moment of the circular sector of radius `rho` between the directions of
-/// `p` and `q` (both outside or on the circle, so neither is the origin).
+/// Area and moment of the sector swept counter-clockwise from `p` to `q`, both on the circle
+/// of radius `rho` (angle in [0, 2π)).
 #[inline]
-fn sector(p: V2, q: V2, rho: f64) -> (f64, V2) {
-    let np = p[0].hypot(p[1]);
-    let nq = q[0].hypot(q[1]);
-    if np == 0.0 || nq == 0.0 {
-        return (0.0, [0.0; 2]);
+fn arc(p: V2, q: V2, rho: f64) -> (f64, V2) {
+    let mut theta = cross(p, q).atan2(p[0] * q[0] + p[1] * q[1]);
+    if theta < 0.0 {
+        theta += 2.0 * std::f64::consts::PI;
     }
-    let theta = cross(p, q).atan2(p[0] * q[0] + p[1] * q[1]);
-    let up = [p[0] / np, p[1] / np];
-    let uq = [q[0] / nq, q[1] / nq];
-    let k = rho * rho * rho / 3.0;
-    // ∫ (cos θ, sin θ) dθ = (Δ sin θ, -Δ cos θ)
+    // ∫ (cos θ, sin θ) dθ = (Δ sin θ, -Δ cos θ), unit vectors p/ρ and q/ρ.
+    let k = rho * rho / 3.0;
     (
         0.5 * rho * rho * theta,
-        [k * (uq[1] - up[1]), -k * (uq[0] - up[0])],
+        [k * (q[1] - p[1]), -k * (q[0] - p[0])],
     )
-}
-
-/// Signed area and moment of disk(radius `rho`) ∩ triangle(origin, a, b).
-#[inline]
-fn disk_triangle(a: V2, b: V2, rho: f64) -> (f64, V2) {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let qa = d[0] * d[0] + d[1] * d[1];
-    if qa == 0.0 {
-        return (0.0, [0.0; 2]);
-    }
-    let qb = a[0] * d[0] + a[1] * d[1];
-    let qc = a[0] * a[0] + a[1] * a[1] - rho * rho;
-    let disc = qb * qb - qa * qc;
-    if disc <= 0.0 {
-        return sector(a, b, rho);
-    }
-    let sq = disc.sqrt();
-    let t1 = ((-qb - sq) / qa).clamp(0.0, 1.0);
-    let t2 = ((-qb + sq) / qa).clamp(0.0, 1.0);
-    let p1 = lerp(a, b, t1);
-    let p2 = lerp(a, b, t2);
-    let mut area = 0.0;
-    let mut mom = [0.0; 2];
-    let mut add = |(ar, m): (f64, V2)| {
-        area += ar;
-        mom[0] += m[0];
-        mom[1] += m[1];
-    };
-    if t1 > 0.0 {
-        add(sector(a, p1, rho));
-    }
-    if t2 > t1 {
-        add(triangle(p1, p2));
-    }
-    if t2 < 1.0 {
-        add(sector(p2, b, rho));
-    }
-    (area, mom)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 //! (the overlap is `u <= 0`).
 
 use super::disk_polygon::Poly2;
+use super::halfspace_overlap::{cap_centroid_distance, cap_volume};
 use super::quadrature::Breaks;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
@@ -155,6 +156,18 @@ pub(crate) fn add_vertices(h: &Vector3<f64>, r: f64, n: &Vector3<f64>, c: f64, a
             let vol = PI * r * r * r / 6.0;
             acc.add(vol, (v + sigma * (3.0 * r / 8.0)) * vol);
             continue;
+        }
+        // Cap inside the octant (the usual lowest corner): closed form. The cap around -m has
+        // half angle α with cos α = -τ/r; it stays in the octant if -m_i >= sin α for all i.
+        if tau < 0.0 {
+            let sin_alpha = (1.0 - (tau / r) * (tau / r)).max(0.0).sqrt();
+            if -m.max() >= sin_alpha {
+                let w = r + tau;
+                let vol = cap_volume(r, w);
+                let centroid = -m * cap_centroid_distance(r, w);
+                acc.add(vol, (v + centroid.component_mul(&sigma)) * vol);
+                continue;
+            }
         }
         // Orthonormal basis (eu, ev) of the slice plane.
         let seed = if m.x.abs() < 0.9 {

@@ -198,12 +198,6 @@ fn cube_resting_flat_matches_decomposition_closed_form() {
     }
 }
 
-/// Distance from `x` (shape frame) to the inner box of half extents `h`.
-fn dist_to_box(x: &Vector3<f64>, h: &Vector3<f64>) -> f64 {
-    let d = x.abs() - h;
-    Vector3::new(d.x.max(0.0), d.y.max(0.0), d.z.max(0.0)).norm()
-}
-
 /// Overlap of the vertical line through (x, y) with {z in [-w, 0], dist(x, K) <= r}: the
 /// distance is convex along the line, so golden-section for its minimum, then bisection for
 /// the two crossings. Returns (length, mid height).
