@@ -78,7 +78,10 @@ pub fn parse_acceleration_csv(
         return Err(csv_err(
             header.0,
             column,
-            format!("header must be `time_s,a_x,a_y,a_z`, got `{}`", header.1.trim()),
+            format!(
+                "header must be `time_s,a_x,a_y,a_z`, got `{}`",
+                header.1.trim()
+            ),
         ));
     }
     let scale = units.to_si();
@@ -475,7 +478,9 @@ mod tests {
 
     #[test]
     fn bad_csv_names_row_and_column() {
-        let good: Vec<String> = (0..20).map(|m| format!("{},0,0,0", m as f64 * 0.01)).collect();
+        let good: Vec<String> = (0..20)
+            .map(|m| format!("{},0,0,0", m as f64 * 0.01))
+            .collect();
         let with = |i: usize, line: &str| {
             let mut rows = good.clone();
             rows[i] = line.to_string();
