@@ -234,6 +234,8 @@ fn sine_on_random_motion_is_consistent() {
     }
     let motion = BaseMotion::from_spec(&spec).unwrap();
     assert!((motion.record_period_s().unwrap() - 2.0).abs() < 1e-12);
+    // 3 cycles of the lowest frequency, the 4.86 Hz tone (below the 5 Hz PSD start).
+    assert!((motion.ramp_s() - 3.0 / 4.86).abs() < 1e-12);
     // scale: a few g, velocities of order 0.1 m/s
     assert_consistent(&motion, 5.0, 0.1, 30.0);
 }
