@@ -118,10 +118,7 @@ pub fn welch_psd(
     if segment_len > signal.len() {
         return Err(invalid(
             "segment_len",
-            format!(
-                "{segment_len} exceeds the signal length {}",
-                signal.len()
-            ),
+            format!("{segment_len} exceeds the signal length {}", signal.len()),
         ));
     }
     let window = window_values(Window::Hann, segment_len);

@@ -64,7 +64,10 @@ pub fn vibration_dose_value(time_s: &[f64], acceleration: &[f64]) -> Result<f64,
 /// VDV of eq. 2.51 for uniformly sampled acceleration with step `dt_s` (trapezoid rule).
 pub fn vibration_dose_value_uniform(acceleration: &[f64], dt_s: f64) -> Result<f64, VdvError> {
     if !(dt_s.is_finite() && dt_s > 0.0) {
-        return Err(invalid("dt_s", format!("must be finite and > 0, got {dt_s}")));
+        return Err(invalid(
+            "dt_s",
+            format!("must be finite and > 0, got {dt_s}"),
+        ));
     }
     if acceleration.len() < 2 {
         return Err(invalid("acceleration", "needs at least 2 samples"));

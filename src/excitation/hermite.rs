@@ -96,8 +96,7 @@ impl SampledRecord {
             let dx = x1 - x0;
             out.displacement_m[c] =
                 x0 + (1.0 - h0) * dx + h * (g0 * v0 + g1 * v1) + h * h * (k0 * a0 + k1 * a1);
-            out.velocity_m_s[c] =
-                -h0d * dx / h + (g0d * v0 + g1d * v1) + h * (k0d * a0 + k1d * a1);
+            out.velocity_m_s[c] = -h0d * dx / h + (g0d * v0 + g1d * v1) + h * (k0d * a0 + k1d * a1);
             out.acceleration_m_s2[c] =
                 -h0dd * dx / (h * h) + (g0dd * v0 + g1dd * v1) / h + (k0dd * a0 + k1dd * a1);
         }

@@ -78,7 +78,10 @@ pub fn parse_acceleration_csv(
         return Err(csv_err(
             header.0,
             column,
-            format!("header must be `time_s,a_x,a_y,a_z`, got `{}`", header.1.trim()),
+            format!(
+                "header must be `time_s,a_x,a_y,a_z`, got `{}`",
+                header.1.trim()
+            ),
         ));
     }
     let scale = units.to_si();
@@ -153,7 +156,7 @@ impl AccelerationRecord {
         }
         let uniform = self.resample_uniform(dt)?;
         let n = uniform.len();
-        let mut spectral = SpectralOps::new(n, dt);
+        let spectral = SpectralOps::new(n, dt);
         let mut samples = vec![MotionSample::default(); n];
         for c in 0..3 {
             let accel: Vec<f64> = uniform.iter().map(|a| a[c]).collect();
@@ -281,30 +284,26 @@ impl SpectralOps {
 
     /// Displacement, velocity and acceleration whose second derivative is the mirrored
     /// `accel` with its mean (DC) and Nyquist line removed.
-    fn integrate_mirrored(&mut self, accel: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn integrate_mirrored(&self, accel: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut spectrum = self.mirrored_spectrum(accel);
-        for k in 0..spectrum.len() {
+        for (k, line) in spectrum.iter_mut().enumerate() {
             let (w, is_nyquist) = self.omega(k);
-            spectrum[k] = if k == 0 || is_nyquist {
+            *line = if k == 0 || is_nyquist {
                 Complex::new(0.0, 0.0)
             } else {
-                -spectrum[k] / (w * w)
+                -*line / (w * w)
             };
         }
         self.with_derivatives(&spectrum)
     }
 
     /// The part of mirrored `y` below `cutoff_hz` (DC included), with its two derivatives.
-    fn low_band_of_mirrored(
-        &mut self,
-        y: &[f64],
-        cutoff_hz: f64,
-    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn low_band_of_mirrored(&self, y: &[f64], cutoff_hz: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut spectrum = self.mirrored_spectrum(y);
         let cutoff_w = std::f64::consts::TAU * cutoff_hz;
-        for k in 0..spectrum.len() {
+        for (k, line) in spectrum.iter_mut().enumerate() {
             if self.omega(k).0.abs() >= cutoff_w {
-                spectrum[k] = Complex::new(0.0, 0.0);
+                *line = Complex::new(0.0, 0.0);
             }
         }
         self.with_derivatives(&spectrum)
@@ -475,7 +474,9 @@ mod tests {
 
     #[test]
     fn bad_csv_names_row_and_column() {
-        let good: Vec<String> = (0..20).map(|m| format!("{},0,0,0", m as f64 * 0.01)).collect();
+        let good: Vec<String> = (0..20)
+            .map(|m| format!("{},0,0,0", m as f64 * 0.01))
+            .collect();
         let with = |i: usize, line: &str| {
             let mut rows = good.clone();
             rows[i] = line.to_string();

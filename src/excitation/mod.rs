@@ -249,7 +249,10 @@ pub(crate) fn require_positive(field: &str, value: f64) -> Result<(), Excitation
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(invalid(field, format!("must be finite and > 0, got {value}")))
+        Err(invalid(
+            field,
+            format!("must be finite and > 0, got {value}"),
+        ))
     }
 }
 
@@ -258,6 +261,9 @@ pub(crate) fn require_non_negative(field: &str, value: f64) -> Result<(), Excita
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(invalid(field, format!("must be finite and >= 0, got {value}")))
+        Err(invalid(
+            field,
+            format!("must be finite and >= 0, got {value}"),
+        ))
     }
 }

@@ -63,7 +63,10 @@ impl BaseMotion {
                 ramp,
             } => {
                 if tones.is_empty() {
-                    return Err(invalid("tones", "a sine excitation needs at least one tone"));
+                    return Err(invalid(
+                        "tones",
+                        "a sine excitation needs at least one tone",
+                    ));
                 }
                 let terms = sine_terms(tones)?;
                 let lowest = terms
@@ -109,11 +112,12 @@ impl BaseMotion {
             } => {
                 let record = match (csv_path, samples) {
                     (Some(path), None) => {
-                        let text =
-                            std::fs::read_to_string(path).map_err(|source| ExcitationError::Io {
+                        let text = std::fs::read_to_string(path).map_err(|source| {
+                            ExcitationError::Io {
                                 path: path.clone(),
                                 source,
-                            })?;
+                            }
+                        })?;
                         parse_acceleration_csv(&text, *units)?
                     }
                     (None, Some(rows)) => AccelerationRecord::from_samples(rows, *units)?,
@@ -223,7 +227,11 @@ impl BaseMotion {
             // Ramp-out: the mirror image of the ramp-in, ending at `end`; product rule.
             let (wo, dwo, ddwo) = ramp_window(end - tau, self.ramp_s);
             let (dwo, ddwo) = (-dwo, ddwo);
-            (w, dw, ddw) = (w * wo, dw * wo + w * dwo, ddw * wo + 2.0 * dw * dwo + w * ddwo);
+            (w, dw, ddw) = (
+                w * wo,
+                dw * wo + w * dwo,
+                ddw * wo + 2.0 * dw * dwo + w * ddwo,
+            );
         }
         let mut out = zero;
         for c in 0..3 {

@@ -130,6 +130,32 @@ mod tests {
     }
 
     #[test]
+    fn measured_spec_parses_with_defaults() {
+        #[derive(Deserialize)]
+        struct Wrapper {
+            excitation: ExcitationSpec,
+        }
+        let text = r#"
+            [excitation]
+            kind = "measured"
+            csv_path = "rail_accel.csv"
+            units = "m_s2"
+        "#;
+        let w: Wrapper = toml::from_str(text).unwrap();
+        assert_eq!(
+            w.excitation,
+            ExcitationSpec::Measured {
+                csv_path: Some("rail_accel.csv".into()),
+                samples: None,
+                units: super::super::AccelUnit::MetresPerSecond2,
+                highpass_hz: 2.0,
+                settle_s: 2.0,
+                ramp: RampSpec::Cycles(3.0),
+            }
+        );
+    }
+
+    #[test]
     fn spec_roundtrips_through_toml() {
         #[derive(Serialize, Deserialize, PartialEq, Debug)]
         struct Wrapper {

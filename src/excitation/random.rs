@@ -223,8 +223,15 @@ mod tests {
         )
         .unwrap_err();
         assert!(err.to_string().contains("psd_breakpoints[1].frequency_hz"));
-        let err = synthesize_random(&[Axis::X], &[(10.0, 0.01), (600.0, 0.02)], 1.0, 1024.0, 1, 1.0)
-            .unwrap_err();
+        let err = synthesize_random(
+            &[Axis::X],
+            &[(10.0, 0.01), (600.0, 0.02)],
+            1.0,
+            1024.0,
+            1,
+            1.0,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("sample_rate_hz"));
     }
 }

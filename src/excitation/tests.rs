@@ -56,9 +56,17 @@ fn synthesis_mean_square_equals_psd_integral() {
     // 5-10 Hz: G = 1e-4 f (3 dB/octave) gives 1e-4 (10² - 5²)/2; 10-500 Hz flat.
     assert!((target - (1e-4 * (100.0 - 25.0) / 2.0 + 0.001 * 490.0)).abs() < 1e-12);
     eprintln!("mean square {mean_square} g² vs {target}");
-    assert!((mean_square / target - 1.0).abs() < 0.01, "{mean_square} vs {target}");
+    assert!(
+        (mean_square / target - 1.0).abs() < 0.01,
+        "{mean_square} vs {target}"
+    );
     // No drift: displacement and velocity have zero mean over the period.
-    let mean_x = rec.samples().iter().map(|s| s.displacement_m[1]).sum::<f64>() / n;
+    let mean_x = rec
+        .samples()
+        .iter()
+        .map(|s| s.displacement_m[1])
+        .sum::<f64>()
+        / n;
     let mean_v = rec.samples().iter().map(|s| s.velocity_m_s[1]).sum::<f64>() / n;
     assert!(mean_x.abs() < 1e-12 && mean_v.abs() < 1e-12);
     // Other axes untouched.
@@ -115,21 +123,36 @@ fn tones_have_their_amplitude() {
     };
     let motion = BaseMotion::from_spec(&spec).unwrap();
     let n = (duration * fs) as usize;
-    let spectrum = amplitude_spectrum(&sample_x(&motion, duration, fs, n), fs, Window::Rectangular)
-        .unwrap();
+    let spectrum =
+        amplitude_spectrum(&sample_x(&motion, duration, fs, n), fs, Window::Rectangular).unwrap();
     for tone in &tones {
         let k = (tone.frequency_hz * duration).round() as usize;
         let amp = tone.amplitude_g * STANDARD_GRAVITY;
-        let line = (2.0 * psd_at(&AH64_PSD, tone.frequency_hz) / duration).sqrt() * STANDARD_GRAVITY;
+        let line =
+            (2.0 * psd_at(&AH64_PSD, tone.frequency_hz) / duration).sqrt() * STANDARD_GRAVITY;
         let err = (spectrum.amplitude[k] - amp).abs();
-        assert!(err <= 0.01 * amp + line, "{} Hz: {err} vs {amp}", tone.frequency_hz);
+        assert!(
+            err <= 0.01 * amp + line,
+            "{} Hz: {err} vs {amp}",
+            tone.frequency_hz
+        );
     }
     // Tones clear of the random band must be exact to 1 %.
     let spec = ExcitationSpec::SineOnRandom {
         axes: vec![Axis::X],
         tones: vec![
-            Tone { axis: Axis::X, frequency_hz: 5.0, amplitude_g: 0.3, phase_deg: 40.0 },
-            Tone { axis: Axis::X, frequency_hz: 20.0, amplitude_g: 2.0, phase_deg: -10.0 },
+            Tone {
+                axis: Axis::X,
+                frequency_hz: 5.0,
+                amplitude_g: 0.3,
+                phase_deg: 40.0,
+            },
+            Tone {
+                axis: Axis::X,
+                frequency_hz: 20.0,
+                amplitude_g: 2.0,
+                phase_deg: -10.0,
+            },
         ],
         psd_breakpoints: vec![(100.0, 0.01), (400.0, 0.01)],
         duration_s: 8.0,
@@ -140,8 +163,12 @@ fn tones_have_their_amplitude() {
         ramp: RampSpec::Seconds(1.0),
     };
     let motion = BaseMotion::from_spec(&spec).unwrap();
-    let spectrum =
-        amplitude_spectrum(&sample_x(&motion, 8.0, fs, 8 * 2048), fs, Window::Rectangular).unwrap();
+    let spectrum = amplitude_spectrum(
+        &sample_x(&motion, 8.0, fs, 8 * 2048),
+        fs,
+        Window::Rectangular,
+    )
+    .unwrap();
     for (f, g) in [(5.0, 0.3), (20.0, 2.0)] {
         let k = (f * 8.0) as usize;
         let amp = g * STANDARD_GRAVITY;
@@ -161,8 +188,14 @@ fn assert_consistent(motion: &BaseMotion, t_end: f64, scale_v: f64, scale_a: f64
         for c in 0..3 {
             let dx = (p.displacement_m[c] - m.displacement_m[c]) / (2.0 * h);
             let dv = (p.velocity_m_s[c] - m.velocity_m_s[c]) / (2.0 * h);
-            assert!((dx - s.velocity_m_s[c]).abs() < 1e-6 * scale_v, "v at t={t}");
-            assert!((dv - s.acceleration_m_s2[c]).abs() < 1e-5 * scale_a, "a at t={t}");
+            assert!(
+                (dx - s.velocity_m_s[c]).abs() < 1e-6 * scale_v,
+                "v at t={t}"
+            );
+            assert!(
+                (dv - s.acceleration_m_s2[c]).abs() < 1e-5 * scale_a,
+                "a at t={t}"
+            );
         }
     }
 }
@@ -201,6 +234,8 @@ fn sine_on_random_motion_is_consistent() {
     }
     let motion = BaseMotion::from_spec(&spec).unwrap();
     assert!((motion.record_period_s().unwrap() - 2.0).abs() < 1e-12);
+    // 3 cycles of the lowest frequency, the 4.86 Hz tone (below the 5 Hz PSD start).
+    assert!((motion.ramp_s() - 3.0 / 4.86).abs() < 1e-12);
     // scale: a few g, velocities of order 0.1 m/s
     assert_consistent(&motion, 5.0, 0.1, 30.0);
 }
@@ -231,7 +266,10 @@ fn measured_motion_ramps_out_and_stops() {
     let t = 3.0;
     let a = motion.acceleration(t)[1];
     let expected = STANDARD_GRAVITY * (TAU * 12.0 * (t - 1.0)).sin();
-    assert!((a - expected).abs() < 0.01 * STANDARD_GRAVITY, "{a} vs {expected}");
+    assert!(
+        (a - expected).abs() < 0.01 * STANDARD_GRAVITY,
+        "{a} vs {expected}"
+    );
     assert_consistent(&motion, 6.0, 0.2, STANDARD_GRAVITY);
 }
 
@@ -245,7 +283,12 @@ fn spec_errors_name_fields() {
     .unwrap_err();
     assert!(err.to_string().contains("`tones`"));
     let err = BaseMotion::from_spec(&ExcitationSpec::Sine {
-        tones: vec![Tone { axis: Axis::X, frequency_hz: 20.0, amplitude_g: 1.0, phase_deg: 0.0 }],
+        tones: vec![Tone {
+            axis: Axis::X,
+            frequency_hz: 20.0,
+            amplitude_g: 1.0,
+            phase_deg: 0.0,
+        }],
         settle_s: -1.0,
         ramp: RampSpec::default(),
     })
