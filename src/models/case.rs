@@ -5,7 +5,7 @@ use super::rattle_box;
 use super::run::{run_model, BuiltModel, ModelRunError, RunOptions, RunReport};
 use super::specs::{CaseSpec, ModelSpecRef, SpecError};
 use crate::analysis::spectra::welch_psd;
-use crate::analysis::svg::{AxisSpec, Plot, Series, VerticalMarker};
+use crate::analysis::svg::{AxisSpec, Plot, Series};
 use crate::analysis::vdv::vibration_dose_value_uniform;
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
@@ -59,11 +59,18 @@ pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<Excitat
             .and_then(Value::as_str)
             .ok_or_else(|| invalid("excitation.profile", "must name a file in configs/profiles"))?;
         if name.contains('/') || name.contains("..") {
-            return Err(invalid("excitation.profile", "must be a plain profile name"));
+            return Err(invalid(
+                "excitation.profile",
+                "must be a plain profile name",
+            ));
         }
         let path = configs_dir.join("profiles").join(format!("{name}.toml"));
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| invalid("excitation.profile", format!("cannot read {}: {e}", path.display())))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            invalid(
+                "excitation.profile",
+                format!("cannot read {}: {e}", path.display()),
+            )
+        })?;
         let file = ProfileFile::from_toml_str(&text)
             .map_err(|e| invalid("excitation.profile", e.to_string()))?;
         value = serde_json::to_value(&file.excitation)
@@ -117,10 +124,11 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
 pub fn build(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError> {
     case.validate()?;
     let excitation = resolve_excitation(case, configs_dir)?;
-    let motion = BaseMotion::from_spec(&excitation).map_err(|e| invalid("excitation", e.to_string()))?;
+    let motion =
+        BaseMotion::from_spec(&excitation).map_err(|e| invalid("excitation", e.to_string()))?;
     match case.model_spec()? {
         ModelSpecRef::RattleBox(spec) => Ok(rattle_box::build(case, spec, motion)),
-        ModelSpecRef::Launcher(spec) => super::launcher::build(case, spec, motion),
+        ModelSpecRef::Launcher(_) => Err(invalid("model", "launcher builder pending")),
         ModelSpecRef::PersistentContact(_) => Err(invalid(
             "model",
             "the persistent-contact fixture runs through `railwear calibrate`, not as a dynamic case in this build",
@@ -154,7 +162,12 @@ pub fn run_case(
 }
 
 /// Summary JSON and plots of a finished run.
-pub fn package(case: &CaseSpec, model: &BuiltModel, options: &RunOptions, r: &RunReport) -> CaseOutcome {
+pub fn package(
+    case: &CaseSpec,
+    model: &BuiltModel,
+    options: &RunOptions,
+    r: &RunReport,
+) -> CaseOutcome {
     let simulated = model.end_time_s;
     let rattle_space = match case.model_spec() {
         Ok(ModelSpecRef::RattleBox(s)) => s.rattle_space().ok(),
@@ -199,13 +212,23 @@ pub fn package(case: &CaseSpec, model: &BuiltModel, options: &RunOptions, r: &Ru
     }
 }
 
-fn plots(case: &CaseSpec, r: &RunReport, psd: Option<&crate::analysis::spectra::Psd>) -> Vec<(String, String)> {
+fn plots(
+    case: &CaseSpec,
+    r: &RunReport,
+    psd: Option<&crate::analysis::spectra::Psd>,
+) -> Vec<(String, String)> {
     let mut out = Vec::new();
     // Wear versus time per contact, mg.
     let density = r
         .contacts
         .first()
-        .map(|_| case.rattle_box.as_ref().map(|s| s.material.density_kg_per_m3).or(case.launcher.as_ref().map(|s| s.material.density_kg_per_m3)).unwrap_or(2810.0))
+        .map(|_| {
+            case.rattle_box
+                .as_ref()
+                .map(|s| s.material.density_kg_per_m3)
+                .or(case.launcher.as_ref().map(|s| s.material.density_kg_per_m3))
+                .unwrap_or(2810.0)
+        })
         .unwrap_or(2810.0);
     let mut wear_plot = Plot::new(
         &format!("{}: wear versus time", case.name),
@@ -228,18 +251,31 @@ fn plots(case: &CaseSpec, r: &RunReport, psd: Option<&crate::analysis::spectra::
         if nonzero.is_empty() {
             continue;
         }
-        let edges: Vec<f64> = (0..=c.wear.pressure_histogram.len()).map(|i| c.wear.pressure_histogram.edge_pa(i) / 1e6).collect();
-        let values: Vec<f64> = c.wear.pressure_histogram.time_density_per_pa().iter().map(|(_, d)| d * 1e6).collect();
+        let edges: Vec<f64> = (0..=c.wear.pressure_histogram.len())
+            .map(|i| c.wear.pressure_histogram.edge_pa(i) / 1e6)
+            .collect();
+        let values: Vec<f64> = c
+            .wear
+            .pressure_histogram
+            .time_density_per_pa()
+            .iter()
+            .map(|(_, d)| d * 1e6)
+            .collect();
         let mut p = Plot::new(
             &format!("{}: contact-pressure PDF, {}", case.name, c.name),
             AxisSpec::log("contact pressure (MPa)"),
             AxisSpec::linear("time density (1/MPa)"),
         )
-        .with_series(Series::histogram("time share", edges, values));
-        let sy = case.rattle_box.as_ref().map(|s| s.material.yield_strength_pa).or(case.launcher.as_ref().map(|s| s.material.yield_strength_pa)).unwrap_or(435e6);
-        p = p.with_marker(VerticalMarker::new("Sy", sy / 1e6));
+        .with_series(Series::histogram("time share", &edges, &values));
+        let sy = case
+            .rattle_box
+            .as_ref()
+            .map(|s| s.material.yield_strength_pa)
+            .or(case.launcher.as_ref().map(|s| s.material.yield_strength_pa))
+            .unwrap_or(435e6);
+        p = p.with_marker(sy / 1e6, "Sy");
         if let Some(cut) = c.wear.cutoff_pressure_pa {
-            p = p.with_marker(VerticalMarker::new("cutoff", cut / 1e6));
+            p = p.with_marker(cut / 1e6, "cutoff");
         }
         out.push((format!("pressure_pdf_{}.svg", c.name), p.to_svg()));
     }

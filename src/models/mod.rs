@@ -1,6 +1,8 @@
 //! The three thesis models (persistent-contact fixture, rattle box, launcher): build a
 //! multibody system from a config and run it with wear post-processing.
 
+pub mod case;
 pub mod motion;
+pub mod rattle_box;
 pub mod run;
 pub mod specs;
