@@ -77,8 +77,7 @@ impl FrictionParams {
             // step(V, -Vs, mu_s, Vs, -mu_s) read as a magnitude: odd through zero.
             self.step.eval(v, -vs, -self.mu_static, vs, self.mu_static)
         } else if v < vd {
-            self.step
-                .eval(v, vs, self.mu_static, vd, self.mu_dynamic)
+            self.step.eval(v, vs, self.mu_static, vd, self.mu_dynamic)
         } else {
             self.mu_dynamic
         }

@@ -87,7 +87,10 @@ impl ImpactParams {
             return (0.0, 0.0);
         }
         let dstep = if w < self.full_damping_depth {
-            self.max_damping * self.step.derivative(w, 0.0, 0.0, self.full_damping_depth, 1.0)
+            self.max_damping
+                * self
+                    .step
+                    .derivative(w, 0.0, 0.0, self.full_damping_depth, 1.0)
         } else {
             0.0
         };

@@ -85,7 +85,8 @@ mod tests {
         for kind in [StepKind::Cycloidal, StepKind::Cubic] {
             for &x in &[0.1, 0.37, 0.8] {
                 let h = 1e-6;
-                let fd = (kind.eval(x + h, 0.0, 1.0, 1.0, 3.0) - kind.eval(x - h, 0.0, 1.0, 1.0, 3.0))
+                let fd = (kind.eval(x + h, 0.0, 1.0, 1.0, 3.0)
+                    - kind.eval(x - h, 0.0, 1.0, 1.0, 3.0))
                     / (2.0 * h);
                 assert!((fd - kind.derivative(x, 0.0, 1.0, 1.0, 3.0)).abs() < 1e-6);
             }
