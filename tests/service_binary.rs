@@ -69,6 +69,35 @@ fn serves_health_metrics_docs_and_enforces_tokens() {
 }
 
 #[test]
+fn unknown_or_unsafe_config_names_are_422_and_store_nothing() {
+    let dir = TempDir::new("names");
+    let server = Binary::start(&dir.db_url(), &[]);
+    for name in ["../../etc/passwd", "no-such-model", ""] {
+        let body = serde_json::json!({"kind": "simulate", "params": {"config": name}}).to_string();
+        let p = curl(
+            "POST",
+            &server.url("/v1/jobs"),
+            Some(ENGINEER),
+            &[],
+            Some(&body),
+        )
+        .problem(422);
+        assert_eq!(p["field"], "params.config");
+    }
+    let p = curl(
+        "POST",
+        &server.url("/v1/jobs"),
+        Some(ENGINEER),
+        &[],
+        Some(r#"{"kind":"simulate","params":{"config":7}}"#),
+    )
+    .problem(422);
+    assert_eq!(p["field"], "params.config");
+    let list = curl("GET", &server.url("/v1/jobs"), Some(ENGINEER), &[], None).json();
+    assert_eq!(list["items"].as_array().unwrap().len(), 0);
+}
+
+#[test]
 fn token_create_command_makes_a_working_token() {
     let dir = TempDir::new("cli");
     let out = Command::new(env!("CARGO_BIN_EXE_railwear"))

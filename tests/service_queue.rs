@@ -568,24 +568,6 @@ async fn rejected_inputs_are_problems_and_change_nothing() {
             None,
         )
         .problem(404);
-        let p = curl(
-            "POST",
-            &jobs,
-            Some(ENGINEER),
-            &[],
-            Some(r#"{"kind":"simulate","params":{"config":"../../etc/passwd"}}"#),
-        )
-        .problem(422);
-        assert_eq!(p["field"], "params.config");
-        let p = curl(
-            "POST",
-            &jobs,
-            Some(ENGINEER),
-            &[],
-            Some(r#"{"kind":"simulate","params":{"config":"no-such-model"}}"#),
-        )
-        .problem(422);
-        assert_eq!(p["field"], "params.config");
 
         let after = curl(
             "GET",

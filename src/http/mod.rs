@@ -63,8 +63,8 @@ pub fn app(state: AppState) -> Router {
             )
         })
         .layer(DefaultBodyLimit::max(limit))
-        .layer(middleware::map_response(problem::problem_for_bare_413))
         .layer(RequestBodyLimitLayer::new(limit))
+        .layer(middleware::map_response(problem::problem_for_bare_413))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
 }

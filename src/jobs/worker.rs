@@ -112,6 +112,24 @@ impl Jobs {
             }
         };
 
+        // Write the last progress the computation reported (a short run may end before the
+        // first heartbeat).
+        let last = latest
+            .lock()
+            .ok()
+            .and_then(|p| *p)
+            .map(|p| job_progress(p, started.elapsed()));
+        if let (Some(p), false) = (last, lost) {
+            self.metrics.attempt_progress(id, p.simulated_time_s);
+            if let Ok(beat) = self
+                .store
+                .heartbeat(id, attempt, Some(p), clock::now_ms(), lease_ms)
+                .await
+            {
+                lost = !beat.owned;
+            }
+        }
+
         let finish = match outcome {
             Ok(Ok(output)) => {
                 let block_samples = self.settings.track_block_samples;
