@@ -1,1 +1,27 @@
-//! contact_models
+//! Quasistatic sphere-on-flat contact models of thesis 2.3.1 (Hertz, fully plastic,
+//! Jackson-Green, Kogut-Etsion) and their least-squares fits to the IMPACT spring `k w^e`.
+//!
+//! They choose IMPACT stiffness and exponent from material data; they are not used inside
+//! the time integration itself.
+
+pub mod fit;
+pub mod quasistatic;
+
+pub use fit::{fit_power_law, table_2_1_parameters, FitSpace, ImpactFitRow, PowerLawFit};
+pub use quasistatic::{QuasistaticModel, SphereOnFlat};
+
+/// Errors of the contact-model library; each names the field and the rule.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContactModelError {
+    /// A parameter broke a rule.
+    #[error("invalid {field}: {rule}")]
+    Invalid {
+        /// Name of the field.
+        field: &'static str,
+        /// The rule it broke.
+        rule: &'static str,
+    },
+    /// The fit did not converge or the data could not be fitted.
+    #[error("fit failed: {0}")]
+    Fit(&'static str),
+}

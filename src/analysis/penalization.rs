@@ -1,0 +1,452 @@
+//! Service-life penalization for manufacturing tolerances, thesis eq. 6.4 and Figure 6.68.
+//!
+//! `T_SL,real = K_SL T_SL,design` with `K_SL(k_rs) = min(1, rate(k_design) / rate(k_rs))`, where
+//! `rate` is the rail wear rate (sum of the rail contacts, mg/h) from a simulated tolerance sweep
+//! for one vehicle profile, environment and wear law. A conservative factor never lengthens the
+//! service life (thesis 6.7), hence the `min(1, ...)`. Between sweep points the rate is
+//! interpolated linearly in `ln(rate)`: wear rates span orders of magnitude, and interpolating
+//! their logarithm keeps the rate positive and, like any piecewise-linear interpolant, monotone
+//! between neighbouring points. Outside the swept range there is no data, so asking there is an
+//! error, not an extrapolation.
+
+use serde::{Deserialize, Serialize};
+
+/// Factor of the first conservative band of Figure 6.68 (10 % below K_SL).
+pub const CONSERVATIVE_BAND_90: f64 = 0.9;
+/// Factor of the second conservative band of Figure 6.68 (20 % below K_SL).
+pub const CONSERVATIVE_BAND_80: f64 = 0.8;
+
+/// Why a penalization curve could not be built or evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PenalizationError {
+    /// A sweep point is unusable (non-finite k_rs, k_rs outside (0, 1], rate not finite and > 0).
+    #[error("sweep point {index}: invalid `{field}`: {rule}")]
+    InvalidSweepPoint {
+        /// Index of the point in the given list.
+        index: usize,
+        /// Field name: `rattle_space` or `rail_wear_rate_mg_per_h`.
+        field: &'static str,
+        /// The rule broken, with the value.
+        rule: String,
+    },
+    /// Fewer than two distinct rattle spaces: there is no curve to interpolate.
+    #[error("the sweep needs at least 2 distinct rattle spaces, got {distinct}")]
+    TooFewPoints {
+        /// Number of distinct k_rs values given.
+        distinct: usize,
+    },
+    /// An input to a query is unusable (non-finite, or a non-positive life).
+    #[error("invalid `{field}`: {rule}")]
+    InvalidInput {
+        /// Field name, e.g. `design_rattle_space`, `design_life_h`, `rattle_space`.
+        field: &'static str,
+        /// The rule broken, with the value.
+        rule: String,
+    },
+    /// The requested rattle space lies outside the swept range: no extrapolation.
+    #[error(
+        "rattle space {rattle_space} is outside the swept range [{min}, {max}]; \
+         run a tolerance sweep that covers it"
+    )]
+    OutOfRange {
+        /// The requested k_rs.
+        rattle_space: f64,
+        /// Smallest swept k_rs.
+        min: f64,
+        /// Largest swept k_rs.
+        max: f64,
+    },
+}
+
+/// One point of a tolerance sweep: a rail configuration's rattle space and its simulated rail
+/// wear rate (thesis Figure 6.67: sum of rail contacts 1, 3 and 5).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepPoint {
+    /// Rattle space k_rs of the configuration (eq. 6.3), dimensionless, in (0, 1].
+    pub rattle_space: f64,
+    /// Rail wear rate at that configuration, mg/h (> 0).
+    pub rail_wear_rate_mg_per_h: f64,
+}
+
+/// Stored form of a curve, validated on deserialization.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PenalizationCurveData {
+    design_rattle_space: f64,
+    points: Vec<SweepPoint>,
+}
+
+/// The penalization curve of one tolerance sweep (thesis Figure 6.68).
+///
+/// Serializes as `{ "design_rattle_space": k, "points": [{ "rattle_space", "rail_wear_rate_mg_per_h" }] }`
+/// with the points sorted by rattle space (repeats merged); deserializing re-validates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "PenalizationCurveData", into = "PenalizationCurveData")]
+pub struct PenalizationCurve {
+    /// Design (nominal) rattle space, inside the swept range.
+    design_rattle_space: f64,
+    /// Sweep points sorted by strictly increasing rattle space.
+    points: Vec<SweepPoint>,
+    /// Interpolated wear rate at the design point, mg/h.
+    design_rate_mg_per_h: f64,
+}
+
+/// K_SL and its conservative bands at one rattle space (Figure 6.68).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PenalizationFactors {
+    /// The rattle space asked about.
+    pub rattle_space: f64,
+    /// K_SL = min(1, rate(design)/rate(k_rs)), eq. 6.4.
+    pub k_sl: f64,
+    /// 0.9 K_SL (Figure 6.68, 10 % band).
+    pub k_sl_conservative_90: f64,
+    /// 0.8 K_SL (Figure 6.68, 20 % band).
+    pub k_sl_conservative_80: f64,
+}
+
+/// Penalized service life (eq. 6.4) with the conservative bands.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PenalizedLife {
+    /// The factors used.
+    pub factors: PenalizationFactors,
+    /// Design service life T_SL,design, h.
+    pub design_life_h: f64,
+    /// T_SL,real = K_SL T_SL,design, h.
+    pub life_h: f64,
+    /// 0.9 K_SL T_SL,design, h.
+    pub life_conservative_90_h: f64,
+    /// 0.8 K_SL T_SL,design, h.
+    pub life_conservative_80_h: f64,
+}
+
+impl TryFrom<PenalizationCurveData> for PenalizationCurve {
+    type Error = PenalizationError;
+    fn try_from(data: PenalizationCurveData) -> Result<Self, Self::Error> {
+        Self::new(&data.points, data.design_rattle_space)
+    }
+}
+
+impl From<PenalizationCurve> for PenalizationCurveData {
+    fn from(curve: PenalizationCurve) -> Self {
+        Self {
+            design_rattle_space: curve.design_rattle_space,
+            points: curve.points,
+        }
+    }
+}
+
+impl PenalizationCurve {
+    /// Builds the curve from sweep points (any order) and the design rattle space.
+    ///
+    /// Rules: each k_rs finite and in (0, 1]; each rate finite and > 0; at least two distinct
+    /// k_rs; the design k_rs inside the swept range. Repeated k_rs (repeat runs, other seeds) are
+    /// merged by the geometric mean of their rates (the mean of ln(rate), the interpolated
+    /// quantity).
+    pub fn new(points: &[SweepPoint], design_rattle_space: f64) -> Result<Self, PenalizationError> {
+        for (index, p) in points.iter().enumerate() {
+            if !(p.rattle_space.is_finite() && p.rattle_space > 0.0 && p.rattle_space <= 1.0) {
+                return Err(PenalizationError::InvalidSweepPoint {
+                    index,
+                    field: "rattle_space",
+                    rule: format!("must be a finite number in (0, 1], got {}", p.rattle_space),
+                });
+            }
+            let rate = p.rail_wear_rate_mg_per_h;
+            if !(rate.is_finite() && rate > 0.0) {
+                return Err(PenalizationError::InvalidSweepPoint {
+                    index,
+                    field: "rail_wear_rate_mg_per_h",
+                    rule: format!("must be a finite number > 0 mg/h, got {rate}"),
+                });
+            }
+        }
+        let mut sorted: Vec<SweepPoint> = points.to_vec();
+        sorted.sort_by(|a, b| a.rattle_space.total_cmp(&b.rattle_space));
+        // Merge repeats: geometric mean of the rates at equal k_rs.
+        let mut merged: Vec<SweepPoint> = Vec::with_capacity(sorted.len());
+        let mut i = 0;
+        while i < sorted.len() {
+            let k = sorted[i].rattle_space;
+            let mut j = i;
+            let mut log_sum = 0.0;
+            while j < sorted.len() && sorted[j].rattle_space == k {
+                log_sum += sorted[j].rail_wear_rate_mg_per_h.ln();
+                j += 1;
+            }
+            merged.push(SweepPoint {
+                rattle_space: k,
+                rail_wear_rate_mg_per_h: (log_sum / (j - i) as f64).exp(),
+            });
+            i = j;
+        }
+        if merged.len() < 2 {
+            return Err(PenalizationError::TooFewPoints {
+                distinct: merged.len(),
+            });
+        }
+        if !design_rattle_space.is_finite() {
+            return Err(PenalizationError::InvalidInput {
+                field: "design_rattle_space",
+                rule: format!("must be a finite number, got {design_rattle_space}"),
+            });
+        }
+        let mut curve = Self {
+            design_rattle_space,
+            points: merged,
+            design_rate_mg_per_h: 0.0,
+        };
+        curve.design_rate_mg_per_h =
+            curve
+                .rail_wear_rate_mg_per_h(design_rattle_space)
+                .map_err(|e| match e {
+                    PenalizationError::OutOfRange { min, max, .. } => {
+                        PenalizationError::InvalidInput {
+                            field: "design_rattle_space",
+                            rule: format!(
+                        "{design_rattle_space} must lie inside the swept range [{min}, {max}]"
+                    ),
+                        }
+                    }
+                    other => other,
+                })?;
+        Ok(curve)
+    }
+
+    /// Design rattle space.
+    pub fn design_rattle_space(&self) -> f64 {
+        self.design_rattle_space
+    }
+
+    /// The merged sweep points, sorted by increasing rattle space.
+    pub fn points(&self) -> &[SweepPoint] {
+        &self.points
+    }
+
+    /// Swept range `(min, max)` of rattle space.
+    pub fn range(&self) -> (f64, f64) {
+        // `new` guarantees at least two points.
+        let first = self.points.first().map_or(f64::NAN, |p| p.rattle_space);
+        let last = self.points.last().map_or(f64::NAN, |p| p.rattle_space);
+        (first, last)
+    }
+
+    /// Interpolated rail wear rate at the design point, mg/h.
+    pub fn design_rate_mg_per_h(&self) -> f64 {
+        self.design_rate_mg_per_h
+    }
+
+    /// Rail wear rate at `rattle_space`, mg/h: piecewise-linear in ln(rate) between sweep points;
+    /// an error outside the swept range.
+    pub fn rail_wear_rate_mg_per_h(&self, rattle_space: f64) -> Result<f64, PenalizationError> {
+        if !rattle_space.is_finite() {
+            return Err(PenalizationError::InvalidInput {
+                field: "rattle_space",
+                rule: format!("must be a finite number, got {rattle_space}"),
+            });
+        }
+        let (min, max) = self.range();
+        if rattle_space < min || rattle_space > max {
+            return Err(PenalizationError::OutOfRange {
+                rattle_space,
+                min,
+                max,
+            });
+        }
+        // First segment whose right end is >= k (points are strictly increasing).
+        let right = self
+            .points
+            .iter()
+            .position(|p| p.rattle_space >= rattle_space)
+            .unwrap_or(self.points.len() - 1)
+            .max(1);
+        let (a, b) = (self.points[right - 1], self.points[right]);
+        let t = (rattle_space - a.rattle_space) / (b.rattle_space - a.rattle_space);
+        let ln_rate =
+            (1.0 - t) * a.rail_wear_rate_mg_per_h.ln() + t * b.rail_wear_rate_mg_per_h.ln();
+        Ok(ln_rate.exp())
+    }
+
+    /// Service-life penalization factor `K_SL = min(1, rate(design) / rate(k_rs))`, eq. 6.4.
+    pub fn k_sl(&self, rattle_space: f64) -> Result<f64, PenalizationError> {
+        let rate = self.rail_wear_rate_mg_per_h(rattle_space)?;
+        Ok((self.design_rate_mg_per_h / rate).min(1.0))
+    }
+
+    /// K_SL with the conservative 0.9 and 0.8 bands of Figure 6.68.
+    pub fn factors(&self, rattle_space: f64) -> Result<PenalizationFactors, PenalizationError> {
+        let k_sl = self.k_sl(rattle_space)?;
+        Ok(PenalizationFactors {
+            rattle_space,
+            k_sl,
+            k_sl_conservative_90: CONSERVATIVE_BAND_90 * k_sl,
+            k_sl_conservative_80: CONSERVATIVE_BAND_80 * k_sl,
+        })
+    }
+
+    /// Penalized service life `T_SL,real = K_SL T_SL,design` (eq. 6.4) and its bands.
+    /// `design_life_h` must be a finite number > 0.
+    pub fn penalized_life(
+        &self,
+        design_life_h: f64,
+        rattle_space: f64,
+    ) -> Result<PenalizedLife, PenalizationError> {
+        if !(design_life_h.is_finite() && design_life_h > 0.0) {
+            return Err(PenalizationError::InvalidInput {
+                field: "design_life_h",
+                rule: format!("must be a finite number > 0 h, got {design_life_h}"),
+            });
+        }
+        let factors = self.factors(rattle_space)?;
+        Ok(PenalizedLife {
+            factors,
+            design_life_h,
+            life_h: factors.k_sl * design_life_h,
+            life_conservative_90_h: factors.k_sl_conservative_90 * design_life_h,
+            life_conservative_80_h: factors.k_sl_conservative_80 * design_life_h,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(k: f64, rate: f64) -> SweepPoint {
+        SweepPoint {
+            rattle_space: k,
+            rail_wear_rate_mg_per_h: rate,
+        }
+    }
+
+    /// Thesis-shaped sweep (Figure 6.67): loose 0.7684, design 0.7990, tight 0.8317; looser
+    /// wears faster. Rates chosen as round numbers so the expected values are by hand.
+    fn thesis_like() -> PenalizationCurve {
+        PenalizationCurve::new(&[pt(0.8317, 1.0), pt(0.7684, 4.0), pt(0.7990, 2.0)], 0.7990)
+            .unwrap()
+    }
+
+    #[test]
+    fn k_sl_is_one_at_design_and_never_above_one() {
+        let c = thesis_like();
+        assert_eq!(c.k_sl(0.7990).unwrap(), 1.0);
+        // Tighter rails wear slower: K_SL would exceed 1 but is capped (conservative, thesis 6.7).
+        assert_eq!(c.k_sl(0.8317).unwrap(), 1.0);
+        for i in 0..=100 {
+            let k = 0.7684 + (0.8317 - 0.7684) * i as f64 / 100.0;
+            assert!(c.k_sl(k).unwrap() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn k_sl_below_one_where_the_rate_is_higher() {
+        let c = thesis_like();
+        // Loose end: rate 4 vs design 2 -> 0.5.
+        assert!((c.k_sl(0.7684).unwrap() - 0.5).abs() < 1e-12);
+        // Midway in k between loose and design, ln-linear: rate = sqrt(4*2) -> K = 2/sqrt(8).
+        let mid = 0.5 * (0.7684 + 0.7990);
+        assert!((c.rail_wear_rate_mg_per_h(mid).unwrap() - 8f64.sqrt()).abs() < 1e-12);
+        assert!((c.k_sl(mid).unwrap() - 2.0 / 8f64.sqrt()).abs() < 1e-12);
+        // Monotone between points: K_SL rises from loose to design.
+        let mut last = 0.0;
+        for i in 0..=50 {
+            let k = 0.7684 + (0.7990 - 0.7684) * i as f64 / 50.0;
+            let v = c.k_sl(k).unwrap();
+            assert!(v >= last - 1e-15);
+            last = v;
+        }
+    }
+
+    #[test]
+    fn bands_and_penalized_life() {
+        let c = thesis_like();
+        let life = c.penalized_life(1000.0, 0.7684).unwrap();
+        assert!((life.life_h - 500.0).abs() < 1e-9);
+        assert!((life.life_conservative_90_h - 450.0).abs() < 1e-9);
+        assert!((life.life_conservative_80_h - 400.0).abs() < 1e-9);
+        assert!((life.factors.k_sl_conservative_90 - 0.45).abs() < 1e-12);
+        let err = c.penalized_life(-5.0, 0.79).unwrap_err();
+        assert!(matches!(
+            err,
+            PenalizationError::InvalidInput {
+                field: "design_life_h",
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn outside_the_sweep_is_an_error_naming_the_range() {
+        let c = thesis_like();
+        let err = c.k_sl(0.70).unwrap_err();
+        assert_eq!(
+            err,
+            PenalizationError::OutOfRange {
+                rattle_space: 0.70,
+                min: 0.7684,
+                max: 0.8317
+            }
+        );
+        assert!(err.to_string().contains("[0.7684, 0.8317]"));
+        assert!(c.k_sl(0.9).is_err());
+        assert!(c.k_sl(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn sweep_point_validation() {
+        let e = PenalizationCurve::new(&[pt(0.8, 1.0)], 0.8).unwrap_err();
+        assert_eq!(e, PenalizationError::TooFewPoints { distinct: 1 });
+        let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.8, 3.0)], 0.8).unwrap_err();
+        assert_eq!(e, PenalizationError::TooFewPoints { distinct: 1 });
+        let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.7, 0.0)], 0.75).unwrap_err();
+        assert!(matches!(
+            e,
+            PenalizationError::InvalidSweepPoint {
+                index: 1,
+                field: "rail_wear_rate_mg_per_h",
+                ..
+            }
+        ));
+        let e = PenalizationCurve::new(&[pt(f64::NAN, 1.0), pt(0.7, 1.0)], 0.75).unwrap_err();
+        assert!(matches!(
+            e,
+            PenalizationError::InvalidSweepPoint {
+                index: 0,
+                field: "rattle_space",
+                ..
+            }
+        ));
+        let e = PenalizationCurve::new(&[pt(0.8, f64::INFINITY), pt(0.7, 1.0)], 0.75).unwrap_err();
+        assert!(matches!(
+            e,
+            PenalizationError::InvalidSweepPoint { index: 0, .. }
+        ));
+        // Design outside the sweep.
+        let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.7, 2.0)], 0.9).unwrap_err();
+        assert!(matches!(
+            e,
+            PenalizationError::InvalidInput {
+                field: "design_rattle_space",
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn repeats_merge_by_geometric_mean() {
+        let c = PenalizationCurve::new(&[pt(0.7, 1.0), pt(0.7, 4.0), pt(0.8, 1.0)], 0.8).unwrap();
+        assert_eq!(c.points().len(), 2);
+        assert!((c.rail_wear_rate_mg_per_h(0.7).unwrap() - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn serde_round_trip_revalidates() {
+        let c = thesis_like();
+        let json = serde_json::to_string(&c).unwrap();
+        assert!(json.contains("design_rattle_space"));
+        let back: PenalizationCurve = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, c);
+        let bad = r#"{"design_rattle_space":0.8,"points":[{"rattle_space":0.8,"rail_wear_rate_mg_per_h":1.0}]}"#;
+        assert!(serde_json::from_str::<PenalizationCurve>(bad).is_err());
+    }
+}

@@ -1,0 +1,265 @@
+//! From a case file to a finished run: resolves the excitation (profiles by name), builds the
+//! model, maps the run settings, runs it and writes the summary, tracks and plots.
+
+use super::rattle_box;
+use super::run::{run_model, BuiltModel, ModelRunError, RunOptions, RunReport};
+use super::specs::{CaseSpec, ModelSpecRef, SpecError};
+use crate::analysis::spectra::welch_psd;
+use crate::analysis::svg::{AxisSpec, Plot, Series, VerticalMarker};
+use crate::analysis::vdv::vibration_dose_value_uniform;
+use crate::excitation::profile::ProfileFile;
+use crate::excitation::{BaseMotion, ExcitationSpec};
+use crate::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
+use crate::physics::simulate::{DivergenceLimits, SimError};
+use crate::pipeline::{CaseOutcome, RunControl, RunError};
+use serde_json::{json, Value};
+use std::path::Path;
+
+/// Code version recorded with every result.
+pub const CODE_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+fn invalid(field: impl Into<String>, rule: impl Into<String>) -> RunError {
+    RunError::InvalidConfig {
+        field: field.into(),
+        rule: rule.into(),
+    }
+}
+
+impl From<SpecError> for RunError {
+    fn from(e: SpecError) -> Self {
+        invalid(e.field, e.rule)
+    }
+}
+
+impl From<ModelRunError> for RunError {
+    fn from(e: ModelRunError) -> Self {
+        match e {
+            ModelRunError::Sim(SimError::Cancelled { .. }) => RunError::Cancelled,
+            ModelRunError::Sim(d) => RunError::Diverged(d.to_string()),
+            ModelRunError::Wear(w) => RunError::Diverged(format!("wear post-processing: {w}")),
+        }
+    }
+}
+
+/// Reads and validates a case file.
+pub fn load_case(path: &Path) -> Result<CaseSpec, RunError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| invalid("config", format!("cannot read {}: {e}", path.display())))?;
+    Ok(CaseSpec::from_toml_str(&text)?)
+}
+
+/// Resolves the `[excitation]` table: `kind = "profile"` loads `configs/profiles/<profile>.toml`;
+/// the case's `simulation.settle_s` becomes the excitation's settle time, and for random
+/// profiles `simulation.seed` replaces the profile's seed (so sweeps and ensembles vary it).
+pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<ExcitationSpec, RunError> {
+    let mut value = case.excitation.clone();
+    if value.get("kind").and_then(Value::as_str) == Some("profile") {
+        let name = value
+            .get("profile")
+            .and_then(Value::as_str)
+            .ok_or_else(|| invalid("excitation.profile", "must name a file in configs/profiles"))?;
+        if name.contains('/') || name.contains("..") {
+            return Err(invalid("excitation.profile", "must be a plain profile name"));
+        }
+        let path = configs_dir.join("profiles").join(format!("{name}.toml"));
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| invalid("excitation.profile", format!("cannot read {}: {e}", path.display())))?;
+        let file = ProfileFile::from_toml_str(&text)
+            .map_err(|e| invalid("excitation.profile", e.to_string()))?;
+        value = serde_json::to_value(&file.excitation)
+            .map_err(|e| invalid("excitation", e.to_string()))?;
+        if let Some(obj) = value.as_object_mut() {
+            if obj.contains_key("seed") {
+                obj.insert("seed".into(), json!(case.simulation.seed));
+            }
+        }
+    }
+    if let Some(obj) = value.as_object_mut() {
+        if obj.get("kind").and_then(Value::as_str) != Some("none") {
+            obj.insert("settle_s".into(), json!(case.simulation.settle_s));
+        }
+    }
+    serde_json::from_value(value).map_err(|e| invalid("excitation", e.to_string()))
+}
+
+/// Maps the `[simulation]` table to integrator settings. The position tolerance sets the
+/// others: velocities `abs_m / 1 ms`, quaternion `abs_m / 10 mm`, angular velocity
+/// `abs_m / (10 mm · 1 ms)`.
+pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunError> {
+    let kind = match case.simulation.integrator.as_str() {
+        "trbdf2" => IntegratorKind::Trbdf2,
+        "sdirk2" => IntegratorKind::Sdirk2,
+        "dopri5" => IntegratorKind::Dopri5,
+        other => {
+            return Err(invalid(
+                "simulation.integrator",
+                format!("unknown integrator {other:?}; use trbdf2, sdirk2 or dopri5"),
+            ))
+        }
+    };
+    let a = case.simulation.abs_tolerance_m;
+    Ok(IntegratorSettings {
+        kind,
+        tolerances: Tolerances {
+            rel: case.simulation.rel_tolerance,
+            abs_position_m: a,
+            abs_rotation: a / 0.01,
+            abs_velocity_m_s: a * 1e3,
+            abs_angular_velocity_rad_s: a * 1e5,
+        },
+        initial_step_s: 1e-6,
+        max_step_s: 1e-3,
+        min_step_s: 1e-15,
+    })
+}
+
+/// Builds the model of a case.
+pub fn build(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError> {
+    case.validate()?;
+    let excitation = resolve_excitation(case, configs_dir)?;
+    let motion = BaseMotion::from_spec(&excitation).map_err(|e| invalid("excitation", e.to_string()))?;
+    match case.model_spec()? {
+        ModelSpecRef::RattleBox(spec) => Ok(rattle_box::build(case, spec, motion)),
+        ModelSpecRef::Launcher(spec) => super::launcher::build(case, spec, motion),
+        ModelSpecRef::PersistentContact(_) => Err(invalid(
+            "model",
+            "the persistent-contact fixture runs through `railwear calibrate`, not as a dynamic case in this build",
+        )),
+    }
+}
+
+/// Run options of a case.
+pub fn run_options(case: &CaseSpec) -> Result<RunOptions, RunError> {
+    Ok(RunOptions {
+        integrator: integrator_settings(case)?,
+        limits: DivergenceLimits::default(),
+        wear_law: case.wear.law,
+        volume_split: case.wear.volume_split,
+        record_interval_s: case.simulation.record_interval_s,
+        response_rate_hz: 2000.0,
+    })
+}
+
+/// Builds and runs a case; returns the raw report and the packaged outcome.
+pub fn run_case(
+    case: &CaseSpec,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<(RunReport, CaseOutcome), RunError> {
+    let model = build(case, configs_dir)?;
+    let options = run_options(case)?;
+    let report = run_model(&model, &options, control)?;
+    let outcome = package(case, &model, &options, &report);
+    Ok((report, outcome))
+}
+
+/// Summary JSON and plots of a finished run.
+pub fn package(case: &CaseSpec, model: &BuiltModel, options: &RunOptions, r: &RunReport) -> CaseOutcome {
+    let simulated = model.end_time_s;
+    let rattle_space = match case.model_spec() {
+        Ok(ModelSpecRef::RattleBox(s)) => s.rattle_space().ok(),
+        Ok(ModelSpecRef::Launcher(s)) => s.rattle_space().ok(),
+        _ => None,
+    };
+    let dt = 1.0 / r.response_rate_hz;
+    let resp_x: Vec<f64> = r.response_acceleration.iter().map(|a| a[0]).collect();
+    let vdv = vibration_dose_value_uniform(&resp_x, dt).ok();
+    let psd = welch_psd(&resp_x, r.response_rate_hz, 512.min(resp_x.len().max(4))).ok();
+    let summary = json!({
+        "name": case.name,
+        "model": case.model,
+        "code_version": CODE_VERSION,
+        "seed": case.simulation.seed,
+        "config": case,
+        "rattle_space": rattle_space,
+        "integrator": {
+            "kind": options.integrator.kind.name(),
+            "tolerances": options.integrator.tolerances,
+            "stats": r.integrator,
+        },
+        "simulated_s": simulated,
+        "window_s": r.window_s,
+        "wall_s": r.wall_s,
+        "real_time_factor": simulated / r.wall_s.max(1e-9),
+        "mean_normal_force_n": r.mean_normal_force_n,
+        "mean_friction_power_w": r.mean_friction_power_w,
+        "contacts": r.contacts,
+        "bodies": r.bodies,
+        "response": {
+            "body": model.system.bodies[model.response_body].name,
+            "vdv_x_m_s2": vdv,
+            "psd_x": psd.as_ref().map(|p| json!({"frequency_hz": p.frequency_hz, "density_m2_s4_per_hz": p.density})),
+        },
+        "track_samples": r.tracks.len(),
+    });
+    CaseOutcome {
+        summary,
+        tracks: r.tracks.clone(),
+        plots: plots(case, r, psd.as_ref()),
+    }
+}
+
+fn plots(case: &CaseSpec, r: &RunReport, psd: Option<&crate::analysis::spectra::Psd>) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    // Wear versus time per contact, mg.
+    let density = r
+        .contacts
+        .first()
+        .map(|_| case.rattle_box.as_ref().map(|s| s.material.density_kg_per_m3).or(case.launcher.as_ref().map(|s| s.material.density_kg_per_m3)).unwrap_or(2810.0))
+        .unwrap_or(2810.0);
+    let mut wear_plot = Plot::new(
+        &format!("{}: wear versus time", case.name),
+        AxisSpec::linear("time (s)"),
+        AxisSpec::linear("wear mass (mg)"),
+    );
+    for (ci, c) in r.contacts.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = r
+            .wear_history
+            .iter()
+            .map(|(t, v)| (*t, v.get(ci).copied().unwrap_or(0.0) * density * 1e6))
+            .collect();
+        wear_plot = wear_plot.with_series(Series::line(&c.name, pts));
+    }
+    out.push(("wear_vs_time.svg".to_string(), wear_plot.to_svg()));
+    // Contact-pressure PDF per contact with S_y and the cutoff marked.
+    for c in &r.contacts {
+        let dens = c.wear.pressure_histogram.time_density_per_pa();
+        let nonzero: Vec<(f64, f64)> = dens.into_iter().filter(|(_, d)| *d > 0.0).collect();
+        if nonzero.is_empty() {
+            continue;
+        }
+        let edges: Vec<f64> = (0..=c.wear.pressure_histogram.len()).map(|i| c.wear.pressure_histogram.edge_pa(i) / 1e6).collect();
+        let values: Vec<f64> = c.wear.pressure_histogram.time_density_per_pa().iter().map(|(_, d)| d * 1e6).collect();
+        let mut p = Plot::new(
+            &format!("{}: contact-pressure PDF, {}", case.name, c.name),
+            AxisSpec::log("contact pressure (MPa)"),
+            AxisSpec::linear("time density (1/MPa)"),
+        )
+        .with_series(Series::histogram("time share", edges, values));
+        let sy = case.rattle_box.as_ref().map(|s| s.material.yield_strength_pa).or(case.launcher.as_ref().map(|s| s.material.yield_strength_pa)).unwrap_or(435e6);
+        p = p.with_marker(VerticalMarker::new("Sy", sy / 1e6));
+        if let Some(cut) = c.wear.cutoff_pressure_pa {
+            p = p.with_marker(VerticalMarker::new("cutoff", cut / 1e6));
+        }
+        out.push((format!("pressure_pdf_{}.svg", c.name), p.to_svg()));
+    }
+    if let Some(psd) = psd {
+        let pts: Vec<(f64, f64)> = psd
+            .frequency_hz
+            .iter()
+            .zip(&psd.density)
+            .filter(|(f, d)| **f > 0.0 && **d > 0.0)
+            .map(|(f, d)| (*f, *d))
+            .collect();
+        if !pts.is_empty() {
+            let p = Plot::new(
+                &format!("{}: response acceleration PSD (x)", case.name),
+                AxisSpec::log("frequency (Hz)"),
+                AxisSpec::log("PSD ((m/s²)²/Hz)"),
+            )
+            .with_series(Series::line("x", pts));
+            out.push(("response_psd.svg".to_string(), p.to_svg()));
+        }
+    }
+    out
+}

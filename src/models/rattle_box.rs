@@ -1,0 +1,115 @@
+//! Rattle box (thesis chapter 5): a rounded 1 in cube free inside a square tube that the shaker
+//! drives transversely. One contact "cube-tube" with one track per wall the cube touches.
+
+use super::run::BuiltModel;
+use super::specs::{CaseSpec, MaterialSpec, RattleBoxSpec};
+use crate::excitation::BaseMotion;
+use crate::geometry::{ConvexShape, HalfSpace};
+use crate::models::motion::TranslatingBase;
+use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
+use crate::physics::contact::Contact;
+use crate::physics::system::MultibodySystem;
+use crate::units::STANDARD_GRAVITY;
+use crate::wear::material::Material;
+use nalgebra::{Isometry3, Matrix3, Unit, Vector3};
+use std::sync::Arc;
+
+/// Converts a config material to the wear module's material.
+pub fn material(m: &MaterialSpec) -> Material {
+    Material {
+        density_kg_m3: m.density_kg_per_m3,
+        yield_strength_pa: m.yield_strength_pa,
+        youngs_modulus_pa: m.youngs_modulus_pa,
+        poisson_ratio: m.poisson_ratio,
+        brinell_hardness_hb: m.brinell_hardness,
+    }
+}
+
+/// Half-space whose solid lies beyond `offset` along `-inward` (wall faces of a cavity):
+/// `inward` points from the wall into the cavity.
+pub fn wall(inward: Vector3<f64>, distance_from_origin: f64) -> HalfSpace {
+    HalfSpace {
+        normal: Unit::new_normalize(inward),
+        offset: -distance_from_origin,
+    }
+}
+
+/// Builds the rattle box system. The cube starts resting on the tube floor at its static
+/// penetration (IMPACT spring alone carrying the weight), centred in the tube.
+pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> BuiltModel {
+    let side = spec.cube_side_m;
+    let half = 0.5 * side;
+    let l = 0.5 * spec.tube_inner_side_m;
+    let mass = spec.cube_mass_kg();
+    let cube = RigidBody {
+        name: "cube".into(),
+        mass: MassProperties {
+            mass,
+            inertia: Matrix3::from_diagonal_element(spec.cube_inertia_kg_m2()),
+        },
+        kind: BodyKind::Dynamic { offset: 0 },
+    };
+    let tube = RigidBody {
+        name: "tube".into(),
+        mass: MassProperties {
+            mass: 1.0,
+            inertia: Matrix3::identity(),
+        },
+        kind: BodyKind::Kinematic(Arc::new(TranslatingBase {
+            reference: Isometry3::identity(),
+            motion,
+        })),
+    };
+    let mut faces = vec![
+        wall(-Vector3::x(), l),
+        wall(Vector3::x(), l),
+        wall(-Vector3::y(), l),
+        wall(Vector3::y(), l),
+    ];
+    if spec.end_caps {
+        let lz = 0.5 * spec.tube_length_m;
+        faces.push(wall(-Vector3::z(), lz));
+        faces.push(wall(Vector3::z(), lz));
+    }
+    let impact = spec.contact.to_impact_params();
+    let contact = Contact {
+        name: "cube-tube".into(),
+        body_a: 0,
+        pieces_a: vec![(
+            Isometry3::identity(),
+            ConvexShape::RoundedBox {
+                half_extents: Vector3::new(half, half, half),
+                roundover: spec.edge_radius_m,
+            },
+        )],
+        body_b: 1,
+        faces_b: faces,
+        impact,
+        friction: Some(spec.friction.to_friction_params()),
+    };
+    let system = MultibodySystem::new(
+        vec![cube, tube],
+        Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
+        vec![],
+        vec![contact],
+    );
+    let w_static = impact.static_penetration(mass * STANDARD_GRAVITY);
+    let mut y = vec![0.0; system.state_len()];
+    write_state(
+        &mut y,
+        0,
+        &Isometry3::translation(0.0, -l + half - w_static, 0.0),
+        Vector3::zeros(),
+        Vector3::zeros(),
+    );
+    let mat = material(&spec.material);
+    BuiltModel {
+        name: case.name.clone(),
+        system,
+        initial_state: y,
+        excitation_start_s: case.simulation.settle_s,
+        end_time_s: case.simulation.settle_s + case.simulation.duration_s,
+        contact_materials: vec![(mat, mat)],
+        response_body: 0,
+    }
+}

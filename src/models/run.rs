@@ -1,0 +1,391 @@
+//! Runs a built model through settle and excitation, integrating wear per contact track
+//! (thesis eq. 3.13-3.15, per track like the thesis' post-processor, summed per contact) and the
+//! friction power `Σ N |v_slip|`, and collects what the reports need.
+
+use crate::physics::body::BodyKind;
+use crate::physics::contact::TrackState;
+use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
+use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
+use crate::physics::system::MultibodySystem;
+use crate::physics::track::TrackSample;
+use crate::pipeline::RunControl;
+use crate::units::{MG_PER_KG, S_PER_H};
+use crate::wear::allocation::VolumeSplit;
+use crate::wear::integrate::{WearAccumulator, WearTotals};
+use crate::wear::law::WearLaw;
+use crate::wear::material::Material;
+use crate::wear::WearError;
+use serde::{Deserialize, Serialize};
+
+/// A model ready to run: the system, its initial state and what each contact wears.
+pub struct BuiltModel {
+    /// Case name.
+    pub name: String,
+    /// The multibody system.
+    pub system: MultibodySystem,
+    /// Initial state (static guess: resting at the static penetration).
+    pub initial_state: Vec<f64>,
+    /// Time at which the excitation starts (end of settle), s.
+    pub excitation_start_s: f64,
+    /// End of the run, s.
+    pub end_time_s: f64,
+    /// Material of body a and body b of each contact (same order as `system.contacts`).
+    pub contact_materials: Vec<(Material, Material)>,
+    /// Body whose acceleration is reported (spectra, VDV).
+    pub response_body: usize,
+}
+
+/// How a run is integrated, limited and post-processed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    /// Integrator and tolerances.
+    pub integrator: IntegratorSettings,
+    /// Divergence bounds.
+    pub limits: DivergenceLimits,
+    /// Wear law.
+    pub wear_law: WearLaw,
+    /// Split of each contact's volume between its bodies.
+    pub volume_split: VolumeSplit,
+    /// Interval between recorded track samples, s (0: every accepted step; negative: none).
+    pub record_interval_s: f64,
+    /// Sample rate of the response acceleration record, Hz.
+    pub response_rate_hz: f64,
+}
+
+/// Wear and loading of one contact over the excitation window.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ContactReport {
+    /// Contact name.
+    pub name: String,
+    /// Body carrying the convex pieces.
+    pub body_a: String,
+    /// Body carrying the faces.
+    pub body_b: String,
+    /// Wear totals (volume, work, work above the cutoff, pressure histogram).
+    pub wear: WearTotals,
+    /// Share of the friction work done above the wear law's cutoff (thesis 5.5), 0..1.
+    pub work_share_above_cutoff: f64,
+    /// Wear mass charged to body a, mg.
+    pub mass_a_mg: f64,
+    /// Wear mass charged to body b, mg.
+    pub mass_b_mg: f64,
+    /// Total wear-mass rate of the contact, mg/h.
+    pub mass_rate_mg_per_h: f64,
+    /// Wear-mass rate charged to body a, mg/h.
+    pub mass_rate_a_mg_per_h: f64,
+    /// Wear-mass rate charged to body b, mg/h.
+    pub mass_rate_b_mg_per_h: f64,
+    /// Time-averaged normal force, N.
+    pub mean_normal_force_n: f64,
+    /// Time-averaged friction power Σ N |v_slip|, W.
+    pub mean_friction_power_w: f64,
+    /// Largest normal force seen, N.
+    pub peak_normal_force_n: f64,
+}
+
+/// Wear charged to one body, summed over its contacts.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BodyReport {
+    /// Body name.
+    pub name: String,
+    /// Wear mass, mg.
+    pub mass_mg: f64,
+    /// Wear-mass rate over the excitation window, mg/h.
+    pub mass_rate_mg_per_h: f64,
+}
+
+/// Everything a run produces.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Per contact.
+    pub contacts: Vec<ContactReport>,
+    /// Per body.
+    pub bodies: Vec<BodyReport>,
+    /// Length of the averaging (excitation) window, s.
+    pub window_s: f64,
+    /// Time-averaged total normal force over the window, N.
+    pub mean_normal_force_n: f64,
+    /// Time-averaged total friction power over the window, W.
+    pub mean_friction_power_w: f64,
+    /// Integrator counters.
+    pub integrator: IntegratorStats,
+    /// Wall-clock time, s.
+    pub wall_s: f64,
+    /// Recorded track samples.
+    pub tracks: Vec<TrackSample>,
+    /// Response-body acceleration, world frame, sampled uniformly over the window, m/s².
+    pub response_acceleration: Vec<[f64; 3]>,
+    /// Sample rate of `response_acceleration`, Hz.
+    pub response_rate_hz: f64,
+    /// Base (drive) acceleration at the same instants, m/s².
+    pub base_acceleration: Vec<[f64; 3]>,
+    /// Cumulative wear volume per contact versus time: (time s, volume m³ per contact).
+    pub wear_history: Vec<(f64, Vec<f64>)>,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelRunError {
+    /// The simulation broke down or was cancelled.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// Wear post-processing rejected a value.
+    #[error(transparent)]
+    Wear(#[from] WearError),
+}
+
+struct TrackAcc {
+    acc: WearAccumulator,
+    open: bool,
+}
+
+/// Runs the model and post-processes wear.
+pub fn run_model(
+    model: &BuiltModel,
+    options: &RunOptions,
+    control: &RunControl,
+) -> Result<RunReport, ModelRunError> {
+    let sys = &model.system;
+    let t0 = model.excitation_start_s;
+    let ncontacts = sys.contacts.len();
+    let mut accs: Vec<Vec<Option<TrackAcc>>> = sys
+        .contacts
+        .iter()
+        .map(|c| (0..c.pieces_a.len() * c.faces_b.len()).map(|_| None).collect())
+        .collect();
+    let mut normal_int = vec![0.0; ncontacts];
+    let mut power_int = vec![0.0; ncontacts];
+    let mut peak = vec![0.0f64; ncontacts];
+    let mut prev_sums: Option<(f64, Vec<f64>, Vec<f64>)> = None;
+    let mut tracks_out: Vec<TrackSample> = Vec::new();
+    let mut next_record = t0;
+    let mut wear_error: Option<WearError> = None;
+    // Response acceleration from velocity differences on a uniform grid.
+    let dt_resp = 1.0 / options.response_rate_hz;
+    let mut next_resp = t0;
+    let mut resp_vel: Vec<(f64, [f64; 3])> = Vec::new();
+    let mut prev_vel: Option<(f64, nalgebra::Vector3<f64>)> = None;
+    let resp_offset = match sys.bodies[model.response_body].kind {
+        BodyKind::Dynamic { offset } => Some(offset),
+        BodyKind::Kinematic(_) => None,
+    };
+    let law = options.wear_law;
+    let mut wear_history: Vec<(f64, Vec<f64>)> = Vec::new();
+    let history_dt = (model.end_time_s - t0) / 200.0;
+    let mut next_history = t0;
+    let mut observer = |v: &StepView| {
+        if v.t < t0 {
+            return;
+        }
+        // Friction power and normal force, trapezoid between step ends.
+        let mut n_sum = vec![0.0; ncontacts];
+        let mut p_sum = vec![0.0; ncontacts];
+        for tr in v.tracks {
+            let c = tr.contact as usize;
+            n_sum[c] += tr.normal_force;
+            p_sum[c] += tr.normal_force * tr.slip_velocity.norm();
+            peak[c] = peak[c].max(tr.normal_force);
+        }
+        if let Some((tp, np, pp)) = &prev_sums {
+            let dt = v.t - tp;
+            for c in 0..ncontacts {
+                normal_int[c] += 0.5 * dt * (np[c] + n_sum[c]);
+                power_int[c] += 0.5 * dt * (pp[c] + p_sum[c]);
+            }
+        }
+        prev_sums = Some((v.t, n_sum, p_sum));
+        // Wear per track; a track that vanished is closed with a zero-force sample.
+        for list in accs.iter_mut() {
+            for a in list.iter_mut().flatten() {
+                a.open = false;
+            }
+        }
+        for tr in v.tracks {
+            let slot = &mut accs[tr.contact as usize][tr.track as usize];
+            let entry = match slot {
+                Some(e) => e,
+                None => match WearAccumulator::new(law) {
+                    Ok(acc) => slot.insert(TrackAcc { acc, open: false }),
+                    Err(e) => {
+                        wear_error.get_or_insert(e);
+                        continue;
+                    }
+                },
+            };
+            entry.open = true;
+            if let Err(e) = entry.acc.push(v.t, tr.normal_force, tr.slip_velocity.norm(), tr.area) {
+                wear_error.get_or_insert(e);
+            }
+        }
+        for list in accs.iter_mut() {
+            for a in list.iter_mut().flatten() {
+                if !a.open {
+                    if let Err(e) = a.acc.push(v.t, 0.0, 0.0, 0.0) {
+                        wear_error.get_or_insert(e);
+                    }
+                    a.open = true; // closed once; further zeros are harmless but skip them
+                }
+            }
+        }
+        if v.t >= next_history {
+            next_history = v.t + history_dt;
+            let vols = accs
+                .iter()
+                .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
+                .collect();
+            wear_history.push((v.t, vols));
+        }
+        // Track samples for export.
+        if options.record_interval_s >= 0.0 && v.t >= next_record {
+            next_record = v.t + options.record_interval_s;
+            record_tracks(v, &mut tracks_out);
+        }
+        // Response velocity, linearly interpolated onto the uniform grid.
+        if let Some(off) = resp_offset {
+            let vel = nalgebra::Vector3::new(v.state[off + 7], v.state[off + 8], v.state[off + 9]);
+            if let Some((tp, vp)) = prev_vel {
+                while next_resp <= v.t && v.t > tp {
+                    let s = (next_resp - tp) / (v.t - tp);
+                    let vi = vp + (vel - vp) * s.clamp(0.0, 1.0);
+                    resp_vel.push((next_resp, [vi.x, vi.y, vi.z]));
+                    next_resp += dt_resp;
+                }
+            }
+            prev_vel = Some((v.t, vel));
+        }
+    };
+    let mut y = model.initial_state.clone();
+    let stats = simulate(
+        sys,
+        &mut y,
+        0.0,
+        model.end_time_s,
+        options.integrator,
+        options.limits,
+        control,
+        &mut observer,
+    )?;
+    if let Some(e) = wear_error {
+        return Err(e.into());
+    }
+    let window = (model.end_time_s - t0).max(f64::MIN_POSITIVE);
+    let mut contacts = Vec::with_capacity(ncontacts);
+    let mut body_mass = vec![0.0; sys.bodies.len()];
+    for (ci, c) in sys.contacts.iter().enumerate() {
+        let mut total: Option<WearTotals> = None;
+        for a in accs[ci].iter_mut().filter_map(|a| a.take()) {
+            let t = a.acc.finish();
+            match &mut total {
+                Some(tot) => tot.merge(&t)?,
+                None => total = Some(t),
+            }
+        }
+        let total = match total {
+            Some(t) => t,
+            None => WearAccumulator::new(law)?.finish(),
+        };
+        let (ma, mb) = &model.contact_materials[ci];
+        let (wa, wb) = options.volume_split.split(total.volume_m3, ma, mb)?;
+        body_mass[c.body_a] += wa.mass_kg;
+        body_mass[c.body_b] += wb.mass_kg;
+        let per_h = S_PER_H / window;
+        contacts.push(ContactReport {
+            name: c.name.clone(),
+            body_a: sys.bodies[c.body_a].name.clone(),
+            body_b: sys.bodies[c.body_b].name.clone(),
+            work_share_above_cutoff: total.work_share_above_cutoff(),
+            mass_a_mg: wa.mass_kg * MG_PER_KG,
+            mass_b_mg: wb.mass_kg * MG_PER_KG,
+            mass_rate_mg_per_h: (wa.mass_kg + wb.mass_kg) * MG_PER_KG * per_h,
+            mass_rate_a_mg_per_h: wa.mass_kg * MG_PER_KG * per_h,
+            mass_rate_b_mg_per_h: wb.mass_kg * MG_PER_KG * per_h,
+            mean_normal_force_n: normal_int[ci] / window,
+            mean_friction_power_w: power_int[ci] / window,
+            peak_normal_force_n: peak[ci],
+            wear: total,
+        });
+    }
+    let bodies = sys
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| BodyReport {
+            name: b.name.clone(),
+            mass_mg: body_mass[i] * MG_PER_KG,
+            mass_rate_mg_per_h: body_mass[i] * MG_PER_KG * S_PER_H / window,
+        })
+        .collect();
+    let mut response_acceleration = Vec::with_capacity(resp_vel.len());
+    let mut base_acceleration = Vec::with_capacity(resp_vel.len());
+    for w in resp_vel.windows(2) {
+        let dt = w[1].0 - w[0].0;
+        response_acceleration.push([
+            (w[1].1[0] - w[0].1[0]) / dt,
+            (w[1].1[1] - w[0].1[1]) / dt,
+            (w[1].1[2] - w[0].1[2]) / dt,
+        ]);
+        let tm = 0.5 * (w[0].0 + w[1].0);
+        let a = base_acceleration_at(sys, tm);
+        base_acceleration.push(a);
+    }
+    Ok(RunReport {
+        mean_normal_force_n: normal_int.iter().sum::<f64>() / window,
+        mean_friction_power_w: power_int.iter().sum::<f64>() / window,
+        contacts,
+        bodies,
+        window_s: window,
+        integrator: stats.integrator,
+        wall_s: stats.wall_s,
+        tracks: tracks_out,
+        response_acceleration,
+        response_rate_hz: options.response_rate_hz,
+        base_acceleration,
+        wear_history,
+    })
+}
+
+fn base_acceleration_at(sys: &MultibodySystem, t: f64) -> [f64; 3] {
+    for b in &sys.bodies {
+        if let BodyKind::Kinematic(m) = &b.kind {
+            let a = m.acceleration(t);
+            if a.norm() > 0.0 {
+                return [a.x, a.y, a.z];
+            }
+        }
+    }
+    [0.0; 3]
+}
+
+fn record_tracks(v: &StepView, out: &mut Vec<TrackSample>) {
+    let sys = v.system;
+    let mut ws = sys.workspace();
+    sys.frames(v.t, v.state, &mut ws);
+    for tr in v.tracks {
+        out.push(track_sample(v.t, tr, sys, &ws.frames));
+    }
+}
+
+fn track_sample(
+    t: f64,
+    tr: &TrackState,
+    sys: &MultibodySystem,
+    frames: &[crate::physics::body::BodyFrame],
+) -> TrackSample {
+    let c = &sys.contacts[tr.contact as usize];
+    let pa = frames[c.body_a].to_local(&tr.point);
+    let pb = frames[c.body_b].to_local(&tr.point);
+    TrackSample {
+        time_s: t,
+        contact: tr.contact,
+        track: tr.track,
+        normal_force_n: tr.normal_force,
+        slip_velocity_m_s: [tr.slip_velocity.x, tr.slip_velocity.y, tr.slip_velocity.z],
+        slip_speed_m_s: tr.slip_velocity.norm(),
+        penetration_m: tr.penetration,
+        penetration_rate_m_s: tr.penetration_rate,
+        area_m2: tr.area,
+        pressure_pa: tr.pressure(),
+        point_in_a_m: [pa.x, pa.y, pa.z],
+        point_in_b_m: [pb.x, pb.y, pb.z],
+    }
+}

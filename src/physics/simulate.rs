@@ -1,0 +1,245 @@
+//! The run loop: advances a system with an integrator, hands every accepted step to an
+//! observer, reports progress, honours cancellation and turns any breakdown into a
+//! [`SimError::Diverged`] diagnostic naming time, body, contact and energy.
+
+use super::body::BodyKind;
+use super::contact::TrackState;
+use super::integrator::{Integrator, IntegratorError, IntegratorSettings, IntegratorStats};
+use super::system::{MultibodySystem, Workspace};
+use crate::pipeline::{Progress, RunControl};
+use std::time::{Duration, Instant};
+
+/// Limits beyond which a run is declared diverged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DivergenceLimits {
+    /// Largest admissible penetration of any track, m (rigid-body contact assumes small
+    /// penetrations; default 2 mm).
+    pub max_penetration_m: f64,
+    /// Largest admissible speed of any dynamic body relative to the world, m/s (default 100).
+    pub max_speed_m_s: f64,
+}
+
+impl Default for DivergenceLimits {
+    fn default() -> Self {
+        Self {
+            max_penetration_m: 2e-3,
+            max_speed_m_s: 100.0,
+        }
+    }
+}
+
+/// What an observer sees after each accepted step.
+pub struct StepView<'a> {
+    /// Start of the step, s.
+    pub t_prev: f64,
+    /// End of the step, s.
+    pub t: f64,
+    /// State at `t`.
+    pub state: &'a [f64],
+    /// Active contact tracks at `t`.
+    pub tracks: &'a [TrackState],
+    /// The system.
+    pub system: &'a MultibodySystem,
+}
+
+/// Why a run stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// Numerical or physical breakdown.
+    #[error("diverged at t = {time_s:.6} s: {reason} (body `{body}`, contact `{contact}`, mechanical energy {energy_j:.4e} J)")]
+    Diverged {
+        /// Simulated time, s.
+        time_s: f64,
+        /// Body most involved.
+        body: String,
+        /// Contact most involved ("none" if no contact was active).
+        contact: String,
+        /// Mechanical energy of the last good state, J.
+        energy_j: f64,
+        /// What happened.
+        reason: String,
+    },
+    /// Stopped through the run control.
+    #[error("cancelled at t = {time_s:.6} s")]
+    Cancelled {
+        /// Simulated time reached, s.
+        time_s: f64,
+    },
+}
+
+/// Summary of a finished run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunStats {
+    /// Integrator counters.
+    pub integrator: IntegratorStats,
+    /// Wall-clock time spent, s.
+    pub wall_s: f64,
+}
+
+/// Integrates `system` from `t0` to `t_end`, updating `y` in place.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    system: &MultibodySystem,
+    y: &mut [f64],
+    t0: f64,
+    t_end: f64,
+    settings: IntegratorSettings,
+    limits: DivergenceLimits,
+    control: &RunControl,
+    observer: &mut dyn FnMut(&StepView),
+) -> Result<RunStats, SimError> {
+    let start = Instant::now();
+    let mut integ = Integrator::new(system, settings);
+    let mut ws = system.workspace();
+    let mut tracks: Vec<TrackState> = Vec::with_capacity(16);
+    let mut last_good = y.to_vec();
+    let mut t = t0;
+    let mut last_progress = Instant::now();
+    collect_tracks(system, t, y, &mut ws, &mut tracks);
+    observer(&StepView {
+        t_prev: t,
+        t,
+        state: y,
+        tracks: &tracks,
+        system,
+    });
+    while t < t_end {
+        if control.is_cancelled() {
+            return Err(SimError::Cancelled { time_s: t });
+        }
+        let t_prev = t;
+        match integ.advance(system, &mut ws, t, y, t_end) {
+            Ok(t_new) => t = t_new,
+            Err(e) => {
+                y.copy_from_slice(&last_good);
+                return Err(diagnose(system, t, y, &mut ws, &e.to_string(), Some(&e)));
+            }
+        }
+        collect_tracks(system, t, y, &mut ws, &mut tracks);
+        if let Some(tr) = tracks
+            .iter()
+            .find(|tr| tr.penetration > limits.max_penetration_m)
+        {
+            let c = &system.contacts[tr.contact as usize];
+            let reason = format!(
+                "penetration {:.4} mm exceeds the bound {:.4} mm",
+                tr.penetration * 1e3,
+                limits.max_penetration_m * 1e3
+            );
+            let energy = system.energy(t_prev, &last_good, &mut ws).total();
+            return Err(SimError::Diverged {
+                time_s: t,
+                body: system.bodies[c.body_a].name.clone(),
+                contact: c.name.clone(),
+                energy_j: energy,
+                reason,
+            });
+        }
+        system.frames(t, y, &mut ws);
+        for (i, b) in system.bodies.iter().enumerate() {
+            if matches!(b.kind, BodyKind::Dynamic { .. })
+                && ws.frames[i].velocity.norm() > limits.max_speed_m_s
+            {
+                let reason = format!(
+                    "body speed {:.3e} m/s exceeds the bound {} m/s",
+                    ws.frames[i].velocity.norm(),
+                    limits.max_speed_m_s
+                );
+                let mut d = diagnose(system, t, y, &mut ws, &reason, None);
+                if let SimError::Diverged { body, .. } = &mut d {
+                    *body = b.name.clone();
+                }
+                return Err(d);
+            }
+        }
+        observer(&StepView {
+            t_prev,
+            t,
+            state: y,
+            tracks: &tracks,
+            system,
+        });
+        last_good.copy_from_slice(y);
+        if last_progress.elapsed() > Duration::from_millis(200) {
+            last_progress = Instant::now();
+            (control.progress)(Progress {
+                simulated_time_s: t,
+                end_time_s: t_end,
+                fraction: ((t - t0) / (t_end - t0)).clamp(0.0, 1.0),
+            });
+        }
+    }
+    (control.progress)(Progress {
+        simulated_time_s: t,
+        end_time_s: t_end,
+        fraction: 1.0,
+    });
+    Ok(RunStats {
+        integrator: integ.stats,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn collect_tracks(
+    system: &MultibodySystem,
+    t: f64,
+    y: &[f64],
+    ws: &mut Workspace,
+    out: &mut Vec<TrackState>,
+) {
+    out.clear();
+    system.tracks(t, y, ws, &mut |tr| out.push(*tr));
+}
+
+/// Builds a divergence diagnostic from the last good state: the contact carrying the largest
+/// normal force (if any) and the body with the largest kinetic energy.
+fn diagnose(
+    system: &MultibodySystem,
+    t: f64,
+    y: &[f64],
+    ws: &mut Workspace,
+    reason: &str,
+    _err: Option<&IntegratorError>,
+) -> SimError {
+    let mut tracks = Vec::new();
+    collect_tracks(system, t, y, ws, &mut tracks);
+    let worst = tracks
+        .iter()
+        .max_by(|a, b| a.normal_force.total_cmp(&b.normal_force));
+    let (contact, contact_body) = match worst {
+        Some(tr) => {
+            let c = &system.contacts[tr.contact as usize];
+            (
+                format!(
+                    "{} (track {}, N = {:.4e} N, w = {:.4e} m)",
+                    c.name, tr.track, tr.normal_force, tr.penetration
+                ),
+                Some(system.bodies[c.body_a].name.clone()),
+            )
+        }
+        None => ("none".to_string(), None),
+    };
+    let energy = system.energy(t, y, ws);
+    system.frames(t, y, ws);
+    let body = contact_body.unwrap_or_else(|| {
+        system
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| matches!(b.kind, BodyKind::Dynamic { .. }))
+            .max_by(|(i, a), (j, b)| {
+                let ea = a.mass.mass * ws.frames[*i].velocity.norm_squared();
+                let eb = b.mass.mass * ws.frames[*j].velocity.norm_squared();
+                ea.total_cmp(&eb)
+            })
+            .map(|(_, b)| b.name.clone())
+            .unwrap_or_else(|| "none".to_string())
+    });
+    SimError::Diverged {
+        time_s: t,
+        body,
+        contact,
+        energy_j: energy.total(),
+        reason: reason.to_string(),
+    }
+}
