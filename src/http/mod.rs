@@ -1,1 +1,170 @@
-//! http
+//! The HTTP API (axum): `/v1/jobs`, `/v1/rails`, `/v1/tokens`, health, metrics, OpenAPI,
+//! dashboard. Each module exposes its own `router()`; shared state is [`AppState`].
+
+pub mod auth;
+pub mod jobs;
+pub mod openapi;
+pub mod ops;
+pub mod pagination;
+pub mod problem;
+pub mod rails;
+pub mod tokens;
+
+use crate::config::{Role, ServiceConfig};
+use crate::jobs::{CaseRunner, CurveDefaults, Jobs, WorkerSettings};
+use crate::store::{self, Store, StoreError};
+use axum::extract::DefaultBodyLimit;
+use axum::http::StatusCode;
+use axum::{middleware, Router};
+use problem::Problem;
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::ops::Deref;
+use std::sync::Arc;
+use std::time::Duration;
+use tower_http::limit::RequestBodyLimitLayer;
+use tower_http::trace::TraceLayer;
+
+/// What every handler shares.
+pub struct AppContext {
+    pub jobs: Arc<Jobs>,
+    pub store: Arc<dyn Store>,
+    pub config: ServiceConfig,
+    /// SHA-256 of each configured token -> (name, role).
+    pub config_tokens: HashMap<String, (String, Role)>,
+}
+
+/// Cheap-to-clone handle on the [`AppContext`].
+#[derive(Clone)]
+pub struct AppState(pub Arc<AppContext>);
+
+impl Deref for AppState {
+    type Target = AppContext;
+    fn deref(&self) -> &AppContext {
+        &self.0
+    }
+}
+
+/// The complete router with body limits, problem+json fallbacks and request tracing.
+pub fn app(state: AppState) -> Router {
+    let limit = state.config.body_limit_bytes;
+    Router::new()
+        .merge(jobs::router())
+        .merge(rails::router())
+        .merge(tokens::router())
+        .merge(ops::router())
+        .fallback(|| async { Problem::not_found("no such resource") })
+        .method_not_allowed_fallback(|| async {
+            Problem::new(
+                StatusCode::METHOD_NOT_ALLOWED,
+                "method-not-allowed",
+                "Method not allowed",
+                "this resource does not support that method",
+            )
+        })
+        .layer(DefaultBodyLimit::max(limit))
+        .layer(RequestBodyLimitLayer::new(limit))
+        .layer(middleware::map_response(problem::problem_for_bare_413))
+        .layer(TraceLayer::new_for_http())
+        .with_state(state)
+}
+
+/// Why the service could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum StartError {
+    #[error(transparent)]
+    Store(#[from] StoreError),
+    #[error("cannot listen on {addr}: {source}")]
+    Bind {
+        addr: String,
+        source: std::io::Error,
+    },
+}
+
+/// A running service (API and, unless disabled, the embedded workers).
+pub struct RunningService {
+    /// Bound address (useful with port 0).
+    pub addr: SocketAddr,
+    pub state: AppState,
+    shutdown: tokio::sync::oneshot::Sender<()>,
+    server: tokio::task::JoinHandle<std::io::Result<()>>,
+    workers: Vec<tokio::task::JoinHandle<()>>,
+}
+
+impl RunningService {
+    /// Stop accepting requests, finish in-flight ones, stop the workers. A job running here
+    /// is left to its lease: it is re-queued when the lease expires.
+    pub async fn stop(self) {
+        let _ = self.shutdown.send(());
+        let _ = self.server.await;
+        for worker in self.workers {
+            worker.abort();
+        }
+    }
+}
+
+/// Open the store, start `config.worker_count()` workers (if `workers`), bind and serve.
+pub async fn start(
+    config: ServiceConfig,
+    runner: Arc<dyn CaseRunner>,
+    workers: bool,
+) -> Result<RunningService, StartError> {
+    let store = store::open(&config.database_url).await?;
+    let settings = WorkerSettings {
+        lease: Duration::from_secs_f64(config.lease_s),
+        heartbeat: Duration::from_secs_f64(config.heartbeat_s),
+        poll: Duration::from_millis(config.poll_interval_ms.max(1)),
+        max_attempts: config.max_attempts,
+        track_block_samples: config.track_block_samples,
+    };
+    let curve_defaults = CurveDefaults {
+        vehicle_profile: config.report.vehicle_profile.clone(),
+        environment: config.report.environment.clone(),
+        wear_law: config.report.wear_law.clone(),
+    };
+    let jobs = Jobs::new(Arc::clone(&store), runner, settings, curve_defaults);
+    let config_tokens = config
+        .tokens
+        .iter()
+        .map(|t| (auth::token_sha256(&t.token), (t.name.clone(), t.role)))
+        .collect();
+    let listener = tokio::net::TcpListener::bind(&config.listen)
+        .await
+        .map_err(|source| StartError::Bind {
+            addr: config.listen.clone(),
+            source,
+        })?;
+    let addr = listener.local_addr().map_err(|source| StartError::Bind {
+        addr: config.listen.clone(),
+        source,
+    })?;
+    let worker_handles = if workers {
+        let count = config.worker_count();
+        tracing::info!(count, "starting workers");
+        jobs.spawn_workers(count, &format!("{}-{}", std::process::id(), addr.port()))
+    } else {
+        Vec::new()
+    };
+    let state = AppState(Arc::new(AppContext {
+        jobs,
+        store,
+        config,
+        config_tokens,
+    }));
+    let router = app(state.clone());
+    let (shutdown, on_shutdown) = tokio::sync::oneshot::channel::<()>();
+    let server = tokio::spawn(async move {
+        axum::serve(listener, router)
+            .with_graceful_shutdown(async move {
+                let _ = on_shutdown.await;
+            })
+            .await
+    });
+    Ok(RunningService {
+        addr,
+        state,
+        shutdown,
+        server,
+        workers: worker_handles,
+    })
+}

@@ -1,1 +1,191 @@
-//! jobs
+//! Job queue and embedded worker pool: submission with idempotency keys, claims with leases and
+//! heartbeats, fenced completion, cancellation, progress. Computations run on tokio's blocking
+//! threads through the [`CaseRunner`] interface.
+
+pub mod metrics;
+pub mod model;
+pub mod runner;
+pub mod worker;
+
+use crate::store::{clock, NewJob, Store, StoreError, Submitted};
+pub use metrics::Metrics;
+pub use model::{JobKind, JobProgress, JobRecord, JobStatus};
+pub use runner::{CaseRunner, CurvePoint, JobOutput, LibraryRunner, PenalizationData};
+use sha2::{Digest, Sha256};
+use std::collections::HashMap;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use tokio::sync::Notify;
+use uuid::Uuid;
+
+/// Version of the code that accepts and runs jobs: `CARGO_PKG_VERSION`, plus `+<git hash>` when
+/// `RAILWEAR_GIT_HASH` was set at build time (`.ci/run` and the Dockerfile set it).
+pub fn code_version() -> String {
+    let version = env!("CARGO_PKG_VERSION");
+    match option_env!("RAILWEAR_GIT_HASH") {
+        Some(hash) if !hash.is_empty() => format!("{version}+{hash}"),
+        _ => version.to_string(),
+    }
+}
+
+/// Key of a penalization curve: vehicle profile, environment and wear law.
+pub fn curve_key(vehicle_profile: &str, environment: &str, wear_law: &str) -> String {
+    format!("{vehicle_profile}/{environment}/{wear_law}")
+}
+
+/// Timing settings of the worker pool (from [`crate::config::ServiceConfig`]).
+#[derive(Debug, Clone, Copy)]
+pub struct WorkerSettings {
+    pub lease: Duration,
+    pub heartbeat: Duration,
+    pub poll: Duration,
+    pub max_attempts: u32,
+    /// Samples per stored track block.
+    pub track_block_samples: usize,
+}
+
+/// Defaults for the curve key of a sweep whose params do not name all three parts.
+#[derive(Debug, Clone)]
+pub struct CurveDefaults {
+    pub vehicle_profile: String,
+    pub environment: String,
+    pub wear_law: String,
+}
+
+/// A submission was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum SubmitError {
+    /// A parameter broke a rule (`field` is a dotted path in the request body).
+    #[error("field `{field}` {rule}")]
+    Invalid { field: String, rule: String },
+    #[error(transparent)]
+    Store(#[from] StoreError),
+}
+
+/// The job system shared by the HTTP layer and the workers.
+pub struct Jobs {
+    pub store: Arc<dyn Store>,
+    pub runner: Arc<dyn CaseRunner>,
+    pub metrics: Arc<Metrics>,
+    pub settings: WorkerSettings,
+    pub curve_defaults: CurveDefaults,
+    /// Wakes an idle worker when a job is submitted.
+    wake: Notify,
+    /// Cancel flags of attempts running in this process, so a cancel request reaches the
+    /// computation at once instead of at the next heartbeat.
+    running: Mutex<HashMap<Uuid, Arc<AtomicBool>>>,
+}
+
+impl Jobs {
+    pub fn new(
+        store: Arc<dyn Store>,
+        runner: Arc<dyn CaseRunner>,
+        settings: WorkerSettings,
+        curve_defaults: CurveDefaults,
+    ) -> Arc<Self> {
+        Arc::new(Self {
+            store,
+            runner,
+            metrics: Arc::new(Metrics::default()),
+            settings,
+            curve_defaults,
+            wake: Notify::new(),
+            running: Mutex::new(HashMap::new()),
+        })
+    }
+
+    fn running_flags(&self) -> std::sync::MutexGuard<'_, HashMap<Uuid, Arc<AtomicBool>>> {
+        match self.running.lock() {
+            Ok(g) => g,
+            Err(poisoned) => poisoned.into_inner(),
+        }
+    }
+
+    /// Queue a job. The same `idempotency_key` with the same kind and params returns the
+    /// earlier job; with different ones it is a [`Submitted::KeyConflict`].
+    pub async fn submit(
+        &self,
+        kind: JobKind,
+        params: serde_json::Value,
+        submitted_by: &str,
+        idempotency_key: Option<String>,
+    ) -> Result<Submitted, SubmitError> {
+        if !params.is_object() {
+            return Err(SubmitError::Invalid {
+                field: "params".into(),
+                rule: "must be a JSON object".into(),
+            });
+        }
+        let seed = match params.get("seed") {
+            None => u64::from_le_bytes(Uuid::new_v4().as_bytes()[..8].try_into().unwrap_or([0; 8])),
+            Some(value) => value.as_u64().ok_or_else(|| SubmitError::Invalid {
+                field: "params.seed".into(),
+                rule: "must be an integer in [0, 2^64)".into(),
+            })?,
+        };
+        self.runner.validate(&kind, &params).map_err(|e| match e {
+            crate::pipeline::RunError::InvalidConfig { field, rule } => SubmitError::Invalid {
+                field: format!("params.{field}"),
+                rule,
+            },
+            other => SubmitError::Invalid {
+                field: "params".into(),
+                rule: other.to_string(),
+            },
+        })?;
+        let curve_key = (kind == JobKind::Sweep).then(|| {
+            let part = |name: &str, default: &str| {
+                params
+                    .get(name)
+                    .and_then(|v| v.as_str())
+                    .unwrap_or(default)
+                    .to_string()
+            };
+            curve_key(
+                &part("vehicle_profile", &self.curve_defaults.vehicle_profile),
+                &part("environment", &self.curve_defaults.environment),
+                &part("wear_law", &self.curve_defaults.wear_law),
+            )
+        });
+        let idempotency = idempotency_key.map(|key| {
+            // serde_json maps are sorted, so this text is canonical for equal bodies.
+            let canonical = serde_json::json!({ "kind": kind, "params": params }).to_string();
+            let sha = Sha256::digest(canonical.as_bytes());
+            (key, hex(&sha))
+        });
+        let submitted = self
+            .store
+            .submit_job(NewJob {
+                id: Uuid::new_v4(),
+                kind,
+                params,
+                seed,
+                code_version: code_version(),
+                submitted_by: submitted_by.to_string(),
+                idempotency,
+                curve_key,
+                created_ms: clock::now_ms(),
+            })
+            .await?;
+        if matches!(submitted, Submitted::Created(_)) {
+            self.wake.notify_one();
+        }
+        Ok(submitted)
+    }
+
+    /// Request cancellation: a queued job is cancelled at once; a running one here is told
+    /// immediately (its computation stops within a second), elsewhere at its next heartbeat.
+    pub async fn cancel(&self, id: Uuid) -> Result<Option<JobRecord>, StoreError> {
+        let record = self.store.request_cancel(id, clock::now_ms()).await?;
+        if let Some(flag) = self.running_flags().get(&id) {
+            flag.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        Ok(record)
+    }
+}
+
+/// Lower-case hex of bytes.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}

@@ -1,1 +1,263 @@
-//! store
+//! Persistence behind one interface, [`Store`], so the SQLite implementation (embedded default)
+//! and a PostgreSQL one (issue 6) serve the same code paths. Every method that writes more than
+//! one row does it in one transaction; every write by a worker is fenced by the job's attempt.
+
+pub mod clock;
+pub mod sqlite;
+pub mod tracks;
+
+use crate::config::Role;
+use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
+use crate::physics::track::TrackSample;
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::Arc;
+pub use tracks::TrackBlock;
+use uuid::Uuid;
+
+/// Boxed future returned by [`Store`] methods (keeps the trait object-safe).
+pub type StoreFuture<'a, T> = Pin<Box<dyn Future<Output = Result<T, StoreError>> + Send + 'a>>;
+
+/// Storage failure. The cause is kept for logs; clients see a generic 500/503.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    /// The database reported an error.
+    #[error("database error: {0}")]
+    Database(#[from] sqlx::Error),
+    /// Migrations could not be applied.
+    #[error("migration error: {0}")]
+    Migrate(#[from] sqlx::migrate::MigrateError),
+    /// A stored value could not be read back (corrupt row, unknown enum name).
+    #[error("corrupt stored data: {0}")]
+    Corrupt(String),
+    /// The database URL names an engine this build does not support.
+    #[error("unsupported database URL `{0}` (expected sqlite://...)")]
+    UnsupportedUrl(String),
+}
+
+/// A job to insert.
+#[derive(Debug, Clone)]
+pub struct NewJob {
+    pub id: Uuid,
+    pub kind: JobKind,
+    pub params: serde_json::Value,
+    pub seed: u64,
+    pub code_version: String,
+    pub submitted_by: String,
+    /// Idempotency-Key header and the SHA-256 of the canonical request body.
+    pub idempotency: Option<(String, String)>,
+    pub curve_key: Option<String>,
+    pub created_ms: i64,
+}
+
+/// Result of a submission.
+#[derive(Debug, Clone)]
+pub enum Submitted {
+    /// A new job was queued.
+    Created(JobRecord),
+    /// Same Idempotency-Key and same body as an earlier submission: that job.
+    Replayed(JobRecord),
+    /// Same Idempotency-Key with a different body: refused; the earlier job's id.
+    KeyConflict(Uuid),
+}
+
+/// What the heartbeat learned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Heartbeat {
+    /// False when this attempt no longer owns the job (lease lost, newer attempt, terminal).
+    pub owned: bool,
+    /// True when someone asked to cancel the job.
+    pub cancel_requested: bool,
+}
+
+/// How an attempt ended.
+#[derive(Debug, Clone)]
+pub enum Finish {
+    /// Summary, contact tracks (encoded blocks), SVG plots and, for sweeps, the curve.
+    Succeeded {
+        summary: serde_json::Value,
+        blocks: Vec<TrackBlock>,
+        plots: Vec<(String, String)>,
+        curve: Option<CurveRecord>,
+    },
+    Failed(String),
+    Cancelled,
+}
+
+/// One page of a list, newest first.
+#[derive(Debug, Clone)]
+pub struct Page<T> {
+    pub items: Vec<T>,
+    /// Pass as `cursor` to get the next page; `None` on the last page.
+    pub next_cursor: Option<String>,
+}
+
+/// Page request: at most `limit` items after `cursor`.
+#[derive(Debug, Clone, Copy)]
+pub struct PageRequest {
+    pub limit: i64,
+    /// Opaque cursor from the previous page: the last seen sequence number.
+    pub after_seq: Option<i64>,
+}
+
+/// A registered rail.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RailRecord {
+    pub serial: String,
+    pub seq: i64,
+    pub created_ms: i64,
+    pub measurements: i64,
+}
+
+/// A rail measurement to insert (the rail is registered on first measurement).
+#[derive(Debug, Clone)]
+pub struct NewMeasurement {
+    pub id: Uuid,
+    pub serial: String,
+    /// Dimensions as posted, mm (JSON object).
+    pub dimensions_mm: serde_json::Value,
+    pub measured_by: String,
+    pub measured_at: String,
+    pub location: String,
+    /// Rattle space k_rs computed from the dimensions (eq. 6.1-6.3), dimensionless.
+    pub rattle_space: f64,
+    pub recorded_by: String,
+    pub recorded_ms: i64,
+}
+
+/// A stored rail measurement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementRecord {
+    pub id: Uuid,
+    pub seq: i64,
+    pub serial: String,
+    pub dimensions_mm: serde_json::Value,
+    pub measured_by: String,
+    pub measured_at: String,
+    pub location: String,
+    pub rattle_space: f64,
+    pub recorded_by: String,
+    pub recorded_ms: i64,
+}
+
+/// A penalization curve produced by a sweep job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveRecord {
+    /// `vehicle_profile/environment/wear_law`.
+    pub key: String,
+    pub job_id: Uuid,
+    /// Curve data (JSON, see `jobs::runner::PenalizationData`).
+    pub curve: serde_json::Value,
+    pub created_ms: i64,
+}
+
+/// An API token as stored (the secret itself is only kept as its SHA-256).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TokenRecord {
+    pub id: Uuid,
+    pub name: String,
+    pub role: Role,
+    pub created_ms: i64,
+    pub revoked: bool,
+}
+
+/// The persistence interface. SQLite: [`sqlite::SqliteStore`].
+pub trait Store: Send + Sync {
+    /// Apply pending migrations.
+    fn migrate(&self) -> StoreFuture<'_, ()>;
+    /// Cheap round trip (readiness).
+    fn ping(&self) -> StoreFuture<'_, ()>;
+
+    /// Insert a job, honouring its idempotency key (one transaction).
+    fn submit_job(&self, job: NewJob) -> StoreFuture<'_, Submitted>;
+    fn get_job(&self, id: Uuid) -> StoreFuture<'_, Option<JobRecord>>;
+    fn list_jobs(
+        &self,
+        page: PageRequest,
+        status: Option<JobStatus>,
+    ) -> StoreFuture<'_, Page<JobRecord>>;
+    /// Atomically take the oldest queued job: status running, attempt + 1, lease until
+    /// `now_ms + lease_ms`. `None` when the queue is empty.
+    fn claim_job(
+        &self,
+        worker: &str,
+        now_ms: i64,
+        lease_ms: i64,
+    ) -> StoreFuture<'_, Option<JobRecord>>;
+    /// Renew the lease of attempt `attempt` and write its progress (fenced).
+    fn heartbeat(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        progress: Option<JobProgress>,
+        now_ms: i64,
+        lease_ms: i64,
+    ) -> StoreFuture<'_, Heartbeat>;
+    /// End attempt `attempt`; returns false (and writes nothing) if that attempt is stale.
+    fn finish_job(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        finish: Finish,
+        now_ms: i64,
+    ) -> StoreFuture<'_, bool>;
+    /// Ask a job to stop: a queued job is cancelled at once, a running one is flagged for its
+    /// worker. Terminal jobs are unchanged. `None` if no such job.
+    fn request_cancel(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, Option<JobRecord>>;
+    /// Re-queue running jobs whose lease expired (or fail them after `max_attempts`, or cancel
+    /// them if cancellation was requested). Returns how many jobs changed.
+    fn requeue_expired(&self, now_ms: i64, max_attempts: i64) -> StoreFuture<'_, u64>;
+    /// Number of jobs per status.
+    fn job_counts(&self) -> StoreFuture<'_, Vec<(JobStatus, i64)>>;
+    /// Encoded contact-track blocks of a job, in order.
+    fn track_blocks(&self, id: Uuid) -> StoreFuture<'_, Vec<TrackBlock>>;
+    /// Names of a job's SVG plots.
+    fn plot_names(&self, id: Uuid) -> StoreFuture<'_, Vec<String>>;
+    fn plot(&self, id: Uuid, name: &str) -> StoreFuture<'_, Option<String>>;
+    /// The newest queued or running sweep for a curve key.
+    fn active_sweep(&self, curve_key: &str) -> StoreFuture<'_, Option<JobRecord>>;
+
+    /// Register the rail if new and insert the measurement (one transaction).
+    fn add_measurement(&self, m: NewMeasurement) -> StoreFuture<'_, MeasurementRecord>;
+    fn get_rail(&self, serial: &str) -> StoreFuture<'_, Option<RailRecord>>;
+    fn list_rails(&self, page: PageRequest) -> StoreFuture<'_, Page<RailRecord>>;
+    fn measurements(
+        &self,
+        serial: &str,
+        page: PageRequest,
+    ) -> StoreFuture<'_, Page<MeasurementRecord>>;
+    fn latest_measurement(&self, serial: &str) -> StoreFuture<'_, Option<MeasurementRecord>>;
+    fn get_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>>;
+
+    fn create_token(
+        &self,
+        name: &str,
+        role: Role,
+        token_sha256: &str,
+        now_ms: i64,
+    ) -> StoreFuture<'_, TokenRecord>;
+    /// The unrevoked token with this hash.
+    fn find_token(&self, token_sha256: &str) -> StoreFuture<'_, Option<TokenRecord>>;
+    fn list_tokens(&self) -> StoreFuture<'_, Vec<TokenRecord>>;
+    fn revoke_token(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, bool>;
+}
+
+/// Open the store named by `database_url` and apply migrations.
+pub async fn open(database_url: &str) -> Result<Arc<dyn Store>, StoreError> {
+    if database_url.starts_with("sqlite:") {
+        let store = sqlite::SqliteStore::connect(database_url).await?;
+        store.migrate().await?;
+        Ok(Arc::new(store))
+    } else {
+        Err(StoreError::UnsupportedUrl(database_url.to_string()))
+    }
+}
+
+/// Decode all of a job's track samples (used by exports and tests).
+pub fn decode_tracks(blocks: &[TrackBlock]) -> Result<Vec<TrackSample>, tracks::BlockError> {
+    let mut out = Vec::new();
+    for block in blocks {
+        out.extend(tracks::decode_block(block)?);
+    }
+    Ok(out)
+}

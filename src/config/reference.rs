@@ -1,0 +1,75 @@
+//! Reference model configurations shipped in `configs/` (rattle-box cases, launcher, fixture),
+//! looked up by name so a job can say `"config": "rattle-box-c"`.
+
+use std::path::{Path, PathBuf};
+
+/// Why a reference config name could not be resolved.
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    /// Names are file stems: letters, digits, `-` and `_` only (no paths).
+    #[error("config name `{0}` must use only letters, digits, '-' and '_'")]
+    BadName(String),
+    /// No `<name>.toml` in the configs directory.
+    #[error("no reference config named `{0}`")]
+    Unknown(String),
+}
+
+/// Path of the reference config `name` (`<dir>/<name>.toml`), refusing anything that is not a
+/// plain file stem so a request cannot read outside the directory.
+pub fn reference_config_path(dir: &Path, name: &str) -> Result<PathBuf, ReferenceError> {
+    let plain = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if !plain {
+        return Err(ReferenceError::BadName(name.to_string()));
+    }
+    let path = dir.join(format!("{name}.toml"));
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(ReferenceError::Unknown(name.to_string()))
+    }
+}
+
+/// Names (file stems) of the reference configs in `dir`, sorted; `service.toml` is excluded
+/// because it configures the service, not a model.
+pub fn reference_config_names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|entry| {
+            let path = entry.path();
+            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+                return None;
+            }
+            let stem = path.file_stem()?.to_str()?.to_string();
+            (stem != "service").then_some(stem)
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn path_traversal_is_refused() {
+        let dir = Path::new(".");
+        assert!(matches!(
+            reference_config_path(dir, "../etc/passwd"),
+            Err(ReferenceError::BadName(_))
+        ));
+        assert!(matches!(
+            reference_config_path(dir, ""),
+            Err(ReferenceError::BadName(_))
+        ));
+        assert!(matches!(
+            reference_config_path(dir, "no-such-config"),
+            Err(ReferenceError::Unknown(_))
+        ));
+    }
+}

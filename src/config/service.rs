@@ -1,0 +1,345 @@
+//! Service settings, layered: built-in defaults, then `configs/service.toml` (every key is
+//! documented there), then `RAILWEAR_*` environment variables (and `DATABASE_URL`).
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Access role carried by an API token.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    /// Maintenance planner: registers rails, posts measurements, reads reports.
+    Planner,
+    /// Engineer: submits, watches, cancels simulation/sweep/calibration jobs.
+    Engineer,
+    /// Administrator: manages tokens; may also do what planners and engineers do.
+    Admin,
+}
+
+impl Role {
+    /// Lower-case name as used in config, CLI and API.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Role::Planner => "planner",
+            Role::Engineer => "engineer",
+            Role::Admin => "admin",
+        }
+    }
+
+    /// Parse a lower-case role name.
+    pub fn parse(text: &str) -> Option<Role> {
+        match text {
+            "planner" => Some(Role::Planner),
+            "engineer" => Some(Role::Engineer),
+            "admin" => Some(Role::Admin),
+            _ => None,
+        }
+    }
+}
+
+/// A token given in the configuration (in addition to tokens created with `railwear token create`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TokenSetting {
+    /// Who holds the token (shown in logs and job records).
+    pub name: String,
+    /// What the token may do.
+    pub role: Role,
+    /// The secret itself (sent as `Authorization: Bearer <token>`).
+    pub token: String,
+}
+
+/// Defaults a rail report uses when the request does not name them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReportSettings {
+    /// Vehicle profile whose penalization curve applies (e.g. `ah64`).
+    pub vehicle_profile: String,
+    /// Environment label of the curve (e.g. `clean`, `sand`).
+    pub environment: String,
+    /// Wear law of the curve (`modified-archard` eq. 3.10-3.15, or `archard` eq. 3.8).
+    pub wear_law: String,
+    /// Design service life T_SL,design that K_SL scales (eq. 6.4), hours.
+    pub design_life_h: f64,
+}
+
+impl Default for ReportSettings {
+    fn default() -> Self {
+        Self {
+            vehicle_profile: "ah64".into(),
+            environment: "clean".into(),
+            wear_law: "modified-archard".into(),
+            design_life_h: 1000.0,
+        }
+    }
+}
+
+/// All service settings. See `configs/service.toml` for the meaning of each key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ServiceConfig {
+    /// Socket address to listen on; port 0 picks a free port (printed on start).
+    pub listen: String,
+    /// sqlx database URL: `sqlite://path?mode=rwc` (PostgreSQL follows, issue 6).
+    pub database_url: String,
+    /// Directory of reference model configs, looked up by name.
+    pub configs_dir: PathBuf,
+    /// Worker threads running simulations; 0 means one per CPU core.
+    pub workers: usize,
+    /// A running job's lease, s: if its worker stops heartbeating this long the job is re-queued.
+    pub lease_s: f64,
+    /// Heartbeat (and progress write) interval of a running job, s. Must be well below `lease_s`.
+    pub heartbeat_s: f64,
+    /// How often an idle worker looks for queued jobs, ms (a submission also wakes it at once).
+    pub poll_interval_ms: u64,
+    /// Attempts before a job whose worker keeps dying is failed.
+    pub max_attempts: u32,
+    /// Largest accepted request body, bytes.
+    pub body_limit_bytes: usize,
+    /// Log format: `text` or `json`.
+    pub log_format: String,
+    /// Samples per stored contact-track block (each block is compressed on its own).
+    pub track_block_samples: usize,
+    /// Rail-report defaults.
+    pub report: ReportSettings,
+    /// Tokens accepted in addition to those stored in the database.
+    pub tokens: Vec<TokenSetting>,
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        Self {
+            listen: "127.0.0.1:8080".into(),
+            database_url: "sqlite://railwear.db?mode=rwc".into(),
+            configs_dir: PathBuf::from("configs"),
+            workers: 0,
+            lease_s: 15.0,
+            heartbeat_s: 1.0,
+            poll_interval_ms: 250,
+            max_attempts: 3,
+            body_limit_bytes: 8 * 1024 * 1024,
+            log_format: "text".into(),
+            track_block_samples: 16_384,
+            report: ReportSettings::default(),
+            tokens: Vec::new(),
+        }
+    }
+}
+
+/// Why the settings could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The settings file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The settings file is not valid TOML for [`ServiceConfig`].
+    #[error("{path}: {source}")]
+    Parse {
+        path: PathBuf,
+        source: Box<toml::de::Error>,
+    },
+    /// A setting (from file or environment) breaks a rule.
+    #[error("setting `{field}` {rule}")]
+    Invalid { field: String, rule: String },
+}
+
+fn invalid(field: &str, rule: &str) -> ConfigError {
+    ConfigError::Invalid {
+        field: field.to_string(),
+        rule: rule.to_string(),
+    }
+}
+
+impl ServiceConfig {
+    /// Defaults, then the file at `path` (when `required` is false a missing file is fine),
+    /// then the environment given by `env` (a lookup function, so tests need not mutate the
+    /// process environment).
+    pub fn load(
+        path: &Path,
+        required: bool,
+        env: impl Fn(&str) -> Option<String>,
+    ) -> Result<Self, ConfigError> {
+        let mut config = match std::fs::read_to_string(path) {
+            Ok(text) => toml::from_str(&text).map_err(|source| ConfigError::Parse {
+                path: path.to_path_buf(),
+                source: Box::new(source),
+            })?,
+            Err(source) if required || source.kind() != std::io::ErrorKind::NotFound => {
+                return Err(ConfigError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            }
+            Err(_) => ServiceConfig::default(),
+        };
+        config.apply_env(env)?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Override settings from environment variables (`RAILWEAR_*`, `DATABASE_URL`).
+    pub fn apply_env(&mut self, env: impl Fn(&str) -> Option<String>) -> Result<(), ConfigError> {
+        fn num<T: std::str::FromStr>(field: &str, text: &str) -> Result<T, ConfigError> {
+            text.trim()
+                .parse()
+                .map_err(|_| invalid(field, "must be a number"))
+        }
+        if let Some(v) = env("RAILWEAR_LISTEN") {
+            self.listen = v;
+        }
+        if let Some(v) = env("DATABASE_URL") {
+            self.database_url = v;
+        }
+        if let Some(v) = env("RAILWEAR_DATABASE_URL") {
+            self.database_url = v;
+        }
+        if let Some(v) = env("RAILWEAR_CONFIGS_DIR") {
+            self.configs_dir = PathBuf::from(v);
+        }
+        if let Some(v) = env("RAILWEAR_WORKERS") {
+            self.workers = num("RAILWEAR_WORKERS", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_LEASE_S") {
+            self.lease_s = num("RAILWEAR_LEASE_S", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_HEARTBEAT_S") {
+            self.heartbeat_s = num("RAILWEAR_HEARTBEAT_S", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_POLL_INTERVAL_MS") {
+            self.poll_interval_ms = num("RAILWEAR_POLL_INTERVAL_MS", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_MAX_ATTEMPTS") {
+            self.max_attempts = num("RAILWEAR_MAX_ATTEMPTS", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_BODY_LIMIT_BYTES") {
+            self.body_limit_bytes = num("RAILWEAR_BODY_LIMIT_BYTES", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_LOG_FORMAT") {
+            self.log_format = v;
+        }
+        if let Some(v) = env("RAILWEAR_TOKENS") {
+            // `name:role:token` entries separated by `,`.
+            for entry in v.split(',').map(str::trim).filter(|e| !e.is_empty()) {
+                let mut parts = entry.splitn(3, ':');
+                let (Some(name), Some(role), Some(token)) =
+                    (parts.next(), parts.next(), parts.next())
+                else {
+                    return Err(invalid(
+                        "RAILWEAR_TOKENS",
+                        "entries must be name:role:token",
+                    ));
+                };
+                let role = Role::parse(role).ok_or_else(|| {
+                    invalid("RAILWEAR_TOKENS", "role must be planner, engineer or admin")
+                })?;
+                self.tokens.push(TokenSetting {
+                    name: name.to_string(),
+                    role,
+                    token: token.to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Check the rules every setting must follow.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if !(self.lease_s.is_finite() && self.lease_s > 0.0) {
+            return Err(invalid("lease_s", "must be a positive number of seconds"));
+        }
+        if !(self.heartbeat_s.is_finite() && self.heartbeat_s > 0.0) {
+            return Err(invalid(
+                "heartbeat_s",
+                "must be a positive number of seconds",
+            ));
+        }
+        if self.heartbeat_s * 2.0 > self.lease_s {
+            return Err(invalid("heartbeat_s", "must be at most half of lease_s"));
+        }
+        if self.max_attempts == 0 {
+            return Err(invalid("max_attempts", "must be at least 1"));
+        }
+        if self.body_limit_bytes < 1024 {
+            return Err(invalid("body_limit_bytes", "must be at least 1024"));
+        }
+        if self.track_block_samples == 0 {
+            return Err(invalid("track_block_samples", "must be at least 1"));
+        }
+        if self.log_format != "text" && self.log_format != "json" {
+            return Err(invalid("log_format", "must be `text` or `json`"));
+        }
+        if !(self.report.design_life_h.is_finite() && self.report.design_life_h > 0.0) {
+            return Err(invalid(
+                "report.design_life_h",
+                "must be a positive number of hours",
+            ));
+        }
+        for (i, token) in self.tokens.iter().enumerate() {
+            if token.token.len() < 16 {
+                return Err(invalid(
+                    &format!("tokens[{i}].token"),
+                    "must be at least 16 characters",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of worker threads to run (`workers`, or one per core when 0).
+    pub fn worker_count(&self) -> usize {
+        if self.workers > 0 {
+            self.workers
+        } else {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn environment_overrides_file() {
+        let dir = std::env::temp_dir().join(format!("railwear-cfg-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("service.toml");
+        std::fs::write(&path, "workers = 3\nlease_s = 20.0\n").unwrap();
+        let env = |key: &str| match key {
+            "RAILWEAR_WORKERS" => Some("5".to_string()),
+            "RAILWEAR_TOKENS" => Some("ops:planner:0123456789abcdef0123".to_string()),
+            _ => None,
+        };
+        let config = ServiceConfig::load(&path, true, env).unwrap();
+        assert_eq!(config.workers, 5);
+        assert_eq!(config.lease_s, 20.0);
+        assert_eq!(config.tokens.len(), 1);
+        assert_eq!(config.tokens[0].role, Role::Planner);
+    }
+
+    #[test]
+    fn bad_settings_name_the_field() {
+        let env = |key: &str| (key == "RAILWEAR_HEARTBEAT_S").then(|| "30".to_string());
+        let err =
+            ServiceConfig::load(Path::new("/nonexistent/service.toml"), false, env).unwrap_err();
+        assert!(matches!(err, ConfigError::Invalid { ref field, .. } if field == "heartbeat_s"));
+        let env = |key: &str| (key == "RAILWEAR_WORKERS").then(|| "many".to_string());
+        let err =
+            ServiceConfig::load(Path::new("/nonexistent/service.toml"), false, env).unwrap_err();
+        assert!(
+            matches!(err, ConfigError::Invalid { ref field, .. } if field == "RAILWEAR_WORKERS")
+        );
+    }
+
+    #[test]
+    fn shipped_service_toml_parses() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/service.toml");
+        let config = ServiceConfig::load(&path, true, |_| None).unwrap();
+        assert_eq!(config.database_url, "sqlite://railwear.db?mode=rwc");
+    }
+}

@@ -1,0 +1,487 @@
+//! `/v1/jobs`: submit (with Idempotency-Key), list, inspect, cancel; results, tracks, plots.
+
+use super::auth::{Area, Caller};
+use super::pagination::{PageQuery, PageView};
+use super::problem::{ApiJson, Problem};
+use super::AppState;
+use crate::jobs::{JobKind, JobProgress, JobRecord, JobStatus, SubmitError};
+use crate::physics::track::TrackSample;
+use crate::store::{clock, tracks, Submitted};
+use axum::extract::{Path, Query, State};
+use axum::http::{header, HeaderMap, HeaderValue, Method, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::{Deserialize, Serialize};
+use utoipa::{IntoParams, ToSchema};
+use uuid::Uuid;
+
+/// Routes under `/v1/jobs`.
+pub fn router() -> Router<AppState> {
+    Router::new()
+        .route("/v1/jobs", post(submit_job).get(list_jobs))
+        .route("/v1/jobs/{id}", get(get_job))
+        .route("/v1/jobs/{id}/cancel", post(cancel_job))
+        .route("/v1/jobs/{id}/result", get(get_result))
+        .route("/v1/jobs/{id}/tracks", get(get_tracks))
+        .route("/v1/jobs/{id}/plots/{name}", get(get_plot))
+}
+
+/// A job submission.
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct JobRequest {
+    /// What to run.
+    pub kind: JobKind,
+    /// Kind-specific parameters (JSON object). `simulate`: `{"config": "<reference name>" or
+    /// {inline config}, "overrides": {...}, "seed": u64}`. `sweep` also takes
+    /// `vehicle_profile`, `environment`, `wear_law` (the penalization-curve key; defaults from
+    /// the service settings). `seed` is drawn at submission when absent.
+    #[schema(value_type = Object)]
+    pub params: serde_json::Value,
+}
+
+/// A job as shown by the API.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobView {
+    pub id: Uuid,
+    pub kind: JobKind,
+    pub status: JobStatus,
+    /// Parameters exactly as submitted.
+    #[schema(value_type = Object)]
+    pub params: serde_json::Value,
+    /// Seed the run uses (from `params.seed` or drawn at submission).
+    pub seed: u64,
+    /// Version of the code that accepted the job (`x.y.z` or `x.y.z+githash`).
+    pub code_version: String,
+    /// Token name of the submitter.
+    pub submitted_by: String,
+    /// Attempts started (more than 1 when a worker died and the job was re-run).
+    pub attempt: i64,
+    /// True once cancellation was requested.
+    pub cancel_requested: bool,
+    /// RFC 3339 UTC times.
+    pub created_at: String,
+    pub started_at: Option<String>,
+    pub finished_at: Option<String>,
+    /// Progress of the running attempt (simulated time, fraction, ETA).
+    pub progress: Option<JobProgress>,
+    /// Why the job failed (or the last lost attempt).
+    pub error: Option<String>,
+    /// Stored contact-track samples.
+    pub track_samples: i64,
+    /// Sweeps: the penalization-curve key `vehicle_profile/environment/wear_law`.
+    pub curve_key: Option<String>,
+    /// Related URLs: `self`, `result`, `tracks_csv`, `tracks_json`, `cancel`.
+    pub links: JobLinks,
+}
+
+/// URLs of a job's resources.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobLinks {
+    #[serde(rename = "self")]
+    pub self_: String,
+    pub cancel: String,
+    pub result: String,
+    pub tracks_csv: String,
+    pub tracks_json: String,
+}
+
+impl From<JobRecord> for JobView {
+    fn from(j: JobRecord) -> Self {
+        let base = format!("/v1/jobs/{}", j.id);
+        JobView {
+            id: j.id,
+            kind: j.kind,
+            status: j.status,
+            params: j.params,
+            seed: j.seed,
+            code_version: j.code_version,
+            submitted_by: j.submitted_by,
+            attempt: j.attempt,
+            cancel_requested: j.cancel_requested,
+            created_at: clock::rfc3339(j.created_ms),
+            started_at: j.started_ms.map(clock::rfc3339),
+            finished_at: j.finished_ms.map(clock::rfc3339),
+            progress: j.progress,
+            error: j.error,
+            track_samples: j.track_samples,
+            curve_key: j.curve_key,
+            links: JobLinks {
+                cancel: format!("{base}/cancel"),
+                result: format!("{base}/result"),
+                tracks_csv: format!("{base}/tracks?format=csv"),
+                tracks_json: format!("{base}/tracks?format=json"),
+                self_: base,
+            },
+        }
+    }
+}
+
+/// A finished job's results.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobResultView {
+    pub id: Uuid,
+    pub kind: JobKind,
+    pub seed: u64,
+    pub code_version: String,
+    /// Summary: wear per contact and body, pressure PDFs, spectra, settings used.
+    #[schema(value_type = Object)]
+    pub summary: serde_json::Value,
+    /// Stored contact-track samples.
+    pub track_samples: i64,
+    /// SVG plots, by name, with their URLs.
+    pub plots: Vec<PlotLink>,
+}
+
+/// A plot of a job.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct PlotLink {
+    pub name: String,
+    pub url: String,
+}
+
+/// Filter for the job list.
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct JobFilter {
+    /// Only jobs in this status.
+    pub status: Option<JobStatus>,
+}
+
+/// Track export options.
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct TrackQuery {
+    /// `csv` (default) or `json`.
+    pub format: Option<String>,
+    /// Keep every N-th sample (downsampling), N >= 1; default 1.
+    pub every: Option<u64>,
+}
+
+fn parse_id(text: &str) -> Result<Uuid, Problem> {
+    Uuid::parse_str(text).map_err(|_| Problem::bad_parameter("id", "must be a UUID"))
+}
+
+async fn load_job(state: &AppState, id: &str) -> Result<JobRecord, Problem> {
+    let id = parse_id(id)?;
+    state
+        .store
+        .get_job(id)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("no job {id}")))
+}
+
+fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, Problem> {
+    match headers.get("idempotency-key") {
+        None => Ok(None),
+        Some(value) => {
+            let key = value
+                .to_str()
+                .ok()
+                .map(str::trim)
+                .filter(|k| !k.is_empty() && k.len() <= 255)
+                .ok_or_else(|| {
+                    Problem::bad_parameter(
+                        "Idempotency-Key",
+                        "must be 1 to 255 visible ASCII characters",
+                    )
+                })?;
+            Ok(Some(key.to_string()))
+        }
+    }
+}
+
+/// Submit a job.
+///
+/// With an `Idempotency-Key` header, repeating the same request returns the job created by the
+/// first one (200, header `Idempotent-Replayed: true`); the same key with a different body is
+/// refused with 422.
+#[utoipa::path(
+    post, path = "/v1/jobs", tag = "jobs",
+    request_body = JobRequest,
+    params(("Idempotency-Key" = Option<String>, Header, description = "Makes retries safe: same key + same body = same job")),
+    responses(
+        (status = 201, description = "Job queued", body = JobView),
+        (status = 200, description = "Replay of an earlier submission with the same Idempotency-Key", body = JobView),
+        (status = 401, body = Problem, content_type = "application/problem+json"),
+        (status = 403, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Invalid field, or Idempotency-Key reused with a different body", body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn submit_job(
+    State(state): State<AppState>,
+    caller: Caller,
+    headers: HeaderMap,
+    ApiJson(request): ApiJson<JobRequest>,
+) -> Result<Response, Problem> {
+    caller.require(Area::Jobs, &Method::POST)?;
+    let key = idempotency_key(&headers)?;
+    let submitted = state
+        .jobs
+        .submit(request.kind, request.params, &caller.name, key)
+        .await
+        .map_err(|e| match e {
+            SubmitError::Invalid { field, rule } => Problem::invalid_field(field, rule),
+            SubmitError::Store(e) => Problem::from(e),
+        })?;
+    match submitted {
+        Submitted::Created(job) => {
+            let location = format!("/v1/jobs/{}", job.id);
+            let mut response = (StatusCode::CREATED, Json(JobView::from(job))).into_response();
+            if let Ok(value) = HeaderValue::from_str(&location) {
+                response.headers_mut().insert(header::LOCATION, value);
+            }
+            Ok(response)
+        }
+        Submitted::Replayed(job) => {
+            let mut response = (StatusCode::OK, Json(JobView::from(job))).into_response();
+            response
+                .headers_mut()
+                .insert("idempotent-replayed", HeaderValue::from_static("true"));
+            Ok(response)
+        }
+        Submitted::KeyConflict(existing) => {
+            let mut p = Problem::new(
+                StatusCode::UNPROCESSABLE_ENTITY,
+                "idempotency-key-reused",
+                "Idempotency-Key reused",
+                format!(
+                    "this Idempotency-Key was used for job {existing} with a different body; use a new key"
+                ),
+            );
+            p.field = Some("Idempotency-Key".into());
+            Err(p)
+        }
+    }
+}
+
+/// List jobs, newest first.
+#[utoipa::path(
+    get, path = "/v1/jobs", tag = "jobs",
+    params(PageQuery, JobFilter),
+    responses(
+        (status = 200, body = PageView<JobView>),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 401, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn list_jobs(
+    State(state): State<AppState>,
+    caller: Caller,
+    page: Query<PageQuery>,
+    filter: Result<Query<JobFilter>, axum::extract::rejection::QueryRejection>,
+) -> Result<Json<PageView<JobView>>, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    let Query(filter) = filter.map_err(|_| {
+        Problem::bad_parameter(
+            "status",
+            "must be queued, running, succeeded, failed or cancelled",
+        )
+    })?;
+    let request = page.to_request()?;
+    let page = state.store.list_jobs(request, filter.status).await?;
+    Ok(Json(PageView::from_page(page, JobView::from)))
+}
+
+/// One job with its status and progress.
+#[utoipa::path(
+    get, path = "/v1/jobs/{id}", tag = "jobs",
+    params(("id" = Uuid, Path)),
+    responses(
+        (status = 200, body = JobView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_job(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+) -> Result<Json<JobView>, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    Ok(Json(load_job(&state, &id).await?.into()))
+}
+
+/// Cancel a job: a queued job is cancelled at once, a running one stops within a second.
+/// Cancelling a finished job changes nothing.
+#[utoipa::path(
+    post, path = "/v1/jobs/{id}/cancel", tag = "jobs",
+    params(("id" = Uuid, Path)),
+    responses(
+        (status = 202, description = "Cancellation requested (or the job had already finished)", body = JobView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn cancel_job(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+) -> Result<(StatusCode, Json<JobView>), Problem> {
+    caller.require(Area::Jobs, &Method::POST)?;
+    let id = parse_id(&id)?;
+    let job = state
+        .jobs
+        .cancel(id)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("no job {id}")))?;
+    Ok((StatusCode::ACCEPTED, Json(job.into())))
+}
+
+fn require_succeeded(job: &JobRecord) -> Result<(), Problem> {
+    if job.status == JobStatus::Succeeded {
+        Ok(())
+    } else {
+        Err(Problem::conflict(
+            "job-not-succeeded",
+            "Job has no results",
+            format!(
+                "job {} is {}; results exist once it has succeeded{}",
+                job.id,
+                job.status.as_str(),
+                job.error
+                    .as_deref()
+                    .map(|e| format!(" (error: {e})"))
+                    .unwrap_or_default()
+            ),
+        ))
+    }
+}
+
+/// Results of a succeeded job: summary and plot links.
+#[utoipa::path(
+    get, path = "/v1/jobs/{id}/result", tag = "jobs",
+    params(("id" = Uuid, Path)),
+    responses(
+        (status = 200, body = JobResultView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "The job has not succeeded", body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_result(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+) -> Result<Json<JobResultView>, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    let job = load_job(&state, &id).await?;
+    require_succeeded(&job)?;
+    let names = state.store.plot_names(job.id).await?;
+    Ok(Json(JobResultView {
+        id: job.id,
+        kind: job.kind,
+        seed: job.seed,
+        code_version: job.code_version,
+        summary: job.result.unwrap_or(serde_json::Value::Null),
+        track_samples: job.track_samples,
+        plots: names
+            .into_iter()
+            .map(|name| PlotLink {
+                url: format!("/v1/jobs/{}/plots/{name}", job.id),
+                name,
+            })
+            .collect(),
+    }))
+}
+
+/// Contact tracks of a succeeded job as CSV (header row with units) or JSON (array of samples),
+/// optionally downsampled to every N-th sample.
+#[utoipa::path(
+    get, path = "/v1/jobs/{id}/tracks", tag = "jobs",
+    params(("id" = Uuid, Path), TrackQuery),
+    responses(
+        (status = 200, description = "CSV (text/csv) or JSON array of track samples", content_type = "text/csv"),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 409, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_tracks(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+    query: Result<Query<TrackQuery>, axum::extract::rejection::QueryRejection>,
+) -> Result<Response, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    let Query(query) =
+        query.map_err(|_| Problem::bad_parameter("every", "must be a positive integer"))?;
+    let every = query.every.unwrap_or(1);
+    if every == 0 {
+        return Err(Problem::bad_parameter(
+            "every",
+            "must be a positive integer",
+        ));
+    }
+    let csv = match query.format.as_deref() {
+        None | Some("csv") => true,
+        Some("json") => false,
+        Some(_) => return Err(Problem::bad_parameter("format", "must be csv or json")),
+    };
+    let job = load_job(&state, &id).await?;
+    require_succeeded(&job)?;
+    let blocks = state.store.track_blocks(job.id).await?;
+    let body = tokio::task::spawn_blocking(move || -> Result<String, tracks::BlockError> {
+        let mut index: u64 = 0;
+        let mut keep: Vec<TrackSample> = Vec::new();
+        let mut out = String::new();
+        if csv {
+            out.push_str(TrackSample::CSV_HEADER);
+            out.push('\n');
+        }
+        for block in &blocks {
+            for sample in tracks::decode_block(block)? {
+                if index % every == 0 {
+                    if csv {
+                        out.push_str(&tracks::csv_line(&sample));
+                        out.push('\n');
+                    } else {
+                        keep.push(sample);
+                    }
+                }
+                index += 1;
+            }
+        }
+        if !csv {
+            out = serde_json::to_string(&keep).unwrap_or_else(|_| "[]".into());
+        }
+        Ok(out)
+    })
+    .await
+    .map_err(|e| Problem::internal(&e))?
+    .map_err(|e| Problem::internal(&e))?;
+    let content_type = if csv {
+        "text/csv; charset=utf-8"
+    } else {
+        "application/json"
+    };
+    Ok(([(header::CONTENT_TYPE, content_type)], body).into_response())
+}
+
+/// One SVG plot of a succeeded job.
+#[utoipa::path(
+    get, path = "/v1/jobs/{id}/plots/{name}", tag = "jobs",
+    params(("id" = Uuid, Path), ("name" = String, Path)),
+    responses(
+        (status = 200, description = "SVG image", content_type = "image/svg+xml"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_plot(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path((id, name)): Path<(String, String)>,
+) -> Result<Response, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    let id = parse_id(&id)?;
+    let svg = state
+        .store
+        .plot(id, &name)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("job {id} has no plot `{name}`")))?;
+    Ok(([(header::CONTENT_TYPE, "image/svg+xml")], svg).into_response())
+}

@@ -1,0 +1,66 @@
+//! The OpenAPI document, generated from the handlers' annotations. `api/openapi.json` is a copy
+//! kept in sync by a test (`railwear openapi > api/openapi.json` regenerates it).
+
+use super::{jobs, ops, pagination, problem, rails, tokens};
+use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityScheme};
+use utoipa::{Modify, OpenApi};
+
+struct BearerAuth;
+
+impl Modify for BearerAuth {
+    fn modify(&self, openapi: &mut utoipa::openapi::OpenApi) {
+        let components = openapi.components.get_or_insert_with(Default::default);
+        components.add_security_scheme(
+            "bearer",
+            SecurityScheme::Http(HttpBuilder::new().scheme(HttpAuthScheme::Bearer).build()),
+        );
+    }
+}
+
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "railwear",
+        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs), admin (tokens)."
+    ),
+    paths(
+        jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::cancel_job, jobs::get_result,
+        jobs::get_tracks, jobs::get_plot,
+        rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
+        rails::get_report,
+        tokens::create_token, tokens::list_tokens, tokens::revoke_token,
+        ops::healthz, ops::readyz, ops::metrics, ops::openapi,
+    ),
+    components(schemas(
+        problem::Problem,
+        jobs::JobRequest, jobs::JobView, jobs::JobLinks, jobs::JobResultView, jobs::PlotLink,
+        pagination::PageView<jobs::JobView>, pagination::PageView<rails::RailView>,
+        pagination::PageView<rails::MeasurementView>,
+        crate::jobs::JobKind, crate::jobs::JobStatus, crate::jobs::JobProgress,
+        crate::jobs::CurvePoint, crate::jobs::PenalizationData,
+        rails::MeasurementRequest, rails::MeasurementView, rails::RailView, rails::ReportView,
+        rails::ServiceLife, rails::MissingCurve,
+        tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
+        crate::config::Role,
+    )),
+    modifiers(&BearerAuth),
+    tags(
+        (name = "jobs", description = "Simulation, sweep and calibration jobs (engineer)"),
+        (name = "rails", description = "Rail registry, measurements and service-life reports (planner)"),
+        (name = "tokens", description = "API tokens (admin)"),
+        (name = "ops", description = "Health, readiness, metrics, this document"),
+    )
+)]
+pub struct ApiDoc;
+
+/// The OpenAPI document as pretty JSON with a trailing newline (the exact text of
+/// `api/openapi.json`).
+pub fn openapi_json() -> String {
+    let mut doc = ApiDoc::openapi();
+    doc.info.version = env!("CARGO_PKG_VERSION").to_string();
+    let mut text = doc
+        .to_pretty_json()
+        .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
+    text.push('\n');
+    text
+}

@@ -1,0 +1,493 @@
+//! `/v1/rails`: the rail registry by serial number, measured dimensions -> rattle space at once
+//! (eq. 6.1-6.3), measurement history, and the service-life report: K_SL and the penalized life
+//! with 0.9/0.8 bands (eq. 6.4, Figure 6.68) from the matching penalization curve, or a clear
+//! answer saying which sweep to run.
+
+use super::auth::{Area, Caller};
+use super::pagination::{PageQuery, PageView};
+use super::problem::{ApiJson, Problem};
+use super::AppState;
+use crate::jobs::{curve_key, CurvePoint, JobStatus, PenalizationData};
+use crate::store::{clock, MeasurementRecord, NewMeasurement, RailRecord};
+use axum::extract::{Path, Query, State};
+use axum::http::{HeaderValue, Method, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::{Deserialize, Serialize};
+use utoipa::{IntoParams, ToSchema};
+use uuid::Uuid;
+
+pub fn router() -> Router<AppState> {
+    Router::new()
+        .route("/v1/rails", get(list_rails))
+        .route("/v1/rails/{serial}", get(get_rail))
+        .route(
+            "/v1/rails/{serial}/measurements",
+            post(post_measurement).get(list_measurements),
+        )
+        .route("/v1/rails/{serial}/report", get(get_report))
+}
+
+/// The analysis library behind one seam: rattle space from measured dimensions and the
+/// penalization of service life by a sweep's curve.
+pub mod seam {
+    use crate::jobs::PenalizationData;
+
+    /// A dimension set was refused: dotted field path (inside `dimensions_mm`) and rule.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct FieldRule {
+        pub field: String,
+        pub rule: String,
+    }
+
+    const UNAVAILABLE: &str = "rattle-space analysis (eq. 6.1-6.3) is not in this build";
+
+    /// Rattle space k_rs (eq. 6.1-6.3) from dimensions given in mm as a JSON object.
+    pub fn rattle_space(_dimensions_mm: &serde_json::Value) -> Result<f64, FieldRule> {
+        Err(FieldRule {
+            field: String::new(),
+            rule: UNAVAILABLE.into(),
+        })
+    }
+
+    /// K_SL at `k_rs` and its 0.9/0.8 bands (eq. 6.4), or why the curve does not cover it.
+    pub fn penalize(_data: &PenalizationData, _k_rs: f64) -> Result<(f64, f64, f64), String> {
+        Err(UNAVAILABLE.into())
+    }
+
+    /// K_SL over the swept rattle spaces (for the plot).
+    pub fn samples(_data: &PenalizationData) -> Result<Vec<(f64, f64)>, String> {
+        Err(UNAVAILABLE.into())
+    }
+}
+
+/// Measured dimensions of one rail (and its rear shoe) with who, when and where.
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MeasurementRequest {
+    /// Rail and shoe dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm, as a JSON
+    /// object with one number per named dimension.
+    #[schema(value_type = Object)]
+    pub dimensions_mm: serde_json::Value,
+    /// Who measured (name or badge), 1-200 characters.
+    pub measured_by: String,
+    /// When, ISO 8601 date or RFC 3339 date-time.
+    pub measured_at: String,
+    /// Where (depot, vehicle, station), 1-200 characters.
+    pub location: String,
+}
+
+/// A stored measurement.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct MeasurementView {
+    pub id: Uuid,
+    pub serial: String,
+    /// Dimensions as posted, mm.
+    #[schema(value_type = Object)]
+    pub dimensions_mm: serde_json::Value,
+    pub measured_by: String,
+    pub measured_at: String,
+    pub location: String,
+    /// Rattle space k_rs = A_ti / A_encl (eq. 6.1-6.3), dimensionless.
+    pub rattle_space: f64,
+    pub recorded_by: String,
+    pub recorded_at: String,
+    /// The rail's report.
+    pub report_url: String,
+}
+
+impl From<MeasurementRecord> for MeasurementView {
+    fn from(m: MeasurementRecord) -> Self {
+        MeasurementView {
+            report_url: format!("/v1/rails/{}/report", m.serial),
+            id: m.id,
+            serial: m.serial,
+            dimensions_mm: m.dimensions_mm,
+            measured_by: m.measured_by,
+            measured_at: m.measured_at,
+            location: m.location,
+            rattle_space: m.rattle_space,
+            recorded_by: m.recorded_by,
+            recorded_at: clock::rfc3339(m.recorded_ms),
+        }
+    }
+}
+
+/// A registered rail.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct RailView {
+    pub serial: String,
+    pub registered_at: String,
+    /// Number of measurements on record.
+    pub measurements: i64,
+    pub report_url: String,
+}
+
+impl From<RailRecord> for RailView {
+    fn from(r: RailRecord) -> Self {
+        RailView {
+            report_url: format!("/v1/rails/{}/report", r.serial),
+            serial: r.serial,
+            registered_at: clock::rfc3339(r.created_ms),
+            measurements: r.measurements,
+        }
+    }
+}
+
+/// Service life penalized for this rail's rattle space (eq. 6.4).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ServiceLife {
+    /// K_SL = min(1, rail wear rate at design / rail wear rate at this k_rs), dimensionless.
+    pub k_sl: f64,
+    /// Conservative bands 0.9*K_SL and 0.8*K_SL (Figure 6.68).
+    pub k_sl_band_90: f64,
+    pub k_sl_band_80: f64,
+    /// T_SL,design, h.
+    pub design_life_h: f64,
+    /// T_SL,real = K_SL * T_SL,design, h; and with the 0.9/0.8 bands.
+    pub penalized_life_h: f64,
+    pub penalized_life_band_90_h: f64,
+    pub penalized_life_band_80_h: f64,
+}
+
+/// Why no service life could be given, and what to do about it.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct MissingCurve {
+    /// `vehicle_profile/environment/wear_law`.
+    pub curve_key: String,
+    /// In words: what is missing and what to do.
+    pub detail: String,
+    /// The sweep already queued or running for this key, if any.
+    pub sweep_job_id: Option<Uuid>,
+    pub sweep_job_status: Option<JobStatus>,
+    /// The job request an engineer should submit (POST /v1/jobs) when none is under way.
+    #[schema(value_type = Option<Object>)]
+    pub suggested_job: Option<serde_json::Value>,
+}
+
+/// A rail's service-life report.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ReportView {
+    pub serial: String,
+    /// The measurement the report is based on (the latest).
+    pub measurement: MeasurementView,
+    /// Rattle space k_rs of that measurement, dimensionless.
+    pub rattle_space: f64,
+    /// Key of the penalization curve used.
+    pub curve_key: String,
+    /// The sweep job that produced the curve.
+    pub curve_job_id: Option<Uuid>,
+    /// Rattle space of the design rail (K_SL = 1 there).
+    pub design_rattle_space: Option<f64>,
+    /// The sweep's points: rail wear rate versus rattle space.
+    pub curve_points: Vec<CurvePoint>,
+    /// K_SL at the swept rattle spaces, for plotting: [k_rs, K_SL] pairs.
+    pub k_sl_curve: Vec<[f64; 2]>,
+    /// Present when a curve covers this rattle space.
+    pub service_life: Option<ServiceLife>,
+    /// Present when no curve covers it.
+    pub missing_curve: Option<MissingCurve>,
+}
+
+/// Which penalization curve and design life a report uses (defaults from the settings).
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct ReportQuery {
+    pub vehicle_profile: Option<String>,
+    pub environment: Option<String>,
+    pub wear_law: Option<String>,
+    /// T_SL,design, h.
+    pub design_life_h: Option<f64>,
+}
+
+fn check_serial(serial: &str) -> Result<(), Problem> {
+    let ok = (1..=64).contains(&serial.len())
+        && serial
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(Problem::bad_parameter(
+            "serial",
+            "must be 1-64 characters of letters, digits, '-', '_' or '.'",
+        ))
+    }
+}
+
+fn check_text(field: &str, value: &str) -> Result<String, Problem> {
+    let value = value.trim();
+    if value.is_empty() || value.chars().count() > 200 {
+        Err(Problem::invalid_field(field, "must be 1 to 200 characters"))
+    } else {
+        Ok(value.to_string())
+    }
+}
+
+/// Record a measurement; the rail is registered on its first one. Answers with the rattle space
+/// at once.
+#[utoipa::path(
+    post, path = "/v1/rails/{serial}/measurements", tag = "rails",
+    params(("serial" = String, Path, description = "Rail serial number")),
+    request_body = MeasurementRequest,
+    responses(
+        (status = 201, body = MeasurementView),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 403, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "A dimension is missing, negative, not finite, implausible (unit mistake) or makes the shoe interfere with the rail; `field` names it", body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn post_measurement(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(serial): Path<String>,
+    ApiJson(request): ApiJson<MeasurementRequest>,
+) -> Result<Response, Problem> {
+    caller.require(Area::Rails, &Method::POST)?;
+    check_serial(&serial)?;
+    let measured_by = check_text("measured_by", &request.measured_by)?;
+    let location = check_text("location", &request.location)?;
+    let measured_at = request.measured_at.trim().to_string();
+    if !clock::is_iso8601(&measured_at) {
+        return Err(Problem::invalid_field(
+            "measured_at",
+            "must be an ISO 8601 date (2024-05-01) or RFC 3339 date-time (2024-05-01T08:30:00Z)",
+        ));
+    }
+    if !request.dimensions_mm.is_object() {
+        return Err(Problem::invalid_field(
+            "dimensions_mm",
+            "must be an object of dimensions in mm",
+        ));
+    }
+    let rattle_space = seam::rattle_space(&request.dimensions_mm).map_err(|e| {
+        let field = if e.field.is_empty() || e.field == "." {
+            "dimensions_mm".to_string()
+        } else {
+            format!("dimensions_mm.{}", e.field)
+        };
+        Problem::invalid_field(field, e.rule)
+    })?;
+    let record = state
+        .store
+        .add_measurement(NewMeasurement {
+            id: Uuid::new_v4(),
+            serial,
+            dimensions_mm: request.dimensions_mm,
+            measured_by,
+            measured_at,
+            location,
+            rattle_space,
+            recorded_by: caller.name,
+            recorded_ms: clock::now_ms(),
+        })
+        .await?;
+    let location_header = format!("/v1/rails/{}/measurements", record.serial);
+    let mut response = (StatusCode::CREATED, Json(MeasurementView::from(record))).into_response();
+    if let Ok(value) = HeaderValue::from_str(&location_header) {
+        response
+            .headers_mut()
+            .insert(axum::http::header::LOCATION, value);
+    }
+    Ok(response)
+}
+
+/// List registered rails, newest first.
+#[utoipa::path(
+    get, path = "/v1/rails", tag = "rails",
+    params(PageQuery),
+    responses((status = 200, body = PageView<RailView>), (status = 400, body = Problem, content_type = "application/problem+json")),
+    security(("bearer" = []))
+)]
+pub async fn list_rails(
+    State(state): State<AppState>,
+    caller: Caller,
+    page: Query<PageQuery>,
+) -> Result<Json<PageView<RailView>>, Problem> {
+    caller.require(Area::Rails, &Method::GET)?;
+    let page = state.store.list_rails(page.to_request()?).await?;
+    Ok(Json(PageView::from_page(page, RailView::from)))
+}
+
+async fn load_rail(state: &AppState, serial: &str) -> Result<RailRecord, Problem> {
+    check_serial(serial)?;
+    state
+        .store
+        .get_rail(serial)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("no rail with serial `{serial}`")))
+}
+
+/// One rail.
+#[utoipa::path(
+    get, path = "/v1/rails/{serial}", tag = "rails",
+    params(("serial" = String, Path)),
+    responses((status = 200, body = RailView), (status = 404, body = Problem, content_type = "application/problem+json")),
+    security(("bearer" = []))
+)]
+pub async fn get_rail(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(serial): Path<String>,
+) -> Result<Json<RailView>, Problem> {
+    caller.require(Area::Rails, &Method::GET)?;
+    Ok(Json(load_rail(&state, &serial).await?.into()))
+}
+
+/// A rail's measurement history, newest first.
+#[utoipa::path(
+    get, path = "/v1/rails/{serial}/measurements", tag = "rails",
+    params(("serial" = String, Path), PageQuery),
+    responses((status = 200, body = PageView<MeasurementView>), (status = 404, body = Problem, content_type = "application/problem+json")),
+    security(("bearer" = []))
+)]
+pub async fn list_measurements(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(serial): Path<String>,
+    page: Query<PageQuery>,
+) -> Result<Json<PageView<MeasurementView>>, Problem> {
+    caller.require(Area::Rails, &Method::GET)?;
+    let request = page.to_request()?;
+    load_rail(&state, &serial).await?;
+    let page = state.store.measurements(&serial, request).await?;
+    Ok(Json(PageView::from_page(page, MeasurementView::from)))
+}
+
+/// The rail's service-life report from its latest measurement.
+#[utoipa::path(
+    get, path = "/v1/rails/{serial}/report", tag = "rails",
+    params(("serial" = String, Path), ReportQuery),
+    responses(
+        (status = 200, description = "Report; `service_life` when a curve covers the rail, otherwise `missing_curve` says which sweep to run", body = ReportView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_report(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(serial): Path<String>,
+    query: Result<Query<ReportQuery>, axum::extract::rejection::QueryRejection>,
+) -> Result<Json<ReportView>, Problem> {
+    caller.require(Area::Rails, &Method::GET)?;
+    let Query(query) = query.map_err(|_| {
+        Problem::bad_parameter("design_life_h", "must be a positive number of hours")
+    })?;
+    load_rail(&state, &serial).await?;
+    let measurement = state
+        .store
+        .latest_measurement(&serial)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("rail `{serial}` has no measurement")))?;
+    let defaults = &state.config.report;
+    let design_life_h = query.design_life_h.unwrap_or(defaults.design_life_h);
+    if !(design_life_h.is_finite() && design_life_h > 0.0) {
+        return Err(Problem::bad_parameter(
+            "design_life_h",
+            "must be a positive number of hours",
+        ));
+    }
+    let profile = query
+        .vehicle_profile
+        .unwrap_or_else(|| defaults.vehicle_profile.clone());
+    let environment = query
+        .environment
+        .unwrap_or_else(|| defaults.environment.clone());
+    let wear_law = query.wear_law.unwrap_or_else(|| defaults.wear_law.clone());
+    let key = curve_key(&profile, &environment, &wear_law);
+    let k_rs = measurement.rattle_space;
+
+    let mut report = ReportView {
+        serial: serial.clone(),
+        measurement: measurement.into(),
+        rattle_space: k_rs,
+        curve_key: key.clone(),
+        curve_job_id: None,
+        design_rattle_space: None,
+        curve_points: Vec::new(),
+        k_sl_curve: Vec::new(),
+        service_life: None,
+        missing_curve: None,
+    };
+    let suggested = serde_json::json!({
+        "kind": "sweep",
+        "params": {
+            "config": "launcher",
+            "vehicle_profile": profile,
+            "environment": environment,
+            "wear_law": wear_law,
+        }
+    });
+    let stored = state.store.get_curve(&key).await?;
+    let data = stored.as_ref().and_then(|c| {
+        serde_json::from_value::<PenalizationData>(c.curve.clone())
+            .map_err(|e| tracing::warn!(key = %c.key, error = %e, "unreadable stored curve"))
+            .ok()
+    });
+    match (stored, data) {
+        (Some(stored), Some(data)) => {
+            report.curve_job_id = Some(stored.job_id);
+            report.design_rattle_space = Some(data.design_rattle_space);
+            report.k_sl_curve = seam::samples(&data)
+                .unwrap_or_default()
+                .into_iter()
+                .map(|(x, k)| [x, k])
+                .collect();
+            report.curve_points = data.points.clone();
+            match seam::penalize(&data, k_rs) {
+                Ok((k_sl, band_90, band_80)) => {
+                    report.service_life = Some(ServiceLife {
+                        k_sl,
+                        k_sl_band_90: band_90,
+                        k_sl_band_80: band_80,
+                        design_life_h,
+                        penalized_life_h: k_sl * design_life_h,
+                        penalized_life_band_90_h: band_90 * design_life_h,
+                        penalized_life_band_80_h: band_80 * design_life_h,
+                    })
+                }
+                Err(reason) => {
+                    report.missing_curve = Some(MissingCurve {
+                        curve_key: key.clone(),
+                        detail: format!(
+                            "the penalization curve {key} (sweep job {}) does not cover rattle space {k_rs:.4}: {reason}; submit a sweep whose range includes it",
+                            stored.job_id
+                        ),
+                        sweep_job_id: None,
+                        sweep_job_status: None,
+                        suggested_job: Some(suggested),
+                    })
+                }
+            }
+        }
+        _ => {
+            let active = state.store.active_sweep(&key).await?;
+            report.missing_curve = Some(match active {
+                Some(job) => MissingCurve {
+                    curve_key: key.clone(),
+                    detail: format!(
+                        "no penalization curve for {key} yet; sweep job {} is {}: the report will include K_SL once it succeeds",
+                        job.id,
+                        job.status.as_str()
+                    ),
+                    sweep_job_id: Some(job.id),
+                    sweep_job_status: Some(job.status),
+                    suggested_job: None,
+                },
+                None => MissingCurve {
+                    curve_key: key.clone(),
+                    detail: format!(
+                        "no penalization curve for {key}: an engineer must run a sweep job (POST /v1/jobs with the suggested_job body)"
+                    ),
+                    sweep_job_id: None,
+                    sweep_job_status: None,
+                    suggested_job: Some(suggested),
+                },
+            });
+        }
+    }
+    Ok(Json(report))
+}

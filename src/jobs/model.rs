@@ -1,0 +1,141 @@
+//! What a job is: its kind, its lifecycle and its stored record.
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+/// Kind of computation a job runs. The set is open: a new kind is one variant here plus one arm
+/// in the production runner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum JobKind {
+    /// One case: a model config (by name or inline) with overrides -> wear, tracks, plots.
+    Simulate,
+    /// A tolerance sweep over rattle space -> rail wear rate versus k_rs -> penalization curve.
+    Sweep,
+    /// Fit friction and K(sigma) from persistent-contact fixture records (thesis chapter 4).
+    Calibrate,
+}
+
+impl JobKind {
+    /// Lower-case name as stored and shown.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobKind::Simulate => "simulate",
+            JobKind::Sweep => "sweep",
+            JobKind::Calibrate => "calibrate",
+        }
+    }
+
+    /// Parse a stored kind name.
+    pub fn parse(text: &str) -> Option<JobKind> {
+        match text {
+            "simulate" => Some(JobKind::Simulate),
+            "sweep" => Some(JobKind::Sweep),
+            "calibrate" => Some(JobKind::Calibrate),
+            _ => None,
+        }
+    }
+}
+
+/// Lifecycle: queued -> running -> succeeded | failed | cancelled. A running job whose lease
+/// expires goes back to queued (next attempt).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum JobStatus {
+    Queued,
+    Running,
+    Succeeded,
+    Failed,
+    Cancelled,
+}
+
+impl JobStatus {
+    /// Lower-case name as stored and shown.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobStatus::Queued => "queued",
+            JobStatus::Running => "running",
+            JobStatus::Succeeded => "succeeded",
+            JobStatus::Failed => "failed",
+            JobStatus::Cancelled => "cancelled",
+        }
+    }
+
+    /// Parse a stored status name.
+    pub fn parse(text: &str) -> Option<JobStatus> {
+        match text {
+            "queued" => Some(JobStatus::Queued),
+            "running" => Some(JobStatus::Running),
+            "succeeded" => Some(JobStatus::Succeeded),
+            "failed" => Some(JobStatus::Failed),
+            "cancelled" => Some(JobStatus::Cancelled),
+            _ => None,
+        }
+    }
+
+    /// True for succeeded, failed and cancelled: nothing changes the job any more.
+    pub fn is_terminal(self) -> bool {
+        matches!(
+            self,
+            JobStatus::Succeeded | JobStatus::Failed | JobStatus::Cancelled
+        )
+    }
+
+    /// All statuses, in lifecycle order.
+    pub const ALL: [JobStatus; 5] = [
+        JobStatus::Queued,
+        JobStatus::Running,
+        JobStatus::Succeeded,
+        JobStatus::Failed,
+        JobStatus::Cancelled,
+    ];
+}
+
+/// Progress of a running job as stored by its heartbeat.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct JobProgress {
+    /// Simulated time reached, s.
+    pub simulated_time_s: f64,
+    /// Simulated time at which the run ends, s.
+    pub end_time_s: f64,
+    /// Fraction done in [0, 1].
+    pub fraction: f64,
+    /// Estimated wall-clock time left, s, from the rate since the attempt started.
+    pub eta_s: Option<f64>,
+}
+
+/// A job as stored.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobRecord {
+    pub id: uuid::Uuid,
+    /// Submission order (pagination cursor).
+    pub seq: i64,
+    pub kind: JobKind,
+    pub status: JobStatus,
+    /// Parameters exactly as submitted.
+    pub params: serde_json::Value,
+    /// Seed handed to the run (from `params.seed`, or drawn at submission).
+    pub seed: u64,
+    /// `CARGO_PKG_VERSION` (+ git hash when known at build) of the code that accepted the job.
+    pub code_version: String,
+    /// Token name of the submitter.
+    pub submitted_by: String,
+    /// Attempts started so far (fencing token: only the current attempt may write).
+    pub attempt: i64,
+    /// True once cancellation was requested.
+    pub cancel_requested: bool,
+    /// Unix times, ms.
+    pub created_ms: i64,
+    pub started_ms: Option<i64>,
+    pub finished_ms: Option<i64>,
+    /// Latest progress written by the heartbeat.
+    pub progress: Option<JobProgress>,
+    /// Result summary (JSON object) once succeeded.
+    pub result: Option<serde_json::Value>,
+    /// Last error (failed jobs, or attempts lost to dead workers).
+    pub error: Option<String>,
+    /// Number of stored contact-track samples.
+    pub track_samples: i64,
+    /// Penalization-curve key (sweeps only): `vehicle_profile/environment/wear_law`.
+    pub curve_key: Option<String>,
+}

@@ -1,0 +1,131 @@
+//! A test double for the queue (not a physics stub): a deterministic computation that takes a
+//! known wall time, reports progress, honours cancellation and produces tracks from its seed.
+//! Injected through `CaseRunner` so queue semantics can be tested without the engine.
+
+use railwear::config::ServiceConfig;
+use railwear::http::RunningService;
+use railwear::jobs::{CaseRunner, JobKind, JobOutput};
+use railwear::physics::track::TrackSample;
+use railwear::pipeline::{Progress, RunControl, RunError};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Runs `steps` steps of `step_ms` each (params `steps`, `step_ms`, `samples`).
+pub struct CountingRunner;
+
+/// Sample `i` of the run seeded with `seed`: a splitmix64 stream, so any two runs of the same
+/// seed agree bit for bit and different seeds differ.
+pub fn sample(seed: u64, i: u64) -> TrackSample {
+    let mut z = seed.wrapping_add(i.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    let u = (z >> 11) as f64 / (1u64 << 53) as f64;
+    TrackSample {
+        time_s: i as f64 * 1e-3,
+        contact: (i % 3) as u32,
+        track: 0,
+        normal_force_n: 10.0 * u,
+        slip_velocity_m_s: [u, -u, 0.5 * u],
+        slip_speed_m_s: u * 1.5f64.sqrt(),
+        penetration_m: 1e-6 * u,
+        penetration_rate_m_s: 1e-4 * (u - 0.5),
+        area_m2: 1e-6,
+        pressure_pa: 1e7 * u,
+        point_in_a_m: [0.0, 0.01, u],
+        point_in_b_m: [u, 0.0, -0.01],
+    }
+}
+
+impl CaseRunner for CountingRunner {
+    fn run(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        control: &RunControl,
+    ) -> Result<JobOutput, RunError> {
+        let get =
+            |name: &str, default: u64| params.get(name).and_then(|v| v.as_u64()).unwrap_or(default);
+        let (steps, step_ms, samples) = (get("steps", 10), get("step_ms", 20), get("samples", 100));
+        let seed = params
+            .get("seed")
+            .and_then(|v| v.as_u64())
+            .ok_or(RunError::InvalidConfig {
+                field: "seed".into(),
+                rule: "the queue must hand the seed to the runner".into(),
+            })?;
+        for step in 0..steps {
+            if control.is_cancelled() {
+                return Err(RunError::Cancelled);
+            }
+            std::thread::sleep(Duration::from_millis(step_ms));
+            (control.progress)(Progress {
+                simulated_time_s: (step + 1) as f64 * 0.1,
+                end_time_s: steps as f64 * 0.1,
+                fraction: (step + 1) as f64 / steps as f64,
+            });
+        }
+        let tracks: Vec<TrackSample> = (0..samples).map(|i| sample(seed, i)).collect();
+        let force_sum: f64 = tracks.iter().map(|t| t.normal_force_n).sum();
+        let penalization = (*kind == JobKind::Sweep).then(|| railwear::jobs::PenalizationData {
+            design_rattle_space: 0.799,
+            points: vec![
+                railwear::jobs::CurvePoint {
+                    rattle_space: 0.7684,
+                    rail_wear_rate_mg_h: 2.0,
+                },
+                railwear::jobs::CurvePoint {
+                    rattle_space: 0.799,
+                    rail_wear_rate_mg_h: 1.5,
+                },
+                railwear::jobs::CurvePoint {
+                    rattle_space: 0.8317,
+                    rail_wear_rate_mg_h: 1.0,
+                },
+            ],
+        });
+        Ok(JobOutput {
+            summary: serde_json::json!({ "seed": seed, "force_sum_n": force_sum, "steps": steps }),
+            tracks,
+            plots: vec![(
+                "force.svg".into(),
+                "<svg xmlns=\"http://www.w3.org/2000/svg\"/>".into(),
+            )],
+            penalization,
+        })
+    }
+
+    fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
+        match params.get("steps") {
+            Some(v) if v.as_u64().is_none() => Err(RunError::InvalidConfig {
+                field: "steps".into(),
+                rule: "must be a non-negative integer".into(),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Settings for an in-process test service on a free port with a fresh database.
+pub fn test_config(db_url: &str) -> ServiceConfig {
+    let mut config = ServiceConfig::default();
+    config.listen = "127.0.0.1:0".into();
+    config.database_url = db_url.to_string();
+    config.workers = 2;
+    config.lease_s = 2.0;
+    config.heartbeat_s = 0.2;
+    config.poll_interval_ms = 50;
+    config.body_limit_bytes = 64 * 1024;
+    config.configs_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    config
+        .apply_env(|key| (key == "RAILWEAR_TOKENS").then(super::tokens_env))
+        .expect("tokens");
+    config
+}
+
+/// Start the service in this process with the counting runner.
+pub async fn start(config: ServiceConfig, workers: bool) -> RunningService {
+    railwear::http::start(config, Arc::new(CountingRunner), workers)
+        .await
+        .expect("service starts")
+}
