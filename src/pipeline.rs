@@ -68,3 +68,148 @@ pub enum RunError {
     #[error("cancelled")]
     Cancelled,
 }
+
+use crate::models::case::{load_case, run_case};
+use crate::models::specs::CaseSpec;
+use std::path::Path;
+
+fn invalid(field: &str, rule: impl Into<String>) -> RunError {
+    RunError::InvalidConfig {
+        field: field.to_string(),
+        rule: rule.into(),
+    }
+}
+
+/// Deep-merges `patch` into `base` (objects merge key by key; anything else replaces).
+pub fn merge_json(base: &mut serde_json::Value, patch: &serde_json::Value) {
+    match (base, patch) {
+        (serde_json::Value::Object(b), serde_json::Value::Object(p)) => {
+            for (k, v) in p {
+                merge_json(b.entry(k.clone()).or_insert(serde_json::Value::Null), v);
+            }
+        }
+        (b, p) => *b = p.clone(),
+    }
+}
+
+/// Resolves job parameters to a case: `{"config": "<reference name>" | {inline case},
+/// "overrides": {...}, "seed": n}`. Overrides deep-merge into the case (e.g.
+/// `{"simulation": {"duration_s": 0.5}}`); `seed` sets `simulation.seed`.
+pub fn case_from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
+    let mut value = match params.get("config") {
+        Some(serde_json::Value::String(name)) => {
+            let path = crate::config::reference_config_path(configs_dir, name)
+                .map_err(|e| invalid("config", e.to_string()))?;
+            let case = load_case(&path)?;
+            serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?
+        }
+        Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
+        Some(_) => return Err(invalid("config", "must be a reference config name or a config object")),
+        None => return Err(invalid("config", "is required (a reference config name or a config object)")),
+    };
+    if let Some(over) = params.get("overrides") {
+        if !over.is_object() {
+            return Err(invalid("overrides", "must be an object"));
+        }
+        merge_json(&mut value, over);
+    }
+    if let Some(seed) = params.get("seed") {
+        let seed = seed.as_u64().ok_or_else(|| invalid("seed", "must be a non-negative integer"))?;
+        merge_json(&mut value, &serde_json::json!({"simulation": {"seed": seed}}));
+    }
+    let case: CaseSpec = serde_json::from_value(value).map_err(|e| invalid("config", e.to_string()))?;
+    case.validate()?;
+    Ok(case)
+}
+
+/// A simulate job: one case end to end.
+pub fn simulate(params: &serde_json::Value, configs_dir: &Path, control: &RunControl) -> Result<CaseOutcome, RunError> {
+    let case = case_from_params(params, configs_dir)?;
+    let (_, outcome) = run_case(&case, configs_dir, control)?;
+    Ok(outcome)
+}
+
+/// One point of a tolerance sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SweepPoint {
+    /// Material-condition offset applied to the launcher dimensions, mm (negative = tighter).
+    pub offset_mm: f64,
+    /// Rattle space k_rs (eq. 6.1-6.3).
+    pub rattle_space: f64,
+    /// Rail wear rate, mg/h.
+    pub rail_wear_rate_mg_per_h: f64,
+}
+
+/// Result of a tolerance sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepOutcome {
+    /// Rattle space of the design dimensions.
+    pub design_rattle_space: f64,
+    /// Points, tight to loose.
+    pub points: Vec<SweepPoint>,
+}
+
+/// Material-condition offsets (mm) of an n-point sweep from tight to loose.
+pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
+    use crate::analysis::rattle_space::{LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM};
+    let n = n.max(2);
+    (0..n)
+        .map(|i| TIGHT_MATERIAL_CONDITION_MM + (LOOSE_MATERIAL_CONDITION_MM - TIGHT_MATERIAL_CONDITION_MM) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// A sweep job: the launcher case of `params` (default `launcher-design`) at `points` (default 5,
+/// at least 2) dimension sets from tight to loose, same seed; returns the rail wear rate versus
+/// rattle space for the penalization curve (eq. 6.4).
+pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunControl) -> Result<(serde_json::Value, SweepOutcome), RunError> {
+    let mut p = params.clone();
+    if p.get("config").is_none() {
+        merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
+    }
+    let base = case_from_params(&p, configs_dir)?;
+    let Some(launcher) = base.launcher.as_ref() else {
+        return Err(invalid("config", "a sweep needs a launcher case"));
+    };
+    let n = match params.get("points") {
+        None => 5,
+        Some(v) => v.as_u64().filter(|n| (2..=50).contains(n)).ok_or_else(|| invalid("points", "must be an integer in 2..=50"))? as usize,
+    };
+    let design = crate::analysis::rattle_space::LauncherDimensions::design();
+    let design_k = design.rattle_space().map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
+    let _ = launcher;
+    let offsets = sweep_offsets_mm(n);
+    let mut points = Vec::with_capacity(n);
+    let total = n as f64;
+    for (i, off) in offsets.iter().enumerate() {
+        if control.is_cancelled() {
+            return Err(RunError::Cancelled);
+        }
+        let mut case = base.clone();
+        if let Some(l) = case.launcher.as_mut() {
+            l.dimensions = design.with_material_condition(*off);
+        }
+        let k = case.launcher.as_ref().and_then(|l| l.rattle_space().ok()).unwrap_or(f64::NAN);
+        let outer = control.progress.clone();
+        let sub = RunControl {
+            cancel: control.cancel.clone(),
+            progress: Arc::new(move |pr: Progress| {
+                outer(Progress {
+                    simulated_time_s: pr.simulated_time_s,
+                    end_time_s: pr.end_time_s,
+                    fraction: (i as f64 + pr.fraction) / total,
+                })
+            }),
+        };
+        let (report, _) = run_case(&case, configs_dir, &sub)?;
+        let rail = report
+            .bodies
+            .iter()
+            .find(|b| b.name == "rail")
+            .map(|b| b.mass_rate_mg_per_h)
+            .ok_or_else(|| invalid("config", "the launcher model has no body named `rail`"))?;
+        points.push(SweepPoint { offset_mm: *off, rattle_space: k, rail_wear_rate_mg_per_h: rail });
+    }
+    let outcome = SweepOutcome { design_rattle_space: design_k, points };
+    let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
+    Ok((summary, outcome))
+}
