@@ -151,7 +151,11 @@ pub fn run_model(
     let mut accs: Vec<Vec<Option<TrackAcc>>> = sys
         .contacts
         .iter()
-        .map(|c| (0..c.pieces_a.len() * c.faces_b.len()).map(|_| None).collect())
+        .map(|c| {
+            (0..c.pieces_a.len() * c.faces_b.len())
+                .map(|_| None)
+                .collect()
+        })
         .collect();
     let mut normal_int = vec![0.0; ncontacts];
     let mut power_int = vec![0.0; ncontacts];
@@ -213,7 +217,10 @@ pub fn run_model(
                 },
             };
             entry.open = true;
-            if let Err(e) = entry.acc.push(v.t, tr.normal_force, tr.slip_velocity.norm(), tr.area) {
+            if let Err(e) = entry
+                .acc
+                .push(v.t, tr.normal_force, tr.slip_velocity.norm(), tr.area)
+            {
                 wear_error.get_or_insert(e);
             }
         }
