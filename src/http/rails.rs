@@ -410,7 +410,7 @@ pub async fn get_report(
     let suggested = serde_json::json!({
         "kind": "sweep",
         "params": {
-            "config": "launcher",
+            "config": "launcher-design",
             "vehicle_profile": profile,
             "environment": environment,
             "wear_law": wear_law,
