@@ -37,7 +37,7 @@ impl Modify for BearerAuth {
         pagination::PageView<jobs::JobView>, pagination::PageView<rails::RailView>,
         pagination::PageView<rails::MeasurementView>,
         crate::jobs::JobKind, crate::jobs::JobStatus, crate::jobs::JobProgress,
-        crate::jobs::CurvePoint, crate::jobs::PenalizationData,
+        rails::CurvePointView, crate::analysis::rattle_space::LauncherDimensions,
         rails::MeasurementRequest, rails::MeasurementView, rails::RailView, rails::ReportView,
         rails::ServiceLife, rails::MissingCurve,
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,

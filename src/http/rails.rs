@@ -7,7 +7,9 @@ use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
 use super::problem::{ApiJson, Problem};
 use super::AppState;
-use crate::jobs::{curve_key, CurvePoint, JobStatus, PenalizationData};
+use crate::analysis::penalization::PenalizationCurve;
+use crate::analysis::rattle_space::LauncherDimensions;
+use crate::jobs::{curve_key, JobStatus};
 use crate::store::{clock, MeasurementRecord, NewMeasurement, RailRecord};
 use axum::extract::{Path, Query, State};
 use axum::http::{HeaderValue, Method, StatusCode};
@@ -32,44 +34,47 @@ pub fn router() -> Router<AppState> {
 /// The analysis library behind one seam: rattle space from measured dimensions and the
 /// penalization of service life by a sweep's curve.
 pub mod seam {
-    use crate::jobs::PenalizationData;
+    use crate::analysis::penalization::PenalizationCurve;
+    use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
 
-    /// A dimension set was refused: dotted field path (inside `dimensions_mm`) and rule.
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct FieldRule {
-        pub field: String,
-        pub rule: String,
-    }
-
-    const UNAVAILABLE: &str = "rattle-space analysis (eq. 6.1-6.3) is not in this build";
-
-    /// Rattle space k_rs (eq. 6.1-6.3) from dimensions given in mm as a JSON object.
-    pub fn rattle_space(_dimensions_mm: &serde_json::Value) -> Result<f64, FieldRule> {
-        Err(FieldRule {
-            field: String::new(),
-            rule: UNAVAILABLE.into(),
+    /// Rattle space k_rs (eq. 6.1-6.3) of measured dimensions, or the field at fault and why.
+    pub fn rattle_space(dimensions: &LauncherDimensions) -> Result<f64, (String, String)> {
+        dimensions.rattle_space().map_err(|e| match e {
+            RattleSpaceError::InvalidDimension { field, rule } => (field.to_string(), rule),
         })
     }
 
     /// K_SL at `k_rs` and its 0.9/0.8 bands (eq. 6.4), or why the curve does not cover it.
-    pub fn penalize(_data: &PenalizationData, _k_rs: f64) -> Result<(f64, f64, f64), String> {
-        Err(UNAVAILABLE.into())
+    pub fn penalize(curve: &PenalizationCurve, k_rs: f64) -> Result<(f64, f64, f64), String> {
+        let f = curve.factors(k_rs).map_err(|e| e.to_string())?;
+        Ok((f.k_sl, f.k_sl_conservative_90, f.k_sl_conservative_80))
     }
 
-    /// K_SL over the swept rattle spaces (for the plot).
-    pub fn samples(_data: &PenalizationData) -> Result<Vec<(f64, f64)>, String> {
-        Err(UNAVAILABLE.into())
+    /// [k_rs, K_SL] at the swept rattle spaces (for the plot).
+    pub fn samples(curve: &PenalizationCurve) -> Vec<[f64; 2]> {
+        curve
+            .points()
+            .iter()
+            .filter_map(|p| curve.k_sl(p.rattle_space).ok().map(|k| [p.rattle_space, k]))
+            .collect()
     }
+}
+
+/// One point of the sweep behind a report.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct CurvePointView {
+    /// Rattle space k_rs (eq. 6.3), dimensionless.
+    pub rattle_space: f64,
+    /// Simulated rail wear rate there, mg/h.
+    pub rail_wear_rate_mg_per_h: f64,
 }
 
 /// Measured dimensions of one rail (and its rear shoe) with who, when and where.
 #[derive(Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeasurementRequest {
-    /// Rail and shoe dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm, as a JSON
-    /// object with one number per named dimension.
-    #[schema(value_type = Object)]
-    pub dimensions_mm: serde_json::Value,
+    /// Rear-shoe and rail dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm.
+    pub dimensions_mm: LauncherDimensions,
     /// Who measured (name or badge), 1-200 characters.
     pub measured_by: String,
     /// When, ISO 8601 date or RFC 3339 date-time.
@@ -181,7 +186,7 @@ pub struct ReportView {
     /// Rattle space of the design rail (K_SL = 1 there).
     pub design_rattle_space: Option<f64>,
     /// The sweep's points: rail wear rate versus rattle space.
-    pub curve_points: Vec<CurvePoint>,
+    pub curve_points: Vec<CurvePointView>,
     /// K_SL at the swept rattle spaces, for plotting: [k_rs, K_SL] pairs.
     pub k_sl_curve: Vec<[f64; 2]>,
     /// Present when a curve covers this rattle space.
@@ -256,26 +261,16 @@ pub async fn post_measurement(
             "must be an ISO 8601 date (2024-05-01) or RFC 3339 date-time (2024-05-01T08:30:00Z)",
         ));
     }
-    if !request.dimensions_mm.is_object() {
-        return Err(Problem::invalid_field(
-            "dimensions_mm",
-            "must be an object of dimensions in mm",
-        ));
-    }
-    let rattle_space = seam::rattle_space(&request.dimensions_mm).map_err(|e| {
-        let field = if e.field.is_empty() || e.field == "." {
-            "dimensions_mm".to_string()
-        } else {
-            format!("dimensions_mm.{}", e.field)
-        };
-        Problem::invalid_field(field, e.rule)
-    })?;
+    let rattle_space = seam::rattle_space(&request.dimensions_mm)
+        .map_err(|(field, rule)| Problem::invalid_field(format!("dimensions_mm.{field}"), rule))?;
+    let dimensions_mm =
+        serde_json::to_value(request.dimensions_mm).map_err(|e| Problem::internal(&e))?;
     let record = state
         .store
         .add_measurement(NewMeasurement {
             id: Uuid::new_v4(),
             serial,
-            dimensions_mm: request.dimensions_mm,
+            dimensions_mm,
             measured_by,
             measured_at,
             location,
@@ -415,7 +410,7 @@ pub async fn get_report(
     let suggested = serde_json::json!({
         "kind": "sweep",
         "params": {
-            "config": "launcher",
+            "config": "launcher-design",
             "vehicle_profile": profile,
             "environment": environment,
             "wear_law": wear_law,
@@ -423,20 +418,23 @@ pub async fn get_report(
     });
     let stored = state.store.get_curve(&key).await?;
     let data = stored.as_ref().and_then(|c| {
-        serde_json::from_value::<PenalizationData>(c.curve.clone())
+        serde_json::from_value::<PenalizationCurve>(c.curve.clone())
             .map_err(|e| tracing::warn!(key = %c.key, error = %e, "unreadable stored curve"))
             .ok()
     });
     match (stored, data) {
         (Some(stored), Some(data)) => {
             report.curve_job_id = Some(stored.job_id);
-            report.design_rattle_space = Some(data.design_rattle_space);
-            report.k_sl_curve = seam::samples(&data)
-                .unwrap_or_default()
-                .into_iter()
-                .map(|(x, k)| [x, k])
+            report.design_rattle_space = Some(data.design_rattle_space());
+            report.k_sl_curve = seam::samples(&data);
+            report.curve_points = data
+                .points()
+                .iter()
+                .map(|p| CurvePointView {
+                    rattle_space: p.rattle_space,
+                    rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
+                })
                 .collect();
-            report.curve_points = data.points.clone();
             match seam::penalize(&data, k_rs) {
                 Ok((k_sl, band_90, band_80)) => {
                     report.service_life = Some(ServiceLife {

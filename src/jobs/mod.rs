@@ -10,7 +10,7 @@ pub mod worker;
 use crate::store::{clock, NewJob, Store, StoreError, Submitted};
 pub use metrics::Metrics;
 pub use model::{JobKind, JobProgress, JobRecord, JobStatus};
-pub use runner::{CaseRunner, CurvePoint, JobOutput, LibraryRunner, PenalizationData};
+pub use runner::{CaseRunner, JobOutput, LibraryRunner};
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;

@@ -3,30 +3,11 @@
 //! stores what comes back.
 
 use super::model::JobKind;
+use crate::analysis::penalization::PenalizationCurve;
 use crate::config::reference_config_path;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{RunControl, RunError};
-use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
-use utoipa::ToSchema;
-
-/// One point of a tolerance sweep: rail wear rate at a rattle space.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
-pub struct CurvePoint {
-    /// Rattle space k_rs (eq. 6.1-6.3), dimensionless.
-    pub rattle_space: f64,
-    /// Rail wear rate at that rattle space, mg/h.
-    pub rail_wear_rate_mg_h: f64,
-}
-
-/// The data a sweep yields for the penalization curve (eq. 6.4, Figure 6.68).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
-pub struct PenalizationData {
-    /// Rattle space of the design rail (the point where K_SL = 1), dimensionless.
-    pub design_rattle_space: f64,
-    /// Rail wear rate versus rattle space, sorted by rattle space.
-    pub points: Vec<CurvePoint>,
-}
 
 /// What a finished job produces.
 #[derive(Debug, Clone, Default)]
@@ -38,8 +19,8 @@ pub struct JobOutput {
     pub tracks: Vec<TrackSample>,
     /// SVG plots: (file name, SVG text).
     pub plots: Vec<(String, String)>,
-    /// Sweeps: the penalization curve data, stored under the job's curve key.
-    pub penalization: Option<PenalizationData>,
+    /// Sweeps: the penalization curve (eq. 6.4, Figure 6.68), stored under the job's curve key.
+    pub penalization: Option<PenalizationCurve>,
 }
 
 /// Runs one job's computation on a blocking thread. Must return [`RunError::Cancelled`] within

@@ -82,10 +82,10 @@ fn encode_block(index: i64, chunk: &[TrackSample]) -> TrackBlock {
     }
     let mut encoder = ZlibEncoder::new(Vec::new(), Compression::fast());
     // Writing into a Vec cannot fail.
-    let data = match encoder.write_all(&raw).and_then(|_| encoder.finish()) {
-        Ok(data) => data,
-        Err(_) => Vec::new(),
-    };
+    let data: Vec<u8> = encoder
+        .write_all(&raw)
+        .and_then(|_| encoder.finish())
+        .unwrap_or_default();
     TrackBlock {
         index,
         samples: n as i64,

@@ -2,6 +2,8 @@
 //! known wall time, reports progress, honours cancellation and produces tracks from its seed.
 //! Injected through `CaseRunner` so queue semantics can be tested without the engine.
 
+use railwear::analysis::penalization::{PenalizationCurve, SweepPoint};
+use railwear::analysis::rattle_space::LauncherDimensions;
 use railwear::config::ServiceConfig;
 use railwear::http::RunningService;
 use railwear::jobs::{CaseRunner, JobKind, JobOutput};
@@ -67,23 +69,30 @@ impl CaseRunner for CountingRunner {
         }
         let tracks: Vec<TrackSample> = (0..samples).map(|i| sample(seed, i)).collect();
         let force_sum: f64 = tracks.iter().map(|t| t.normal_force_n).sum();
-        let penalization = (*kind == JobKind::Sweep).then(|| railwear::jobs::PenalizationData {
-            design_rattle_space: 0.799,
-            points: vec![
-                railwear::jobs::CurvePoint {
-                    rattle_space: 0.7684,
-                    rail_wear_rate_mg_h: 2.0,
-                },
-                railwear::jobs::CurvePoint {
-                    rattle_space: 0.799,
-                    rail_wear_rate_mg_h: 1.5,
-                },
-                railwear::jobs::CurvePoint {
-                    rattle_space: 0.8317,
-                    rail_wear_rate_mg_h: 1.0,
-                },
-            ],
-        });
+        // Sweeps yield a curve from fixed points (rates in mg/h at the thesis' loose, design
+        // and tight rattle spaces; only their ratios matter to K_SL).
+        let penalization = if *kind == JobKind::Sweep {
+            let point = |rattle_space, rail_wear_rate_mg_per_h| SweepPoint {
+                rattle_space,
+                rail_wear_rate_mg_per_h,
+            };
+            // At the exact rattle spaces of the named loose/design/tight dimension sets.
+            let k = |d: LauncherDimensions| d.rattle_space().unwrap_or(f64::NAN);
+            let design = k(LauncherDimensions::design());
+            let points = [
+                point(k(LauncherDimensions::loose()), 2.0),
+                point(design, 1.5),
+                point(k(LauncherDimensions::tight()), 1.0),
+            ];
+            Some(
+                PenalizationCurve::new(&points, design).map_err(|e| RunError::InvalidConfig {
+                    field: "points".into(),
+                    rule: e.to_string(),
+                })?,
+            )
+        } else {
+            None
+        };
         Ok(JobOutput {
             summary: serde_json::json!({ "seed": seed, "force_sum_n": force_sum, "steps": steps }),
             tracks,
