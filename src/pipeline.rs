@@ -213,3 +213,33 @@ pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunContro
     let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }
+
+/// A calibrate job (thesis 4.3-4.4). `{"friction": {"fixture": {...}, "records": [...]}}` fits
+/// eq. 4.5 to torque records (eq. 4.1-4.4); `{"wear_law": {"density_kg_m3": .., "cutoff_pressure_pa": ..,
+/// "records": [...]}}` fits K(sigma) (eq. 4.16-4.18). Either or both.
+pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunError> {
+    use crate::analysis::calibration as cal;
+    let mut out = serde_json::Map::new();
+    if let Some(f) = params.get("friction") {
+        let fixture: cal::Fixture = serde_json::from_value(f.get("fixture").cloned().unwrap_or_default())
+            .map_err(|e| invalid("friction.fixture", e.to_string()))?;
+        let records: Vec<cal::TorqueRecord> = serde_json::from_value(f.get("records").cloned().unwrap_or_default())
+            .map_err(|e| invalid("friction.records", e.to_string()))?;
+        let samples = cal::friction_samples(&records, &fixture).map_err(|e| invalid("friction.records", e.to_string()))?;
+        let fit = cal::fit_friction(&samples, crate::physics::step::StepKind::Cycloidal)
+            .map_err(|e| invalid("friction", e.to_string()))?;
+        out.insert("friction".into(), serde_json::to_value(fit).map_err(|e| invalid("friction", e.to_string()))?);
+    }
+    if let Some(w) = params.get("wear_law") {
+        let records: Vec<cal::WearTestRecord> = serde_json::from_value(w.get("records").cloned().unwrap_or_default())
+            .map_err(|e| invalid("wear_law.records", e.to_string()))?;
+        let density = w.get("density_kg_m3").and_then(serde_json::Value::as_f64).unwrap_or(2810.0);
+        let cutoff = w.get("cutoff_pressure_pa").and_then(serde_json::Value::as_f64).unwrap_or(870e6);
+        let fit = cal::fit_wear_law(&records, density, cutoff).map_err(|e| invalid("wear_law", e.to_string()))?;
+        out.insert("wear_law".into(), serde_json::to_value(fit).map_err(|e| invalid("wear_law", e.to_string()))?);
+    }
+    if out.is_empty() {
+        return Err(invalid("params", "give `friction` and/or `wear_law` calibration data"));
+    }
+    Ok(serde_json::Value::Object(out))
+}

@@ -75,22 +75,75 @@ impl CaseRunner for LibraryRunner {
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
-        _control: &RunControl,
+        control: &RunControl,
     ) -> Result<JobOutput, RunError> {
         self.validate(kind, params)?;
-        // Each kind is wired to its `railwear::pipeline` entry point as the library provides
-        // it; until then the job fails with a clear reason instead of a fake result.
         match kind {
-            JobKind::Simulate | JobKind::Sweep | JobKind::Calibrate => {
-                Err(RunError::InvalidConfig {
-                    field: "kind".into(),
-                    rule: format!("`{}` is not available in this build", kind.as_str()),
+            JobKind::Simulate => {
+                let out = crate::pipeline::simulate(params, &self.configs_dir, control)?;
+                Ok(JobOutput {
+                    summary: out.summary,
+                    tracks: out.tracks,
+                    plots: out.plots,
+                    penalization: None,
                 })
             }
+            JobKind::Sweep => {
+                let (summary, sweep) = crate::pipeline::sweep(params, &self.configs_dir, control)?;
+                let points: Vec<crate::analysis::penalization::SweepPoint> = sweep
+                    .points
+                    .iter()
+                    .map(|p| crate::analysis::penalization::SweepPoint {
+                        rattle_space: p.rattle_space,
+                        rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
+                    })
+                    .collect();
+                let curve = PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
+                    RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
+                })?;
+                let plot = curve_plot(&curve);
+                Ok(JobOutput {
+                    summary,
+                    tracks: Vec::new(),
+                    plots: vec![("penalization.svg".to_string(), plot)],
+                    penalization: Some(curve),
+                })
+            }
+            JobKind::Calibrate => Ok(JobOutput {
+                summary: crate::pipeline::calibrate(params)?,
+                ..JobOutput::default()
+            }),
         }
     }
 
     fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
         self.check_config_name(params)
     }
+}
+
+/// K_SL versus rattle space with the 0.9 and 0.8 bands (thesis Figure 6.68).
+pub fn curve_plot(curve: &PenalizationCurve) -> String {
+    use crate::analysis::svg::{AxisSpec, Plot, Series};
+    let (lo, hi) = curve.range();
+    let n = 60;
+    let mut k_sl = Vec::new();
+    let mut b90 = Vec::new();
+    let mut b80 = Vec::new();
+    for i in 0..=n {
+        let k = lo + (hi - lo) * i as f64 / n as f64;
+        if let Ok(f) = curve.factors(k) {
+            k_sl.push((k, f.k_sl));
+            b90.push((k, f.k_sl_conservative_90));
+            b80.push((k, f.k_sl_conservative_80));
+        }
+    }
+    Plot::new(
+        "Service-life penalization (eq. 6.4)",
+        AxisSpec::linear("rattle space k_rs"),
+        AxisSpec::linear("K_SL"),
+    )
+    .with_series(Series::line("K_SL", k_sl))
+    .with_series(Series::line("0.9 K_SL", b90))
+    .with_series(Series::line("0.8 K_SL", b80))
+    .to_svg()
 }
