@@ -128,7 +128,7 @@ pub fn build(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError
         BaseMotion::from_spec(&excitation).map_err(|e| invalid("excitation", e.to_string()))?;
     match case.model_spec()? {
         ModelSpecRef::RattleBox(spec) => Ok(rattle_box::build(case, spec, motion)),
-        ModelSpecRef::Launcher(_) => Err(invalid("model", "launcher builder pending")),
+        ModelSpecRef::Launcher(spec) => super::launcher::build(case, spec, motion),
         ModelSpecRef::PersistentContact(_) => Err(invalid(
             "model",
             "the persistent-contact fixture runs through `railwear calibrate`, not as a dynamic case in this build",
