@@ -8,6 +8,7 @@
 //! conversions from the thesis' ADAMS units (mm, kg, s, N).
 
 pub mod analysis;
+pub mod cli;
 pub mod config;
 pub mod contact_models;
 pub mod excitation;
@@ -19,4 +20,6 @@ pub mod physics;
 pub mod pipeline;
 pub mod store;
 pub mod units;
+pub mod validation;
+pub mod validation_slow;
 pub mod wear;

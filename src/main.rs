@@ -50,6 +50,36 @@ enum Command {
     },
     /// Apply database migrations and exit.
     Migrate,
+    /// Run one case config end to end with a progress bar; print a summary table and write
+    /// summary.json, tracks.csv and SVG plots to the output directory.
+    Run {
+        /// Case config file, e.g. configs/rattle-box-c.toml.
+        config_file: PathBuf,
+        /// Output directory (default out/<case name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override the excited duration, s.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Override the settle time, s.
+        #[arg(long)]
+        settle: Option<f64>,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
+    /// Run the thesis anchors and print expected vs measured vs verdict.
+    Validate {
+        /// One JSON object per anchor (name, expected, measured, tolerance, pass).
+        #[arg(long)]
+        json: bool,
+        /// Also run the slow anchors (rattle box and launcher simulations, minutes).
+        #[arg(long)]
+        slow: bool,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -164,6 +194,24 @@ async fn main() -> Result<()> {
                 record.id
             );
             println!("{token}");
+            Ok(())
+        }
+        Command::Run {
+            config_file,
+            out,
+            duration,
+            settle,
+            configs_dir,
+        } => railwear::cli::run(config_file, out.as_deref(), *duration, *settle, configs_dir),
+        Command::Validate {
+            json,
+            slow,
+            configs_dir,
+        } => {
+            let all_pass = railwear::cli::validate(*json, *slow, configs_dir)?;
+            if !all_pass {
+                std::process::exit(1);
+            }
             Ok(())
         }
         Command::Migrate => {

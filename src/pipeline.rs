@@ -95,7 +95,10 @@ pub fn merge_json(base: &mut serde_json::Value, patch: &serde_json::Value) {
 /// Resolves job parameters to a case: `{"config": "<reference name>" | {inline case},
 /// "overrides": {...}, "seed": n}`. Overrides deep-merge into the case (e.g.
 /// `{"simulation": {"duration_s": 0.5}}`); `seed` sets `simulation.seed`.
-pub fn case_from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
+pub fn case_from_params(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+) -> Result<CaseSpec, RunError> {
     let mut value = match params.get("config") {
         Some(serde_json::Value::String(name)) => {
             let path = crate::config::reference_config_path(configs_dir, name)
@@ -104,8 +107,18 @@ pub fn case_from_params(params: &serde_json::Value, configs_dir: &Path) -> Resul
             serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?
         }
         Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
-        Some(_) => return Err(invalid("config", "must be a reference config name or a config object")),
-        None => return Err(invalid("config", "is required (a reference config name or a config object)")),
+        Some(_) => {
+            return Err(invalid(
+                "config",
+                "must be a reference config name or a config object",
+            ))
+        }
+        None => {
+            return Err(invalid(
+                "config",
+                "is required (a reference config name or a config object)",
+            ))
+        }
     };
     if let Some(over) = params.get("overrides") {
         if !over.is_object() {
@@ -114,16 +127,26 @@ pub fn case_from_params(params: &serde_json::Value, configs_dir: &Path) -> Resul
         merge_json(&mut value, over);
     }
     if let Some(seed) = params.get("seed") {
-        let seed = seed.as_u64().ok_or_else(|| invalid("seed", "must be a non-negative integer"))?;
-        merge_json(&mut value, &serde_json::json!({"simulation": {"seed": seed}}));
+        let seed = seed
+            .as_u64()
+            .ok_or_else(|| invalid("seed", "must be a non-negative integer"))?;
+        merge_json(
+            &mut value,
+            &serde_json::json!({"simulation": {"seed": seed}}),
+        );
     }
-    let case: CaseSpec = serde_json::from_value(value).map_err(|e| invalid("config", e.to_string()))?;
+    let case: CaseSpec =
+        serde_json::from_value(value).map_err(|e| invalid("config", e.to_string()))?;
     case.validate()?;
     Ok(case)
 }
 
 /// A simulate job: one case end to end.
-pub fn simulate(params: &serde_json::Value, configs_dir: &Path, control: &RunControl) -> Result<CaseOutcome, RunError> {
+pub fn simulate(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<CaseOutcome, RunError> {
     let case = case_from_params(params, configs_dir)?;
     let (_, outcome) = run_case(&case, configs_dir, control)?;
     Ok(outcome)
@@ -154,14 +177,22 @@ pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
     use crate::analysis::rattle_space::{LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM};
     let n = n.max(2);
     (0..n)
-        .map(|i| TIGHT_MATERIAL_CONDITION_MM + (LOOSE_MATERIAL_CONDITION_MM - TIGHT_MATERIAL_CONDITION_MM) * i as f64 / (n - 1) as f64)
+        .map(|i| {
+            TIGHT_MATERIAL_CONDITION_MM
+                + (LOOSE_MATERIAL_CONDITION_MM - TIGHT_MATERIAL_CONDITION_MM) * i as f64
+                    / (n - 1) as f64
+        })
         .collect()
 }
 
 /// A sweep job: the launcher case of `params` (default `launcher-design`) at `points` (default 5,
 /// at least 2) dimension sets from tight to loose, same seed; returns the rail wear rate versus
 /// rattle space for the penalization curve (eq. 6.4).
-pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunControl) -> Result<(serde_json::Value, SweepOutcome), RunError> {
+pub fn sweep(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<(serde_json::Value, SweepOutcome), RunError> {
     let mut p = params.clone();
     if p.get("config").is_none() {
         merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
@@ -172,10 +203,16 @@ pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunContro
     };
     let n = match params.get("points") {
         None => 5,
-        Some(v) => v.as_u64().filter(|n| (2..=50).contains(n)).ok_or_else(|| invalid("points", "must be an integer in 2..=50"))? as usize,
+        Some(v) => v
+            .as_u64()
+            .filter(|n| (2..=50).contains(n))
+            .ok_or_else(|| invalid("points", "must be an integer in 2..=50"))?
+            as usize,
     };
     let design = crate::analysis::rattle_space::LauncherDimensions::design();
-    let design_k = design.rattle_space().map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
+    let design_k = design
+        .rattle_space()
+        .map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
     let _ = launcher;
     let offsets = sweep_offsets_mm(n);
     let mut points = Vec::with_capacity(n);
@@ -188,7 +225,11 @@ pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunContro
         if let Some(l) = case.launcher.as_mut() {
             l.dimensions = design.with_material_condition(*off);
         }
-        let k = case.launcher.as_ref().and_then(|l| l.rattle_space().ok()).unwrap_or(f64::NAN);
+        let k = case
+            .launcher
+            .as_ref()
+            .and_then(|l| l.rattle_space().ok())
+            .unwrap_or(f64::NAN);
         let outer = control.progress.clone();
         let sub = RunControl {
             cancel: control.cancel.clone(),
@@ -207,9 +248,16 @@ pub fn sweep(params: &serde_json::Value, configs_dir: &Path, control: &RunContro
             .find(|b| b.name == "rail")
             .map(|b| b.mass_rate_mg_per_h)
             .ok_or_else(|| invalid("config", "the launcher model has no body named `rail`"))?;
-        points.push(SweepPoint { offset_mm: *off, rattle_space: k, rail_wear_rate_mg_per_h: rail });
+        points.push(SweepPoint {
+            offset_mm: *off,
+            rattle_space: k,
+            rail_wear_rate_mg_per_h: rail,
+        });
     }
-    let outcome = SweepOutcome { design_rattle_space: design_k, points };
+    let outcome = SweepOutcome {
+        design_rattle_space: design_k,
+        points,
+    };
     let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }
@@ -221,25 +269,45 @@ pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunErr
     use crate::analysis::calibration as cal;
     let mut out = serde_json::Map::new();
     if let Some(f) = params.get("friction") {
-        let fixture: cal::Fixture = serde_json::from_value(f.get("fixture").cloned().unwrap_or_default())
-            .map_err(|e| invalid("friction.fixture", e.to_string()))?;
-        let records: Vec<cal::TorqueRecord> = serde_json::from_value(f.get("records").cloned().unwrap_or_default())
+        let fixture: cal::Fixture =
+            serde_json::from_value(f.get("fixture").cloned().unwrap_or_default())
+                .map_err(|e| invalid("friction.fixture", e.to_string()))?;
+        let records: Vec<cal::TorqueRecord> =
+            serde_json::from_value(f.get("records").cloned().unwrap_or_default())
+                .map_err(|e| invalid("friction.records", e.to_string()))?;
+        let samples = cal::friction_samples(&records, &fixture)
             .map_err(|e| invalid("friction.records", e.to_string()))?;
-        let samples = cal::friction_samples(&records, &fixture).map_err(|e| invalid("friction.records", e.to_string()))?;
         let fit = cal::fit_friction(&samples, crate::physics::step::StepKind::Cycloidal)
             .map_err(|e| invalid("friction", e.to_string()))?;
-        out.insert("friction".into(), serde_json::to_value(fit).map_err(|e| invalid("friction", e.to_string()))?);
+        out.insert(
+            "friction".into(),
+            serde_json::to_value(fit).map_err(|e| invalid("friction", e.to_string()))?,
+        );
     }
     if let Some(w) = params.get("wear_law") {
-        let records: Vec<cal::WearTestRecord> = serde_json::from_value(w.get("records").cloned().unwrap_or_default())
-            .map_err(|e| invalid("wear_law.records", e.to_string()))?;
-        let density = w.get("density_kg_m3").and_then(serde_json::Value::as_f64).unwrap_or(2810.0);
-        let cutoff = w.get("cutoff_pressure_pa").and_then(serde_json::Value::as_f64).unwrap_or(870e6);
-        let fit = cal::fit_wear_law(&records, density, cutoff).map_err(|e| invalid("wear_law", e.to_string()))?;
-        out.insert("wear_law".into(), serde_json::to_value(fit).map_err(|e| invalid("wear_law", e.to_string()))?);
+        let records: Vec<cal::WearTestRecord> =
+            serde_json::from_value(w.get("records").cloned().unwrap_or_default())
+                .map_err(|e| invalid("wear_law.records", e.to_string()))?;
+        let density = w
+            .get("density_kg_m3")
+            .and_then(serde_json::Value::as_f64)
+            .unwrap_or(2810.0);
+        let cutoff = w
+            .get("cutoff_pressure_pa")
+            .and_then(serde_json::Value::as_f64)
+            .unwrap_or(870e6);
+        let fit = cal::fit_wear_law(&records, density, cutoff)
+            .map_err(|e| invalid("wear_law", e.to_string()))?;
+        out.insert(
+            "wear_law".into(),
+            serde_json::to_value(fit).map_err(|e| invalid("wear_law", e.to_string()))?,
+        );
     }
     if out.is_empty() {
-        return Err(invalid("params", "give `friction` and/or `wear_law` calibration data"));
+        return Err(invalid(
+            "params",
+            "give `friction` and/or `wear_law` calibration data",
+        ));
     }
     Ok(serde_json::Value::Object(out))
 }

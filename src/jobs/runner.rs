@@ -98,9 +98,12 @@ impl CaseRunner for LibraryRunner {
                         rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
                     })
                     .collect();
-                let curve = PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
-                    RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
-                })?;
+                let curve =
+                    PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
+                        RunError::Diverged(format!(
+                            "sweep produced no usable penalization curve: {e}"
+                        ))
+                    })?;
                 let plot = curve_plot(&curve);
                 Ok(JobOutput {
                     summary,
