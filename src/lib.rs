@@ -7,6 +7,13 @@
 //! Units: SI inside the engine (m, kg, s, N, Pa). See [`units`] for the
 //! conversions from the thesis' ADAMS units (mm, kg, s, N).
 
+// `!(x > 0.0)` is used on purpose throughout input validation: it rejects NaN, which the
+// "simplified" `x <= 0.0` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Numerical kernels index several equally sized arrays in one loop; iterator zips would hide
+// the algebra.
+#![allow(clippy::needless_range_loop)]
+
 pub mod analysis;
 pub mod cli;
 pub mod config;

@@ -231,7 +231,7 @@ fn plots(
         })
         .unwrap_or(2810.0);
     let mut wear_plot = Plot::new(
-        &format!("{}: wear versus time", case.name),
+        format!("{}: wear versus time", case.name),
         AxisSpec::linear("time (s)"),
         AxisSpec::linear("wear mass (mg)"),
     );
@@ -262,7 +262,7 @@ fn plots(
             .map(|(_, d)| d * 1e6)
             .collect();
         let mut p = Plot::new(
-            &format!("{}: contact-pressure PDF, {}", case.name, c.name),
+            format!("{}: contact-pressure PDF, {}", case.name, c.name),
             AxisSpec::log("contact pressure (MPa)"),
             AxisSpec::linear("time density (1/MPa)"),
         )
@@ -289,7 +289,7 @@ fn plots(
             .collect();
         if !pts.is_empty() {
             let p = Plot::new(
-                &format!("{}: response acceleration PSD (x)", case.name),
+                format!("{}: response acceleration PSD (x)", case.name),
                 AxisSpec::log("frequency (Hz)"),
                 AxisSpec::log("PSD ((m/s²)²/Hz)"),
             )

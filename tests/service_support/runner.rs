@@ -117,15 +117,17 @@ impl CaseRunner for CountingRunner {
 
 /// Settings for an in-process test service on a free port with a fresh database.
 pub fn test_config(db_url: &str) -> ServiceConfig {
-    let mut config = ServiceConfig::default();
-    config.listen = "127.0.0.1:0".into();
-    config.database_url = db_url.to_string();
-    config.workers = 2;
-    config.lease_s = 2.0;
-    config.heartbeat_s = 0.2;
-    config.poll_interval_ms = 50;
-    config.body_limit_bytes = 64 * 1024;
-    config.configs_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let mut config = ServiceConfig {
+        listen: "127.0.0.1:0".into(),
+        database_url: db_url.to_string(),
+        workers: 2,
+        lease_s: 2.0,
+        heartbeat_s: 0.2,
+        poll_interval_ms: 50,
+        body_limit_bytes: 64 * 1024,
+        configs_dir: std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
+        ..ServiceConfig::default()
+    };
     config
         .apply_env(|key| (key == "RAILWEAR_TOKENS").then(super::tokens_env))
         .expect("tokens");
