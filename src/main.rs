@@ -68,6 +68,21 @@ enum Command {
         #[arg(long, default_value = "configs")]
         configs_dir: PathBuf,
     },
+    /// Run rattle-box cases A-D and write the comparison page against thesis Tables 5.3/5.4.
+    CompareRattleBox {
+        /// Excited duration per case, s.
+        #[arg(long, default_value_t = 5.0)]
+        duration: f64,
+        /// Settle time per case, s.
+        #[arg(long, default_value_t = 1.0)]
+        settle: f64,
+        /// Markdown page to write.
+        #[arg(long, default_value = "docs/validation.md")]
+        out: PathBuf,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
     /// Run the thesis anchors and print expected vs measured vs verdict.
     Validate {
         /// One JSON object per anchor (name, expected, measured, tolerance, pass).
@@ -203,6 +218,12 @@ async fn main() -> Result<()> {
             settle,
             configs_dir,
         } => railwear::cli::run(config_file, out.as_deref(), *duration, *settle, configs_dir),
+        Command::CompareRattleBox {
+            duration,
+            settle,
+            out,
+            configs_dir,
+        } => railwear::cli::compare_rattle_box(*duration, *settle, out, configs_dir),
         Command::Validate {
             json,
             slow,
