@@ -362,7 +362,7 @@ fn wear_linear_solve(points: &[(f64, f64)], b: f64) -> Option<(f64, f64, f64)> {
         t2 += w * k;
     }
     let det = s11 * s22 - s12 * s12;
-    if !(det.abs() > 0.0) || !det.is_finite() {
+    if det == 0.0 || !det.is_finite() {
         return None;
     }
     let c1 = (t1 * s22 - s12 * t2) / det;
@@ -382,7 +382,7 @@ pub fn fit_wear_law(
     density_kg_m3: f64,
     cutoff_pressure_pa: f64,
 ) -> Result<WearLawFit, CalibrationError> {
-    if !(cutoff_pressure_pa > 0.0) {
+    if cutoff_pressure_pa.is_nan() || cutoff_pressure_pa <= 0.0 {
         return Err(invalid("cutoff_pressure_pa", 0, "must be > 0 Pa"));
     }
     let mut points = Vec::with_capacity(records.len());

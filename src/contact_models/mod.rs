@@ -7,7 +7,10 @@
 pub mod fit;
 pub mod quasistatic;
 
-pub use fit::{fit_power_law, table_2_1_parameters, FitSpace, ImpactFitRow, PowerLawFit};
+pub use fit::{
+    fit_model, fit_power_law, static_penetration, table_2_1_parameters, FitSpace, ImpactFitRow,
+    PowerLawFit,
+};
 pub use quasistatic::{QuasistaticModel, SphereOnFlat};
 
 /// Errors of the contact-model library; each names the field and the rule.

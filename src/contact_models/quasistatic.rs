@@ -55,7 +55,7 @@ impl QuasistaticModel {
 
     /// Normal force F(w), N, for interference `w_m` (m); 0 for w <= 0.
     pub fn force_n(&self, c: &SphereOnFlat, w_m: f64) -> f64 {
-        if !(w_m > 0.0) {
+        if w_m.is_nan() || w_m <= 0.0 {
             return 0.0;
         }
         match self {
@@ -93,7 +93,7 @@ impl QuasistaticModel {
 
     /// Contact area A(w), m², for interference `w_m` (m); 0 for w <= 0.
     pub fn area_m2(&self, c: &SphereOnFlat, w_m: f64) -> f64 {
-        if !(w_m > 0.0) {
+        if w_m.is_nan() || w_m <= 0.0 {
             return 0.0;
         }
         let ac = c.critical_area_m2();

@@ -113,7 +113,7 @@ impl WearLaw {
                 if !finite(c3) {
                     return Err(WearError::invalid("c3", "must be a finite number"));
                 }
-                if !(cutoff_pressure_pa > 0.0) || cutoff_pressure_pa.is_nan() {
+                if cutoff_pressure_pa.is_nan() || cutoff_pressure_pa <= 0.0 {
                     return Err(WearError::invalid("cutoff_pressure_pa", "must be > 0 Pa"));
                 }
             }

@@ -98,7 +98,7 @@ impl PressureHistogram {
     /// Adds `time_s` of contact and `work_j` of friction work at pressure `pressure_pa`.
     #[inline]
     pub fn add(&mut self, pressure_pa: f64, time_s: f64, work_j: f64) {
-        if !(pressure_pa >= self.min_pressure_pa) {
+        if pressure_pa.is_nan() || pressure_pa < self.min_pressure_pa {
             self.underflow_time_s += time_s;
             self.underflow_work_j += work_j;
             return;
