@@ -126,7 +126,7 @@ fn token_create_command_makes_a_working_token() {
 }
 
 /// Request body of a short simulate job of rattle-box case C.
-const SHORT_SIMULATE: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":11,"overrides":{"simulation":{"duration_s":0.5}}}}"#;
+const SHORT_SIMULATE: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":11,"overrides":{"simulation":{"settle_s":0.5,"duration_s":0.5}}}}"#;
 
 fn wait_succeeded(server: &Binary, id: &str, timeout: Duration) -> serde_json::Value {
     wait_for(timeout, "job success", || {
@@ -144,7 +144,6 @@ fn wait_succeeded(server: &Binary, id: &str, timeout: Duration) -> serde_json::V
 }
 
 #[test]
-#[ignore = "needs engine (lead wires pipeline)"]
 fn simulate_job_succeeds_with_results_and_tracks_csv() {
     let dir = TempDir::new("sim");
     let server = Binary::start(&dir.db_url(), &[]);
@@ -184,7 +183,6 @@ fn simulate_job_succeeds_with_results_and_tracks_csv() {
 }
 
 #[test]
-#[ignore = "needs engine (lead wires pipeline)"]
 fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     // Reference: uninterrupted run of the same seed.
     let ref_dir = TempDir::new("ref");
@@ -266,7 +264,6 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
 }
 
 #[test]
-#[ignore = "needs engine (lead wires pipeline)"]
 fn cancel_a_running_simulation() {
     let dir = TempDir::new("bincancel");
     let server = Binary::start(&dir.db_url(), &[]);
