@@ -53,34 +53,6 @@ pub fn shape_halfspace_overlap(
     })
 }
 
-/// Signed penetration of `shape` (placed by `pose`) into the solid `half_space`, m (negative:
-/// the gap to the plane), and the deepest point of the shape, world. Support function only
-/// (a few flops): used to bound integrator steps before a contact closes.
-pub fn shape_halfspace_depth(
-    shape: &ConvexShape,
-    pose: &Isometry3<f64>,
-    half_space: &HalfSpace,
-) -> (f64, Point3<f64>) {
-    let n_world = half_space.normal.into_inner();
-    let n = pose.rotation.inverse_transform_vector(&n_world);
-    let c = half_space.offset - n_world.dot(&pose.translation.vector);
-    let (depth, deepest) = match *shape {
-        ConvexShape::Sphere { radius } => (radius + c, -n * radius),
-        ConvexShape::RoundedBox {
-            half_extents,
-            roundover: r,
-        } => {
-            let h = half_extents - Vector3::repeat(r);
-            let support = |ni: f64, hi: f64| -hi.copysign(ni);
-            (
-                c + n.x.abs() * h.x + n.y.abs() * h.y + n.z.abs() * h.z + r,
-                Vector3::new(support(n.x, h.x), support(n.y, h.y), support(n.z, h.z)) - n * r,
-            )
-        }
-    };
-    (depth, pose * Point3::from(deepest))
-}
-
 /// Volume of a spherical cap of height `w` on a ball of radius `r`, m³.
 #[inline]
 pub(crate) fn cap_volume(r: f64, w: f64) -> f64 {

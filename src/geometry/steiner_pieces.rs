@@ -51,7 +51,7 @@ fn quarter_section(r: f64, m: [f64; 2], t: f64, p_min: f64, p_max: f64) -> (f64,
 /// (`|u0| + r`) the closed form of [`edge_closed_form`] would lose digits to cancellation
 /// (relative error about `ε / ratio²`); such nearly parallel edges keep the quadrature, where
 /// the section then varies so little along the edge that few sub-intervals arise.
-const CLOSED_FORM_MIN_TILT: f64 = 1e-2;
+const CLOSED_FORM_MIN_TILT: f64 = 3e-3;
 
 /// Volume (m³), moment along the edge (m⁴, about the edge midpoint) and transverse moment
 /// (m⁴, quarter-disk coordinates) of one edge piece below the plane, in closed form.

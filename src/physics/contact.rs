@@ -7,7 +7,7 @@ use super::body::BodyFrame;
 use super::forces::{apply, Wrench};
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
-use crate::geometry::{shape_halfspace_depth, shape_halfspace_overlap, ConvexShape, HalfSpace};
+use crate::geometry::{shape_halfspace_overlap, ConvexShape, HalfSpace};
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
@@ -66,34 +66,6 @@ impl TrackState {
 }
 
 impl Contact {
-    /// Largest step, s, over which no (piece, face) pair is predicted (at its current
-    /// approach speed) to penetrate deeper than its current depth plus `depth_increase_m`
-    /// (or, while apart, than `depth_increase_m` past first touch). Infinite when nothing
-    /// approaches. A step-size bound for the integrator only: it changes no force.
-    pub fn step_limit(&self, frames: &[BodyFrame], depth_increase_m: f64) -> f64 {
-        let fa = &frames[self.body_a];
-        let fb = &frames[self.body_b];
-        let iso_a = fa.isometry();
-        let mut h = f64::INFINITY;
-        for (piece_pose, shape) in &self.pieces_a {
-            let pose = iso_a * piece_pose;
-            for face in &self.faces_b {
-                let n_world = fb.rotation * face.normal.into_inner();
-                let hs = HalfSpace {
-                    normal: Unit::new_unchecked(n_world),
-                    offset: face.offset + n_world.dot(&fb.position),
-                };
-                let (depth, deepest) = shape_halfspace_depth(shape, &pose, &hs);
-                let v_rel = fa.point_velocity(&deepest) - fb.point_velocity(&deepest);
-                let rate = -v_rel.dot(&n_world);
-                if rate > 0.0 {
-                    h = h.min(((-depth).max(0.0) + depth_increase_m) / rate);
-                }
-            }
-        }
-        h
-    }
-
     /// Evaluates all tracks; adds forces to `wrenches` when given, and calls `sink` per active
     /// track. Returns the elastic potential energy stored (∫ k w^e dw), J.
     pub fn evaluate(

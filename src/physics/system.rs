@@ -176,29 +176,6 @@ impl MultibodySystem {
         self.derivative_with(t, y, dy, ws, &mut |_| {})
     }
 
-    /// Largest step, s, before any contact is predicted to penetrate more than
-    /// `fraction` × its damping-ramp depth `d` (thesis eq. 2.2) beyond where it is now (or
-    /// past first touch while apart), at the current approach speeds. Lets the integrator walk
-    /// into an impact at the IMPACT law's own length scale instead of discovering it by
-    /// rejected steps. Infinite when no contact approaches.
-    pub fn contact_step_limit(&self, t: f64, y: &[f64], ws: &mut Workspace, fraction: f64) -> f64 {
-        if self.contacts.is_empty() {
-            return f64::INFINITY;
-        }
-        self.frames(t, y, ws);
-        let mut h = f64::INFINITY;
-        for c in &self.contacts {
-            // A zero ramp (d = 0) falls back to the static penetration under 1 N.
-            let scale = if c.impact.full_damping_depth > 0.0 {
-                c.impact.full_damping_depth
-            } else {
-                c.impact.static_penetration(1.0)
-            };
-            h = h.min(c.step_limit(&ws.frames, fraction * scale));
-        }
-        h
-    }
-
     /// Active tracks at (t, y) (no forces accumulated).
     pub fn tracks(&self, t: f64, y: &[f64], ws: &mut Workspace, sink: &mut dyn FnMut(&TrackState)) {
         self.frames(t, y, ws);
