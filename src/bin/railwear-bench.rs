@@ -752,7 +752,12 @@ fn peers(
         let script = Path::new("bench/peers/run_peers.sh");
         let mut cmd = std::process::Command::new("bash");
         cmd.arg(script)
-            .args(["--window", &window.to_string(), "--settle", &settle.to_string()])
+            .args([
+                "--window",
+                &window.to_string(),
+                "--settle",
+                &settle.to_string(),
+            ])
             .args(peer_args.split_whitespace())
             .stderr(std::process::Stdio::inherit());
         eprintln!("peers: running {} (MuJoCo, Drake) ...", script.display());
@@ -765,8 +770,8 @@ fn peers(
             "peers measured in this run by bench/peers/run_peers.sh --window {window} --settle {settle} {peer_args}"
         ));
     } else if let Some(path) = peers_json {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("reading {}", path.display()))?;
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
         peer_rows.extend(parse_json_lines(&text));
         notes.push(format!(
             "peer rows read from {} (an earlier run), not measured in this run",
@@ -984,7 +989,9 @@ fn launcher(
         let f = |k: &str| v.get(k).and_then(Value::as_f64);
         let sim = f("simulated_s").unwrap_or(f64::NAN);
         let label = if (sim - 60.0).abs() < 1e-9 {
-            format!("memory: 60 s run (settle {settle} s + window {mem_window} s), all tracks stored")
+            format!(
+                "memory: 60 s run (settle {settle} s + window {mem_window} s), all tracks stored"
+            )
         } else {
             format!(
                 "memory: SHORTENED to {sim} s (settle {settle} s + window {mem_window} s; the target is a 60 s run), all tracks stored"
@@ -1012,6 +1019,16 @@ fn launcher(
                 f("track_sample_bytes").unwrap_or(f64::NAN),
                 case.simulation.record_interval_s
             ));
+            if let (Some(n), Some(bytes)) = (f("track_samples"), f("track_sample_bytes")) {
+                if sim < 60.0 && mem_window > 0.0 {
+                    // Samples accrue over the window only (recording starts with the excitation).
+                    let n60 = n * (60.0 - settle).max(0.0) / mem_window;
+                    let est_mb = h / 1024.0 + (n60 - n) * bytes * 2.0 / 1048576.0;
+                    t.note(format!(
+                        "ESTIMATE, not measured: at this run's rate a 60 s run stores about {n60:.0}                          track samples; with two copies of {bytes} bytes each the peak would be about                          {est_mb:.0} MB (plus up to 2x Vec growth slack on the track buffers)"
+                    ));
+                }
+            }
         }
     }
     t.note(
@@ -1313,10 +1330,7 @@ fn start_server(bin: &Path, configs_dir: &Path, tokens: &str) -> Result<Server> 
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_nanos())
         .unwrap_or(0);
-    let dir = std::env::temp_dir().join(format!(
-        "railwear-bench-{}-{nanos}",
-        std::process::id()
-    ));
+    let dir = std::env::temp_dir().join(format!("railwear-bench-{}-{nanos}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let db = format!("sqlite://{}?mode=rwc", dir.join("bench.db").display());
     let mut child = std::process::Command::new(bin)
@@ -1369,7 +1383,11 @@ fn load(
     curve: bool,
     client_threads: usize,
 ) -> Result<Vec<Table>> {
-    if rails == 0 || concurrency == 0 || !(seconds > 0.0) || client_threads == 0 {
+    if rails == 0
+        || concurrency == 0
+        || !(seconds.is_finite() && seconds > 0.0)
+        || client_threads == 0
+    {
         bail!("--rails, --concurrency, --client-threads >= 1 and --seconds > 0");
     }
     let stamp = std::time::SystemTime::now()
@@ -1452,7 +1470,8 @@ async fn load_async(
                         break;
                     }
                     if t0.elapsed() > Duration::from_secs(600) {
-                        curve_text = "sweep job not done in 600 s; reports answer `missing_curve`".into();
+                        curve_text =
+                            "sweep job not done in 600 s; reports answer `missing_curve`".into();
                         break;
                     }
                 }
