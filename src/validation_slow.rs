@@ -19,7 +19,7 @@ pub fn run(configs_dir: &Path) -> Vec<Anchor> {
             return f64::NAN;
         };
         case.simulation.settle_s = 0.5;
-        case.simulation.duration_s = 2.0;
+        case.simulation.duration_s = 16.0;
         case.simulation.rel_tolerance *= scale;
         case.simulation.abs_tolerance_m *= scale;
         case.simulation.record_interval_s = 0.01;

@@ -26,10 +26,14 @@ fn run_c(settle: f64, duration: f64, tol_scale: f64, excitation: Option<serde_js
 
 #[test]
 fn halving_tolerances_changes_friction_power_by_less_than_two_percent() {
-    // 3 s of 15 g, 20 Hz after a 0.5 s settle; the rattle is chaotic, so shorter windows
-    // average too few impacts for a 2 % statement.
-    let p1 = run_c(0.5, 3.0, 1.0, None);
-    let p2 = run_c(0.5, 3.0, 0.5, None);
+    // 16 s of 15 g, 20 Hz after a 0.5 s settle: the rattle is chaotic, and 3-8 s averages
+    // scatter by about 2 % between any two trajectories (docs/performance.md), so the 2 %
+    // statement needs about 640 impacts. The two runs go on two threads.
+    let (p1, p2) = std::thread::scope(|s| {
+        let a = s.spawn(|| run_c(0.5, 16.0, 1.0, None));
+        let b = s.spawn(|| run_c(0.5, 16.0, 0.5, None));
+        (a.join().expect("run 1"), b.join().expect("run 2"))
+    });
     let change = (p2.mean_friction_power_w - p1.mean_friction_power_w).abs() / p1.mean_friction_power_w;
     assert!(change < 0.02, "friction power {} W vs {} W: {:.2} %", p1.mean_friction_power_w, p2.mean_friction_power_w, 100.0 * change);
     // Wear is reported per contact in mg/h; equal materials split the volume half and half
