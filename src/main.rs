@@ -107,7 +107,7 @@ enum TokenCommand {
 
 fn load_config(cli: &Cli) -> Result<ServiceConfig> {
     let explicit = std::env::var_os("RAILWEAR_CONFIG").is_some()
-        || cli.config != PathBuf::from("configs/service.toml");
+        || cli.config.as_path() != std::path::Path::new("configs/service.toml");
     ServiceConfig::load(&cli.config, explicit, |key| std::env::var(key).ok())
         .with_context(|| format!("loading settings from {}", cli.config.display()))
 }
