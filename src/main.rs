@@ -41,6 +41,16 @@ enum Command {
         #[arg(long)]
         no_workers: bool,
     },
+    /// Run job workers only (no HTTP): claim jobs from the shared database, run them, store the
+    /// results. Start any number of these on any hosts next to `serve --no-workers`.
+    Worker {
+        /// Database URL (overrides settings), e.g. postgres://user@db-host:5432/railwear.
+        #[arg(long)]
+        database_url: Option<String>,
+        /// Worker threads in this process (overrides settings; 0 = one per core).
+        #[arg(long)]
+        workers: Option<usize>,
+    },
     /// Print the OpenAPI document (`railwear openapi > api/openapi.json`).
     Openapi,
     /// Manage API tokens in the database.
@@ -172,6 +182,54 @@ async fn serve(
     Ok(())
 }
 
+async fn worker(
+    mut config: ServiceConfig,
+    database_url: Option<String>,
+    workers: Option<usize>,
+) -> Result<()> {
+    if let Some(url) = database_url {
+        config.database_url = url;
+    }
+    if let Some(workers) = workers {
+        config.workers = workers;
+    }
+    init_logging(config.log_format == "json");
+    let store = railwear::store::open(&config.database_url)
+        .await
+        .context("opening the job database")?;
+    let settings = railwear::jobs::WorkerSettings {
+        lease: std::time::Duration::from_secs_f64(config.lease_s),
+        heartbeat: std::time::Duration::from_secs_f64(config.heartbeat_s),
+        poll: std::time::Duration::from_millis(config.poll_interval_ms.max(1)),
+        max_attempts: config.max_attempts,
+        track_block_samples: config.track_block_samples,
+    };
+    let curve_defaults = railwear::jobs::CurveDefaults {
+        vehicle_profile: config.report.vehicle_profile.clone(),
+        environment: config.report.environment.clone(),
+        wear_law: config.report.wear_law.clone(),
+    };
+    let runner = Arc::new(LibraryRunner {
+        configs_dir: config.configs_dir.clone(),
+    });
+    let jobs = railwear::jobs::Jobs::new(store, runner, settings, curve_defaults);
+    let count = config.worker_count();
+    // Worker names carry host and pid so a lease owner can be traced to its process.
+    let host = std::env::var("HOSTNAME").unwrap_or_else(|_| "host".into());
+    let handles = jobs.spawn_workers(count, &format!("{host}-{}", std::process::id()));
+    // Tests and scripts read this line to know the workers are polling.
+    println!("workers started: {count}");
+    std::io::stdout().flush()?;
+    tracing::info!(count, version = %railwear::jobs::code_version(), "workers started");
+    shutdown_signal().await;
+    // Attempts in flight are abandoned; their leases expire and another worker re-runs them.
+    tracing::info!("shutting down");
+    for handle in handles {
+        handle.abort();
+    }
+    Ok(())
+}
+
 #[tokio::main]
 async fn main() -> Result<()> {
     let cli = Cli::parse();
@@ -181,6 +239,10 @@ async fn main() -> Result<()> {
             workers,
             no_workers,
         } => serve(load_config(&cli)?, listen.clone(), *workers, *no_workers).await,
+        Command::Worker {
+            database_url,
+            workers,
+        } => worker(load_config(&cli)?, database_url.clone(), *workers).await,
         Command::Openapi => {
             print!("{}", railwear::http::openapi::openapi_json());
             Ok(())

@@ -3,6 +3,7 @@
 //! one row does it in one transaction; every write by a worker is fenced by the job's attempt.
 
 pub mod clock;
+pub mod postgres;
 pub mod sqlite;
 pub mod tracks;
 
@@ -31,7 +32,7 @@ pub enum StoreError {
     #[error("corrupt stored data: {0}")]
     Corrupt(String),
     /// The database URL names an engine this build does not support.
-    #[error("unsupported database URL `{0}` (expected sqlite://...)")]
+    #[error("unsupported database URL `{0}` (expected sqlite://... or postgres://...)")]
     UnsupportedUrl(String),
 }
 
@@ -161,7 +162,7 @@ pub struct TokenRecord {
     pub revoked: bool,
 }
 
-/// The persistence interface. SQLite: [`sqlite::SqliteStore`].
+/// The persistence interface. SQLite: [`sqlite::SqliteStore`]; PostgreSQL: [`postgres::PgStore`].
 pub trait Store: Send + Sync {
     /// Apply pending migrations.
     fn migrate(&self) -> StoreFuture<'_, ()>;
@@ -246,6 +247,10 @@ pub trait Store: Send + Sync {
 pub async fn open(database_url: &str) -> Result<Arc<dyn Store>, StoreError> {
     if database_url.starts_with("sqlite:") {
         let store = sqlite::SqliteStore::connect(database_url).await?;
+        store.migrate().await?;
+        Ok(Arc::new(store))
+    } else if database_url.starts_with("postgres:") || database_url.starts_with("postgresql:") {
+        let store = postgres::PgStore::connect(database_url).await?;
         store.migrate().await?;
         Ok(Arc::new(store))
     } else {

@@ -1,0 +1,777 @@
+//! PostgreSQL implementation of [`Store`], the shared queue and store when API servers and
+//! `railwear worker` processes run on many hosts (issue 6). Same semantics as
+//! [`super::sqlite::SqliteStore`]: a claim takes the oldest queued row with
+//! `FOR UPDATE SKIP LOCKED` inside one transaction (concurrent claimers skip each other's row
+//! instead of waiting or taking it twice), every worker write is fenced by the job's attempt, and
+//! expired leases go back to the queue until `max_attempts`.
+
+use super::{
+    CurveRecord, Finish, Heartbeat, MeasurementRecord, NewJob, NewMeasurement, Page, PageRequest,
+    RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+};
+use crate::config::Role;
+use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
+use sqlx::postgres::{PgConnectOptions, PgPool, PgPoolOptions, PgRow};
+use sqlx::Row;
+use std::str::FromStr;
+use std::time::Duration;
+use uuid::Uuid;
+
+/// Store on one PostgreSQL database.
+#[derive(Clone)]
+pub struct PgStore {
+    pool: PgPool,
+}
+
+impl PgStore {
+    /// Connect to `postgres://user@host:port/database` (any URL sqlx accepts).
+    pub async fn connect(url: &str) -> Result<Self, StoreError> {
+        let options = PgConnectOptions::from_str(url)?;
+        let pool = PgPoolOptions::new()
+            .max_connections(8)
+            .acquire_timeout(Duration::from_secs(10))
+            .connect_with(options)
+            .await?;
+        Ok(Self { pool })
+    }
+
+    /// The underlying pool (benchmarks and tests).
+    pub fn pool(&self) -> &PgPool {
+        &self.pool
+    }
+
+    async fn job_by_id(&self, id: Uuid) -> Result<Option<JobRecord>, StoreError> {
+        let sql = format!("SELECT {JOB_COLUMNS} FROM jobs WHERE id = $1");
+        let row = sqlx::query(&sql)
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await?;
+        row.as_ref().map(job_from_row).transpose()
+    }
+
+    /// The job submitted earlier with Idempotency-Key `key`: a replay when its body hash is
+    /// `sha`, a conflict otherwise. `None` without a key or when no job has it.
+    async fn keyed_job(
+        &self,
+        tx: &mut sqlx::Transaction<'_, sqlx::Postgres>,
+        key: Option<&str>,
+        sha: Option<&str>,
+    ) -> Result<Option<Submitted>, StoreError> {
+        let Some(key) = key else {
+            return Ok(None);
+        };
+        let sql =
+            format!("SELECT {JOB_COLUMNS}, request_sha256 FROM jobs WHERE idempotency_key = $1");
+        let Some(row) = sqlx::query(&sql)
+            .bind(key)
+            .fetch_optional(&mut **tx)
+            .await?
+        else {
+            return Ok(None);
+        };
+        let stored_sha: Option<String> = row.try_get("request_sha256")?;
+        let record = job_from_row(&row)?;
+        Ok(Some(
+            if stored_sha.is_some() && stored_sha.as_deref() == sha {
+                Submitted::Replayed(record)
+            } else {
+                Submitted::KeyConflict(record.id)
+            },
+        ))
+    }
+}
+
+fn corrupt(what: impl Into<String>) -> StoreError {
+    StoreError::Corrupt(what.into())
+}
+
+fn parse_json(text: &str, what: &str) -> Result<serde_json::Value, StoreError> {
+    serde_json::from_str(text).map_err(|e| corrupt(format!("{what}: {e}")))
+}
+
+const JOB_COLUMNS: &str = "seq, id, kind, status, params, seed, code_version, submitted_by, \
+    attempt, cancel_requested, created_ms, started_ms, finished_ms, progress_simulated_s, \
+    progress_end_s, progress_fraction, progress_eta_s, result, error, track_samples, curve_key";
+
+fn job_from_row(row: &PgRow) -> Result<JobRecord, StoreError> {
+    let kind: String = row.try_get("kind")?;
+    let status: String = row.try_get("status")?;
+    let params: String = row.try_get("params")?;
+    let result: Option<String> = row.try_get("result")?;
+    let progress = match (
+        row.try_get::<Option<f64>, _>("progress_simulated_s")?,
+        row.try_get::<Option<f64>, _>("progress_end_s")?,
+        row.try_get::<Option<f64>, _>("progress_fraction")?,
+    ) {
+        (Some(simulated_time_s), Some(end_time_s), Some(fraction)) => Some(JobProgress {
+            simulated_time_s,
+            end_time_s,
+            fraction,
+            eta_s: row.try_get("progress_eta_s")?,
+        }),
+        _ => None,
+    };
+    Ok(JobRecord {
+        id: row.try_get("id")?,
+        seq: row.try_get("seq")?,
+        kind: JobKind::parse(&kind).ok_or_else(|| corrupt(format!("job kind `{kind}`")))?,
+        status: JobStatus::parse(&status)
+            .ok_or_else(|| corrupt(format!("job status `{status}`")))?,
+        params: parse_json(&params, "job params")?,
+        seed: row.try_get::<i64, _>("seed")? as u64,
+        code_version: row.try_get("code_version")?,
+        submitted_by: row.try_get("submitted_by")?,
+        attempt: row.try_get("attempt")?,
+        cancel_requested: row.try_get("cancel_requested")?,
+        created_ms: row.try_get("created_ms")?,
+        started_ms: row.try_get("started_ms")?,
+        finished_ms: row.try_get("finished_ms")?,
+        progress,
+        result: result
+            .as_deref()
+            .map(|r| parse_json(r, "job result"))
+            .transpose()?,
+        error: row.try_get("error")?,
+        track_samples: row.try_get("track_samples")?,
+        curve_key: row.try_get("curve_key")?,
+    })
+}
+
+fn measurement_from_row(row: &PgRow) -> Result<MeasurementRecord, StoreError> {
+    let dims: String = row.try_get("dimensions_mm")?;
+    Ok(MeasurementRecord {
+        id: row.try_get("id")?,
+        seq: row.try_get("seq")?,
+        serial: row.try_get("serial")?,
+        dimensions_mm: parse_json(&dims, "measurement dimensions")?,
+        measured_by: row.try_get("measured_by")?,
+        measured_at: row.try_get("measured_at")?,
+        location: row.try_get("location")?,
+        rattle_space: row.try_get("rattle_space")?,
+        recorded_by: row.try_get("recorded_by")?,
+        recorded_ms: row.try_get("recorded_ms")?,
+    })
+}
+
+fn rail_from_row(row: &PgRow) -> Result<RailRecord, StoreError> {
+    Ok(RailRecord {
+        serial: row.try_get("serial")?,
+        seq: row.try_get("seq")?,
+        created_ms: row.try_get("created_ms")?,
+        measurements: row.try_get("measurements")?,
+    })
+}
+
+fn token_from_row(row: &PgRow) -> Result<TokenRecord, StoreError> {
+    let role: String = row.try_get("role")?;
+    Ok(TokenRecord {
+        id: row.try_get("id")?,
+        name: row.try_get("name")?,
+        role: Role::parse(&role).ok_or_else(|| corrupt(format!("token role `{role}`")))?,
+        created_ms: row.try_get("created_ms")?,
+        revoked: row.try_get::<Option<i64>, _>("revoked_ms")?.is_some(),
+    })
+}
+
+/// Cut a fetched `limit + 1` list into a page.
+fn paginate<T>(mut items: Vec<T>, limit: i64, seq: impl Fn(&T) -> i64) -> Page<T> {
+    let limit = limit.max(0) as usize;
+    let next_cursor = if items.len() > limit {
+        items.truncate(limit);
+        items.last().map(|last| seq(last).to_string())
+    } else {
+        None
+    };
+    Page { items, next_cursor }
+}
+
+impl Store for PgStore {
+    fn migrate(&self) -> StoreFuture<'_, ()> {
+        Box::pin(async move {
+            // sqlx takes an advisory lock, so API and worker processes starting together on
+            // one database apply the migrations once.
+            sqlx::migrate!("./migrations/postgres")
+                .run(&self.pool)
+                .await?;
+            Ok(())
+        })
+    }
+
+    fn ping(&self) -> StoreFuture<'_, ()> {
+        Box::pin(async move {
+            sqlx::query("SELECT 1").execute(&self.pool).await?;
+            Ok(())
+        })
+    }
+
+    fn submit_job(&self, job: NewJob) -> StoreFuture<'_, Submitted> {
+        Box::pin(async move {
+            let (key, sha) = match &job.idempotency {
+                Some((k, s)) => (Some(k.clone()), Some(s.clone())),
+                None => (None, None),
+            };
+            let mut tx = self.pool.begin().await?;
+            // An earlier job with this key: look first, so a replay does not consume a `seq`
+            // (the list order then matches SQLite's exactly).
+            if let Some(found) = self
+                .keyed_job(&mut tx, key.as_deref(), sha.as_deref())
+                .await?
+            {
+                tx.commit().await?;
+                return Ok(found);
+            }
+            // ON CONFLICT DO NOTHING waits for a concurrent insert of the same key to commit,
+            // so two racing submissions yield one job and one replay, never a unique-key error.
+            let sql = format!(
+                "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
+                 idempotency_key, request_sha256, curve_key, created_ms) \
+                 VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7, $8, $9, $10) \
+                 ON CONFLICT (idempotency_key) DO NOTHING RETURNING {JOB_COLUMNS}"
+            );
+            let inserted = sqlx::query(&sql)
+                .bind(job.id)
+                .bind(job.kind.as_str())
+                .bind(job.params.to_string())
+                .bind(job.seed as i64)
+                .bind(&job.code_version)
+                .bind(&job.submitted_by)
+                .bind(&key)
+                .bind(&sha)
+                .bind(&job.curve_key)
+                .bind(job.created_ms)
+                .fetch_optional(&mut *tx)
+                .await?;
+            let submitted = match inserted {
+                Some(row) => Submitted::Created(job_from_row(&row)?),
+                // Lost the race to a concurrent submission with the same key.
+                None => self
+                    .keyed_job(&mut tx, key.as_deref(), sha.as_deref())
+                    .await?
+                    .ok_or_else(|| corrupt("idempotent job vanished"))?,
+            };
+            tx.commit().await?;
+            Ok(submitted)
+        })
+    }
+
+    fn get_job(&self, id: Uuid) -> StoreFuture<'_, Option<JobRecord>> {
+        Box::pin(self.job_by_id(id))
+    }
+
+    fn list_jobs(
+        &self,
+        page: PageRequest,
+        status: Option<JobStatus>,
+    ) -> StoreFuture<'_, Page<JobRecord>> {
+        Box::pin(async move {
+            let sql = format!(
+                "SELECT {JOB_COLUMNS} FROM jobs WHERE ($1::BIGINT IS NULL OR seq < $1) \
+                 AND ($2::TEXT IS NULL OR status = $2) ORDER BY seq DESC LIMIT $3"
+            );
+            let rows = sqlx::query(&sql)
+                .bind(page.after_seq)
+                .bind(status.map(|s| s.as_str()))
+                .bind(page.limit + 1)
+                .fetch_all(&self.pool)
+                .await?;
+            let items = rows
+                .iter()
+                .map(job_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |j| j.seq))
+        })
+    }
+
+    fn claim_job(
+        &self,
+        worker: &str,
+        now_ms: i64,
+        lease_ms: i64,
+    ) -> StoreFuture<'_, Option<JobRecord>> {
+        let worker = worker.to_string();
+        Box::pin(async move {
+            let mut tx = self.pool.begin().await?;
+            // The row lock is held to commit; a concurrent claimer skips the locked row and
+            // takes the next one, so no job is handed out twice and nobody waits.
+            let picked = sqlx::query(
+                "SELECT seq FROM jobs WHERE status = 'queued' ORDER BY seq LIMIT 1 \
+                 FOR UPDATE SKIP LOCKED",
+            )
+            .fetch_optional(&mut *tx)
+            .await?;
+            let Some(picked) = picked else {
+                tx.rollback().await?;
+                return Ok(None);
+            };
+            let seq: i64 = picked.try_get("seq")?;
+            let sql = format!(
+                "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $2, \
+                 lease_expires_ms = $3 + $4, started_ms = COALESCE(started_ms, $3), \
+                 attempt_started_ms = $3, progress_simulated_s = NULL, progress_end_s = NULL, \
+                 progress_fraction = NULL, progress_eta_s = NULL \
+                 WHERE seq = $1 AND status = 'queued' RETURNING {JOB_COLUMNS}"
+            );
+            let row = sqlx::query(&sql)
+                .bind(seq)
+                .bind(worker)
+                .bind(now_ms)
+                .bind(lease_ms)
+                .fetch_optional(&mut *tx)
+                .await?;
+            let record = row.as_ref().map(job_from_row).transpose()?;
+            tx.commit().await?;
+            Ok(record)
+        })
+    }
+
+    fn heartbeat(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        progress: Option<JobProgress>,
+        now_ms: i64,
+        lease_ms: i64,
+    ) -> StoreFuture<'_, Heartbeat> {
+        Box::pin(async move {
+            let row = sqlx::query(
+                "UPDATE jobs SET lease_expires_ms = $3 + $4, \
+                 progress_simulated_s = COALESCE($5, progress_simulated_s), \
+                 progress_end_s = COALESCE($6, progress_end_s), \
+                 progress_fraction = COALESCE($7, progress_fraction), \
+                 progress_eta_s = CASE WHEN $5::DOUBLE PRECISION IS NULL THEN progress_eta_s \
+                   ELSE $8 END \
+                 WHERE id = $1 AND attempt = $2 AND status = 'running' \
+                 RETURNING cancel_requested",
+            )
+            .bind(id)
+            .bind(attempt)
+            .bind(now_ms)
+            .bind(lease_ms)
+            .bind(progress.map(|p| p.simulated_time_s))
+            .bind(progress.map(|p| p.end_time_s))
+            .bind(progress.map(|p| p.fraction))
+            .bind(progress.and_then(|p| p.eta_s))
+            .fetch_optional(&self.pool)
+            .await?;
+            Ok(match row {
+                Some(row) => Heartbeat {
+                    owned: true,
+                    cancel_requested: row.try_get("cancel_requested")?,
+                },
+                None => Heartbeat {
+                    owned: false,
+                    cancel_requested: false,
+                },
+            })
+        })
+    }
+
+    fn finish_job(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        finish: Finish,
+        now_ms: i64,
+    ) -> StoreFuture<'_, bool> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin().await?;
+            let (status, result, error, samples) = match &finish {
+                Finish::Succeeded {
+                    summary, blocks, ..
+                } => (
+                    JobStatus::Succeeded,
+                    Some(summary.to_string()),
+                    None,
+                    blocks.iter().map(|b| b.samples).sum::<i64>(),
+                ),
+                Finish::Failed(message) => (JobStatus::Failed, None, Some(message.clone()), 0),
+                Finish::Cancelled => (JobStatus::Cancelled, None, None, 0),
+            };
+            // Fenced: only the current attempt of a running job may end it. The row lock taken
+            // here serializes against a concurrent re-queue of the same job.
+            let updated = sqlx::query(
+                "UPDATE jobs SET status = $3, finished_ms = $4, result = $5, error = $6, \
+                 track_samples = $7, lease_owner = NULL, lease_expires_ms = NULL, \
+                 progress_fraction = CASE WHEN $3 = 'succeeded' THEN 1.0 ELSE progress_fraction END, \
+                 progress_simulated_s = CASE WHEN $3 = 'succeeded' THEN progress_end_s ELSE progress_simulated_s END, \
+                 progress_eta_s = CASE WHEN $3 = 'succeeded' THEN 0.0 ELSE progress_eta_s END \
+                 WHERE id = $1 AND attempt = $2 AND status = 'running'",
+            )
+            .bind(id)
+            .bind(attempt)
+            .bind(status.as_str())
+            .bind(now_ms)
+            .bind(result)
+            .bind(error)
+            .bind(samples)
+            .execute(&mut *tx)
+            .await?;
+            if updated.rows_affected() != 1 {
+                tx.rollback().await?;
+                return Ok(false);
+            }
+            if let Finish::Succeeded {
+                blocks,
+                plots,
+                curve,
+                ..
+            } = finish
+            {
+                for block in blocks {
+                    sqlx::query(
+                        "INSERT INTO job_track_blocks (job_id, block, samples, t_start_s, t_end_s, data) \
+                         VALUES ($1, $2, $3, $4, $5, $6)",
+                    )
+                    .bind(id)
+                    .bind(block.index)
+                    .bind(block.samples)
+                    .bind(block.t_start_s)
+                    .bind(block.t_end_s)
+                    .bind(block.data)
+                    .execute(&mut *tx)
+                    .await?;
+                }
+                for (name, svg) in plots {
+                    sqlx::query(
+                        "INSERT INTO job_plots (job_id, name, svg) VALUES ($1, $2, $3) \
+                         ON CONFLICT (job_id, name) DO UPDATE SET svg = EXCLUDED.svg",
+                    )
+                    .bind(id)
+                    .bind(name)
+                    .bind(svg)
+                    .execute(&mut *tx)
+                    .await?;
+                }
+                if let Some(curve) = curve {
+                    sqlx::query(
+                        "INSERT INTO penalization_curves (curve_key, job_id, curve, created_ms) \
+                         VALUES ($1, $2, $3, $4) ON CONFLICT (curve_key) DO UPDATE SET \
+                         job_id = EXCLUDED.job_id, curve = EXCLUDED.curve, created_ms = EXCLUDED.created_ms",
+                    )
+                    .bind(curve.key)
+                    .bind(curve.job_id)
+                    .bind(curve.curve.to_string())
+                    .bind(curve.created_ms)
+                    .execute(&mut *tx)
+                    .await?;
+                }
+            }
+            tx.commit().await?;
+            Ok(true)
+        })
+    }
+
+    fn request_cancel(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, Option<JobRecord>> {
+        Box::pin(async move {
+            // SET expressions all see the old row, so `status = 'queued'` tests the old status.
+            let sql = format!(
+                "UPDATE jobs SET \
+                 cancel_requested = CASE WHEN status IN ('queued', 'running') THEN TRUE ELSE cancel_requested END, \
+                 finished_ms = CASE WHEN status = 'queued' THEN $2 ELSE finished_ms END, \
+                 status = CASE WHEN status = 'queued' THEN 'cancelled' ELSE status END \
+                 WHERE id = $1 RETURNING {JOB_COLUMNS}"
+            );
+            let row = sqlx::query(&sql)
+                .bind(id)
+                .bind(now_ms)
+                .fetch_optional(&self.pool)
+                .await?;
+            row.as_ref().map(job_from_row).transpose()
+        })
+    }
+
+    fn requeue_expired(&self, now_ms: i64, max_attempts: i64) -> StoreFuture<'_, u64> {
+        Box::pin(async move {
+            // Every idle worker runs this; SKIP LOCKED lets them split the expired rows (and
+            // skip a row whose worker is finishing it right now) without lock waits or
+            // deadlocks between two multi-row updates.
+            let done = sqlx::query(
+                "UPDATE jobs SET \
+                 error = CASE WHEN cancel_requested THEN error \
+                   ELSE 'attempt ' || attempt || ' lost its worker (lease expired)' END, \
+                 finished_ms = CASE WHEN cancel_requested OR attempt >= $2 THEN $1 ELSE NULL END, \
+                 status = CASE WHEN cancel_requested THEN 'cancelled' \
+                   WHEN attempt >= $2 THEN 'failed' ELSE 'queued' END, \
+                 lease_owner = NULL, lease_expires_ms = NULL \
+                 WHERE seq IN (SELECT seq FROM jobs WHERE status = 'running' \
+                   AND lease_expires_ms < $1 ORDER BY seq FOR UPDATE SKIP LOCKED) \
+                 AND status = 'running' AND lease_expires_ms < $1",
+            )
+            .bind(now_ms)
+            .bind(max_attempts)
+            .execute(&self.pool)
+            .await?;
+            Ok(done.rows_affected())
+        })
+    }
+
+    fn job_counts(&self) -> StoreFuture<'_, Vec<(JobStatus, i64)>> {
+        Box::pin(async move {
+            let rows = sqlx::query("SELECT status, COUNT(*) AS n FROM jobs GROUP BY status")
+                .fetch_all(&self.pool)
+                .await?;
+            let mut counts: Vec<(JobStatus, i64)> =
+                JobStatus::ALL.iter().map(|s| (*s, 0)).collect();
+            for row in rows {
+                let status: String = row.try_get("status")?;
+                let n: i64 = row.try_get("n")?;
+                if let Some(slot) = counts.iter_mut().find(|(s, _)| s.as_str() == status) {
+                    slot.1 = n;
+                }
+            }
+            Ok(counts)
+        })
+    }
+
+    fn track_blocks(&self, id: Uuid) -> StoreFuture<'_, Vec<TrackBlock>> {
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT block, samples, t_start_s, t_end_s, data FROM job_track_blocks \
+                 WHERE job_id = $1 ORDER BY block",
+            )
+            .bind(id)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    Ok(TrackBlock {
+                        index: row.try_get("block")?,
+                        samples: row.try_get("samples")?,
+                        t_start_s: row.try_get("t_start_s")?,
+                        t_end_s: row.try_get("t_end_s")?,
+                        data: row.try_get("data")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn plot_names(&self, id: Uuid) -> StoreFuture<'_, Vec<String>> {
+        Box::pin(async move {
+            // COLLATE "C": byte order, the same order SQLite's default BINARY collation gives.
+            let rows = sqlx::query(
+                "SELECT name FROM job_plots WHERE job_id = $1 ORDER BY name COLLATE \"C\"",
+            )
+            .bind(id)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|r| r.try_get("name").map_err(StoreError::from))
+                .collect()
+        })
+    }
+
+    fn plot(&self, id: Uuid, name: &str) -> StoreFuture<'_, Option<String>> {
+        let name = name.to_string();
+        Box::pin(async move {
+            let row = sqlx::query("SELECT svg FROM job_plots WHERE job_id = $1 AND name = $2")
+                .bind(id)
+                .bind(name)
+                .fetch_optional(&self.pool)
+                .await?;
+            row.map(|r| r.try_get("svg").map_err(StoreError::from))
+                .transpose()
+        })
+    }
+
+    fn active_sweep(&self, curve_key: &str) -> StoreFuture<'_, Option<JobRecord>> {
+        let curve_key = curve_key.to_string();
+        Box::pin(async move {
+            let sql = format!(
+                "SELECT {JOB_COLUMNS} FROM jobs WHERE curve_key = $1 AND kind = 'sweep' \
+                 AND status IN ('queued', 'running') ORDER BY seq DESC LIMIT 1"
+            );
+            let row = sqlx::query(&sql)
+                .bind(curve_key)
+                .fetch_optional(&self.pool)
+                .await?;
+            row.as_ref().map(job_from_row).transpose()
+        })
+    }
+
+    fn add_measurement(&self, m: NewMeasurement) -> StoreFuture<'_, MeasurementRecord> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin().await?;
+            sqlx::query(
+                "INSERT INTO rails (serial, created_ms) VALUES ($1, $2) ON CONFLICT (serial) DO NOTHING",
+            )
+            .bind(&m.serial)
+            .bind(m.recorded_ms)
+            .execute(&mut *tx)
+            .await?;
+            let row = sqlx::query(
+                "INSERT INTO rail_measurements (id, serial, dimensions_mm, measured_by, measured_at, \
+                 location, rattle_space, recorded_by, recorded_ms) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9) RETURNING *",
+            )
+            .bind(m.id)
+            .bind(&m.serial)
+            .bind(m.dimensions_mm.to_string())
+            .bind(&m.measured_by)
+            .bind(&m.measured_at)
+            .bind(&m.location)
+            .bind(m.rattle_space)
+            .bind(&m.recorded_by)
+            .bind(m.recorded_ms)
+            .fetch_one(&mut *tx)
+            .await?;
+            let record = measurement_from_row(&row)?;
+            tx.commit().await?;
+            Ok(record)
+        })
+    }
+
+    fn get_rail(&self, serial: &str) -> StoreFuture<'_, Option<RailRecord>> {
+        let serial = serial.to_string();
+        Box::pin(async move {
+            let row = sqlx::query(
+                "SELECT r.serial, r.seq, r.created_ms, \
+                 (SELECT COUNT(*) FROM rail_measurements m WHERE m.serial = r.serial) AS measurements \
+                 FROM rails r WHERE r.serial = $1",
+            )
+            .bind(serial)
+            .fetch_optional(&self.pool)
+            .await?;
+            row.as_ref().map(rail_from_row).transpose()
+        })
+    }
+
+    fn list_rails(&self, page: PageRequest) -> StoreFuture<'_, Page<RailRecord>> {
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT r.serial, r.seq, r.created_ms, \
+                 (SELECT COUNT(*) FROM rail_measurements m WHERE m.serial = r.serial) AS measurements \
+                 FROM rails r WHERE ($1::BIGINT IS NULL OR r.seq < $1) ORDER BY r.seq DESC LIMIT $2",
+            )
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(rail_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |r| r.seq))
+        })
+    }
+
+    fn measurements(
+        &self,
+        serial: &str,
+        page: PageRequest,
+    ) -> StoreFuture<'_, Page<MeasurementRecord>> {
+        let serial = serial.to_string();
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT * FROM rail_measurements WHERE serial = $1 \
+                 AND ($2::BIGINT IS NULL OR seq < $2) ORDER BY seq DESC LIMIT $3",
+            )
+            .bind(serial)
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(measurement_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |m| m.seq))
+        })
+    }
+
+    fn latest_measurement(&self, serial: &str) -> StoreFuture<'_, Option<MeasurementRecord>> {
+        let serial = serial.to_string();
+        Box::pin(async move {
+            let row = sqlx::query(
+                "SELECT * FROM rail_measurements WHERE serial = $1 ORDER BY seq DESC LIMIT 1",
+            )
+            .bind(serial)
+            .fetch_optional(&self.pool)
+            .await?;
+            row.as_ref().map(measurement_from_row).transpose()
+        })
+    }
+
+    fn get_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>> {
+        let key = key.to_string();
+        Box::pin(async move {
+            let row = sqlx::query(
+                "SELECT curve_key, job_id, curve, created_ms FROM penalization_curves WHERE curve_key = $1",
+            )
+            .bind(key)
+            .fetch_optional(&self.pool)
+            .await?;
+            row.map(|row| {
+                let curve: String = row.try_get("curve")?;
+                Ok(CurveRecord {
+                    key: row.try_get("curve_key")?,
+                    job_id: row.try_get("job_id")?,
+                    curve: parse_json(&curve, "penalization curve")?,
+                    created_ms: row.try_get("created_ms")?,
+                })
+            })
+            .transpose()
+        })
+    }
+
+    fn create_token(
+        &self,
+        name: &str,
+        role: Role,
+        token_sha256: &str,
+        now_ms: i64,
+    ) -> StoreFuture<'_, TokenRecord> {
+        let (name, sha) = (name.to_string(), token_sha256.to_string());
+        Box::pin(async move {
+            let row = sqlx::query(
+                "INSERT INTO api_tokens (id, name, role, token_sha256, created_ms) \
+                 VALUES ($1, $2, $3, $4, $5) RETURNING *",
+            )
+            .bind(Uuid::new_v4())
+            .bind(name)
+            .bind(role.as_str())
+            .bind(sha)
+            .bind(now_ms)
+            .fetch_one(&self.pool)
+            .await?;
+            token_from_row(&row)
+        })
+    }
+
+    fn find_token(&self, token_sha256: &str) -> StoreFuture<'_, Option<TokenRecord>> {
+        let sha = token_sha256.to_string();
+        Box::pin(async move {
+            let row = sqlx::query(
+                "SELECT * FROM api_tokens WHERE token_sha256 = $1 AND revoked_ms IS NULL",
+            )
+            .bind(sha)
+            .fetch_optional(&self.pool)
+            .await?;
+            row.as_ref().map(token_from_row).transpose()
+        })
+    }
+
+    fn list_tokens(&self) -> StoreFuture<'_, Vec<TokenRecord>> {
+        Box::pin(async move {
+            // SQLite orders UUID text by bytes; `id::TEXT COLLATE "C"` gives the same order.
+            let rows =
+                sqlx::query("SELECT * FROM api_tokens ORDER BY created_ms, id::TEXT COLLATE \"C\"")
+                    .fetch_all(&self.pool)
+                    .await?;
+            rows.iter().map(token_from_row).collect()
+        })
+    }
+
+    fn revoke_token(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, bool> {
+        Box::pin(async move {
+            let done = sqlx::query(
+                "UPDATE api_tokens SET revoked_ms = $2 WHERE id = $1 AND revoked_ms IS NULL",
+            )
+            .bind(id)
+            .bind(now_ms)
+            .execute(&self.pool)
+            .await?;
+            Ok(done.rows_affected() == 1)
+        })
+    }
+}

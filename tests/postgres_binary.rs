@@ -1,0 +1,194 @@
+//! The real binary on PostgreSQL: `railwear serve --no-workers` (API only) and separate
+//! `railwear worker --database-url ...` processes share one fresh database. A job submitted over
+//! HTTP is run by a worker process; a worker killed with SIGKILL mid-job loses its lease and
+//! another worker process finishes the job.
+
+mod postgres_support;
+mod service_support;
+
+use service_support::{curl, tokens_env, wait_for, ENGINEER};
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// A child process killed (SIGKILL) and reaped on drop.
+struct Proc(Child);
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Start `railwear <args>` and wait for a stdout line starting with `ready_prefix`; returns the
+/// process and the rest of that line.
+fn spawn(args: &[&str], db_url: &str, env: &[(&str, &str)], ready_prefix: &str) -> (Proc, String) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_railwear"));
+    cmd.current_dir(root)
+        .args(args)
+        .env("DATABASE_URL", db_url)
+        .env("RAILWEAR_TOKENS", tokens_env())
+        .env("RAILWEAR_CONFIGS_DIR", root.join("configs"))
+        .env("RUST_LOG", "warn")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let mut child = cmd.spawn().expect("start railwear");
+    let stdout = child.stdout.take().expect("stdout");
+    let (tx, rx) = mpsc::channel();
+    let prefix = ready_prefix.to_string();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if let Some(rest) = line.strip_prefix(&prefix) {
+                let _ = tx.send(rest.to_string());
+            }
+        }
+    });
+    let proc = Proc(child);
+    let rest = rx
+        .recv_timeout(Duration::from_secs(60))
+        .unwrap_or_else(|_| panic!("railwear {args:?} did not print `{ready_prefix}`"));
+    (proc, rest)
+}
+
+fn api(db_url: &str, env: &[(&str, &str)]) -> (Proc, String) {
+    spawn(
+        &["serve", "--no-workers", "--listen", "127.0.0.1:0"],
+        db_url,
+        env,
+        "listening on ",
+    )
+}
+
+fn worker(db_url: &str, env: &[(&str, &str)]) -> Proc {
+    // The URL comes from the flag: DATABASE_URL is pointed elsewhere to prove the flag wins.
+    let (proc, _) = spawn(
+        &["worker", "--database-url", db_url, "--workers", "1"],
+        "sqlite://not-used-by-the-worker.db?mode=ro",
+        env,
+        "workers started: ",
+    );
+    proc
+}
+
+fn job(base: &str, id: &str) -> serde_json::Value {
+    let r = curl(
+        "GET",
+        &format!("{base}/v1/jobs/{id}"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()
+}
+
+fn submit(base: &str, body: &str) -> String {
+    let r = curl(
+        "POST",
+        &format!("{base}/v1/jobs"),
+        Some(ENGINEER),
+        &[],
+        Some(body),
+    );
+    assert_eq!(r.status, 201, "{}", r.body);
+    r.json()["id"].as_str().expect("job id").to_string()
+}
+
+fn wait_status(base: &str, id: &str, status: &str, timeout: Duration) -> serde_json::Value {
+    wait_for(timeout, status, || {
+        let j = job(base, id);
+        assert_ne!(j["status"], "failed", "job failed: {j}");
+        (j["status"] == status).then_some(j)
+    })
+}
+
+/// A very short simulate job of rattle-box case C.
+const SHORT: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":5,"overrides":{"simulation":{"settle_s":0.05,"duration_s":0.05,"record_interval_s":0.01}}}}"#;
+
+#[test]
+fn api_without_workers_and_a_worker_process_complete_a_job() {
+    let rt = tokio::runtime::Runtime::new().expect("runtime");
+    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("bin").await }) else {
+        return;
+    };
+    let (_api, base) = api(&db.url, &[]);
+    let id = submit(&base, SHORT);
+    // The API runs no workers: the job stays queued.
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(job(&base, &id)["status"], "queued");
+
+    let _worker = worker(&db.url, &[]);
+    let done = wait_status(&base, &id, "succeeded", Duration::from_secs(300));
+    assert_eq!(done["attempt"], 1);
+    assert!(done["track_samples"].as_i64().unwrap() > 0);
+    let result = curl(
+        "GET",
+        &format!("{base}/v1/jobs/{id}/result"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(result.status, 200, "{}", result.body);
+    assert!(result.json()["summary"].is_object());
+    // Tracks written by the worker process are served by the API process, one CSV row each.
+    let csv = curl(
+        "GET",
+        &format!("{base}/v1/jobs/{id}/tracks?format=csv"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(csv.status, 200);
+    let lines: Vec<&str> = csv.body.lines().collect();
+    assert_eq!(lines[0], railwear::physics::track::TrackSample::CSV_HEADER);
+    assert_eq!(
+        lines.len() as i64,
+        1 + done["track_samples"].as_i64().unwrap()
+    );
+    drop(rt);
+}
+
+#[test]
+fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
+    let rt = tokio::runtime::Runtime::new().expect("runtime");
+    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("kill").await }) else {
+        return;
+    };
+    let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
+    let (_api, base) = api(&db.url, &env);
+    // Long enough to be caught running (cancelled at the end, so its length costs nothing).
+    let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
+    let id = submit(&base, long);
+    let first = worker(&db.url, &env);
+    let running = wait_status(&base, &id, "running", Duration::from_secs(60));
+    assert_eq!(running["attempt"], 1);
+    drop(first); // SIGKILL: no shutdown code runs, the lease is left to expire
+
+    let _second = worker(&db.url, &env);
+    let retaken = wait_for(Duration::from_secs(60), "attempt 2", || {
+        let j = job(&base, &id);
+        (j["status"] == "running" && j["attempt"] == 2).then_some(j)
+    });
+    assert_eq!(
+        retaken["error"], "attempt 1 lost its worker (lease expired)",
+        "{retaken}"
+    );
+    // The new owner heartbeats: its cancel request reaches it through the database.
+    curl(
+        "POST",
+        &format!("{base}/v1/jobs/{id}/cancel"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    let cancelled = wait_status(&base, &id, "cancelled", Duration::from_secs(30));
+    assert_eq!(cancelled["attempt"], 2);
+    drop(rt);
+}

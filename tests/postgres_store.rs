@@ -1,0 +1,593 @@
+//! The PostgreSQL store against the local server: concurrent claims hand every job out exactly
+//! once, expired leases are re-queued and fence out the stale attempt, retries are bounded with
+//! the last error kept, and one scripted use of every `Store` method gives the same records on
+//! PostgreSQL as on SQLite.
+
+mod postgres_support;
+mod service_support;
+
+use railwear::config::Role;
+use railwear::jobs::{JobKind, JobProgress, JobStatus};
+use railwear::store::{
+    self, CurveRecord, Finish, Heartbeat, NewJob, NewMeasurement, PageRequest, Store, Submitted,
+    TrackBlock,
+};
+use std::collections::HashMap;
+use std::sync::Arc;
+use uuid::Uuid;
+
+/// Job `n` of a test: fixed id and params so two stores can be compared record for record.
+fn new_job(n: u128, kind: JobKind, idempotency: Option<(&str, &str)>) -> NewJob {
+    NewJob {
+        id: Uuid::from_u128(0x5eed_0000 + n),
+        kind,
+        params: serde_json::json!({ "n": n as u64, "x": 0.1 + 1e-17 * n as f64 }),
+        seed: u64::MAX - n as u64, // above i64::MAX: the bit-pattern round trip matters
+        code_version: "test".into(),
+        submitted_by: "tester".into(),
+        idempotency: idempotency.map(|(k, s)| (k.to_string(), s.to_string())),
+        curve_key: (kind == JobKind::Sweep).then(|| "ah64/clean/modified-archard".to_string()),
+        created_ms: 1_000 + n as i64,
+    }
+}
+
+fn succeeded(samples: i64) -> Finish {
+    Finish::Succeeded {
+        summary: serde_json::json!({ "rail_wear_mg": 1.25 }),
+        blocks: if samples > 0 {
+            vec![TrackBlock {
+                index: 0,
+                samples,
+                t_start_s: 0.0,
+                t_end_s: 0.5,
+                data: vec![1, 2, 3, 0, 255],
+            }]
+        } else {
+            Vec::new()
+        },
+        plots: vec![
+            ("wear".into(), "<svg>w</svg>".into()),
+            ("Force".into(), "<svg>f</svg>".into()),
+        ],
+        curve: None,
+    }
+}
+
+fn count(counts: &[(JobStatus, i64)], status: JobStatus) -> i64 {
+    counts
+        .iter()
+        .find(|(s, _)| *s == status)
+        .map_or(-1, |(_, n)| *n)
+}
+
+/// Must-have (a): 8 workers, each with its own connection pool as separate processes would
+/// have, race to claim 200 queued jobs. Every job is claimed exactly once, at attempt 1.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn eight_workers_claim_two_hundred_jobs_each_exactly_once() {
+    let db = fresh_db!("claims");
+    let store = store::open(&db.url).await.expect("open postgres store");
+    for n in 0..200 {
+        let submitted = store
+            .submit_job(new_job(n, JobKind::Simulate, None))
+            .await
+            .unwrap();
+        assert!(matches!(submitted, Submitted::Created(_)));
+    }
+    let start = Arc::new(tokio::sync::Barrier::new(8));
+    let mut workers = Vec::new();
+    for w in 0..8 {
+        let store = store::open(&db.url).await.expect("open worker store");
+        let start = Arc::clone(&start);
+        workers.push(tokio::spawn(async move {
+            let name = format!("worker-{w}");
+            let mut claimed = Vec::new();
+            start.wait().await;
+            while let Some(job) = store.claim_job(&name, 10_000, 60_000).await.unwrap() {
+                assert_eq!(job.status, JobStatus::Running);
+                claimed.push((job.id, job.attempt));
+                // Finishing while others claim exercises the claim against concurrent updates.
+                let done = store
+                    .finish_job(job.id, job.attempt, succeeded(0), 10_001)
+                    .await
+                    .unwrap();
+                assert!(done, "worker {name} was fenced out of its own claim");
+            }
+            claimed
+        }));
+    }
+    let mut times_claimed: HashMap<Uuid, usize> = HashMap::new();
+    let mut busy_workers = 0;
+    for worker in workers {
+        let claimed = worker.await.unwrap();
+        busy_workers += usize::from(!claimed.is_empty());
+        for (id, attempt) in claimed {
+            assert_eq!(attempt, 1, "job {id} was claimed on a later attempt");
+            *times_claimed.entry(id).or_default() += 1;
+        }
+    }
+    assert_eq!(times_claimed.len(), 200, "every job claimed");
+    assert!(
+        times_claimed.values().all(|&n| n == 1),
+        "a job was claimed twice: {:?}",
+        times_claimed
+            .iter()
+            .filter(|(_, &n)| n > 1)
+            .collect::<Vec<_>>()
+    );
+    assert!(busy_workers >= 2, "the claims did not run concurrently");
+    let counts = store.job_counts().await.unwrap();
+    assert_eq!(count(&counts, JobStatus::Succeeded), 200);
+    assert_eq!(count(&counts, JobStatus::Queued), 0);
+    assert_eq!(count(&counts, JobStatus::Running), 0);
+}
+
+/// Must-have (b): a lease that is not renewed expires, the job goes back to the queue, a newer
+/// attempt takes it, and the stale attempt can neither heartbeat nor finish. After
+/// `max_attempts` lost attempts the job fails with the last error kept.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn expired_lease_is_requeued_and_the_stale_attempt_is_fenced_out() {
+    let db = fresh_db!("lease");
+    let store = store::open(&db.url).await.expect("open postgres store");
+    let id = match store
+        .submit_job(new_job(1, JobKind::Simulate, None))
+        .await
+        .unwrap()
+    {
+        Submitted::Created(job) => job.id,
+        other => panic!("{other:?}"),
+    };
+    let lease_ms = 1_000;
+    let first = store
+        .claim_job("a", 10_000, lease_ms)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!((first.id, first.attempt), (id, 1));
+    // A heartbeat inside the lease renews it: at 10 900 the lease runs to 11 900.
+    let beat = store
+        .heartbeat(id, 1, None, 10_900, lease_ms)
+        .await
+        .unwrap();
+    assert_eq!(
+        beat,
+        Heartbeat {
+            owned: true,
+            cancel_requested: false
+        }
+    );
+    assert_eq!(store.requeue_expired(11_500, 3).await.unwrap(), 0);
+    // Past the renewed lease the job is re-queued with the reason recorded.
+    assert_eq!(store.requeue_expired(11_901, 3).await.unwrap(), 1);
+    let job = store.get_job(id).await.unwrap().unwrap();
+    assert_eq!(job.status, JobStatus::Queued);
+    assert_eq!(
+        job.error.as_deref(),
+        Some("attempt 1 lost its worker (lease expired)")
+    );
+    let second = store
+        .claim_job("b", 12_000, lease_ms)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!((second.id, second.attempt), (id, 2));
+    assert_eq!(second.started_ms, Some(10_000), "first start is kept");
+
+    // The stale attempt 1 is refused everywhere and writes nothing.
+    let stale_beat = store
+        .heartbeat(
+            id,
+            1,
+            Some(JobProgress {
+                simulated_time_s: 9.0,
+                end_time_s: 10.0,
+                fraction: 0.9,
+                eta_s: Some(1.0),
+            }),
+            12_100,
+            lease_ms,
+        )
+        .await
+        .unwrap();
+    assert!(!stale_beat.owned);
+    assert!(!store.finish_job(id, 1, succeeded(7), 12_200).await.unwrap());
+    let job = store.get_job(id).await.unwrap().unwrap();
+    assert_eq!((job.status, job.attempt), (JobStatus::Running, 2));
+    assert_eq!(job.progress, None, "the stale heartbeat wrote progress");
+    assert!(store.track_blocks(id).await.unwrap().is_empty());
+
+    // Attempts 2 and 3 die too; with max_attempts = 3 the third loss fails the job.
+    assert_eq!(store.requeue_expired(13_001, 3).await.unwrap(), 1);
+    let third = store
+        .claim_job("c", 14_000, lease_ms)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(third.attempt, 3);
+    assert_eq!(store.requeue_expired(15_001, 3).await.unwrap(), 1);
+    let job = store.get_job(id).await.unwrap().unwrap();
+    assert_eq!(job.status, JobStatus::Failed);
+    assert_eq!(job.finished_ms, Some(15_001));
+    assert_eq!(
+        job.error.as_deref(),
+        Some("attempt 3 lost its worker (lease expired)")
+    );
+    assert!(store
+        .claim_job("d", 16_000, lease_ms)
+        .await
+        .unwrap()
+        .is_none());
+    assert!(!store.finish_job(id, 3, succeeded(7), 16_000).await.unwrap());
+}
+
+/// Eight concurrent submissions with one Idempotency-Key make one job: one `Created`, seven
+/// `Replayed` of that job, no unique-key error.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn racing_idempotent_submissions_make_one_job() {
+    let db = fresh_db!("idem");
+    let store = store::open(&db.url).await.expect("open postgres store");
+    let mut tasks = Vec::new();
+    for n in 0..8 {
+        let store = Arc::clone(&store);
+        tasks.push(tokio::spawn(async move {
+            store
+                .submit_job(new_job(100 + n, JobKind::Simulate, Some(("k", "sha"))))
+                .await
+                .unwrap()
+        }));
+    }
+    let (mut created, mut replayed) = (Vec::new(), Vec::new());
+    for task in tasks {
+        match task.await.unwrap() {
+            Submitted::Created(job) => created.push(job.id),
+            Submitted::Replayed(job) => replayed.push(job.id),
+            Submitted::KeyConflict(id) => panic!("conflict with {id}"),
+        }
+    }
+    assert_eq!(created.len(), 1);
+    assert_eq!(replayed.len(), 7);
+    assert!(replayed.iter().all(|id| *id == created[0]));
+    let counts = store.job_counts().await.unwrap();
+    assert_eq!(count(&counts, JobStatus::Queued), 1);
+}
+
+/// One script over every `Store` method; returns what each call gave (ids and times are fixed,
+/// so the two engines must agree exactly).
+async fn script(store: &dyn Store) -> Vec<String> {
+    let mut trace = Vec::new();
+    let mut log = |what: &str, value: String| trace.push(format!("{what}: {value}"));
+    store.ping().await.unwrap();
+
+    // Idempotency: replay, conflict.
+    let a = store
+        .submit_job(new_job(1, JobKind::Simulate, Some(("key-1", "sha-a"))))
+        .await
+        .unwrap();
+    assert!(matches!(a, Submitted::Created(_)));
+    log("submit a", format!("{a:?}"));
+    let replay = store
+        .submit_job(new_job(2, JobKind::Simulate, Some(("key-1", "sha-a"))))
+        .await
+        .unwrap();
+    assert!(matches!(&replay, Submitted::Replayed(j) if j.id == Uuid::from_u128(0x5eed_0001)));
+    log("replay", format!("{replay:?}"));
+    let conflict = store
+        .submit_job(new_job(3, JobKind::Simulate, Some(("key-1", "sha-b"))))
+        .await
+        .unwrap();
+    assert!(matches!(conflict, Submitted::KeyConflict(id) if id == Uuid::from_u128(0x5eed_0001)));
+    log("conflict", format!("{conflict:?}"));
+    for n in 4..=7 {
+        let kind = if n == 6 {
+            JobKind::Sweep
+        } else {
+            JobKind::Simulate
+        };
+        log(
+            "submit",
+            format!(
+                "{:?}",
+                store.submit_job(new_job(n, kind, None)).await.unwrap()
+            ),
+        );
+    }
+    let seed_back = store
+        .get_job(Uuid::from_u128(0x5eed_0004))
+        .await
+        .unwrap()
+        .unwrap()
+        .seed;
+    assert_eq!(seed_back, u64::MAX - 4);
+
+    // Claim order is submission order.
+    let c1 = store.claim_job("w", 2_000, 5_000).await.unwrap().unwrap();
+    assert_eq!(c1.id, Uuid::from_u128(0x5eed_0001));
+    log("claim", format!("{c1:?}"));
+    let progress = JobProgress {
+        simulated_time_s: 0.25,
+        end_time_s: 0.5,
+        fraction: 0.5,
+        eta_s: Some(2.0),
+    };
+    log(
+        "beat",
+        format!(
+            "{:?}",
+            store
+                .heartbeat(c1.id, 1, Some(progress), 2_500, 5_000)
+                .await
+                .unwrap()
+        ),
+    );
+    // A heartbeat without progress keeps the stored progress.
+    store.heartbeat(c1.id, 1, None, 2_600, 5_000).await.unwrap();
+    assert_eq!(
+        store.get_job(c1.id).await.unwrap().unwrap().progress,
+        Some(progress)
+    );
+    assert!(store
+        .finish_job(c1.id, 1, succeeded(42), 3_000)
+        .await
+        .unwrap());
+    log("done", format!("{:?}", store.get_job(c1.id).await.unwrap()));
+    log(
+        "blocks",
+        format!("{:?}", store.track_blocks(c1.id).await.unwrap()),
+    );
+    let names = store.plot_names(c1.id).await.unwrap();
+    assert_eq!(names, vec!["Force".to_string(), "wear".to_string()]);
+    log(
+        "plot",
+        format!("{:?}", store.plot(c1.id, "wear").await.unwrap()),
+    );
+    log(
+        "no plot",
+        format!("{:?}", store.plot(c1.id, "none").await.unwrap()),
+    );
+
+    // Cancel: queued job at once; running job flagged, seen by its heartbeat.
+    let c4 = store.claim_job("w", 3_100, 5_000).await.unwrap().unwrap();
+    assert_eq!(c4.id, Uuid::from_u128(0x5eed_0004));
+    let queued_cancel = store
+        .request_cancel(Uuid::from_u128(0x5eed_0005), 3_200)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(queued_cancel.status, JobStatus::Cancelled);
+    log("cancel queued", format!("{queued_cancel:?}"));
+    let running_cancel = store.request_cancel(c4.id, 3_300).await.unwrap().unwrap();
+    assert_eq!(running_cancel.status, JobStatus::Running);
+    assert!(running_cancel.cancel_requested);
+    let beat = store.heartbeat(c4.id, 1, None, 3_400, 5_000).await.unwrap();
+    assert!(beat.owned && beat.cancel_requested);
+    assert!(store
+        .finish_job(c4.id, 1, Finish::Cancelled, 3_500)
+        .await
+        .unwrap());
+    let terminal = store.request_cancel(c1.id, 3_600).await.unwrap().unwrap();
+    assert_eq!(terminal.status, JobStatus::Succeeded);
+    assert!(!terminal.cancel_requested);
+    assert!(store
+        .request_cancel(Uuid::from_u128(1), 0)
+        .await
+        .unwrap()
+        .is_none());
+
+    // A cancelled-while-running job whose worker died ends cancelled, not re-queued.
+    let sweep_key = "ah64/clean/modified-archard";
+    log(
+        "active sweep",
+        format!("{:?}", store.active_sweep(sweep_key).await.unwrap()),
+    );
+    let c6 = store.claim_job("w", 4_000, 100).await.unwrap().unwrap();
+    assert_eq!(c6.kind, JobKind::Sweep);
+    store.request_cancel(c6.id, 4_010).await.unwrap();
+    assert_eq!(store.requeue_expired(4_200, 3).await.unwrap(), 1);
+    log(
+        "cancelled by sweep",
+        format!("{:?}", store.get_job(c6.id).await.unwrap()),
+    );
+    assert_eq!(
+        store.get_job(c6.id).await.unwrap().unwrap().status,
+        JobStatus::Cancelled
+    );
+    // A failure keeps its message; a sweep success stores its curve.
+    let c7 = store.claim_job("w", 5_000, 5_000).await.unwrap().unwrap();
+    assert!(store
+        .finish_job(
+            c7.id,
+            1,
+            Finish::Failed("field `x` must be > 0".into()),
+            5_100
+        )
+        .await
+        .unwrap());
+    assert_eq!(
+        store
+            .get_job(c7.id)
+            .await
+            .unwrap()
+            .unwrap()
+            .error
+            .as_deref(),
+        Some("field `x` must be > 0")
+    );
+    let s = store
+        .submit_job(new_job(8, JobKind::Sweep, None))
+        .await
+        .unwrap();
+    log("sweep", format!("{s:?}"));
+    log(
+        "active sweep",
+        format!("{:?}", store.active_sweep(sweep_key).await.unwrap()),
+    );
+    let c8 = store.claim_job("w", 6_000, 5_000).await.unwrap().unwrap();
+    let curve = CurveRecord {
+        key: sweep_key.into(),
+        job_id: c8.id,
+        curve: serde_json::json!({"k_sl": [1.0, 0.8125]}),
+        created_ms: 6_500,
+    };
+    let Finish::Succeeded {
+        summary,
+        blocks,
+        plots,
+        ..
+    } = succeeded(0)
+    else {
+        unreachable!()
+    };
+    assert!(store
+        .finish_job(
+            c8.id,
+            1,
+            Finish::Succeeded {
+                summary,
+                blocks,
+                plots,
+                curve: Some(curve.clone())
+            },
+            6_500
+        )
+        .await
+        .unwrap());
+    assert_eq!(store.get_curve(sweep_key).await.unwrap(), Some(curve));
+    assert_eq!(store.get_curve("none").await.unwrap(), None);
+    assert!(store.claim_job("w", 7_000, 5_000).await.unwrap().is_none());
+
+    // Listing: newest first, cursor pages, status filter; counts.
+    let page = store
+        .list_jobs(
+            PageRequest {
+                limit: 3,
+                after_seq: None,
+            },
+            None,
+        )
+        .await
+        .unwrap();
+    log("page 1", format!("{page:?}"));
+    let cursor = page
+        .next_cursor
+        .as_deref()
+        .map(|c| c.parse::<i64>().unwrap());
+    let page2 = store
+        .list_jobs(
+            PageRequest {
+                limit: 3,
+                after_seq: cursor,
+            },
+            None,
+        )
+        .await
+        .unwrap();
+    log("page 2", format!("{page2:?}"));
+    assert_eq!(page.items.len() + page2.items.len(), 6);
+    assert_eq!(page2.next_cursor, None);
+    let cancelled = store
+        .list_jobs(
+            PageRequest {
+                limit: 10,
+                after_seq: None,
+            },
+            Some(JobStatus::Cancelled),
+        )
+        .await
+        .unwrap();
+    assert_eq!(cancelled.items.len(), 3);
+    log("counts", format!("{:?}", store.job_counts().await.unwrap()));
+
+    // Rails and measurements.
+    for (i, serial) in ["R-1", "R-2", "R-1"].iter().enumerate() {
+        let m = store
+            .add_measurement(NewMeasurement {
+                id: Uuid::from_u128(0xabc0 + i as u128),
+                serial: serial.to_string(),
+                dimensions_mm: serde_json::json!({"w": 10.25 + i as f64}),
+                measured_by: "insp".into(),
+                measured_at: "2024-01-02".into(),
+                location: "depot".into(),
+                rattle_space: 0.01 * (i + 1) as f64,
+                recorded_by: "eng".into(),
+                recorded_ms: 8_000 + i as i64,
+            })
+            .await
+            .unwrap();
+        log("measurement", format!("{m:?}"));
+    }
+    let r1 = store.get_rail("R-1").await.unwrap().unwrap();
+    assert_eq!(r1.measurements, 2);
+    assert_eq!(r1.created_ms, 8_000);
+    assert_eq!(store.get_rail("R-9").await.unwrap(), None);
+    log(
+        "rails",
+        format!(
+            "{:?}",
+            store
+                .list_rails(PageRequest {
+                    limit: 1,
+                    after_seq: None
+                })
+                .await
+                .unwrap()
+        ),
+    );
+    log(
+        "measurements",
+        format!(
+            "{:?}",
+            store
+                .measurements(
+                    "R-1",
+                    PageRequest {
+                        limit: 5,
+                        after_seq: None
+                    }
+                )
+                .await
+                .unwrap()
+        ),
+    );
+    let latest = store.latest_measurement("R-1").await.unwrap().unwrap();
+    assert_eq!(latest.id, Uuid::from_u128(0xabc2));
+
+    // Tokens (their ids are random: compare the rest).
+    let t = store
+        .create_token("ops", Role::Engineer, "sha-t", 9_000)
+        .await
+        .unwrap();
+    store
+        .create_token("boss", Role::Admin, "sha-u", 9_001)
+        .await
+        .unwrap();
+    assert_eq!(
+        store.find_token("sha-t").await.unwrap().map(|t| t.role),
+        Some(Role::Engineer)
+    );
+    assert!(store.revoke_token(t.id, 9_100).await.unwrap());
+    assert!(!store.revoke_token(t.id, 9_200).await.unwrap());
+    assert_eq!(store.find_token("sha-t").await.unwrap(), None);
+    let tokens: Vec<_> = store
+        .list_tokens()
+        .await
+        .unwrap()
+        .into_iter()
+        .map(|t| (t.name, t.role, t.created_ms, t.revoked))
+        .collect();
+    log("tokens", format!("{tokens:?}"));
+    trace
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn every_store_method_behaves_as_on_sqlite() {
+    let db = fresh_db!("script");
+    let pg = store::open(&db.url).await.expect("open postgres store");
+    let pg_trace = script(pg.as_ref()).await;
+
+    let dir = service_support::TempDir::new("pg-script");
+    let sqlite = store::open(&dir.db_url()).await.expect("open sqlite store");
+    let sqlite_trace = script(sqlite.as_ref()).await;
+    assert_eq!(pg_trace.len(), sqlite_trace.len());
+    for (p, s) in pg_trace.iter().zip(&sqlite_trace) {
+        assert_eq!(p, s);
+    }
+}
