@@ -165,7 +165,12 @@ const TABLE_5_3: [(&str, f64, &str); 4] = [
 ];
 
 /// `railwear compare-rattle-box`: runs cases A-D and writes the comparison page.
-pub fn compare_rattle_box(duration: f64, settle: f64, out: &Path, configs_dir: &Path) -> Result<()> {
+pub fn compare_rattle_box(
+    duration: f64,
+    settle: f64,
+    out: &Path,
+    configs_dir: &Path,
+) -> Result<()> {
     use crate::validation_slow::TABLE_5_4_ADAMS_MG_PER_H;
     use crate::wear::law::WearLaw;
     let mut rows = Vec::new();
@@ -175,14 +180,28 @@ pub fn compare_rattle_box(duration: f64, settle: f64, out: &Path, configs_dir: &
         case.simulation.duration_s = duration;
         case.simulation.settle_s = settle;
         case.simulation.record_interval_s = duration;
-        eprintln!("running {} ({duration} s after {settle} s settle)...", case.name);
+        eprintln!(
+            "running {} ({duration} s after {settle} s settle)...",
+            case.name
+        );
         let (r, _) = run_case(&case, configs_dir, &RunControl::silent())?;
         let c = r
             .contacts
             .first()
             .ok_or_else(|| anyhow::anyhow!("case {} has no contact", case.name))?;
-        let k_rs = case.rattle_box.as_ref().and_then(|s| s.rattle_space().ok()).unwrap_or(f64::NAN);
-        rows.push((TABLE_5_3[i], *adams, k_rs, c.clone(), r.wall_s, settle + duration));
+        let k_rs = case
+            .rattle_box
+            .as_ref()
+            .and_then(|s| s.rattle_space().ok())
+            .unwrap_or(f64::NAN);
+        rows.push((
+            TABLE_5_3[i],
+            *adams,
+            k_rs,
+            c.clone(),
+            r.wall_s,
+            settle + duration,
+        ));
     }
     // The effective wear coefficient ADAMS' rate would need at railwear's friction power, and
     // the largest K(sigma) Table 4.3 allows (at the cutoff).
@@ -200,7 +219,11 @@ pub fn compare_rattle_box(duration: f64, settle: f64, out: &Path, configs_dir: &
     for ((letter, measured, repeats), adams, k_rs, c, wall, _sim) in &rows {
         let vol_rate_m3_s = adams * 1e-6 / 2810.0 / 3600.0;
         let k_needed = vol_rate_m3_s / c.mean_friction_power_w.max(1e-30);
-        let meas = if repeats.is_empty() { format!("{measured}") } else { format!("{measured} ({repeats})") };
+        let meas = if repeats.is_empty() {
+            format!("{measured}")
+        } else {
+            format!("{measured} ({repeats})")
+        };
         md.push_str(&format!(
             "| {letter} | {k_rs:.2} | {:.4} | {:.4} | {adams} | {meas} | {:.3} | {:.1} % | {:.4} | {:.3} | {:.0} | {:.2e} | {wall:.1} |\n",
             c.mass_rate_mg_per_h,

@@ -11,7 +11,12 @@ fn configs() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/configs"))
 }
 
-fn run_c(settle: f64, duration: f64, tol_scale: f64, excitation: Option<serde_json::Value>) -> RunReport {
+fn run_c(
+    settle: f64,
+    duration: f64,
+    tol_scale: f64,
+    excitation: Option<serde_json::Value>,
+) -> RunReport {
     let mut case = load_case(&configs().join("rattle-box-c.toml")).expect("case C loads");
     case.simulation.settle_s = settle;
     case.simulation.duration_s = duration;
@@ -21,7 +26,9 @@ fn run_c(settle: f64, duration: f64, tol_scale: f64, excitation: Option<serde_js
     if let Some(e) = excitation {
         case.excitation = e;
     }
-    run_case(&case, configs(), &RunControl::silent()).expect("runs").0
+    run_case(&case, configs(), &RunControl::silent())
+        .expect("runs")
+        .0
 }
 
 #[test]
@@ -34,13 +41,22 @@ fn halving_tolerances_changes_friction_power_by_less_than_two_percent() {
         let b = s.spawn(|| run_c(0.5, 16.0, 0.5, None));
         (a.join().expect("run 1"), b.join().expect("run 2"))
     });
-    let change = (p2.mean_friction_power_w - p1.mean_friction_power_w).abs() / p1.mean_friction_power_w;
-    assert!(change < 0.02, "friction power {} W vs {} W: {:.2} %", p1.mean_friction_power_w, p2.mean_friction_power_w, 100.0 * change);
+    let change =
+        (p2.mean_friction_power_w - p1.mean_friction_power_w).abs() / p1.mean_friction_power_w;
+    assert!(
+        change < 0.02,
+        "friction power {} W vs {} W: {:.2} %",
+        p1.mean_friction_power_w,
+        p2.mean_friction_power_w,
+        100.0 * change
+    );
     // Wear is reported per contact in mg/h; equal materials split the volume half and half
     // (inverse hardness), and mass = 2810 kg/m³ × volume.
     let c = &p1.contacts[0];
     assert!(c.mass_rate_mg_per_h.is_finite() && c.mass_rate_mg_per_h > 0.0);
-    assert!((c.mass_rate_a_mg_per_h - 0.5 * c.mass_rate_mg_per_h).abs() <= 1e-12 * c.mass_rate_mg_per_h);
+    assert!(
+        (c.mass_rate_a_mg_per_h - 0.5 * c.mass_rate_mg_per_h).abs() <= 1e-12 * c.mass_rate_mg_per_h
+    );
     let from_volume = c.wear.volume_m3 * 2810.0 * 1e6 * 3600.0 / p1.window_s;
     assert!((from_volume - c.mass_rate_mg_per_h).abs() <= 1e-9 * from_volume);
     assert!((0.0..=1.0).contains(&c.work_share_above_cutoff));
@@ -50,7 +66,16 @@ fn halving_tolerances_changes_friction_power_by_less_than_two_percent() {
 fn resting_cube_carries_its_weight_and_does_not_wear() {
     let r = run_c(0.2, 1.0, 1.0, Some(serde_json::json!({"kind": "none"})));
     let weight = 0.0254f64.powi(3) * 2810.0 * STANDARD_GRAVITY;
-    assert!((r.mean_normal_force_n - weight).abs() / weight < 0.005, "mean N {} vs m g {}", r.mean_normal_force_n, weight);
+    assert!(
+        (r.mean_normal_force_n - weight).abs() / weight < 0.005,
+        "mean N {} vs m g {}",
+        r.mean_normal_force_n,
+        weight
+    );
     // Without input nothing slides: friction power and wear are (numerically) nil.
-    assert!(r.mean_friction_power_w < 1e-6, "friction power {}", r.mean_friction_power_w);
+    assert!(
+        r.mean_friction_power_w < 1e-6,
+        "friction power {}",
+        r.mean_friction_power_w
+    );
 }
