@@ -71,6 +71,7 @@ pub fn run_all(slow: bool, configs_dir: &Path) -> Vec<Anchor> {
     out.push(incline_anchor());
     out.push(wear_integral_anchor());
     out.push(synthesis_anchor());
+    out.extend(friction_calibration_anchors());
     if slow {
         out.extend(crate::validation_slow::run(configs_dir));
     }
@@ -480,4 +481,77 @@ pub fn synthesis_anchor() -> Anchor {
         measured,
         1.0,
     )
+}
+
+/// Friction calibration (eq. 4.1-4.4) recovers Table 4.2 from torque records generated with it
+/// plus 2 % multiplicative noise (deterministic ChaCha8 with a fixed seed, Box-Muller).
+pub fn friction_calibration_anchors() -> Vec<Anchor> {
+    use crate::analysis::calibration::{fit_friction, friction_samples, Fixture, TorqueRecord};
+    use rand::{Rng, SeedableRng};
+    let truth = FrictionParams::thesis_table_5_2();
+    let fixture = Fixture {
+        polar_inertia_kg_m2: 0.02,
+        mean_radius_m: 0.02,
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(42);
+    let w = 2.0 * std::f64::consts::PI * 0.1;
+    let records: Vec<TorqueRecord> = (0..20_000)
+        .map(|i| {
+            let t = i as f64 * 1e-3;
+            let thd = 1.5 * (w * t).sin();
+            let thdd = 1.5 * w * (w * t).cos();
+            let v = thd * fixture.mean_radius_m;
+            let mu = truth.coefficient(v.abs()) * v.signum();
+            let torque =
+                fixture.polar_inertia_kg_m2 * thdd + 3.0 * fixture.mean_radius_m * 300.0 * mu;
+            let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+            let gauss = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
+            TorqueRecord {
+                time_s: t,
+                angle_rad: -1.5 / w * (w * t).cos(),
+                angular_velocity_rad_s: thd,
+                normal_load_n: 300.0,
+                input_torque_n_m: torque * (1.0 + 0.02 * gauss),
+            }
+        })
+        .collect();
+    let fit = friction_samples(&records, &fixture)
+        .ok()
+        .and_then(|s| fit_friction(&s, crate::physics::step::StepKind::Cycloidal).ok())
+        .map(|f| f.params);
+    let get = |f: fn(&FrictionParams) -> f64| fit.as_ref().map(f).unwrap_or(f64::NAN);
+    vec![
+        anchor(
+            "friction calibration: mu_s from noisy torque records",
+            "Table 4.2, eq. 4.3 (within 3 %)",
+            "-",
+            0.1799,
+            get(|p| p.mu_static),
+            0.03 * 0.1799,
+        ),
+        anchor(
+            "friction calibration: mu_d from noisy torque records",
+            "Table 4.2, eq. 4.3 (within 3 %)",
+            "-",
+            0.1660,
+            get(|p| p.mu_dynamic),
+            0.03 * 0.1660,
+        ),
+        anchor(
+            "friction calibration: stiction transition speed",
+            "Table 4.2 (within 10 %)",
+            "m/s",
+            6.4634e-3,
+            get(|p| p.stiction_transition_speed),
+            0.1 * 6.4634e-3,
+        ),
+        anchor(
+            "friction calibration: friction transition speed",
+            "Table 4.2 (within 10 %)",
+            "m/s",
+            12.0e-3,
+            get(|p| p.friction_transition_speed),
+            0.1 * 12.0e-3,
+        ),
+    ]
 }

@@ -39,5 +39,58 @@ pub fn run(configs_dir: &Path) -> Vec<Anchor> {
         tolerance: 0.02,
         pass: ((p2 - p1) / p1).abs() < 0.02,
     });
+    out.extend(launcher_trend(configs_dir));
     out
+}
+
+/// Rail wear rate of the tight, design and loose launchers (1 s settle + 2 s AH-64 transverse):
+/// looser rails wear faster (thesis 6.6), so K_SL (eq. 6.4) is 1 at design and below 1 loose.
+fn launcher_trend(configs_dir: &Path) -> Vec<Anchor> {
+    let rate = |v: &str| -> (f64, f64) {
+        let Ok(mut case) = load_case(&configs_dir.join(format!("launcher-{v}.toml"))) else {
+            return (f64::NAN, f64::NAN);
+        };
+        case.simulation.settle_s = 1.0;
+        case.simulation.duration_s = 2.0;
+        case.simulation.record_interval_s = 2.0;
+        let k = case
+            .launcher
+            .as_ref()
+            .and_then(|l| l.rattle_space().ok())
+            .unwrap_or(f64::NAN);
+        match run_case(&case, configs_dir, &RunControl::silent()) {
+            Ok((r, _)) => (
+                k,
+                r.bodies
+                    .iter()
+                    .find(|b| b.name == "rail")
+                    .map(|b| b.mass_rate_mg_per_h)
+                    .unwrap_or(f64::NAN),
+            ),
+            Err(_) => (k, f64::NAN),
+        }
+    };
+    let (t, d, l) = (rate("tight"), rate("design"), rate("loose"));
+    let ordered = t.1 < d.1 && d.1 < l.1;
+    let k_sl_loose = (d.1 / l.1).min(1.0);
+    vec![
+        Anchor {
+            name: "launcher: rail wear tight < design < loose (1 = ordered)".into(),
+            source: "thesis 6.6 / SPEC 8: looser rails wear faster".into(),
+            unit: "-".into(),
+            expected: 1.0,
+            measured: if ordered { 1.0 } else { 0.0 },
+            tolerance: 0.0,
+            pass: ordered,
+        },
+        Anchor {
+            name: "launcher: K_SL at the loose rail is below 1".into(),
+            source: "eq. 6.4".into(),
+            unit: "-".into(),
+            expected: 0.5,
+            measured: k_sl_loose,
+            tolerance: 0.5,
+            pass: k_sl_loose < 1.0 && k_sl_loose > 0.0,
+        },
+    ]
 }
