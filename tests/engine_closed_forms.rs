@@ -1,10 +1,7 @@
 //! Engine verification against closed forms and thesis anchors (issue 2, items 1, 2, 4).
 
-use nalgebra::{Isometry3, Matrix3, Point3, Unit, UnitQuaternion, Vector3};
-use railwear::geometry::{ConvexShape, HalfSpace};
-use railwear::physics::body::{write_state, BodyKind, Fixed, MassProperties, RigidBody};
-use railwear::physics::contact::Contact;
-use railwear::physics::forces::{Attachment, ConstantForce, ForceElement};
+use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
+use railwear::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
@@ -12,29 +9,9 @@ use railwear::physics::simulate::{simulate, DivergenceLimits, StepView};
 use railwear::physics::step::StepKind;
 use railwear::physics::system::MultibodySystem;
 use railwear::pipeline::RunControl;
-use std::sync::Arc;
+use railwear::validation::{settle_penetration, sphere_on_floor, table_2_1_settle_impact};
 
 const G: f64 = 9.80665;
-const DENSITY_7075: f64 = 2810.0;
-
-fn ground() -> RigidBody {
-    RigidBody {
-        name: "ground".into(),
-        mass: MassProperties {
-            mass: 1.0,
-            inertia: Matrix3::identity(),
-        },
-        kind: BodyKind::Kinematic(Arc::new(Fixed(Isometry3::identity()))),
-    }
-}
-
-fn floor_y() -> HalfSpace {
-    HalfSpace {
-        normal: Unit::new_normalize(Vector3::y()),
-        offset: 0.0,
-    }
-}
-
 fn settings(kind: IntegratorKind, rel: f64) -> IntegratorSettings {
     IntegratorSettings {
         kind,
@@ -45,40 +22,9 @@ fn settings(kind: IntegratorKind, rel: f64) -> IntegratorSettings {
     }
 }
 
-/// Sphere of radius r on the floor y = 0, centre at height y0 with vertical speed v0.
+/// Sphere of radius r on the floor y = 0 (the library's validation builder).
 fn sphere_system(r: f64, impact: ImpactParams, extra_load_n: f64) -> MultibodySystem {
-    let sphere = RigidBody {
-        name: "sphere".into(),
-        mass: MassProperties::solid_sphere(r, DENSITY_7075),
-        kind: BodyKind::Dynamic { offset: 0 },
-    };
-    let contact = Contact {
-        name: "sphere-floor".into(),
-        body_a: 0,
-        pieces_a: vec![(Isometry3::identity(), ConvexShape::Sphere { radius: r })],
-        body_b: 1,
-        faces_b: vec![floor_y()],
-        impact,
-        friction: None,
-    };
-    let mut forces = vec![];
-    if extra_load_n != 0.0 {
-        forces.push(ForceElement::ConstantForce(ConstantForce {
-            name: "load".into(),
-            a: Attachment {
-                body: 0,
-                point: Point3::origin(),
-            },
-            force_body: Vector3::new(0.0, -extra_load_n, 0.0),
-            reaction: None,
-        }));
-    }
-    MultibodySystem::new(
-        vec![sphere, ground()],
-        Vector3::new(0.0, -G, 0.0),
-        forces,
-        vec![contact],
-    )
+    sphere_on_floor(r, impact, extra_load_n).0
 }
 
 fn initial(sys: &MultibodySystem, y0: f64, v0: f64) -> Vec<f64> {
@@ -242,39 +188,13 @@ fn restitution_falls_as_damping_rises() {
     }
 }
 
-/// Thesis Table 2.1 (ADAMS units: N/mm^e) with the small settle damping of thesis 2.3.1
-/// (c_max = 10 N·s/mm) as used for Table 2.2.
 fn table_2_1(index: usize) -> ImpactParams {
-    let (k, e) = [
-        (12_042_000.0, 1.5),
-        (382_646.0, 1.0),
-        (1_643_500.0, 2.47),
-        (988_250.0, 2.409),
-    ][index];
-    let mut p = ImpactParams::from_adams_units(k, e, 10.0, 0.0);
-    p.full_damping_depth = 1e-9;
-    p
+    table_2_1_settle_impact(index)
 }
 
 fn settle_penetration_mm(impact: ImpactParams) -> f64 {
-    let r = 0.05;
-    let sys = sphere_system(r, impact, 1000.0);
-    let mut y = initial(&sys, r, 0.0); // just touching, w = 0
-    let mut last_w = 0.0;
-    simulate(
-        &sys,
-        &mut y,
-        0.0,
-        0.5,
-        settings(IntegratorKind::Trbdf2, 1e-6),
-        DivergenceLimits::default(),
-        &RunControl::silent(),
-        &mut |v: &StepView| {
-            last_w = v.tracks.first().map(|t| t.penetration).unwrap_or(0.0);
-        },
-    )
-    .expect("settles");
-    last_w * 1e3
+    // 50 mm sphere, gravity plus 1000 N, starting just in contact (w = 0).
+    settle_penetration(impact, 0.05, 1000.0) * 1e3
 }
 
 #[test]
@@ -331,87 +251,8 @@ fn hertz_row_of_table_2_1_bounces_highest() {
     }
 }
 
-/// A sled: one body resting on four small spheres on a plane tilted by `angle` about z.
 fn sled_on_incline(angle: f64, t_end: f64) -> (f64, f64) {
-    let r = 0.002;
-    let mass = MassProperties {
-        mass: 0.5,
-        inertia: Matrix3::from_diagonal_element(1e-3),
-    };
-    let sled = RigidBody {
-        name: "sled".into(),
-        mass,
-        kind: BodyKind::Dynamic { offset: 0 },
-    };
-    let pieces = [(-0.02, -0.02), (-0.02, 0.02), (0.02, -0.02), (0.02, 0.02)]
-        .iter()
-        .map(|&(x, z)| {
-            (
-                Isometry3::translation(x, -0.01, z),
-                ConvexShape::Sphere { radius: r },
-            )
-        })
-        .collect();
-    let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
-    let plane_pose = Isometry3::from_parts(nalgebra::Translation3::identity(), rot);
-    let incline = RigidBody {
-        name: "incline".into(),
-        mass: MassProperties {
-            mass: 1.0,
-            inertia: Matrix3::identity(),
-        },
-        kind: BodyKind::Kinematic(Arc::new(Fixed(plane_pose))),
-    };
-    let contact = Contact {
-        name: "sled-incline".into(),
-        body_a: 0,
-        pieces_a: pieces,
-        body_b: 1,
-        faces_b: vec![floor_y()],
-        impact: ImpactParams::thesis_table_5_2(),
-        friction: Some(FrictionParams::thesis_table_5_2()),
-    };
-    let sys = MultibodySystem::new(
-        vec![sled, incline],
-        Vector3::new(0.0, -G, 0.0),
-        vec![],
-        vec![contact],
-    );
-    let mut y = vec![0.0; sys.state_len()];
-    // Resting on the spheres at about the static penetration, aligned with the incline.
-    let w0 = ImpactParams::thesis_table_5_2().static_penetration(0.5 * G * angle.cos() / 4.0);
-    let p = rot * Vector3::new(0.0, 0.01 + r - w0, 0.0);
-    write_state(
-        &mut y,
-        0,
-        &Isometry3::from_parts(p.into(), rot),
-        Vector3::zeros(),
-        Vector3::zeros(),
-    );
-    let downhill = rot * -Vector3::x();
-    let mut samples: Vec<(f64, f64)> = vec![];
-    simulate(
-        &sys,
-        &mut y,
-        0.0,
-        t_end,
-        settings(IntegratorKind::Trbdf2, 1e-6),
-        DivergenceLimits::default(),
-        &RunControl::silent(),
-        &mut |v: &StepView| {
-            let vel = Vector3::new(v.state[7], v.state[8], v.state[9]);
-            samples.push((v.t, vel.dot(&downhill)));
-        },
-    )
-    .expect("runs");
-    // Speed at the end and mean acceleration over the second half.
-    let (t1, v1) = *samples.last().expect("samples");
-    let half = samples
-        .iter()
-        .find(|(t, _)| *t >= t_end / 2.0)
-        .copied()
-        .unwrap_or((0.0, 0.0));
-    (v1, (v1 - half.1) / (t1 - half.0))
+    railwear::validation::sled_on_incline(angle, t_end).expect("sled run")
 }
 
 #[test]
