@@ -55,28 +55,7 @@ pub fn run(
     let mut csv = std::io::BufWriter::new(std::fs::File::create(dir.join("tracks.csv"))?);
     writeln!(csv, "{}", crate::physics::track::TrackSample::CSV_HEADER)?;
     for s in &outcome.tracks {
-        writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            s.time_s,
-            s.contact,
-            s.track,
-            s.normal_force_n,
-            s.slip_velocity_m_s[0],
-            s.slip_velocity_m_s[1],
-            s.slip_velocity_m_s[2],
-            s.slip_speed_m_s,
-            s.penetration_m,
-            s.penetration_rate_m_s,
-            s.area_m2,
-            s.pressure_pa,
-            s.point_in_a_m[0],
-            s.point_in_a_m[1],
-            s.point_in_a_m[2],
-            s.point_in_b_m[0],
-            s.point_in_b_m[1],
-            s.point_in_b_m[2]
-        )?;
+        writeln!(csv, "{}", crate::store::tracks::csv_line(s))?;
     }
     csv.flush()?;
     for (name, svg) in &outcome.plots {
