@@ -218,17 +218,14 @@ fn plots(
 ) -> Vec<(String, String)> {
     let mut out = Vec::new();
     // Wear versus time per contact, mg.
-    let density = r
-        .contacts
-        .first()
-        .map(|_| {
-            case.rattle_box
-                .as_ref()
-                .map(|s| s.material.density_kg_per_m3)
-                .or(case.launcher.as_ref().map(|s| s.material.density_kg_per_m3))
-                .unwrap_or(2810.0)
-        })
-        .unwrap_or(2810.0);
+    // The rattle box and the launcher are one material (7075-T73 unless the config says
+    // otherwise); the persistent-contact case has no dynamic run.
+    let material = match case.model_spec() {
+        Ok(ModelSpecRef::RattleBox(s)) => s.material,
+        Ok(ModelSpecRef::Launcher(s)) => s.material,
+        _ => super::specs::MaterialSpec::default(),
+    };
+    let density = material.density_kg_per_m3;
     let mut wear_plot = Plot::new(
         format!("{}: wear versus time", case.name),
         AxisSpec::linear("time (s)"),
@@ -266,13 +263,7 @@ fn plots(
             AxisSpec::linear("time density (1/MPa)"),
         )
         .with_series(Series::histogram("time share", &edges, &values));
-        let sy = case
-            .rattle_box
-            .as_ref()
-            .map(|s| s.material.yield_strength_pa)
-            .or(case.launcher.as_ref().map(|s| s.material.yield_strength_pa))
-            .unwrap_or(435e6);
-        p = p.with_marker(sy / 1e6, "Sy");
+        p = p.with_marker(material.yield_strength_pa / 1e6, "Sy");
         if let Some(cut) = c.wear.cutoff_pressure_pa {
             p = p.with_marker(cut / 1e6, "cutoff");
         }
