@@ -19,6 +19,7 @@
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
 
+use super::contact::GeometryMode;
 use super::system::{MultibodySystem, Workspace};
 use serde::{Deserialize, Serialize};
 
@@ -163,6 +164,8 @@ pub struct Integrator {
     settings: IntegratorSettings,
     n: usize,
     abs_tol: Vec<f64>,
+    /// State entries that are velocities (their Jacobian columns keep all poses).
+    velocity_column: Vec<bool>,
     h: f64,
     k: [Vec<f64>; 7],
     fsal_valid: bool,
@@ -199,8 +202,9 @@ impl Integrator {
     pub fn new(system: &MultibodySystem, settings: IntegratorSettings) -> Self {
         let n = system.state_len();
         let tol = settings.tolerances;
-        let abs_tol = system
-            .state_kinds()
+        let kinds = system.state_kinds();
+        let velocity_column = kinds.iter().map(|&k| k >= 2).collect();
+        let abs_tol = kinds
             .into_iter()
             .map(|k| match k {
                 0 => tol.abs_position_m,
@@ -214,6 +218,7 @@ impl Integrator {
             settings,
             n,
             abs_tol,
+            velocity_column,
             h: settings.initial_step_s,
             k: [v(), v(), v(), v(), v(), v(), v()],
             fsal_valid: false,
@@ -267,10 +272,22 @@ impl Integrator {
     }
 
     fn compute_jacobian(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64]) {
-        // Forward differences around (t, y); f(t, y) is k[0] (valid: FSAL).
+        // Forward differences around (t, y); f(t, y) is k[0] (valid: FSAL). Velocity columns
+        // leave every pose unchanged: the first one records the contact geometry, the others
+        // replay it (bit-identical forces, no overlap computation).
         let n = self.n;
         self.jac_y.copy_from_slice(y);
+        let mut recorded = false;
         for j in 0..n {
+            let mode = if !self.velocity_column[j] {
+                GeometryMode::Compute
+            } else if recorded {
+                GeometryMode::Replay
+            } else {
+                recorded = true;
+                GeometryMode::Record
+            };
+            ws.geometry.set_mode(mode);
             let scale = self.abs_tol[j] * 1e3;
             let delta = 1.5e-8 * y[j].abs().max(scale);
             self.jac_y[j] = y[j] + delta;
@@ -282,6 +299,7 @@ impl Integrator {
             }
             self.jac_y[j] = y[j];
         }
+        ws.geometry.set_mode(GeometryMode::Compute);
         self.stats.jacobians += 1;
         self.jac_fresh = true;
         self.jac_age = 0;
