@@ -67,63 +67,66 @@ impl TrackState {
 
 /// What [`Contact::evaluate`] does with the overlap geometry of each (piece, face) pair.
 ///
-/// The finite-difference Jacobian perturbs velocities in half of its columns; those columns
-/// leave every pose unchanged, so the overlap geometry (85 % of a right-hand side) is computed
-/// once and replayed, giving bit-identical forces at a fraction of the cost.
+/// The finite-difference Jacobian perturbs one state entry per column. Velocity columns leave
+/// every pose unchanged, and a pose column of one body leaves the contacts of the other bodies
+/// unchanged; those contacts replay the overlaps (85 % of a right-hand side) recorded at the
+/// unperturbed state, which gives bit-identical forces at a fraction of the cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GeometryMode {
     /// Compute every overlap (normal evaluation).
     #[default]
     Compute,
-    /// Compute every overlap and remember it in evaluation order.
+    /// Compute every overlap and remember it.
     Record,
-    /// Reuse the overlaps remembered by the last `Record` pass (same poses only).
+    /// Reuse the overlaps remembered by the last `Record` pass: every pose is the recorded one.
     Replay,
+    /// Poses of all bodies but this one are the recorded ones: contacts not touching it replay.
+    ReplayExcept(usize),
 }
 
-/// Overlaps remembered between a `Record` pass and `Replay` passes over the same poses.
+/// Overlaps remembered between a `Record` pass and replays over the same poses.
 #[derive(Debug, Clone, Default)]
 pub struct GeometryCache {
     /// Current mode.
     pub mode: GeometryMode,
+    /// Overlap of every (piece, face) pair of every contact, in evaluation order.
     entries: Vec<Option<PlaneOverlap>>,
-    cursor: usize,
+    /// Index of each contact's first entry.
+    contact_start: Vec<usize>,
 }
 
 impl GeometryCache {
-    /// Switches mode; `Record` forgets the old entries, `Replay` rewinds to the first one.
+    /// Switches mode; `Record` forgets the old entries.
     pub fn set_mode(&mut self, mode: GeometryMode) {
         self.mode = mode;
-        self.cursor = 0;
         if mode == GeometryMode::Record {
             self.entries.clear();
+            self.contact_start.clear();
         }
     }
 
-    #[inline]
-    fn overlap(
-        &mut self,
-        shape: &ConvexShape,
-        pose: &Isometry3<f64>,
-        hs: &HalfSpace,
-    ) -> Option<PlaneOverlap> {
-        match self.mode {
-            GeometryMode::Compute => shape_halfspace_overlap(shape, pose, hs),
+    /// Where contact `index` (with `pairs` piece-face pairs between bodies `a` and `b`) reads
+    /// its overlaps from: `Some(first entry)` to replay, `None` to compute. Registers the
+    /// contact when recording.
+    fn begin(&mut self, index: usize, pairs: usize, a: usize, b: usize) -> Option<usize> {
+        let replay = match self.mode {
+            GeometryMode::Compute => false,
             GeometryMode::Record => {
-                let ov = shape_halfspace_overlap(shape, pose, hs);
-                self.entries.push(ov);
-                ov
+                if self.contact_start.len() <= index {
+                    self.contact_start.resize(index + 1, usize::MAX);
+                }
+                self.contact_start[index] = self.entries.len();
+                false
             }
-            GeometryMode::Replay => {
-                let ov = match self.entries.get(self.cursor) {
-                    Some(ov) => *ov,
-                    // Fewer entries than pairs: the record pass was for another system.
-                    None => shape_halfspace_overlap(shape, pose, hs),
-                };
-                self.cursor += 1;
-                ov
-            }
-        }
+            GeometryMode::Replay => true,
+            GeometryMode::ReplayExcept(body) => body != a && body != b,
+        };
+        let start = *self.contact_start.get(index)?;
+        (replay
+            && start
+                .checked_add(pairs)
+                .is_some_and(|end| end <= self.entries.len()))
+        .then_some(start)
     }
 }
 
@@ -155,6 +158,13 @@ impl Contact {
         let iso_a = fa.isometry();
         let mut energy = 0.0;
         let nfaces = self.faces_b.len();
+        let replay_from = geometry.begin(
+            index as usize,
+            self.pieces_a.len() * nfaces,
+            self.body_a,
+            self.body_b,
+        );
+        let recording = geometry.mode == GeometryMode::Record;
         for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
             let pose = iso_a * piece_pose;
             for (jf, face) in self.faces_b.iter().enumerate() {
@@ -164,7 +174,17 @@ impl Contact {
                     normal: Unit::new_unchecked(n_world),
                     offset: offset_world,
                 };
-                let Some(ov) = geometry.overlap(shape, &pose, &hs) else {
+                let ov = match replay_from {
+                    Some(start) => geometry.entries[start + ip * nfaces + jf],
+                    None => {
+                        let ov = shape_halfspace_overlap(shape, &pose, &hs);
+                        if recording {
+                            geometry.entries.push(ov);
+                        }
+                        ov
+                    }
+                };
+                let Some(ov) = ov else {
                     continue;
                 };
                 let w = ov.depth;

@@ -19,6 +19,7 @@
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
 
+use super::body::{BodyKind, BODY_STATE_LEN};
 use super::contact::GeometryMode;
 use super::system::{MultibodySystem, Workspace};
 use serde::{Deserialize, Serialize};
@@ -166,6 +167,8 @@ pub struct Integrator {
     abs_tol: Vec<f64>,
     /// State entries that are velocities (their Jacobian columns keep all poses).
     velocity_column: Vec<bool>,
+    /// Body owning each state entry.
+    column_body: Vec<usize>,
     h: f64,
     k: [Vec<f64>; 7],
     fsal_valid: bool,
@@ -204,6 +207,14 @@ impl Integrator {
         let tol = settings.tolerances;
         let kinds = system.state_kinds();
         let velocity_column = kinds.iter().map(|&k| k >= 2).collect();
+        let mut column_body = vec![0; n];
+        for (i, b) in system.bodies.iter().enumerate() {
+            if let BodyKind::Dynamic { offset } = b.kind {
+                for c in column_body.iter_mut().skip(offset).take(BODY_STATE_LEN) {
+                    *c = i;
+                }
+            }
+        }
         let abs_tol = kinds
             .into_iter()
             .map(|k| match k {
@@ -219,6 +230,7 @@ impl Integrator {
             n,
             abs_tol,
             velocity_column,
+            column_body,
             h: settings.initial_step_s,
             k: [v(), v(), v(), v(), v(), v(), v()],
             fsal_valid: false,
@@ -272,15 +284,23 @@ impl Integrator {
     }
 
     fn compute_jacobian(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64]) {
-        // Forward differences around (t, y); f(t, y) is k[0] (valid: FSAL). Velocity columns
-        // leave every pose unchanged: the first one records the contact geometry, the others
-        // replay it (bit-identical forces, no overlap computation).
+        // Forward differences around (t, y); f(t, y) is k[0] (valid: FSAL). A velocity column
+        // leaves every pose unchanged and a pose column moves one body: contacts whose poses
+        // are unchanged replay the geometry (bit-identical forces, no overlap computation).
         let n = self.n;
         self.jac_y.copy_from_slice(y);
+        // Velocity columns first: the first records the geometry at the unperturbed poses.
         let mut recorded = false;
-        for j in 0..n {
+        let velocity_first = (0..n)
+            .filter(|&j| self.velocity_column[j])
+            .chain((0..n).filter(|&j| !self.velocity_column[j]));
+        for j in velocity_first {
             let mode = if !self.velocity_column[j] {
-                GeometryMode::Compute
+                if recorded {
+                    GeometryMode::ReplayExcept(self.column_body[j])
+                } else {
+                    GeometryMode::Compute
+                }
             } else if recorded {
                 GeometryMode::Replay
             } else {
