@@ -57,6 +57,20 @@ fn plain(a: f64, b: f64, visit: &mut impl FnMut(f64, f64)) {
     }
 }
 
+/// 3-point Gauss–Legendre on `[a, b]` (exact to degree 5). For an integrand analytic in the
+/// Bernstein ellipse of parameter `ρ` around `[a, b]` its error is of order `ρ⁻⁶`: with every
+/// kink or singularity at least 100 half-lengths from the midpoint (`ρ ≈ 200`), about 1.6e-14
+/// of the integrand's scale, the same as the 6-point rule's round-off.
+#[inline]
+pub(crate) fn gauss3(a: f64, b: f64, visit: &mut impl FnMut(f64, f64)) {
+    const X: f64 = 0.774_596_669_241_483_4; // sqrt(3/5)
+    let half = 0.5 * (b - a);
+    let mid = 0.5 * (a + b);
+    visit(mid - half * X, half * 5.0 / 9.0);
+    visit(mid, half * 8.0 / 9.0);
+    visit(mid + half * X, half * 5.0 / 9.0);
+}
+
 /// Nodes for `x = x0 + l y²`, `y ∈ [0, 1]`; `|dx| = 2 |l| y dy`.
 #[inline]
 fn clustered(x0: f64, l: f64, visit: &mut impl FnMut(f64, f64)) {
@@ -137,6 +151,19 @@ mod tests {
         let exact = 3.0 * std::f64::consts::PI / 128.0;
         // worst case: both ends singular, branch points of (1 - x)^{3/2} near the split.
         assert!((s - exact).abs() < 2e-7 * exact, "{s} vs {exact}");
+    }
+
+    #[test]
+    fn three_point_rule_is_exact_to_degree_five_and_converges_far_from_a_singularity() {
+        let mut s = 0.0;
+        gauss3(-1.0, 3.0, &mut |x, w| s += w * x.powi(5));
+        assert!((s - (3f64.powi(6) - 1.0) / 6.0).abs() < 1e-12 * s);
+        // (d - x)^{3/2} with the branch point d = 100 half-lengths from the midpoint of [-1, 1].
+        let d = 100.0;
+        let mut s = 0.0;
+        gauss3(-1.0, 1.0, &mut |x, w| s += w * (d - x).powf(1.5));
+        let exact = ((d + 1.0).powf(2.5) - (d - 1.0).powf(2.5)) / 2.5;
+        assert!((s - exact).abs() < 2e-14 * exact, "{s} vs {exact}");
     }
 
     #[test]
