@@ -269,8 +269,8 @@ pub fn sweep_point(
         .ok_or_else(|| invalid("point", format!("must be below {}", plan.len())))?;
     let mut case = plan.base.clone();
     if let Some(l) = case.launcher.as_mut() {
-        l.dimensions =
-            crate::analysis::rattle_space::LauncherDimensions::design().with_material_condition(offset_mm);
+        l.dimensions = crate::analysis::rattle_space::LauncherDimensions::design()
+            .with_material_condition(offset_mm);
     }
     let rattle_space = case
         .launcher

@@ -8,8 +8,8 @@ pub mod sqlite;
 pub mod tracks;
 
 use crate::config::Role;
-use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 pub use crate::jobs::model::{ChildCounts, ChildOf};
+use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use crate::physics::track::TrackSample;
 use std::future::Future;
 use std::pin::Pin;

@@ -585,16 +585,7 @@ impl Store for PgStore {
             end_attempt(&mut tx, id, attempt, status.into(), now_ms).await?;
             if let Some(parent) = parent {
                 let index: i64 = updated.try_get("child_index")?;
-                child_ended(
-                    &mut tx,
-                    parent,
-                    id,
-                    index,
-                    status,
-                    error.as_deref(),
-                    now_ms,
-                )
-                .await?;
+                child_ended(&mut tx, parent, id, index, status, error.as_deref(), now_ms).await?;
             }
             if let Finish::Succeeded {
                 blocks,
@@ -870,16 +861,8 @@ impl Store for PgStore {
                 if let (Some(parent), true) = (parent, status.is_terminal()) {
                     let error: Option<String> = row.try_get("error")?;
                     let index: i64 = row.try_get("child_index")?;
-                    child_ended(
-                        &mut tx,
-                        parent,
-                        id,
-                        index,
-                        status,
-                        error.as_deref(),
-                        now_ms,
-                    )
-                    .await?;
+                    child_ended(&mut tx, parent, id, index, status, error.as_deref(), now_ms)
+                        .await?;
                 }
                 tx.commit().await?;
                 changed += 1;

@@ -254,12 +254,10 @@ async fn cancel_children(
             .execute(&mut *conn)
             .await?;
     }
-    sqlx::query(
-        "UPDATE jobs SET cancel_requested = 1 WHERE parent_id = ?1 AND status = 'running'",
-    )
-    .bind(parent)
-    .execute(&mut *conn)
-    .await?;
+    sqlx::query("UPDATE jobs SET cancel_requested = 1 WHERE parent_id = ?1 AND status = 'running'")
+        .bind(parent)
+        .execute(&mut *conn)
+        .await?;
     Ok(())
 }
 
@@ -651,7 +649,14 @@ impl Store for SqliteStore {
                 .execute(&mut *tx)
                 .await?;
             }
-            end_attempt(&mut tx, &parent_id, attempt, AttemptOutcome::FannedOut, now_ms).await?;
+            end_attempt(
+                &mut tx,
+                &parent_id,
+                attempt,
+                AttemptOutcome::FannedOut,
+                now_ms,
+            )
+            .await?;
             tx.commit().await?;
             Ok(FanOutResult::FannedOut)
         })
