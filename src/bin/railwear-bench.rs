@@ -1280,7 +1280,7 @@ fn sweep_procs(
     settle: f64,
     window: f64,
 ) -> Result<Vec<Table>> {
-    if !(settle >= 0.0 && window > 0.0) || !(2..=50).contains(&points) {
+    if !(settle >= 0.0 && window > 0.0 && (2..=50).contains(&points)) {
         bail!("--settle >= 0, --window > 0, --points in 2..=50");
     }
     if !bin.exists() {
