@@ -129,11 +129,12 @@ enum Command {
         /// Points per sweep (child jobs).
         #[arg(long, default_value_t = 12)]
         points: u64,
-        /// Settle time of each point, s.
-        #[arg(long, default_value_t = 0.2)]
+        /// Settle time of each point, s (long enough that process start-up and polling are
+        /// small beside a point's run).
+        #[arg(long, default_value_t = 0.5)]
         settle: f64,
         /// Excitation window of each point, s.
-        #[arg(long, default_value_t = 0.3)]
+        #[arg(long, default_value_t = 1.0)]
         window: f64,
     },
     /// Service load: the real `railwear serve`, N rails stored, two simulations running, then
@@ -1260,6 +1261,17 @@ impl Drop for BenchDb {
     }
 }
 
+/// CPU time of this process's reaped children (user + system), s, from /proc/self/stat
+/// (`cutime`, `cstime` in USER_HZ ticks, 100 per second on Linux).
+fn reaped_children_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name `(...)`: state is field 3, cutime 16, cstime 17.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(13)? + ticks(14)?) / 100.0)
+}
+
 /// Worker processes, killed (SIGKILL) and reaped on drop.
 struct Workers(Vec<std::process::Child>);
 
@@ -1335,6 +1347,8 @@ fn sweep_procs(
             ("wall_s", "wall s"),
             ("simulations_per_min", "simulations/min"),
             ("ratio", "ratio to 1 process"),
+            ("cores_used", "worker CPU s / wall s"),
+            ("points_per_process", "points run per process"),
         ],
     );
     let mut base: Option<f64> = None;
@@ -1352,6 +1366,7 @@ fn sweep_procs(
             Ok(other) => bail!("unexpected submission answer {other:?}"),
             Err(e) => bail!("submission refused: {e}"),
         };
+        let cpu_before = reaped_children_cpu_s();
         let start = Instant::now();
         let mut workers = Workers(Vec::new());
         for _ in 0..procs {
@@ -1379,6 +1394,24 @@ fn sweep_procs(
         };
         let wall = start.elapsed().as_secs_f64();
         drop(workers);
+        let cores_used = match (cpu_before, reaped_children_cpu_s()) {
+            (Some(a), Some(b)) => Some((b - a) / wall),
+            _ => None,
+        };
+        // Which process ran each point (the succeeded attempt's lease owner, `<host>-<pid>-0`).
+        let mut per_worker: std::collections::BTreeMap<String, u64> = Default::default();
+        for child in rt.block_on(store.children(id))? {
+            for a in rt.block_on(store.attempts(child.id))? {
+                if a.outcome == railwear::store::AttemptOutcome::Succeeded {
+                    *per_worker.entry(a.worker).or_default() += 1;
+                }
+            }
+        }
+        let spread = per_worker
+            .values()
+            .map(u64::to_string)
+            .collect::<Vec<_>>()
+            .join(" + ");
         if job.status != railwear::jobs::JobStatus::Succeeded {
             bail!(
                 "sweep {id} ended {}: {}",
@@ -1396,6 +1429,8 @@ fn sweep_procs(
             Cell::Num(wall),
             Cell::Num(per_min),
             Cell::Num(ratio),
+            Cell::opt(cores_used),
+            Cell::text(spread),
         ]);
     }
     t.note(format!(
@@ -1407,7 +1442,10 @@ fn sweep_procs(
             "DIFFERENT"
         }
     ));
-    t.note("2 processes can reach 2x only with 2 idle cores");
+    t.note(
+        "2 processes can reach 2x only with 2 idle cores: `worker CPU s / wall s` is how many \
+         cores the worker processes got (the rest went to other load on the machine)",
+    );
     t.note(machine_note());
     drop(store);
     drop(jobs);
