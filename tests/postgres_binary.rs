@@ -209,7 +209,8 @@ fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
 /// sweep fanned out into 12 child jobs; one worker is killed (SIGKILL) while it holds a child.
 /// Every child ends with exactly one succeeded attempt (the killed one is logged lost and its
 /// child re-run elsewhere), the sweep is fanned out once and assembled once, and its result
-/// equals the sequential in-process sweep (`pipeline::sweep`) with the same seed bit for bit.
+/// equals bit for bit both the same sweep run by a single `railwear serve` process on SQLite
+/// (fanned out to its embedded workers) and the sequential in-process `pipeline::sweep`.
 #[test]
 fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     use railwear::store::AttemptOutcome;
@@ -221,12 +222,12 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     let (_api, base) = api(&db.url, &env);
     let mut workers: Vec<Option<Proc>> = (0..3).map(|_| Some(worker(&db.url, &env))).collect();
 
-    // Short points (about a second each in the test profile).
+    // Short points (under a second each in the test profile).
     let params = serde_json::json!({
         "config": "launcher-design",
         "points": 12,
         "seed": 2024,
-        "overrides": {"simulation": {"settle_s": 0.2, "duration_s": 0.5, "record_interval_s": 0.01}},
+        "overrides": {"simulation": {"settle_s": 0.2, "duration_s": 0.3, "record_interval_s": 0.01}},
     });
     // The single-process reference, computed here while the workers run.
     let reference = {
@@ -237,10 +238,12 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
                 .expect("sequential sweep")
         })
     };
-    let id = submit(
-        &base,
-        &serde_json::json!({"kind": "sweep", "params": params}).to_string(),
-    );
+    let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
+    let id = submit(&base, &body);
+    // The same sweep in one process on SQLite.
+    let sqlite_dir = service_support::TempDir::new("fanout-sqlite");
+    let single = service_support::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
+    let single_id = submit(&single.base, &body);
 
     // SIGKILL the worker process that holds a running child.
     let victim_worker = wait_for(Duration::from_secs(120), "a running child", || {
@@ -309,9 +312,27 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
     );
 
-    // The assembled result and the stored curve equal the sequential single-process sweep.
+    // The assembled result and the stored curve equal the sequential single-process sweep, and
+    // the single-process SQLite service's result.
     let (summary, outcome) = reference.join().expect("reference sweep");
     let job = rt.block_on(store.get_job(id)).expect("job").expect("job");
+    let single_done = wait_status(
+        &single.base,
+        &single_id,
+        "succeeded",
+        Duration::from_secs(300),
+    );
+    assert_eq!(single_done["children"]["succeeded"], 12);
+    let single_result = curl(
+        "GET",
+        &format!("{}/v1/jobs/{single_id}/result", single.base),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(single_result.status, 200, "{}", single_result.body);
+    assert_eq!(job.result, Some(single_result.json()["summary"].clone()));
+    single.kill9();
     let assembled: railwear::pipeline::SweepOutcome =
         serde_json::from_value(job.result.clone().expect("result")).expect("sweep outcome");
     assert_eq!(
