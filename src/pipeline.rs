@@ -391,3 +391,39 @@ pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunErr
     }
     Ok(serde_json::Value::Object(out))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn configs() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+    }
+
+    #[test]
+    fn a_point_child_plans_the_same_sweep_as_its_parent() {
+        let parent = serde_json::json!({"points": 4, "seed": 9, "vehicle_profile": "ah64"});
+        let child = sweep_point_params(&parent, 3);
+        assert_eq!(sweep_point_index(&child).unwrap(), 3);
+        let a = SweepPlan::from_params(&parent, &configs()).unwrap();
+        let b = SweepPlan::from_params(&child, &configs()).unwrap();
+        assert_eq!(a.offsets_mm, b.offsets_mm);
+        assert_eq!(a.base.simulation.seed, 9);
+        assert_eq!(b.base.simulation.seed, 9);
+        assert_eq!(a.design_rattle_space, b.design_rattle_space);
+        // Tight to loose, ends at the named material conditions.
+        use crate::analysis::rattle_space::{
+            LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM,
+        };
+        assert_eq!(a.offsets_mm.first(), Some(&TIGHT_MATERIAL_CONDITION_MM));
+        assert_eq!(a.offsets_mm.last(), Some(&LOOSE_MATERIAL_CONDITION_MM));
+        assert!(matches!(
+            sweep_point_index(&parent),
+            Err(RunError::InvalidConfig { field, .. }) if field == "point"
+        ));
+        assert!(matches!(
+            sweep_point(&a, 4, &configs(), &RunControl::silent()),
+            Err(RunError::InvalidConfig { field, .. }) if field == "point"
+        ));
+    }
+}

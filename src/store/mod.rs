@@ -428,3 +428,35 @@ pub fn decode_tracks(blocks: &[TrackBlock]) -> Result<Vec<TrackSample>, tracks::
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn attempt_outcomes_round_trip_their_stored_names() {
+        for outcome in [
+            AttemptOutcome::Running,
+            AttemptOutcome::Succeeded,
+            AttemptOutcome::Failed,
+            AttemptOutcome::Cancelled,
+            AttemptOutcome::FannedOut,
+            AttemptOutcome::Lost,
+        ] {
+            assert_eq!(AttemptOutcome::parse(outcome.as_str()), Some(outcome));
+        }
+        assert_eq!(AttemptOutcome::parse("done"), None);
+    }
+
+    #[test]
+    fn a_failed_child_is_named_with_its_error() {
+        assert_eq!(
+            child_failure_message("c-1", 3, JobStatus::Failed, Some("simulation diverged")),
+            "child 3 (job c-1) failed: simulation diverged"
+        );
+        assert_eq!(
+            child_failure_message("c-2", 0, JobStatus::Cancelled, None),
+            "child 0 (job c-2) was cancelled"
+        );
+    }
+}
