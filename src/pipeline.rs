@@ -185,51 +185,145 @@ pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// A sweep job: the launcher case of `params` (default `launcher-design`) at `points` (default 5,
-/// at least 2) dimension sets from tight to loose, same seed; returns the rail wear rate versus
-/// rattle space for the penalization curve (eq. 6.4).
+/// A planned tolerance sweep: the launcher case every point starts from and the
+/// material-condition offsets of its points. Built from a sweep job's params alone, so the
+/// sequential [`sweep`] and each `sweep_point` child job of a fanned-out sweep agree on it.
+#[derive(Debug, Clone)]
+pub struct SweepPlan {
+    /// The launcher case of `params.config` (default `launcher-design`) with `overrides` and
+    /// `seed` applied; each point replaces its launcher dimensions.
+    pub base: CaseSpec,
+    /// Material-condition offsets of the points, mm, tight to loose ([`sweep_offsets_mm`]).
+    pub offsets_mm: Vec<f64>,
+    /// Rattle space of the design dimensions (eq. 6.1-6.3), dimensionless.
+    pub design_rattle_space: f64,
+}
+
+impl SweepPlan {
+    /// Plan the sweep of `params`: `config` (default `launcher-design`, must be a launcher case),
+    /// `overrides`, `seed`, `points` (default 5, 2..=50).
+    pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
+        let mut p = params.clone();
+        if p.get("config").is_none() {
+            merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
+        }
+        let base = case_from_params(&p, configs_dir)?;
+        if base.launcher.is_none() {
+            return Err(invalid("config", "a sweep needs a launcher case"));
+        }
+        let n = match params.get("points") {
+            None => 5,
+            Some(v) => v
+                .as_u64()
+                .filter(|n| (2..=50).contains(n))
+                .ok_or_else(|| invalid("points", "must be an integer in 2..=50"))?
+                as usize,
+        };
+        let design_rattle_space = crate::analysis::rattle_space::LauncherDimensions::design()
+            .rattle_space()
+            .map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
+        Ok(Self {
+            base,
+            offsets_mm: sweep_offsets_mm(n),
+            design_rattle_space,
+        })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.offsets_mm.len()
+    }
+
+    /// True when the plan has no points (never for a plan from [`SweepPlan::from_params`]).
+    pub fn is_empty(&self) -> bool {
+        self.offsets_mm.is_empty()
+    }
+
+    /// Simulated time one point runs to, s (settle + duration).
+    pub fn point_end_time_s(&self) -> f64 {
+        self.base.simulation.settle_s + self.base.simulation.duration_s
+    }
+
+    /// The outcome of the sweep from its points, tight to loose.
+    pub fn outcome(&self, points: Vec<SweepPoint>) -> SweepOutcome {
+        SweepOutcome {
+            design_rattle_space: self.design_rattle_space,
+            points,
+        }
+    }
+}
+
+/// Point `index` of a planned sweep: the base case with the design dimensions moved by the
+/// point's material-condition offset, run to the end; the rail's wear rate there. The
+/// sequential [`sweep`] and a fanned-out sweep's `sweep_point` child jobs both call this, so a
+/// point depends only on the sweep's params and seed.
+pub fn sweep_point(
+    plan: &SweepPlan,
+    index: usize,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<SweepPoint, RunError> {
+    let offset_mm = *plan
+        .offsets_mm
+        .get(index)
+        .ok_or_else(|| invalid("point", format!("must be below {}", plan.len())))?;
+    let mut case = plan.base.clone();
+    if let Some(l) = case.launcher.as_mut() {
+        l.dimensions = crate::analysis::rattle_space::LauncherDimensions::design()
+            .with_material_condition(offset_mm);
+    }
+    let rattle_space = case
+        .launcher
+        .as_ref()
+        .and_then(|l| l.rattle_space().ok())
+        .unwrap_or(f64::NAN);
+    let (report, _) = run_case(&case, configs_dir, control)?;
+    let rail_wear_rate_mg_per_h = report
+        .bodies
+        .iter()
+        .find(|b| b.name == "rail")
+        .map(|b| b.mass_rate_mg_per_h)
+        .ok_or_else(|| invalid("config", "the launcher model has no body named `rail`"))?;
+    Ok(SweepPoint {
+        offset_mm,
+        rattle_space,
+        rail_wear_rate_mg_per_h,
+    })
+}
+
+/// Params of the child job that runs point `index` of the sweep with `params`: the sweep's
+/// params (which carry its seed) plus `"point": index`.
+pub fn sweep_point_params(params: &serde_json::Value, index: usize) -> serde_json::Value {
+    let mut p = params.clone();
+    merge_json(&mut p, &serde_json::json!({ "point": index }));
+    p
+}
+
+/// The point index of a `sweep_point` child job's params.
+pub fn sweep_point_index(params: &serde_json::Value) -> Result<usize, RunError> {
+    params
+        .get("point")
+        .and_then(serde_json::Value::as_u64)
+        .map(|i| i as usize)
+        .ok_or_else(|| invalid("point", "is required (a non-negative integer)"))
+}
+
+/// A sweep job run in one process: the launcher case of `params` (default `launcher-design`) at
+/// `points` (default 5, at least 2) dimension sets from tight to loose, same seed, one after the
+/// other; returns the rail wear rate versus rattle space for the penalization curve (eq. 6.4).
+/// The service fans the same points out to child jobs instead (see ARCHITECTURE.md).
 pub fn sweep(
     params: &serde_json::Value,
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<(serde_json::Value, SweepOutcome), RunError> {
-    let mut p = params.clone();
-    if p.get("config").is_none() {
-        merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
-    }
-    let base = case_from_params(&p, configs_dir)?;
-    let Some(launcher) = base.launcher.as_ref() else {
-        return Err(invalid("config", "a sweep needs a launcher case"));
-    };
-    let n = match params.get("points") {
-        None => 5,
-        Some(v) => v
-            .as_u64()
-            .filter(|n| (2..=50).contains(n))
-            .ok_or_else(|| invalid("points", "must be an integer in 2..=50"))?
-            as usize,
-    };
-    let design = crate::analysis::rattle_space::LauncherDimensions::design();
-    let design_k = design
-        .rattle_space()
-        .map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
-    let _ = launcher;
-    let offsets = sweep_offsets_mm(n);
-    let mut points = Vec::with_capacity(n);
-    let total = n as f64;
-    for (i, off) in offsets.iter().enumerate() {
+    let plan = SweepPlan::from_params(params, configs_dir)?;
+    let total = plan.len() as f64;
+    let mut points = Vec::with_capacity(plan.len());
+    for i in 0..plan.len() {
         if control.is_cancelled() {
             return Err(RunError::Cancelled);
         }
-        let mut case = base.clone();
-        if let Some(l) = case.launcher.as_mut() {
-            l.dimensions = design.with_material_condition(*off);
-        }
-        let k = case
-            .launcher
-            .as_ref()
-            .and_then(|l| l.rattle_space().ok())
-            .unwrap_or(f64::NAN);
         let outer = control.progress.clone();
         let sub = RunControl {
             cancel: control.cancel.clone(),
@@ -241,23 +335,9 @@ pub fn sweep(
                 })
             }),
         };
-        let (report, _) = run_case(&case, configs_dir, &sub)?;
-        let rail = report
-            .bodies
-            .iter()
-            .find(|b| b.name == "rail")
-            .map(|b| b.mass_rate_mg_per_h)
-            .ok_or_else(|| invalid("config", "the launcher model has no body named `rail`"))?;
-        points.push(SweepPoint {
-            offset_mm: *off,
-            rattle_space: k,
-            rail_wear_rate_mg_per_h: rail,
-        });
+        points.push(sweep_point(&plan, i, configs_dir, &sub)?);
     }
-    let outcome = SweepOutcome {
-        design_rattle_space: design_k,
-        points,
-    };
+    let outcome = plan.outcome(points);
     let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }
@@ -310,4 +390,40 @@ pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunErr
         ));
     }
     Ok(serde_json::Value::Object(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn configs() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+    }
+
+    #[test]
+    fn a_point_child_plans_the_same_sweep_as_its_parent() {
+        let parent = serde_json::json!({"points": 4, "seed": 9, "vehicle_profile": "ah64"});
+        let child = sweep_point_params(&parent, 3);
+        assert_eq!(sweep_point_index(&child).unwrap(), 3);
+        let a = SweepPlan::from_params(&parent, &configs()).unwrap();
+        let b = SweepPlan::from_params(&child, &configs()).unwrap();
+        assert_eq!(a.offsets_mm, b.offsets_mm);
+        assert_eq!(a.base.simulation.seed, 9);
+        assert_eq!(b.base.simulation.seed, 9);
+        assert_eq!(a.design_rattle_space, b.design_rattle_space);
+        // Tight to loose, ends at the named material conditions.
+        use crate::analysis::rattle_space::{
+            LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM,
+        };
+        assert_eq!(a.offsets_mm.first(), Some(&TIGHT_MATERIAL_CONDITION_MM));
+        assert_eq!(a.offsets_mm.last(), Some(&LOOSE_MATERIAL_CONDITION_MM));
+        assert!(matches!(
+            sweep_point_index(&parent),
+            Err(RunError::InvalidConfig { field, .. }) if field == "point"
+        ));
+        assert!(matches!(
+            sweep_point(&a, 4, &configs(), &RunControl::silent()),
+            Err(RunError::InvalidConfig { field, .. }) if field == "point"
+        ));
+    }
 }

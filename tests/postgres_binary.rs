@@ -192,3 +192,177 @@ fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
     assert_eq!(cancelled["attempt"], 2);
     drop(rt);
 }
+
+fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
+    let r = curl(
+        "GET",
+        &format!("{base}/v1/jobs?parent={id}&limit=100"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()["items"].as_array().cloned().unwrap_or_default()
+}
+
+/// Issue 6, item 1: one API process and three worker processes on PostgreSQL run a 12-point
+/// sweep fanned out into 12 child jobs; one worker is killed (SIGKILL) while it holds a child.
+/// Every child ends with exactly one succeeded attempt (the killed one is logged lost and its
+/// child re-run elsewhere), the sweep is fanned out once and assembled once, and its result
+/// equals bit for bit both the same sweep run by a single `railwear serve` process on SQLite
+/// (fanned out to its embedded workers) and the sequential in-process `pipeline::sweep`.
+#[test]
+fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
+    use railwear::store::AttemptOutcome;
+    let rt = tokio::runtime::Runtime::new().expect("runtime");
+    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("fanout").await }) else {
+        return;
+    };
+    let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
+    let (_api, base) = api(&db.url, &env);
+    let mut workers: Vec<Option<Proc>> = (0..3).map(|_| Some(worker(&db.url, &env))).collect();
+
+    // Short points (under a second each in the test profile).
+    let params = serde_json::json!({
+        "config": "launcher-design",
+        "points": 12,
+        "seed": 2024,
+        "overrides": {"simulation": {"settle_s": 0.2, "duration_s": 0.3, "record_interval_s": 0.01}},
+    });
+    // The single-process reference, computed here while the workers run.
+    let reference = {
+        let params = params.clone();
+        std::thread::spawn(move || {
+            let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+            railwear::pipeline::sweep(&params, &configs, &railwear::pipeline::RunControl::silent())
+                .expect("sequential sweep")
+        })
+    };
+    let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
+    let id = submit(&base, &body);
+    // The same sweep in one process on SQLite.
+    let sqlite_dir = service_support::TempDir::new("fanout-sqlite");
+    let single = service_support::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
+    let single_id = submit(&single.base, &body);
+
+    // SIGKILL the worker process that holds a running child.
+    let victim_worker = wait_for(Duration::from_secs(120), "a running child", || {
+        children(&base, &id).iter().find_map(|c| {
+            let worker = c["worker"].as_str()?;
+            (c["status"] == "running").then(|| worker.to_string())
+        })
+    });
+    // Worker names are `<host>-<pid>-<n>`.
+    let pid: u32 = victim_worker
+        .rsplit('-')
+        .nth(1)
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no pid in worker name {victim_worker}"));
+    let slot = workers
+        .iter()
+        .position(|w| w.as_ref().is_some_and(|p| p.0.id() == pid))
+        .unwrap_or_else(|| panic!("worker {victim_worker} is not one of ours"));
+    drop(workers[slot].take());
+
+    let done = wait_status(&base, &id, "succeeded", Duration::from_secs(300));
+    assert_eq!(
+        done["children"],
+        serde_json::json!({"total": 12, "succeeded": 12, "failed": 0, "cancelled": 0})
+    );
+    let kids = children(&base, &id);
+    assert_eq!(kids.len(), 12);
+    assert!(kids.iter().all(|c| c["status"] == "succeeded"), "{kids:?}");
+
+    let store = rt
+        .block_on(railwear::store::open(&db.url))
+        .expect("open the test database");
+    let id: uuid::Uuid = id.parse().expect("uuid");
+    let children = rt.block_on(store.children(id)).expect("children");
+    assert_eq!(
+        children.iter().map(|c| c.index).collect::<Vec<_>>(),
+        (0..12).collect::<Vec<i64>>()
+    );
+    // Exactly one succeeded attempt per child; every other attempt was lost (fenced out).
+    let mut lost = Vec::new();
+    for child in &children {
+        let attempts = rt.block_on(store.attempts(child.id)).expect("attempts");
+        let succeeded: Vec<_> = attempts
+            .iter()
+            .filter(|a| a.outcome == AttemptOutcome::Succeeded)
+            .collect();
+        assert_eq!(succeeded.len(), 1, "child {}: {attempts:?}", child.index);
+        assert_eq!(succeeded[0].attempt, attempts.len() as i64);
+        for a in &attempts[..attempts.len() - 1] {
+            assert_eq!(a.outcome, AttemptOutcome::Lost, "{attempts:?}");
+            lost.push((child.id, a.worker.clone()));
+        }
+        assert_ne!(succeeded[0].worker, victim_worker);
+    }
+    // The child the killed worker held, and only that, was run twice (if the worker had just
+    // moved on from the child seen running, the child it moved on to).
+    assert_eq!(lost.len(), 1, "{lost:?}");
+    assert_eq!(lost[0].1, victim_worker);
+    // Fanned out once, assembled once.
+    let parent_attempts = rt.block_on(store.attempts(id)).expect("attempts");
+    assert_eq!(
+        parent_attempts
+            .iter()
+            .map(|a| a.outcome)
+            .collect::<Vec<_>>(),
+        [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
+    );
+
+    // The assembled result and the stored curve equal the sequential single-process sweep, and
+    // the single-process SQLite service's result.
+    let (summary, outcome) = reference.join().expect("reference sweep");
+    let job = rt.block_on(store.get_job(id)).expect("job").expect("job");
+    let single_done = wait_status(
+        &single.base,
+        &single_id,
+        "succeeded",
+        Duration::from_secs(300),
+    );
+    assert_eq!(single_done["children"]["succeeded"], 12);
+    let single_result = curl(
+        "GET",
+        &format!("{}/v1/jobs/{single_id}/result", single.base),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(single_result.status, 200, "{}", single_result.body);
+    assert_eq!(job.result, Some(single_result.json()["summary"].clone()));
+    single.kill9();
+    let assembled: railwear::pipeline::SweepOutcome =
+        serde_json::from_value(job.result.clone().expect("result")).expect("sweep outcome");
+    assert_eq!(
+        assembled.design_rattle_space.to_bits(),
+        outcome.design_rattle_space.to_bits()
+    );
+    assert_eq!(assembled.points.len(), 12);
+    for (a, b) in assembled.points.iter().zip(&outcome.points) {
+        assert_eq!(a.offset_mm.to_bits(), b.offset_mm.to_bits());
+        assert_eq!(a.rattle_space.to_bits(), b.rattle_space.to_bits());
+        assert_eq!(
+            a.rail_wear_rate_mg_per_h.to_bits(),
+            b.rail_wear_rate_mg_per_h.to_bits(),
+            "offset {} mm",
+            b.offset_mm
+        );
+    }
+    assert_eq!(job.result, Some(summary));
+    let curve = rt
+        .block_on(store.get_curve(job.curve_key.as_deref().expect("curve key")))
+        .expect("curve")
+        .expect("curve stored");
+    assert_eq!(curve.job_id, id);
+    let expected = railwear::jobs::runner::sweep_output(&outcome).expect("curve");
+    assert_eq!(
+        Some(curve.curve),
+        expected
+            .penalization
+            .map(|c| serde_json::to_value(c).expect("curve json"))
+    );
+    drop(store);
+    drop(rt);
+}

@@ -9,8 +9,8 @@ mod service_support;
 use railwear::config::Role;
 use railwear::jobs::{JobKind, JobProgress, JobStatus};
 use railwear::store::{
-    self, CurveRecord, Finish, Heartbeat, NewJob, NewMeasurement, PageRequest, Store, Submitted,
-    TrackBlock,
+    self, CurveRecord, Finish, Heartbeat, JobFilter, NewJob, NewMeasurement, PageRequest, Store,
+    Submitted, TrackBlock,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -461,7 +461,7 @@ async fn script(store: &dyn Store) -> Vec<String> {
                 limit: 3,
                 after_seq: None,
             },
-            None,
+            JobFilter::default(),
         )
         .await
         .unwrap();
@@ -476,7 +476,7 @@ async fn script(store: &dyn Store) -> Vec<String> {
                 limit: 3,
                 after_seq: cursor,
             },
-            None,
+            JobFilter::default(),
         )
         .await
         .unwrap();
@@ -489,7 +489,10 @@ async fn script(store: &dyn Store) -> Vec<String> {
                 limit: 10,
                 after_seq: None,
             },
-            Some(JobStatus::Cancelled),
+            JobFilter {
+                status: Some(JobStatus::Cancelled),
+                ..JobFilter::default()
+            },
         )
         .await
         .unwrap();

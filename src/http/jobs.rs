@@ -4,7 +4,7 @@ use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
 use super::problem::{ApiJson, Problem};
 use super::AppState;
-use crate::jobs::{JobKind, JobProgress, JobRecord, JobStatus, SubmitError};
+use crate::jobs::{ChildCounts, JobKind, JobProgress, JobRecord, JobStatus, SubmitError};
 use crate::physics::track::TrackSample;
 use crate::store::{clock, tracks, Submitted};
 use axum::extract::{Path, Query, State};
@@ -34,9 +34,11 @@ pub struct JobRequest {
     /// What to run.
     pub kind: JobKind,
     /// Kind-specific parameters (JSON object). `simulate`: `{"config": "<reference name>" or
-    /// {inline config}, "overrides": {...}, "seed": u64}`. `sweep` also takes
-    /// `vehicle_profile`, `environment`, `wear_law` (the penalization-curve key; defaults from
-    /// the service settings). `seed` is drawn at submission when absent.
+    /// {inline config}, "overrides": {...}, "seed": u64}`. `sweep` also takes `points` (2..=50,
+    /// default 5) and `vehicle_profile`, `environment`, `wear_law` (the penalization-curve key;
+    /// defaults from the service settings); it fans out into one `sweep_point` child job per
+    /// point (`sweep_point` jobs cannot be submitted). `seed` is drawn at submission when
+    /// absent.
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
 }
@@ -72,7 +74,17 @@ pub struct JobView {
     pub track_samples: i64,
     /// Sweeps: the penalization-curve key `vehicle_profile/environment/wear_law`.
     pub curve_key: Option<String>,
-    /// Related URLs: `self`, `result`, `tracks_csv`, `tracks_json`, `cancel`.
+    /// Worker holding the running attempt (`<host>-<pid>-<n>` for `railwear worker`).
+    pub worker: Option<String>,
+    /// Child jobs (a sweep's `sweep_point` jobs): the job that fanned out.
+    pub parent_id: Option<Uuid>,
+    /// Child jobs: index among the siblings (a sweep's point, tight to loose).
+    pub child_index: Option<i64>,
+    /// Jobs that fanned out (sweeps): how their children stand. The job waits while they run,
+    /// its progress is the fraction that succeeded, and its result is assembled once all have.
+    pub children: Option<ChildCounts>,
+    /// Related URLs: `self`, `result`, `tracks_csv`, `tracks_json`, `cancel`, and `children`
+    /// for a job that fanned out.
     pub links: JobLinks,
 }
 
@@ -85,6 +97,9 @@ pub struct JobLinks {
     pub result: String,
     pub tracks_csv: String,
     pub tracks_json: String,
+    /// The job's children (`/v1/jobs?parent=<id>`), for a job that fanned out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub children: Option<String>,
 }
 
 impl From<JobRecord> for JobView {
@@ -107,11 +122,18 @@ impl From<JobRecord> for JobView {
             error: j.error,
             track_samples: j.track_samples,
             curve_key: j.curve_key,
+            worker: j.lease_owner,
+            parent_id: j.parent.map(|p| p.parent_id),
+            child_index: j.parent.map(|p| p.index),
+            children: j.children,
             links: JobLinks {
                 cancel: format!("{base}/cancel"),
                 result: format!("{base}/result"),
                 tracks_csv: format!("{base}/tracks?format=csv"),
                 tracks_json: format!("{base}/tracks?format=json"),
+                children: j
+                    .children
+                    .map(|_| format!("/v1/jobs?parent={}&limit=100", j.id)),
                 self_: base,
             },
         }
@@ -141,12 +163,50 @@ pub struct PlotLink {
     pub url: String,
 }
 
-/// Filter for the job list.
+/// Filter for the job list (kept as text so a bad value gets a problem naming it).
 #[derive(Debug, Deserialize, IntoParams)]
 #[into_params(parameter_in = Query)]
 pub struct JobFilter {
     /// Only jobs in this status.
-    pub status: Option<JobStatus>,
+    #[param(value_type = Option<JobStatus>)]
+    pub status: Option<String>,
+    /// Only the children of this job (a sweep's points).
+    #[param(value_type = Option<Uuid>)]
+    pub parent: Option<String>,
+    /// `true`: only jobs that are not children of another (what was submitted).
+    #[param(value_type = Option<bool>)]
+    pub top_level: Option<String>,
+}
+
+impl JobFilter {
+    fn to_filter(&self) -> Result<crate::store::JobFilter, Problem> {
+        let status = match &self.status {
+            None => None,
+            Some(text) => Some(JobStatus::parse(text).ok_or_else(|| {
+                Problem::bad_parameter(
+                    "status",
+                    "must be queued, running, waiting, succeeded, failed or cancelled",
+                )
+            })?),
+        };
+        let parent = match &self.parent {
+            None => None,
+            Some(text) => Some(
+                Uuid::parse_str(text)
+                    .map_err(|_| Problem::bad_parameter("parent", "must be a job id (UUID)"))?,
+            ),
+        };
+        let top_level = match self.top_level.as_deref() {
+            None | Some("false") => false,
+            Some("true") => true,
+            Some(_) => return Err(Problem::bad_parameter("top_level", "must be true or false")),
+        };
+        Ok(crate::store::JobFilter {
+            status,
+            parent,
+            top_level,
+        })
+    }
 }
 
 /// Track export options.
@@ -257,7 +317,8 @@ pub async fn submit_job(
     }
 }
 
-/// List jobs, newest first.
+/// List jobs, newest first. `parent=<id>` lists the children of a sweep (one `sweep_point`
+/// job per point); `top_level=true` leaves children out.
 #[utoipa::path(
     get, path = "/v1/jobs", tag = "jobs",
     params(PageQuery, JobFilter),
@@ -275,14 +336,11 @@ pub async fn list_jobs(
     filter: Result<Query<JobFilter>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Json<PageView<JobView>>, Problem> {
     caller.require(Area::Jobs, &Method::GET)?;
-    let Query(filter) = filter.map_err(|_| {
-        Problem::bad_parameter(
-            "status",
-            "must be queued, running, succeeded, failed or cancelled",
-        )
-    })?;
+    let Query(filter) =
+        filter.map_err(|_| Problem::bad_parameter("query", "must be status, parent, top_level"))?;
+    let filter = filter.to_filter()?;
     let request = page.to_request()?;
-    let page = state.store.list_jobs(request, filter.status).await?;
+    let page = state.store.list_jobs(request, filter).await?;
     Ok(Json(PageView::from_page(page, JobView::from)))
 }
 

@@ -9,8 +9,8 @@ pub mod worker;
 
 use crate::store::{clock, NewJob, Store, StoreError, Submitted};
 pub use metrics::Metrics;
-pub use model::{JobKind, JobProgress, JobRecord, JobStatus};
-pub use runner::{CaseRunner, JobOutput, LibraryRunner};
+pub use model::{ChildCounts, ChildOf, JobKind, JobProgress, JobRecord, JobStatus};
+pub use runner::{CaseRunner, ChildJob, FanOutPlan, JobOutput, LibraryRunner};
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
@@ -111,6 +111,13 @@ impl Jobs {
         submitted_by: &str,
         idempotency_key: Option<String>,
     ) -> Result<Submitted, SubmitError> {
+        if kind == JobKind::SweepPoint {
+            return Err(SubmitError::Invalid {
+                field: "kind".into(),
+                rule: "sweep_point jobs are created by sweep jobs (one per point); submit a sweep"
+                    .into(),
+            });
+        }
         if !params.is_object() {
             return Err(SubmitError::Invalid {
                 field: "params".into(),
@@ -176,10 +183,18 @@ impl Jobs {
 
     /// Request cancellation: a queued job is cancelled at once; a running one here is told
     /// immediately (its computation stops within a second), elsewhere at its next heartbeat.
+    /// Cancelling a job that fanned out cancels its children the same way.
     pub async fn cancel(&self, id: Uuid) -> Result<Option<JobRecord>, StoreError> {
         let record = self.store.request_cancel(id, clock::now_ms()).await?;
-        if let Some(flag) = self.running_flags().get(&id) {
-            flag.store(true, std::sync::atomic::Ordering::Relaxed);
+        let mut stop = vec![id];
+        if record.as_ref().is_some_and(|r| r.children.is_some()) {
+            stop.extend(self.store.children(id).await?.iter().map(|c| c.id));
+        }
+        let flags = self.running_flags();
+        for job in stop {
+            if let Some(flag) = flags.get(&job) {
+                flag.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
         }
         Ok(record)
     }

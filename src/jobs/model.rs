@@ -6,7 +6,7 @@ use utoipa::ToSchema;
 /// Kind of computation a job runs. The set is open: a new kind is one variant here plus one arm
 /// in the production runner.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "snake_case")]
 pub enum JobKind {
     /// One case: a model config (by name or inline) with overrides -> wear, tracks, plots.
     Simulate,
@@ -14,6 +14,9 @@ pub enum JobKind {
     Sweep,
     /// Fit friction and K(sigma) from persistent-contact fixture records (thesis chapter 4).
     Calibrate,
+    /// One point of a sweep: a child job the service creates when a sweep fans out (not
+    /// submitted directly). Its result is the point's rattle space and rail wear rate.
+    SweepPoint,
 }
 
 impl JobKind {
@@ -23,6 +26,7 @@ impl JobKind {
             JobKind::Simulate => "simulate",
             JobKind::Sweep => "sweep",
             JobKind::Calibrate => "calibrate",
+            JobKind::SweepPoint => "sweep_point",
         }
     }
 
@@ -32,18 +36,23 @@ impl JobKind {
             "simulate" => Some(JobKind::Simulate),
             "sweep" => Some(JobKind::Sweep),
             "calibrate" => Some(JobKind::Calibrate),
+            "sweep_point" => Some(JobKind::SweepPoint),
             _ => None,
         }
     }
 }
 
 /// Lifecycle: queued -> running -> succeeded | failed | cancelled. A running job whose lease
-/// expires goes back to queued (next attempt).
+/// expires goes back to queued (next attempt). A job that fans out (a sweep) goes
+/// running -> waiting while its child jobs run, then queued -> running once more to assemble
+/// its result when the last child has succeeded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum JobStatus {
     Queued,
     Running,
+    /// Fanned out: waiting for its child jobs (no worker holds it).
+    Waiting,
     Succeeded,
     Failed,
     Cancelled,
@@ -55,6 +64,7 @@ impl JobStatus {
         match self {
             JobStatus::Queued => "queued",
             JobStatus::Running => "running",
+            JobStatus::Waiting => "waiting",
             JobStatus::Succeeded => "succeeded",
             JobStatus::Failed => "failed",
             JobStatus::Cancelled => "cancelled",
@@ -66,6 +76,7 @@ impl JobStatus {
         match text {
             "queued" => Some(JobStatus::Queued),
             "running" => Some(JobStatus::Running),
+            "waiting" => Some(JobStatus::Waiting),
             "succeeded" => Some(JobStatus::Succeeded),
             "failed" => Some(JobStatus::Failed),
             "cancelled" => Some(JobStatus::Cancelled),
@@ -82,9 +93,10 @@ impl JobStatus {
     }
 
     /// All statuses, in lifecycle order.
-    pub const ALL: [JobStatus; 5] = [
+    pub const ALL: [JobStatus; 6] = [
         JobStatus::Queued,
         JobStatus::Running,
+        JobStatus::Waiting,
         JobStatus::Succeeded,
         JobStatus::Failed,
         JobStatus::Cancelled,
@@ -138,4 +150,30 @@ pub struct JobRecord {
     pub track_samples: i64,
     /// Penalization-curve key (sweeps only): `vehicle_profile/environment/wear_law`.
     pub curve_key: Option<String>,
+    /// Worker holding the current attempt's lease (`<host>-<pid>-<n>`), while running.
+    pub lease_owner: Option<String>,
+    /// Child jobs: the job that fanned out, and this child's index among its siblings (for a
+    /// sweep, the point index, tight to loose).
+    pub parent: Option<ChildOf>,
+    /// Jobs that fanned out: how their children stand.
+    pub children: Option<ChildCounts>,
+}
+
+/// Where a child job sits in its parent's fan-out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChildOf {
+    pub parent_id: uuid::Uuid,
+    pub index: i64,
+}
+
+/// Children of a job that fanned out, by how they ended (the rest are queued or running).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+pub struct ChildCounts {
+    /// Child jobs created by the fan-out.
+    pub total: i64,
+    pub succeeded: i64,
+    /// Failed after their bounded retries (the first such failure fails the parent).
+    pub failed: i64,
+    /// Cancelled (with the parent, or one by one).
+    pub cancelled: i64,
 }

@@ -6,7 +6,7 @@ use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::config::reference_config_path;
 use crate::physics::track::TrackSample;
-use crate::pipeline::{RunControl, RunError};
+use crate::pipeline::{RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
 use std::path::PathBuf;
 
 /// What a finished job produces.
@@ -23,9 +23,32 @@ pub struct JobOutput {
     pub penalization: Option<PenalizationCurve>,
 }
 
+/// A child job of a fan-out: what to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChildJob {
+    pub kind: JobKind,
+    /// Complete params of the child (they carry the parent's seed): the child's result depends
+    /// on them alone.
+    pub params: serde_json::Value,
+}
+
+/// How a job splits into child jobs that any worker (any process, any host) can run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FanOutPlan {
+    /// The children, in index order; the parent's result is assembled from their results in
+    /// this order.
+    pub children: Vec<ChildJob>,
+    /// Simulated time all children reach together, s (the parent's progress end time).
+    pub end_time_s: f64,
+}
+
 /// Runs one job's computation on a blocking thread. Must return [`RunError::Cancelled`] within
 /// a second of `control.cancel` being set, and should call `control.progress` a few times per
 /// second at most. `params` carry the job's `seed`.
+///
+/// A job may instead fan out ([`CaseRunner::fan_out`]): the queue then stores the child jobs,
+/// and once every child has succeeded one worker calls [`CaseRunner::assemble`] with their
+/// results.
 pub trait CaseRunner: Send + Sync {
     fn run(
         &self,
@@ -38,6 +61,32 @@ pub trait CaseRunner: Send + Sync {
     /// failed job. The default accepts everything and leaves checks to [`CaseRunner::run`].
     fn validate(&self, _kind: &JobKind, _params: &serde_json::Value) -> Result<(), RunError> {
         Ok(())
+    }
+
+    /// The child jobs this job splits into, or `None` to run it whole with
+    /// [`CaseRunner::run`] (the default). Called on a blocking thread; should be quick (no
+    /// simulation).
+    fn fan_out(
+        &self,
+        _kind: &JobKind,
+        _params: &serde_json::Value,
+    ) -> Result<Option<FanOutPlan>, RunError> {
+        Ok(None)
+    }
+
+    /// The output of a job that fanned out, from its children's result summaries in index
+    /// order (all succeeded). Must depend on `params` and the summaries only: if the worker
+    /// assembling dies, another assembles again and only one result is stored.
+    fn assemble(
+        &self,
+        kind: &JobKind,
+        _params: &serde_json::Value,
+        _children: &[serde_json::Value],
+    ) -> Result<JobOutput, RunError> {
+        Err(RunError::InvalidConfig {
+            field: "kind".into(),
+            rule: format!("{} jobs do not fan out", kind.as_str()),
+        })
     }
 }
 
@@ -89,27 +138,16 @@ impl CaseRunner for LibraryRunner {
                 })
             }
             JobKind::Sweep => {
-                let (summary, sweep) = crate::pipeline::sweep(params, &self.configs_dir, control)?;
-                let points: Vec<crate::analysis::penalization::SweepPoint> = sweep
-                    .points
-                    .iter()
-                    .map(|p| crate::analysis::penalization::SweepPoint {
-                        rattle_space: p.rattle_space,
-                        rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
-                    })
-                    .collect();
-                let curve =
-                    PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
-                        RunError::Diverged(format!(
-                            "sweep produced no usable penalization curve: {e}"
-                        ))
-                    })?;
-                let plot = curve_plot(&curve);
+                let (_, sweep) = crate::pipeline::sweep(params, &self.configs_dir, control)?;
+                sweep_output(&sweep)
+            }
+            JobKind::SweepPoint => {
+                let plan = SweepPlan::from_params(params, &self.configs_dir)?;
+                let index = crate::pipeline::sweep_point_index(params)?;
+                let point = crate::pipeline::sweep_point(&plan, index, &self.configs_dir, control)?;
                 Ok(JobOutput {
-                    summary,
-                    tracks: Vec::new(),
-                    plots: vec![("penalization.svg".to_string(), plot)],
-                    penalization: Some(curve),
+                    summary: sweep_point_summary(index, &point),
+                    ..JobOutput::default()
                 })
             }
             JobKind::Calibrate => Ok(JobOutput {
@@ -122,6 +160,104 @@ impl CaseRunner for LibraryRunner {
     fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
         self.check_config_name(params)
     }
+
+    /// A sweep fans out into one `sweep_point` child per point.
+    fn fan_out(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+    ) -> Result<Option<FanOutPlan>, RunError> {
+        if *kind != JobKind::Sweep {
+            return Ok(None);
+        }
+        self.validate(kind, params)?;
+        let plan = SweepPlan::from_params(params, &self.configs_dir)?;
+        Ok(Some(FanOutPlan {
+            children: (0..plan.len())
+                .map(|index| ChildJob {
+                    kind: JobKind::SweepPoint,
+                    params: crate::pipeline::sweep_point_params(params, index),
+                })
+                .collect(),
+            end_time_s: plan.len() as f64 * plan.point_end_time_s(),
+        }))
+    }
+
+    /// A sweep's outcome from its points' results, exactly as the sequential sweep makes it.
+    fn assemble(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        children: &[serde_json::Value],
+    ) -> Result<JobOutput, RunError> {
+        if *kind != JobKind::Sweep {
+            return Err(RunError::InvalidConfig {
+                field: "kind".into(),
+                rule: format!("{} jobs do not fan out", kind.as_str()),
+            });
+        }
+        let plan = SweepPlan::from_params(params, &self.configs_dir)?;
+        if children.len() != plan.len() {
+            return Err(RunError::InvalidConfig {
+                field: "points".into(),
+                rule: format!(
+                    "the sweep has {} points but {} child results",
+                    plan.len(),
+                    children.len()
+                ),
+            });
+        }
+        let points = children
+            .iter()
+            .enumerate()
+            .map(|(index, summary)| {
+                serde_json::from_value::<SweepPoint>(summary.clone()).map_err(|e| {
+                    RunError::InvalidConfig {
+                        field: format!("children[{index}]"),
+                        rule: format!("is not a sweep point result: {e}"),
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        sweep_output(&plan.outcome(points))
+    }
+}
+
+/// Result summary of a `sweep_point` child job: its index and the point.
+pub fn sweep_point_summary(index: usize, point: &SweepPoint) -> serde_json::Value {
+    serde_json::json!({
+        "point": index,
+        "offset_mm": point.offset_mm,
+        "rattle_space": point.rattle_space,
+        "rail_wear_rate_mg_per_h": point.rail_wear_rate_mg_per_h,
+    })
+}
+
+/// A sweep job's output from its outcome (sequential or assembled): the outcome as summary, the
+/// penalization curve (eq. 6.4) and its plot.
+pub fn sweep_output(sweep: &SweepOutcome) -> Result<JobOutput, RunError> {
+    let points: Vec<crate::analysis::penalization::SweepPoint> = sweep
+        .points
+        .iter()
+        .map(|p| crate::analysis::penalization::SweepPoint {
+            rattle_space: p.rattle_space,
+            rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
+        })
+        .collect();
+    let curve = PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
+        RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
+    })?;
+    let plot = curve_plot(&curve);
+    let summary = serde_json::to_value(sweep).map_err(|e| RunError::InvalidConfig {
+        field: "sweep".into(),
+        rule: e.to_string(),
+    })?;
+    Ok(JobOutput {
+        summary,
+        tracks: Vec::new(),
+        plots: vec![("penalization.svg".to_string(), plot)],
+        penalization: Some(curve),
+    })
 }
 
 /// K_SL versus rattle space with the 0.9 and 0.8 bands (thesis Figure 6.68).

@@ -1,11 +1,16 @@
 //! The embedded worker pool. Each worker loops: re-queue expired leases, claim the oldest queued
 //! job, run it on a blocking thread while a heartbeat renews the lease and writes progress, then
 //! end the attempt with a fenced write (a stale attempt's result is discarded).
+//!
+//! A job the runner splits ([`super::CaseRunner::fan_out`], a sweep) is not run: the attempt
+//! stores its child jobs and leaves it waiting. When its last child succeeds the store re-queues
+//! it, and the attempt that claims it then assembles its result from the children's results.
 
 use super::model::{JobProgress, JobRecord, JobStatus};
+use super::runner::FanOutPlan;
 use super::Jobs;
 use crate::pipeline::{Progress, RunControl, RunError};
-use crate::store::{clock, tracks, CurveRecord, Finish};
+use crate::store::{clock, tracks, CurveRecord, FanOut, FanOutResult, Finish, NewChild};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -53,6 +58,36 @@ impl Jobs {
     async fn run_attempt(self: &Arc<Self>, worker: &str, job: JobRecord) {
         let (id, attempt, kind) = (job.id, job.attempt, job.kind);
         tracing::info!(%worker, job = %id, attempt, kind = kind.as_str(), "attempt started");
+        let mut params = job.params.clone();
+        if let Some(map) = params.as_object_mut() {
+            map.insert("seed".into(), serde_json::Value::from(job.seed));
+        }
+        // What this attempt does: assemble a fanned-out job whose children all succeeded, fan
+        // a job out, or run it whole.
+        let work = if job.children.is_some() {
+            match self.store.children(id).await {
+                Ok(children) => Work::Assemble(children_summaries(children)),
+                Err(e) => {
+                    // The lease expires and another attempt assembles.
+                    tracing::warn!(job = %id, attempt, error = %e, "reading the children failed");
+                    return;
+                }
+            }
+        } else {
+            let runner = Arc::clone(&self.runner);
+            let plan_params = params.clone();
+            match tokio::task::spawn_blocking(move || runner.fan_out(&kind, &plan_params)).await {
+                Ok(Ok(Some(plan))) => return self.fan_out(&job, plan).await,
+                Ok(Ok(None)) => Work::Run,
+                Ok(Err(e)) => Work::Refused(e),
+                Err(join) => {
+                    tracing::error!(job = %id, error = %join, "fan-out planning panicked");
+                    Work::Refused(RunError::Diverged(
+                        "internal error: the fan-out planning panicked".into(),
+                    ))
+                }
+            }
+        };
         let cancel = Arc::new(AtomicBool::new(job.cancel_requested));
         self.running_flags().insert(id, Arc::clone(&cancel));
         self.metrics.attempt_started(id);
@@ -67,13 +102,12 @@ impl Jobs {
                 }
             }),
         };
-        let mut params = job.params.clone();
-        if let Some(map) = params.as_object_mut() {
-            map.insert("seed".into(), serde_json::Value::from(job.seed));
-        }
         let runner = Arc::clone(&self.runner);
-        let mut computation =
-            tokio::task::spawn_blocking(move || runner.run(&kind, &params, &control));
+        let mut computation = tokio::task::spawn_blocking(move || match work {
+            Work::Run => runner.run(&kind, &params, &control),
+            Work::Assemble(Ok(summaries)) => runner.assemble(&kind, &params, &summaries),
+            Work::Assemble(Err(e)) | Work::Refused(e) => Err(e),
+        });
 
         let started = Instant::now();
         let lease_ms = self.settings.lease.as_millis() as i64;
@@ -162,18 +196,20 @@ impl Jobs {
                 Finish::Failed("internal error: the computation panicked".into())
             }
         };
-        let status = match &finish {
-            Finish::Succeeded { .. } => JobStatus::Succeeded,
-            Finish::Failed(_) => JobStatus::Failed,
-            Finish::Cancelled => JobStatus::Cancelled,
-        };
+        let status = finish.status();
         self.running_flags().remove(&id);
         self.metrics.attempt_finished(id, kind, status);
         if lost {
             tracing::warn!(job = %id, attempt, "lease lost to a newer attempt; result discarded");
             return;
         }
-        // A finish that fails on a transient database error is retried; a fenced-out one is not.
+        self.finish(id, attempt, finish).await;
+    }
+
+    /// End an attempt. A finish that fails on a transient database error is retried; a
+    /// fenced-out one is not.
+    async fn finish(&self, id: uuid::Uuid, attempt: i64, finish: Finish) {
+        let status = finish.status();
         for retry in 0..5u32 {
             match self
                 .store
@@ -195,6 +231,81 @@ impl Jobs {
             }
         }
     }
+
+    /// Store the child jobs of `job` and leave it waiting for them (one transaction fenced by
+    /// the attempt, retried on transient errors; if it never lands, the lease expires and the
+    /// next attempt fans out again, there being nothing half-made to clean up).
+    async fn fan_out(&self, job: &JobRecord, plan: FanOutPlan) {
+        let (id, attempt) = (job.id, job.attempt);
+        let fan_out = FanOut {
+            children: plan
+                .children
+                .into_iter()
+                .map(|child| NewChild {
+                    id: uuid::Uuid::new_v4(),
+                    kind: child.kind,
+                    params: child.params,
+                })
+                .collect(),
+            end_time_s: plan.end_time_s,
+        };
+        let count = fan_out.children.len();
+        for retry in 0..5u32 {
+            match self
+                .store
+                .fan_out(id, attempt, fan_out.clone(), clock::now_ms())
+                .await
+            {
+                Ok(FanOutResult::FannedOut) => {
+                    tracing::info!(job = %id, attempt, children = count, "fanned out");
+                    // Idle workers of this process take the children at once.
+                    self.wake.notify_waiters();
+                    return;
+                }
+                Ok(FanOutResult::Stale) => {
+                    tracing::warn!(job = %id, attempt, "stale attempt; fan-out discarded");
+                    return;
+                }
+                Ok(FanOutResult::CancelRequested) => {
+                    return self.finish(id, attempt, Finish::Cancelled).await;
+                }
+                Err(e) => {
+                    tracing::warn!(job = %id, attempt, retry, error = %e, "fan-out failed");
+                    tokio::time::sleep(Duration::from_millis(200 << retry)).await;
+                }
+            }
+        }
+    }
+}
+
+/// What an attempt computes.
+enum Work {
+    /// The whole job.
+    Run,
+    /// The result of a fanned-out job from its children's summaries (or why it cannot be).
+    Assemble(Result<Vec<serde_json::Value>, RunError>),
+    /// Nothing: the fan-out planning refused the params.
+    Refused(RunError),
+}
+
+/// The children's result summaries in index order, once every child has succeeded.
+fn children_summaries(
+    children: Vec<crate::store::ChildRecord>,
+) -> Result<Vec<serde_json::Value>, RunError> {
+    children
+        .into_iter()
+        .map(|child| match (child.status, child.result) {
+            (JobStatus::Succeeded, Some(summary)) => Ok(summary),
+            (status, _) => Err(RunError::InvalidConfig {
+                field: format!("children[{}]", child.index),
+                rule: format!(
+                    "child job {} is {}, not succeeded with a result",
+                    child.id,
+                    status.as_str()
+                ),
+            }),
+        })
+        .collect()
 }
 
 /// Stored progress with an ETA from the attempt's rate so far.

@@ -8,6 +8,7 @@ pub mod sqlite;
 pub mod tracks;
 
 use crate::config::Role;
+pub use crate::jobs::model::{ChildCounts, ChildOf};
 use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use crate::physics::track::TrackSample;
 use std::future::Future;
@@ -83,6 +84,150 @@ pub enum Finish {
     },
     Failed(String),
     Cancelled,
+}
+
+/// A child job to create when a job fans out. Its index among its siblings is its position in
+/// [`FanOut::children`]; seed, code version and submitter are the parent's.
+#[derive(Debug, Clone)]
+pub struct NewChild {
+    pub id: Uuid,
+    pub kind: JobKind,
+    pub params: serde_json::Value,
+}
+
+/// A fan-out to store: the children, and the simulated time all of them reach together, s
+/// (the parent's progress end time; its progress is the fraction of children that succeeded).
+#[derive(Debug, Clone)]
+pub struct FanOut {
+    pub children: Vec<NewChild>,
+    pub end_time_s: f64,
+}
+
+/// What [`Store::fan_out`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FanOutResult {
+    /// Children created, the parent is waiting for them.
+    FannedOut,
+    /// This attempt no longer owns the parent: nothing written.
+    Stale,
+    /// Cancellation was requested before the fan-out: nothing written; end the attempt as
+    /// cancelled.
+    CancelRequested,
+}
+
+/// A child job as its parent's assembly reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChildRecord {
+    pub id: Uuid,
+    pub index: i64,
+    pub status: JobStatus,
+    pub result: Option<serde_json::Value>,
+    pub error: Option<String>,
+}
+
+/// How an attempt ended (the attempt log).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AttemptOutcome {
+    /// Still running (or its worker died and the lease has not been found expired yet).
+    Running,
+    Succeeded,
+    Failed,
+    Cancelled,
+    /// The attempt created the job's children and left it waiting for them.
+    FannedOut,
+    /// The lease expired: the worker died or lost contact; its later writes are fenced out.
+    Lost,
+}
+
+impl AttemptOutcome {
+    /// Name as stored.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AttemptOutcome::Running => "running",
+            AttemptOutcome::Succeeded => "succeeded",
+            AttemptOutcome::Failed => "failed",
+            AttemptOutcome::Cancelled => "cancelled",
+            AttemptOutcome::FannedOut => "fanned_out",
+            AttemptOutcome::Lost => "lost",
+        }
+    }
+
+    /// Parse a stored name.
+    pub fn parse(text: &str) -> Option<Self> {
+        [
+            AttemptOutcome::Running,
+            AttemptOutcome::Succeeded,
+            AttemptOutcome::Failed,
+            AttemptOutcome::Cancelled,
+            AttemptOutcome::FannedOut,
+            AttemptOutcome::Lost,
+        ]
+        .into_iter()
+        .find(|o| o.as_str() == text)
+    }
+}
+
+impl From<JobStatus> for AttemptOutcome {
+    /// The outcome of an attempt that ended the job with `status` (succeeded, failed or
+    /// cancelled; a job still queued, running or waiting has its attempt running).
+    fn from(status: JobStatus) -> Self {
+        match status {
+            JobStatus::Succeeded => AttemptOutcome::Succeeded,
+            JobStatus::Failed => AttemptOutcome::Failed,
+            JobStatus::Cancelled => AttemptOutcome::Cancelled,
+            JobStatus::Queued | JobStatus::Running | JobStatus::Waiting => AttemptOutcome::Running,
+        }
+    }
+}
+
+/// The error a parent fails with when its child `child` (index `index`) ended with `status`
+/// (failed or cancelled), with the child's error if any.
+pub fn child_failure_message(
+    child: &str,
+    index: i64,
+    status: JobStatus,
+    error: Option<&str>,
+) -> String {
+    let what = if status == JobStatus::Cancelled {
+        "was cancelled".to_string()
+    } else {
+        format!("failed: {}", error.unwrap_or("no error recorded"))
+    };
+    format!("child {index} (job {child}) {what}")
+}
+
+/// One attempt of a job: written at the claim and at the attempt's end, in the same
+/// transactions as the job row, so it shows every write that took effect.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AttemptRecord {
+    pub attempt: i64,
+    /// Lease owner: `<host>-<pid>-<n>` for `railwear worker`.
+    pub worker: String,
+    pub started_ms: i64,
+    pub ended_ms: Option<i64>,
+    pub outcome: AttemptOutcome,
+}
+
+/// Which jobs a list shows.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct JobFilter {
+    /// Only jobs in this status.
+    pub status: Option<JobStatus>,
+    /// Only the children of this job.
+    pub parent: Option<Uuid>,
+    /// Only jobs that are not children of another.
+    pub top_level: bool,
+}
+
+impl Finish {
+    /// The status the job ends in.
+    pub fn status(&self) -> JobStatus {
+        match self {
+            Finish::Succeeded { .. } => JobStatus::Succeeded,
+            Finish::Failed(_) => JobStatus::Failed,
+            Finish::Cancelled => JobStatus::Cancelled,
+        }
+    }
 }
 
 /// One page of a list, newest first.
@@ -172,13 +317,9 @@ pub trait Store: Send + Sync {
     /// Insert a job, honouring its idempotency key (one transaction).
     fn submit_job(&self, job: NewJob) -> StoreFuture<'_, Submitted>;
     fn get_job(&self, id: Uuid) -> StoreFuture<'_, Option<JobRecord>>;
-    fn list_jobs(
-        &self,
-        page: PageRequest,
-        status: Option<JobStatus>,
-    ) -> StoreFuture<'_, Page<JobRecord>>;
+    fn list_jobs(&self, page: PageRequest, filter: JobFilter) -> StoreFuture<'_, Page<JobRecord>>;
     /// Atomically take the oldest queued job: status running, attempt + 1, lease until
-    /// `now_ms + lease_ms`. `None` when the queue is empty.
+    /// `now_ms + lease_ms`, and log the attempt. `None` when the queue is empty.
     fn claim_job(
         &self,
         worker: &str,
@@ -195,6 +336,10 @@ pub trait Store: Send + Sync {
         lease_ms: i64,
     ) -> StoreFuture<'_, Heartbeat>;
     /// End attempt `attempt`; returns false (and writes nothing) if that attempt is stale.
+    /// For a child job the parent's bookkeeping is part of the same transaction: the child
+    /// that completes the set re-queues the parent (to assemble its result, exactly once); a
+    /// child that fails or is cancelled fails the parent, naming the child, and cancels its
+    /// siblings.
     fn finish_job(
         &self,
         id: Uuid,
@@ -202,11 +347,28 @@ pub trait Store: Send + Sync {
         finish: Finish,
         now_ms: i64,
     ) -> StoreFuture<'_, bool>;
-    /// Ask a job to stop: a queued job is cancelled at once, a running one is flagged for its
-    /// worker. Terminal jobs are unchanged. `None` if no such job.
+    /// Fan attempt `attempt` of a running job out into child jobs, in one transaction fenced by
+    /// the attempt: insert the children (queued; unique per parent and index) and move the
+    /// parent to waiting. Nothing is written unless the attempt owns the job and no
+    /// cancellation was requested.
+    fn fan_out(
+        &self,
+        parent: Uuid,
+        attempt: i64,
+        fan_out: FanOut,
+        now_ms: i64,
+    ) -> StoreFuture<'_, FanOutResult>;
+    /// The children of a job, by index.
+    fn children(&self, parent: Uuid) -> StoreFuture<'_, Vec<ChildRecord>>;
+    /// The attempt log of a job, oldest first.
+    fn attempts(&self, id: Uuid) -> StoreFuture<'_, Vec<AttemptRecord>>;
+    /// Ask a job to stop: a queued or waiting job is cancelled at once (a waiting job's queued
+    /// children too, its running ones are flagged), a running one is flagged for its worker.
+    /// Terminal jobs are unchanged. `None` if no such job.
     fn request_cancel(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, Option<JobRecord>>;
     /// Re-queue running jobs whose lease expired (or fail them after `max_attempts`, or cancel
-    /// them if cancellation was requested). Returns how many jobs changed.
+    /// them if cancellation was requested), logging the attempt as lost. A child that ends
+    /// this way fails its parent. Returns how many jobs changed.
     fn requeue_expired(&self, now_ms: i64, max_attempts: i64) -> StoreFuture<'_, u64>;
     /// Number of jobs per status.
     fn job_counts(&self) -> StoreFuture<'_, Vec<(JobStatus, i64)>>;
@@ -215,7 +377,7 @@ pub trait Store: Send + Sync {
     /// Names of a job's SVG plots.
     fn plot_names(&self, id: Uuid) -> StoreFuture<'_, Vec<String>>;
     fn plot(&self, id: Uuid, name: &str) -> StoreFuture<'_, Option<String>>;
-    /// The newest queued or running sweep for a curve key.
+    /// The newest queued, running or waiting sweep for a curve key.
     fn active_sweep(&self, curve_key: &str) -> StoreFuture<'_, Option<JobRecord>>;
 
     /// Register the rail if new and insert the measurement (one transaction).
@@ -265,4 +427,36 @@ pub fn decode_tracks(blocks: &[TrackBlock]) -> Result<Vec<TrackSample>, tracks::
         out.extend(tracks::decode_block(block)?);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn attempt_outcomes_round_trip_their_stored_names() {
+        for outcome in [
+            AttemptOutcome::Running,
+            AttemptOutcome::Succeeded,
+            AttemptOutcome::Failed,
+            AttemptOutcome::Cancelled,
+            AttemptOutcome::FannedOut,
+            AttemptOutcome::Lost,
+        ] {
+            assert_eq!(AttemptOutcome::parse(outcome.as_str()), Some(outcome));
+        }
+        assert_eq!(AttemptOutcome::parse("done"), None);
+    }
+
+    #[test]
+    fn a_failed_child_is_named_with_its_error() {
+        assert_eq!(
+            child_failure_message("c-1", 3, JobStatus::Failed, Some("simulation diverged")),
+            "child 3 (job c-1) failed: simulation diverged"
+        );
+        assert_eq!(
+            child_failure_message("c-2", 0, JobStatus::Cancelled, None),
+            "child 0 (job c-2) was cancelled"
+        );
+    }
 }

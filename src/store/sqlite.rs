@@ -3,14 +3,15 @@
 //! writers queue instead of deadlocking on a lock upgrade), single-statement job claims.
 
 use super::{
-    CurveRecord, Finish, Heartbeat, MeasurementRecord, NewJob, NewMeasurement, Page, PageRequest,
-    RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord, CurveRecord, FanOut,
+    FanOutResult, Finish, Heartbeat, JobFilter, MeasurementRecord, NewJob, NewMeasurement, Page,
+    PageRequest, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
 use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use sqlx::sqlite::{
-    SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteRow,
-    SqliteSynchronous,
+    SqliteConnectOptions, SqliteConnection, SqliteJournalMode, SqlitePool, SqlitePoolOptions,
+    SqliteRow, SqliteSynchronous,
 };
 use sqlx::Row;
 use std::str::FromStr;
@@ -100,6 +101,26 @@ fn job_from_row(row: &SqliteRow) -> Result<JobRecord, StoreError> {
         error: row.try_get("error")?,
         track_samples: row.try_get("track_samples")?,
         curve_key: row.try_get("curve_key")?,
+        lease_owner: row.try_get("lease_owner")?,
+        parent: match (
+            row.try_get::<Option<String>, _>("parent_id")?,
+            row.try_get::<Option<i64>, _>("child_index")?,
+        ) {
+            (Some(parent_id), Some(index)) => Some(ChildOf {
+                parent_id: parse_uuid(&parent_id)?,
+                index,
+            }),
+            _ => None,
+        },
+        children: match row.try_get::<i64, _>("children_total")? {
+            0 => None,
+            total => Some(ChildCounts {
+                total,
+                succeeded: row.try_get("children_succeeded")?,
+                failed: row.try_get("children_failed")?,
+                cancelled: row.try_get("children_cancelled")?,
+            }),
+        },
     })
 }
 
@@ -155,7 +176,110 @@ fn paginate<T>(mut items: Vec<T>, limit: i64, seq: impl Fn(&T) -> i64) -> Page<T
 
 const JOB_COLUMNS: &str = "seq, id, kind, status, params, seed, code_version, submitted_by, \
     attempt, cancel_requested, created_ms, started_ms, finished_ms, progress_simulated_s, \
-    progress_end_s, progress_fraction, progress_eta_s, result, error, track_samples, curve_key";
+    progress_end_s, progress_fraction, progress_eta_s, result, error, track_samples, curve_key, \
+    lease_owner, parent_id, child_index, children_total, children_succeeded, children_failed, \
+    children_cancelled";
+
+/// Parent bookkeeping when child `child` (index `index`) of `parent` ended with `status`, in the
+/// caller's write transaction (SQLite has one writer, so the count it reads is final). The
+/// success that completes the set re-queues a waiting parent for its assembly; a failure or
+/// cancellation fails a waiting parent, naming the child, and cancels the siblings.
+async fn child_ended(
+    conn: &mut SqliteConnection,
+    parent: &str,
+    child: &str,
+    index: i64,
+    status: JobStatus,
+    error: Option<&str>,
+    now_ms: i64,
+) -> Result<(), StoreError> {
+    if status == JobStatus::Succeeded {
+        sqlx::query(
+            "UPDATE jobs SET children_succeeded = children_succeeded + 1, \
+             progress_fraction = CAST(children_succeeded + 1 AS REAL) / children_total, \
+             progress_simulated_s = progress_end_s * (children_succeeded + 1) / children_total, \
+             status = CASE WHEN status = 'waiting' AND children_succeeded + 1 >= children_total \
+               THEN 'queued' ELSE status END \
+             WHERE id = ?1",
+        )
+        .bind(parent)
+        .execute(&mut *conn)
+        .await?;
+        return Ok(());
+    }
+    let message = super::child_failure_message(child, index, status, error);
+    let row = sqlx::query(
+        "UPDATE jobs SET children_failed = children_failed + ?2, \
+         children_cancelled = children_cancelled + ?3, \
+         error = CASE WHEN status = 'waiting' THEN ?4 ELSE error END, \
+         finished_ms = CASE WHEN status = 'waiting' THEN ?5 ELSE finished_ms END, \
+         status = CASE WHEN status = 'waiting' THEN 'failed' ELSE status END \
+         WHERE id = ?1 RETURNING status",
+    )
+    .bind(parent)
+    .bind(i64::from(status == JobStatus::Failed))
+    .bind(i64::from(status == JobStatus::Cancelled))
+    .bind(message)
+    .bind(now_ms)
+    .fetch_optional(&mut *conn)
+    .await?;
+    if let Some(row) = row {
+        let parent_status: String = row.try_get("status")?;
+        if parent_status == "failed" || parent_status == "cancelled" {
+            cancel_children(conn, parent, now_ms).await?;
+        }
+    }
+    Ok(())
+}
+
+/// Cancel the queued children of a terminal parent at once and flag its running ones.
+async fn cancel_children(
+    conn: &mut SqliteConnection,
+    parent: &str,
+    now_ms: i64,
+) -> Result<(), StoreError> {
+    let cancelled = sqlx::query(
+        "UPDATE jobs SET status = 'cancelled', cancel_requested = 1, finished_ms = ?2 \
+         WHERE parent_id = ?1 AND status = 'queued'",
+    )
+    .bind(parent)
+    .bind(now_ms)
+    .execute(&mut *conn)
+    .await?
+    .rows_affected();
+    if cancelled > 0 {
+        sqlx::query("UPDATE jobs SET children_cancelled = children_cancelled + ?2 WHERE id = ?1")
+            .bind(parent)
+            .bind(cancelled as i64)
+            .execute(&mut *conn)
+            .await?;
+    }
+    sqlx::query("UPDATE jobs SET cancel_requested = 1 WHERE parent_id = ?1 AND status = 'running'")
+        .bind(parent)
+        .execute(&mut *conn)
+        .await?;
+    Ok(())
+}
+
+/// Record how attempt `attempt` of job `id` ended.
+async fn end_attempt(
+    conn: &mut SqliteConnection,
+    id: &str,
+    attempt: i64,
+    outcome: AttemptOutcome,
+    now_ms: i64,
+) -> Result<(), StoreError> {
+    sqlx::query(
+        "UPDATE job_attempts SET outcome = ?3, ended_ms = ?4 WHERE job_id = ?1 AND attempt = ?2",
+    )
+    .bind(id)
+    .bind(attempt)
+    .bind(outcome.as_str())
+    .bind(now_ms)
+    .execute(&mut *conn)
+    .await?;
+    Ok(())
+}
 
 impl SqliteStore {
     async fn job_by_id(&self, id: Uuid) -> Result<Option<JobRecord>, StoreError> {
@@ -245,20 +369,19 @@ impl Store for SqliteStore {
         Box::pin(self.job_by_id(id))
     }
 
-    fn list_jobs(
-        &self,
-        page: PageRequest,
-        status: Option<JobStatus>,
-    ) -> StoreFuture<'_, Page<JobRecord>> {
+    fn list_jobs(&self, page: PageRequest, filter: JobFilter) -> StoreFuture<'_, Page<JobRecord>> {
         Box::pin(async move {
             let sql = format!(
                 "SELECT {JOB_COLUMNS} FROM jobs WHERE (?1 IS NULL OR seq < ?1) \
-                 AND (?2 IS NULL OR status = ?2) ORDER BY seq DESC LIMIT ?3"
+                 AND (?2 IS NULL OR status = ?2) AND (?4 IS NULL OR parent_id = ?4) \
+                 AND (?5 = 0 OR parent_id IS NULL) ORDER BY seq DESC LIMIT ?3"
             );
             let rows = sqlx::query(&sql)
                 .bind(page.after_seq)
-                .bind(status.map(|s| s.as_str()))
+                .bind(filter.status.map(|s| s.as_str()))
                 .bind(page.limit + 1)
+                .bind(filter.parent.map(|p| p.to_string()))
+                .bind(i64::from(filter.top_level))
                 .fetch_all(&self.pool)
                 .await?;
             let items = rows
@@ -278,22 +401,42 @@ impl Store for SqliteStore {
         let worker = worker.to_string();
         Box::pin(async move {
             // One statement: the sub-select and the update run under the same write lock, so
-            // two workers can never take the same job.
+            // two workers can never take the same job. A parent queued for its assembly keeps
+            // the progress of its children.
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
             let sql = format!(
                 "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = ?1, \
                  lease_expires_ms = ?2 + ?3, started_ms = COALESCE(started_ms, ?2), \
-                 attempt_started_ms = ?2, progress_simulated_s = NULL, progress_end_s = NULL, \
-                 progress_fraction = NULL, progress_eta_s = NULL \
+                 attempt_started_ms = ?2, \
+                 progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
+                 progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
+                 progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
+                 progress_eta_s = NULL \
                  WHERE seq = (SELECT seq FROM jobs WHERE status = 'queued' ORDER BY seq LIMIT 1) \
                  AND status = 'queued' RETURNING {JOB_COLUMNS}"
             );
             let row = sqlx::query(&sql)
-                .bind(worker)
+                .bind(&worker)
                 .bind(now_ms)
                 .bind(lease_ms)
-                .fetch_optional(&self.pool)
+                .fetch_optional(&mut *tx)
                 .await?;
-            row.as_ref().map(job_from_row).transpose()
+            let Some(job) = row.as_ref().map(job_from_row).transpose()? else {
+                tx.rollback().await?;
+                return Ok(None);
+            };
+            sqlx::query(
+                "INSERT INTO job_attempts (job_id, attempt, worker, started_ms, outcome) \
+                 VALUES (?1, ?2, ?3, ?4, 'running')",
+            )
+            .bind(job.id.to_string())
+            .bind(job.attempt)
+            .bind(&worker)
+            .bind(now_ms)
+            .execute(&mut *tx)
+            .await?;
+            tx.commit().await?;
+            Ok(Some(job))
         })
     }
 
@@ -366,20 +509,36 @@ impl Store for SqliteStore {
                  progress_fraction = CASE WHEN ?3 = 'succeeded' THEN 1.0 ELSE progress_fraction END, \
                  progress_simulated_s = CASE WHEN ?3 = 'succeeded' THEN progress_end_s ELSE progress_simulated_s END, \
                  progress_eta_s = CASE WHEN ?3 = 'succeeded' THEN 0.0 ELSE progress_eta_s END \
-                 WHERE id = ?1 AND attempt = ?2 AND status = 'running'",
+                 WHERE id = ?1 AND attempt = ?2 AND status = 'running' \
+                 RETURNING parent_id, child_index",
             )
             .bind(id.to_string())
             .bind(attempt)
             .bind(status.as_str())
             .bind(now_ms)
             .bind(result)
-            .bind(error)
+            .bind(&error)
             .bind(samples)
-            .execute(&mut *tx)
+            .fetch_optional(&mut *tx)
             .await?;
-            if updated.rows_affected() != 1 {
+            let Some(updated) = updated else {
                 tx.rollback().await?;
                 return Ok(false);
+            };
+            end_attempt(&mut tx, &id.to_string(), attempt, status.into(), now_ms).await?;
+            let parent: Option<String> = updated.try_get("parent_id")?;
+            if let Some(parent) = parent {
+                let index: i64 = updated.try_get("child_index")?;
+                child_ended(
+                    &mut tx,
+                    &parent,
+                    &id.to_string(),
+                    index,
+                    status,
+                    error.as_deref(),
+                    now_ms,
+                )
+                .await?;
             }
             if let Finish::Succeeded {
                 blocks,
@@ -431,28 +590,202 @@ impl Store for SqliteStore {
         })
     }
 
+    fn fan_out(
+        &self,
+        parent: Uuid,
+        attempt: i64,
+        fan_out: FanOut,
+        now_ms: i64,
+    ) -> StoreFuture<'_, FanOutResult> {
+        Box::pin(async move {
+            if fan_out.children.is_empty() {
+                return Err(corrupt("a fan-out needs at least one child"));
+            }
+            let parent_id = parent.to_string();
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let moved = sqlx::query(
+                "UPDATE jobs SET status = 'waiting', children_total = ?3, lease_owner = NULL, \
+                 lease_expires_ms = NULL, progress_simulated_s = 0.0, progress_end_s = ?4, \
+                 progress_fraction = 0.0, progress_eta_s = NULL \
+                 WHERE id = ?1 AND attempt = ?2 AND status = 'running' AND cancel_requested = 0",
+            )
+            .bind(&parent_id)
+            .bind(attempt)
+            .bind(fan_out.children.len() as i64)
+            .bind(fan_out.end_time_s)
+            .execute(&mut *tx)
+            .await?;
+            if moved.rows_affected() != 1 {
+                let owned_but_cancelled = sqlx::query(
+                    "SELECT 1 FROM jobs WHERE id = ?1 AND attempt = ?2 AND status = 'running' \
+                     AND cancel_requested = 1",
+                )
+                .bind(&parent_id)
+                .bind(attempt)
+                .fetch_optional(&mut *tx)
+                .await?
+                .is_some();
+                tx.rollback().await?;
+                return Ok(if owned_but_cancelled {
+                    FanOutResult::CancelRequested
+                } else {
+                    FanOutResult::Stale
+                });
+            }
+            for (index, child) in fan_out.children.iter().enumerate() {
+                // Seed, code version and submitter are the parent's.
+                sqlx::query(
+                    "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
+                     created_ms, parent_id, child_index) \
+                     SELECT ?1, ?2, 'queued', ?3, seed, code_version, submitted_by, ?4, id, ?5 \
+                     FROM jobs WHERE id = ?6",
+                )
+                .bind(child.id.to_string())
+                .bind(child.kind.as_str())
+                .bind(child.params.to_string())
+                .bind(now_ms)
+                .bind(index as i64)
+                .bind(&parent_id)
+                .execute(&mut *tx)
+                .await?;
+            }
+            end_attempt(
+                &mut tx,
+                &parent_id,
+                attempt,
+                AttemptOutcome::FannedOut,
+                now_ms,
+            )
+            .await?;
+            tx.commit().await?;
+            Ok(FanOutResult::FannedOut)
+        })
+    }
+
+    fn children(&self, parent: Uuid) -> StoreFuture<'_, Vec<ChildRecord>> {
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT id, child_index, status, result, error FROM jobs WHERE parent_id = ?1 \
+                 ORDER BY child_index",
+            )
+            .bind(parent.to_string())
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let id: String = row.try_get("id")?;
+                    let status: String = row.try_get("status")?;
+                    let result: Option<String> = row.try_get("result")?;
+                    Ok(ChildRecord {
+                        id: parse_uuid(&id)?,
+                        index: row.try_get("child_index")?,
+                        status: JobStatus::parse(&status)
+                            .ok_or_else(|| corrupt(format!("job status `{status}`")))?,
+                        result: result
+                            .as_deref()
+                            .map(|r| parse_json(r, "child result"))
+                            .transpose()?,
+                        error: row.try_get("error")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn attempts(&self, id: Uuid) -> StoreFuture<'_, Vec<AttemptRecord>> {
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT attempt, worker, started_ms, ended_ms, outcome FROM job_attempts \
+                 WHERE job_id = ?1 ORDER BY attempt",
+            )
+            .bind(id.to_string())
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let outcome: String = row.try_get("outcome")?;
+                    Ok(AttemptRecord {
+                        attempt: row.try_get("attempt")?,
+                        worker: row.try_get("worker")?,
+                        started_ms: row.try_get("started_ms")?,
+                        ended_ms: row.try_get("ended_ms")?,
+                        outcome: AttemptOutcome::parse(&outcome)
+                            .ok_or_else(|| corrupt(format!("attempt outcome `{outcome}`")))?,
+                    })
+                })
+                .collect()
+        })
+    }
+
     fn request_cancel(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, Option<JobRecord>> {
         Box::pin(async move {
-            // SET expressions all see the old row, so `status = 'queued'` tests the old status.
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let Some(before) = sqlx::query("SELECT status FROM jobs WHERE id = ?1")
+                .bind(id.to_string())
+                .fetch_optional(&mut *tx)
+                .await?
+            else {
+                tx.rollback().await?;
+                return Ok(None);
+            };
+            let before: String = before.try_get("status")?;
+            // SET expressions all see the old row, so `status IN (...)` tests the old status:
+            // queued and waiting jobs end at once, a running one is flagged for its worker.
             let sql = format!(
                 "UPDATE jobs SET \
-                 cancel_requested = CASE WHEN status IN ('queued', 'running') THEN 1 ELSE cancel_requested END, \
-                 finished_ms = CASE WHEN status = 'queued' THEN ?2 ELSE finished_ms END, \
-                 status = CASE WHEN status = 'queued' THEN 'cancelled' ELSE status END \
+                 cancel_requested = CASE WHEN status IN ('queued', 'running', 'waiting') THEN 1 ELSE cancel_requested END, \
+                 finished_ms = CASE WHEN status IN ('queued', 'waiting') THEN ?2 ELSE finished_ms END, \
+                 status = CASE WHEN status IN ('queued', 'waiting') THEN 'cancelled' ELSE status END \
                  WHERE id = ?1 RETURNING {JOB_COLUMNS}"
             );
             let row = sqlx::query(&sql)
                 .bind(id.to_string())
                 .bind(now_ms)
-                .fetch_optional(&self.pool)
+                .fetch_one(&mut *tx)
                 .await?;
-            row.as_ref().map(job_from_row).transpose()
+            let mut job = job_from_row(&row)?;
+            if before == "queued" || before == "waiting" {
+                if before == "waiting" {
+                    cancel_children(&mut tx, &id.to_string(), now_ms).await?;
+                }
+                if let Some(of) = job.parent {
+                    child_ended(
+                        &mut tx,
+                        &of.parent_id.to_string(),
+                        &id.to_string(),
+                        of.index,
+                        JobStatus::Cancelled,
+                        None,
+                        now_ms,
+                    )
+                    .await?;
+                }
+                let sql = format!("SELECT {JOB_COLUMNS} FROM jobs WHERE id = ?1");
+                let row = sqlx::query(&sql)
+                    .bind(id.to_string())
+                    .fetch_one(&mut *tx)
+                    .await?;
+                job = job_from_row(&row)?;
+            }
+            tx.commit().await?;
+            Ok(Some(job))
         })
     }
 
     fn requeue_expired(&self, now_ms: i64, max_attempts: i64) -> StoreFuture<'_, u64> {
         Box::pin(async move {
-            let done = sqlx::query(
+            // Cheap check first: most calls find nothing and need no write lock.
+            let any = sqlx::query(
+                "SELECT 1 FROM jobs WHERE status = 'running' AND lease_expires_ms < ?1 LIMIT 1",
+            )
+            .bind(now_ms)
+            .fetch_optional(&self.pool)
+            .await?;
+            if any.is_none() {
+                return Ok(0);
+            }
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let expired = sqlx::query(
                 "UPDATE jobs SET \
                  error = CASE WHEN cancel_requested = 1 THEN error \
                    ELSE 'attempt ' || attempt || ' lost its worker (lease expired)' END, \
@@ -460,13 +793,38 @@ impl Store for SqliteStore {
                  status = CASE WHEN cancel_requested = 1 THEN 'cancelled' \
                    WHEN attempt >= ?2 THEN 'failed' ELSE 'queued' END, \
                  lease_owner = NULL, lease_expires_ms = NULL \
-                 WHERE status = 'running' AND lease_expires_ms < ?1",
+                 WHERE status = 'running' AND lease_expires_ms < ?1 \
+                 RETURNING id, attempt, status, error, parent_id, child_index",
             )
             .bind(now_ms)
             .bind(max_attempts)
-            .execute(&self.pool)
+            .fetch_all(&mut *tx)
             .await?;
-            Ok(done.rows_affected())
+            for row in &expired {
+                let id: String = row.try_get("id")?;
+                let attempt: i64 = row.try_get("attempt")?;
+                end_attempt(&mut tx, &id, attempt, AttemptOutcome::Lost, now_ms).await?;
+                let status: String = row.try_get("status")?;
+                let status = JobStatus::parse(&status)
+                    .ok_or_else(|| corrupt(format!("job status `{status}`")))?;
+                let parent: Option<String> = row.try_get("parent_id")?;
+                if let (Some(parent), true) = (parent, status.is_terminal()) {
+                    let error: Option<String> = row.try_get("error")?;
+                    let index: i64 = row.try_get("child_index")?;
+                    child_ended(
+                        &mut tx,
+                        &parent,
+                        &id,
+                        index,
+                        status,
+                        error.as_deref(),
+                        now_ms,
+                    )
+                    .await?;
+                }
+            }
+            tx.commit().await?;
+            Ok(expired.len() as u64)
         })
     }
 
@@ -541,7 +899,7 @@ impl Store for SqliteStore {
         Box::pin(async move {
             let sql = format!(
                 "SELECT {JOB_COLUMNS} FROM jobs WHERE curve_key = ?1 AND kind = 'sweep' \
-                 AND status IN ('queued', 'running') ORDER BY seq DESC LIMIT 1"
+                 AND status IN ('queued', 'running', 'waiting') ORDER BY seq DESC LIMIT 1"
             );
             let row = sqlx::query(&sql)
                 .bind(curve_key)

@@ -1,12 +1,15 @@
 //! A test double for the queue (not a physics stub): a deterministic computation that takes a
 //! known wall time, reports progress, honours cancellation and produces tracks from its seed.
 //! Injected through `CaseRunner` so queue semantics can be tested without the engine.
+//!
+//! A sweep with `"children": n` fans out into n `sweep_point` children (each the same counted
+//! computation, `"fail_point": i` makes child i fail) and is assembled from their results.
 
 use railwear::analysis::penalization::{PenalizationCurve, SweepPoint};
 use railwear::analysis::rattle_space::LauncherDimensions;
 use railwear::config::ServiceConfig;
 use railwear::http::RunningService;
-use railwear::jobs::{CaseRunner, JobKind, JobOutput};
+use railwear::jobs::{CaseRunner, ChildJob, FanOutPlan, JobKind, JobOutput};
 use railwear::physics::track::TrackSample;
 use railwear::pipeline::{Progress, RunControl, RunError};
 use std::sync::Arc;
@@ -67,29 +70,29 @@ impl CaseRunner for CountingRunner {
                 fraction: (step + 1) as f64 / steps as f64,
             });
         }
+        if *kind == JobKind::SweepPoint {
+            let point = params
+                .get("point")
+                .and_then(|v| v.as_u64())
+                .unwrap_or(u64::MAX);
+            if params.get("fail_point").and_then(|v| v.as_u64()) == Some(point) {
+                return Err(RunError::Diverged(format!(
+                    "point {point} diverged on purpose"
+                )));
+            }
+            // A value that depends on the seed and the point only.
+            return Ok(JobOutput {
+                summary: serde_json::json!({
+                    "point": point,
+                    "value": sample(seed, point).normal_force_n,
+                }),
+                ..JobOutput::default()
+            });
+        }
         let tracks: Vec<TrackSample> = (0..samples).map(|i| sample(seed, i)).collect();
         let force_sum: f64 = tracks.iter().map(|t| t.normal_force_n).sum();
-        // Sweeps yield a curve from fixed points (rates in mg/h at the thesis' loose, design
-        // and tight rattle spaces; only their ratios matter to K_SL).
         let penalization = if *kind == JobKind::Sweep {
-            let point = |rattle_space, rail_wear_rate_mg_per_h| SweepPoint {
-                rattle_space,
-                rail_wear_rate_mg_per_h,
-            };
-            // At the exact rattle spaces of the named loose/design/tight dimension sets.
-            let k = |d: LauncherDimensions| d.rattle_space().unwrap_or(f64::NAN);
-            let design = k(LauncherDimensions::design());
-            let points = [
-                point(k(LauncherDimensions::loose()), 2.0),
-                point(design, 1.5),
-                point(k(LauncherDimensions::tight()), 1.0),
-            ];
-            Some(
-                PenalizationCurve::new(&points, design).map_err(|e| RunError::InvalidConfig {
-                    field: "points".into(),
-                    rule: e.to_string(),
-                })?,
-            )
+            Some(fixed_curve()?)
         } else {
             None
         };
@@ -104,6 +107,58 @@ impl CaseRunner for CountingRunner {
         })
     }
 
+    fn fan_out(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+    ) -> Result<Option<FanOutPlan>, RunError> {
+        let Some(n) = params.get("children").and_then(|v| v.as_u64()) else {
+            return Ok(None);
+        };
+        if *kind != JobKind::Sweep {
+            return Ok(None);
+        }
+        let steps = params.get("steps").and_then(|v| v.as_u64()).unwrap_or(10);
+        Ok(Some(FanOutPlan {
+            children: (0..n)
+                .map(|i| {
+                    let mut child = params.clone();
+                    child["point"] = serde_json::json!(i);
+                    ChildJob {
+                        kind: JobKind::SweepPoint,
+                        params: child,
+                    }
+                })
+                .collect(),
+            end_time_s: n as f64 * steps as f64 * 0.1,
+        }))
+    }
+
+    fn assemble(
+        &self,
+        _kind: &JobKind,
+        _params: &serde_json::Value,
+        children: &[serde_json::Value],
+    ) -> Result<JobOutput, RunError> {
+        for (i, child) in children.iter().enumerate() {
+            if child["point"] != serde_json::json!(i) {
+                return Err(RunError::InvalidConfig {
+                    field: format!("children[{i}]"),
+                    rule: format!("holds point {}", child["point"]),
+                });
+            }
+        }
+        Ok(JobOutput {
+            summary: serde_json::json!({ "points": children }),
+            plots: vec![(
+                "penalization.svg".into(),
+                "<svg xmlns=\"http://www.w3.org/2000/svg\"/>".into(),
+            )],
+            penalization: Some(fixed_curve()?),
+            ..JobOutput::default()
+        })
+    }
+
     fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
         match params.get("steps") {
             Some(v) if v.as_u64().is_none() => Err(RunError::InvalidConfig {
@@ -113,6 +168,27 @@ impl CaseRunner for CountingRunner {
             _ => Ok(()),
         }
     }
+}
+
+/// The curve every counted sweep yields: fixed points (rates in mg/h at the thesis' loose,
+/// design and tight rattle spaces; only their ratios matter to K_SL).
+fn fixed_curve() -> Result<PenalizationCurve, RunError> {
+    let point = |rattle_space, rail_wear_rate_mg_per_h| SweepPoint {
+        rattle_space,
+        rail_wear_rate_mg_per_h,
+    };
+    // At the exact rattle spaces of the named loose/design/tight dimension sets.
+    let k = |d: LauncherDimensions| d.rattle_space().unwrap_or(f64::NAN);
+    let design = k(LauncherDimensions::design());
+    let points = [
+        point(k(LauncherDimensions::loose()), 2.0),
+        point(design, 1.5),
+        point(k(LauncherDimensions::tight()), 1.0),
+    ];
+    PenalizationCurve::new(&points, design).map_err(|e| RunError::InvalidConfig {
+        field: "points".into(),
+        rule: e.to_string(),
+    })
 }
 
 /// Settings for an in-process test service on a free port with a fresh database.

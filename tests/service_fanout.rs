@@ -1,0 +1,269 @@
+//! Fan-out through the embedded workers on SQLite (the same code path as `railwear worker`
+//! processes on PostgreSQL), over HTTP, with the counting test runner: a sweep becomes child
+//! jobs listed under `?parent=`, its progress is the fraction of children done, its result is
+//! assembled once from the children's results in index order; a failing child fails the sweep
+//! naming it and cancels the rest; cancelling the sweep cancels its children.
+
+mod service_support;
+
+use railwear::store::AttemptOutcome;
+use serde_json::{json, Value};
+use service_support::runner::{sample, start, test_config};
+use service_support::{curl, wait_for, TempDir, ENGINEER};
+use std::time::Duration;
+
+fn get(base: &str, path: &str) -> Value {
+    let r = curl("GET", &format!("{base}{path}"), Some(ENGINEER), &[], None);
+    assert_eq!(r.status, 200, "{path}: {}", r.body);
+    r.json()
+}
+
+fn submit(base: &str, body: &str) -> String {
+    let r = curl(
+        "POST",
+        &format!("{base}/v1/jobs"),
+        Some(ENGINEER),
+        &[],
+        Some(body),
+    );
+    assert_eq!(r.status, 201, "{}", r.body);
+    r.json()["id"].as_str().expect("job id").to_string()
+}
+
+fn children(base: &str, id: &str) -> Vec<Value> {
+    get(base, &format!("/v1/jobs?parent={id}&limit=100"))["items"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default()
+}
+
+fn count(items: &[Value], status: &str) -> usize {
+    items.iter().filter(|j| j["status"] == status).count()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
+    let dir = TempDir::new("fanout");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 3;
+    let service = start(config, true).await;
+    let store = service.state.store.clone();
+    let base = format!("http://{}", service.addr);
+    let (id, child_ids) = tokio::task::spawn_blocking(move || {
+        let body = r#"{"kind":"sweep","params":{"children":6,"steps":3,"step_ms":20,"seed":42}}"#;
+        let id = submit(&base, body);
+        let done = wait_for(Duration::from_secs(30), "sweep success", || {
+            let j = get(&base, &format!("/v1/jobs/{id}"));
+            assert_ne!(j["status"], "failed", "{j}");
+            (j["status"] == "succeeded").then_some(j)
+        });
+        assert_eq!(
+            done["children"],
+            json!({"total": 6, "succeeded": 6, "failed": 0, "cancelled": 0})
+        );
+        assert_eq!(done["progress"]["fraction"], 1.0);
+        assert_eq!(done["parent_id"], Value::Null);
+        assert_eq!(
+            done["links"]["children"],
+            format!("/v1/jobs?parent={id}&limit=100").as_str()
+        );
+
+        let kids = children(&base, &id);
+        assert_eq!(kids.len(), 6);
+        let mut indices: Vec<i64> = kids
+            .iter()
+            .map(|c| c["child_index"].as_i64().unwrap())
+            .collect();
+        indices.sort_unstable();
+        assert_eq!(indices, [0, 1, 2, 3, 4, 5]);
+        for c in &kids {
+            assert_eq!(c["kind"], "sweep_point");
+            assert_eq!(c["status"], "succeeded");
+            assert_eq!(c["parent_id"], id.as_str());
+            assert_eq!(c["seed"], 42);
+            assert_eq!(c["children"], Value::Null);
+        }
+        // Submitted jobs only: the children stay out of the top-level list.
+        let top = get(&base, "/v1/jobs?top_level=true")["items"].clone();
+        assert_eq!(top.as_array().map(Vec::len), Some(1));
+        assert_eq!(top[0]["id"], id.as_str());
+
+        // The assembled result lists the children's results in index order; each is the
+        // runner's value for the sweep's seed and that point, so the seed reached every child.
+        let result = get(&base, &format!("/v1/jobs/{id}/result"));
+        let points = result["summary"]["points"].as_array().unwrap().clone();
+        assert_eq!(points.len(), 6);
+        for (i, p) in points.iter().enumerate() {
+            assert_eq!(p["point"], i);
+            assert_eq!(
+                p["value"].as_f64().unwrap().to_bits(),
+                sample(42, i as u64).normal_force_n.to_bits()
+            );
+        }
+        assert_eq!(result["plots"][0]["name"], "penalization.svg");
+        let child_ids: Vec<uuid::Uuid> = kids
+            .iter()
+            .map(|c| c["id"].as_str().unwrap().parse().unwrap())
+            .collect();
+        (id.parse::<uuid::Uuid>().unwrap(), child_ids)
+    })
+    .await
+    .unwrap();
+    // The attempt log: fanned out once, assembled once; every child ran once.
+    let outcomes = |a: Vec<railwear::store::AttemptRecord>| -> Vec<AttemptOutcome> {
+        a.iter().map(|a| a.outcome).collect()
+    };
+    assert_eq!(
+        outcomes(store.attempts(id).await.unwrap()),
+        [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
+    );
+    for child in child_ids {
+        assert_eq!(
+            outcomes(store.attempts(child).await.unwrap()),
+            [AttemptOutcome::Succeeded]
+        );
+    }
+    let job = store.get_job(id).await.unwrap().unwrap();
+    let curve = store
+        .get_curve(job.curve_key.as_deref().unwrap())
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(curve.job_id, id);
+    service.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
+    let dir = TempDir::new("fanout-fail");
+    let service = start(test_config(&dir.db_url()), true).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let body = r#"{"kind":"sweep","params":{"children":6,"steps":5,"step_ms":40,"fail_point":0,"seed":1}}"#;
+        let id = submit(&base, body);
+        let failed = wait_for(Duration::from_secs(30), "sweep failure", || {
+            let j = get(&base, &format!("/v1/jobs/{id}"));
+            assert_ne!(j["status"], "succeeded", "{j}");
+            (j["status"] == "failed").then_some(j)
+        });
+        let kids = wait_for(Duration::from_secs(30), "children ended", || {
+            let kids = children(&base, &id);
+            (count(&kids, "queued") + count(&kids, "running") == 0).then_some(kids)
+        });
+        let first = kids
+            .iter()
+            .find(|c| c["child_index"] == 0)
+            .expect("child 0");
+        assert_eq!(first["status"], "failed");
+        assert_eq!(first["error"], "simulation diverged: point 0 diverged on purpose");
+        assert_eq!(
+            failed["error"],
+            format!(
+                "child 0 (job {}) failed: simulation diverged: point 0 diverged on purpose",
+                first["id"].as_str().unwrap()
+            )
+            .as_str()
+        );
+        // The others either finished before they heard or were cancelled.
+        assert_eq!(count(&kids, "failed"), 1);
+        assert_eq!(count(&kids, "succeeded") + count(&kids, "cancelled"), 5);
+        assert!(count(&kids, "cancelled") >= 3, "queued children were not cancelled");
+        let parent = get(&base, &format!("/v1/jobs/{id}"));
+        assert_eq!(parent["status"], "failed");
+        assert_eq!(
+            parent["children"],
+            json!({
+                "total": 6,
+                "succeeded": count(&kids, "succeeded"),
+                "failed": 1,
+                "cancelled": count(&kids, "cancelled"),
+            })
+        );
+        let r = curl(
+            "GET",
+            &format!("{base}/v1/jobs/{id}/result"),
+            Some(ENGINEER),
+            &[],
+            None,
+        );
+        r.problem(409);
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
+    let dir = TempDir::new("fanout-cancel");
+    let service = start(test_config(&dir.db_url()), true).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        // 600 steps of 50 ms = 30 s per child if not cancelled.
+        let body = r#"{"kind":"sweep","params":{"children":5,"steps":600,"step_ms":50}}"#;
+        let id = submit(&base, body);
+        wait_for(Duration::from_secs(20), "two running children", || {
+            let kids = children(&base, &id);
+            (kids.len() == 5 && count(&kids, "running") == 2).then_some(())
+        });
+        let waiting = get(&base, &format!("/v1/jobs/{id}"));
+        assert_eq!(waiting["status"], "waiting");
+        assert_eq!(waiting["worker"], Value::Null);
+        assert_eq!(waiting["progress"]["fraction"], 0.0);
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/jobs/{id}/cancel"),
+            Some(ENGINEER),
+            &[],
+            None,
+        );
+        assert_eq!(r.status, 202, "{}", r.body);
+        assert_eq!(r.json()["status"], "cancelled");
+        // The running children stop at once: the cancel reaches them in this process.
+        let kids = wait_for(Duration::from_secs(5), "children cancelled", || {
+            let kids = children(&base, &id);
+            (count(&kids, "cancelled") == 5).then_some(kids)
+        });
+        assert!(kids.iter().all(|c| c["cancel_requested"] == true));
+        let parent = get(&base, &format!("/v1/jobs/{id}"));
+        assert_eq!(parent["status"], "cancelled");
+        assert_eq!(parent["children"]["cancelled"], 5);
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sweep_points_cannot_be_submitted_and_bad_filters_are_refused() {
+    let dir = TempDir::new("fanout-refuse");
+    let service = start(test_config(&dir.db_url()), false).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/jobs"),
+            Some(ENGINEER),
+            &[],
+            Some(r#"{"kind":"sweep_point","params":{"point":0}}"#),
+        );
+        assert_eq!(r.problem(422)["field"], "kind");
+        for (query, field) in [
+            ("parent=7", "parent"),
+            ("top_level=yes", "top_level"),
+            ("status=done", "status"),
+        ] {
+            let r = curl(
+                "GET",
+                &format!("{base}/v1/jobs?{query}"),
+                Some(ENGINEER),
+                &[],
+                None,
+            );
+            assert_eq!(r.problem(400)["field"], field, "{query}");
+        }
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
