@@ -40,9 +40,7 @@ fn quarter_section(r: f64, m: [f64; 2], t: f64, p_min: f64, p_max: f64) -> (f64,
         let q = r * r * r / 3.0;
         return (PI * r * r / 4.0, [q, q]);
     }
-    Poly2::square(2.0 * r)
-        .clip([-1.0, 0.0], 0.0)
-        .clip([0.0, -1.0], 0.0)
+    Poly2::first_quadrant(2.0 * r)
         .clip(m, t)
         .disk_intersection(r)
 }
@@ -71,9 +69,7 @@ const FAR_KINK_HALF_LENGTHS: f64 = 100.0;
 fn edge_closed_form(r: f64, m: [f64; 2], u0: f64, nk: f64, hk: f64) -> (f64, f64, [f64; 2]) {
     let an = nk.abs();
     let sgn = if nk < 0.0 { -1.0 } else { 1.0 };
-    let quarter = Poly2::square(2.0 * r)
-        .clip([-1.0, 0.0], 0.0)
-        .clip([0.0, -1.0], 0.0);
+    let quarter = Poly2::first_quadrant(2.0 * r);
     // Strip 0 < f < 2h_k:  m·ν < h_k a_n - u0  and  -m·ν < u0 + h_k a_n.
     let strip = quarter
         .clip(m, hk * an - u0)
