@@ -44,6 +44,16 @@ impl Poly2 {
         Self { v, n: 4 }
     }
 
+    /// Index of the vertex after `k` (no integer division in the hot loops).
+    #[inline]
+    fn next(&self, k: usize) -> usize {
+        if k + 1 == self.n {
+            0
+        } else {
+            k + 1
+        }
+    }
+
     /// Keeps the part with `a·p <= b` (Sutherland–Hodgman, one half-plane).
     #[inline]
     pub(crate) fn clip(&self, a: V2, b: f64) -> Self {
@@ -51,7 +61,7 @@ impl Poly2 {
         let mut m = 0;
         for k in 0..self.n {
             let p = self.v[k];
-            let q = self.v[(k + 1) % self.n];
+            let q = self.v[self.next(k)];
             let dp = a[0] * p[0] + a[1] * p[1] - b;
             let dq = a[0] * q[0] + a[1] * q[1] - b;
             if dp <= 0.0 && m < MAX_VERTS {
@@ -92,7 +102,7 @@ impl Poly2 {
         let mut all_inside = true;
         for k in 0..self.n {
             let a = self.v[k];
-            let b = self.v[(k + 1) % self.n];
+            let b = self.v[self.next(k)];
             if a[0] * a[0] + a[1] * a[1] > rho2 {
                 all_inside = false;
             }
@@ -142,7 +152,7 @@ impl Poly2 {
             // No crossing and a vertex outside: the disk is inside the polygon iff its centre
             // is (counter-clockwise polygon: centre left of every edge), else they are apart.
             let centre_inside =
-                (0..self.n).all(|k| cross(self.v[k], self.v[(k + 1) % self.n]) >= 0.0);
+                (0..self.n).all(|k| cross(self.v[k], self.v[self.next(k)]) >= 0.0);
             if centre_inside {
                 return (std::f64::consts::PI * rho2, [0.0; 2]);
             }
@@ -222,7 +232,7 @@ impl Poly2 {
         let mut all_inside = true;
         for k in 0..self.n {
             let a = self.v[k];
-            let b = self.v[(k + 1) % self.n];
+            let b = self.v[self.next(k)];
             if a[0] * a[0] + a[1] * a[1] > rho2 {
                 all_inside = false;
             }
@@ -270,7 +280,7 @@ impl Poly2 {
         }
         if !any_event && !all_inside {
             let centre_inside =
-                (0..self.n).all(|k| cross(self.v[k], self.v[(k + 1) % self.n]) >= 0.0);
+                (0..self.n).all(|k| cross(self.v[k], self.v[self.next(k)]) >= 0.0);
             if centre_inside {
                 let q = std::f64::consts::PI * rho2 * rho2 / 4.0;
                 return DiskMoments {
