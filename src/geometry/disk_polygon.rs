@@ -79,149 +79,25 @@ impl Poly2 {
 
     /// Area (m²) and first moment (m³, about the origin) of this polygon ∩ the disk of
     /// radius `rho` centred at the origin.
-    ///
-    /// Green's theorem along the boundary of the intersection: polygon chords inside the circle
-    /// give triangles (centre, chord); each run of the polygon outside the circle is replaced
-    /// by one counter-clockwise arc from the exit to the next entry point (one `atan2` per arc).
     #[inline]
     pub(crate) fn disk_intersection(&self, rho: f64) -> (f64, V2) {
-        let mut area = 0.0;
-        let mut moment = [0.0; 2];
-        if self.n < 3 || rho <= 0.0 {
-            return (area, moment);
-        }
-        let rho2 = rho * rho;
-        let mut add = |(ar, m): (f64, V2)| {
-            area += ar;
-            moment[0] += m[0];
-            moment[1] += m[1];
-        };
-        let mut exit: Option<V2> = None;
-        let mut first_entry: Option<V2> = None;
-        let mut any_event = false;
-        let mut all_inside = true;
-        for k in 0..self.n {
-            let a = self.v[k];
-            let b = self.v[self.next(k)];
-            if a[0] * a[0] + a[1] * a[1] > rho2 {
-                all_inside = false;
-            }
-            let d = [b[0] - a[0], b[1] - a[1]];
-            let qa = d[0] * d[0] + d[1] * d[1];
-            if qa == 0.0 {
-                continue;
-            }
-            let qb = a[0] * d[0] + a[1] * d[1];
-            let qc = a[0] * a[0] + a[1] * a[1] - rho2;
-            let disc = qb * qb - qa * qc;
-            if disc <= 0.0 {
-                continue;
-            }
-            let sq = disc.sqrt();
-            let t1 = (-qb - sq) / qa;
-            let t2 = (-qb + sq) / qa;
-            let (s1, s2) = (t1.max(0.0), t2.min(1.0));
-            if s1 > s2 {
-                continue;
-            }
-            let p1 = lerp(a, b, s1);
-            let p2 = lerp(a, b, s2);
-            if t1 > 0.0 {
-                any_event = true;
-                match exit.take() {
-                    Some(q) => add(arc(q, p1, rho)),
-                    None => {
-                        if first_entry.is_none() {
-                            first_entry = Some(p1);
-                        }
-                    }
-                }
-            }
-            if s2 > s1 {
-                add(triangle(p1, p2));
-            }
-            if t2 < 1.0 {
-                any_event = true;
-                exit = Some(p2);
-            }
-        }
-        if let (Some(q), Some(p)) = (exit, first_entry) {
-            add(arc(q, p, rho));
-        }
-        if !any_event && !all_inside {
-            // No crossing and a vertex outside: the disk is inside the polygon iff its centre
-            // is (counter-clockwise polygon: centre left of every edge), else they are apart.
-            let centre_inside =
-                (0..self.n).all(|k| cross(self.v[k], self.v[self.next(k)]) >= 0.0);
-            if centre_inside {
-                return (std::f64::consts::PI * rho2, [0.0; 2]);
-            }
-            return (0.0, [0.0; 2]);
-        }
-        (area, moment)
+        let m: AreaMoment = self.green_walk(rho);
+        (m.area, m.first)
     }
-}
 
-#[inline]
-fn cross(p: V2, q: V2) -> f64 {
-    p[0] * q[1] - p[1] * q[0]
-}
-
-#[inline]
-fn lerp(p: V2, q: V2, t: f64) -> V2 {
-    [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
-}
-
-/// Signed area and moment of the straight triangle (origin, p, q).
-#[inline]
-fn triangle(p: V2, q: V2) -> (f64, V2) {
-    let a = 0.5 * cross(p, q);
-    (a, [a * (p[0] + q[0]) / 3.0, a * (p[1] + q[1]) / 3.0])
-}
-
-/// Area and moment of the sector swept counter-clockwise from `p` to `q`, both on the circle
-/// of radius `rho` (angle in [0, 2π)).
-#[inline]
-fn arc(p: V2, q: V2, rho: f64) -> (f64, V2) {
-    let mut theta = cross(p, q).atan2(p[0] * q[0] + p[1] * q[1]);
-    if theta < 0.0 {
-        theta += 2.0 * std::f64::consts::PI;
-    }
-    // ∫ (cos θ, sin θ) dθ = (Δ sin θ, -Δ cos θ), unit vectors p/ρ and q/ρ.
-    let k = rho * rho / 3.0;
-    (
-        0.5 * rho * rho * theta,
-        [k * (q[1] - p[1]), -k * (q[0] - p[0])],
-    )
-}
-
-/// Area (m²), first moment (m³) and second moments `[∫x², ∫xy, ∫y²]` (m⁴), all about the
-/// origin, of a convex polygon ∩ the disk of radius `rho` centred at the origin.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct DiskMoments {
-    pub area: f64,
-    pub first: V2,
-    pub second: [f64; 3],
-}
-
-impl DiskMoments {
-    #[inline]
-    fn add(&mut self, o: DiskMoments) {
-        self.area += o.area;
-        self.first[0] += o.first[0];
-        self.first[1] += o.first[1];
-        self.second[0] += o.second[0];
-        self.second[1] += o.second[1];
-        self.second[2] += o.second[2];
-    }
-}
-
-impl Poly2 {
-    /// Like [`Poly2::disk_intersection`], plus the second moments (same Green's-theorem
-    /// traversal: triangles (centre, chord) inside the circle, sectors outside).
+    /// Like [`Poly2::disk_intersection`], plus the second moments.
     #[inline]
     pub(crate) fn disk_moments(&self, rho: f64) -> DiskMoments {
-        let mut acc = DiskMoments::default();
+        self.green_walk(rho)
+    }
+
+    /// Green's theorem along the boundary of polygon ∩ disk: polygon chords inside the circle
+    /// give triangles (centre, chord); each run of the polygon outside the circle is replaced
+    /// by one counter-clockwise arc from the exit to the next entry point (one `atan2` per
+    /// arc). `M` says which integrals are summed.
+    #[inline]
+    fn green_walk<M: DiskPieces>(&self, rho: f64) -> M {
+        let mut acc = M::default();
         if self.n < 3 || rho <= 0.0 {
             return acc;
         }
@@ -259,7 +135,7 @@ impl Poly2 {
             if t1 > 0.0 {
                 any_event = true;
                 match exit.take() {
-                    Some(q) => acc.add(arc2(q, p1, rho)),
+                    Some(q) => acc.add(M::arc(q, p1, rho)),
                     None => {
                         if first_entry.is_none() {
                             first_entry = Some(p1);
@@ -268,7 +144,7 @@ impl Poly2 {
                 }
             }
             if s2 > s1 {
-                acc.add(triangle2(p1, p2));
+                acc.add(M::triangle(p1, p2));
             }
             if t2 < 1.0 {
                 any_event = true;
@@ -276,63 +152,168 @@ impl Poly2 {
             }
         }
         if let (Some(q), Some(p)) = (exit, first_entry) {
-            acc.add(arc2(q, p, rho));
+            acc.add(M::arc(q, p, rho));
         }
         if !any_event && !all_inside {
-            let centre_inside =
-                (0..self.n).all(|k| cross(self.v[k], self.v[self.next(k)]) >= 0.0);
-            if centre_inside {
-                let q = std::f64::consts::PI * rho2 * rho2 / 4.0;
-                return DiskMoments {
-                    area: std::f64::consts::PI * rho2,
-                    first: [0.0; 2],
-                    second: [q, 0.0, q],
-                };
-            }
-            return DiskMoments::default();
+            // No crossing and a vertex outside: the disk is inside the polygon iff its centre
+            // is (counter-clockwise polygon: centre left of every edge), else they are apart.
+            let centre_inside = (0..self.n).all(|k| cross(self.v[k], self.v[self.next(k)]) >= 0.0);
+            return if centre_inside {
+                M::full_disk(rho)
+            } else {
+                M::default()
+            };
         }
         acc
     }
 }
 
-/// Signed area, first and second moments of the straight triangle (origin, p, q).
 #[inline]
-fn triangle2(p: V2, q: V2) -> DiskMoments {
-    let a = 0.5 * cross(p, q);
-    DiskMoments {
-        area: a,
-        first: [a * (p[0] + q[0]) / 3.0, a * (p[1] + q[1]) / 3.0],
-        second: [
-            a / 6.0 * (p[0] * p[0] + p[0] * q[0] + q[0] * q[0]),
-            a / 12.0 * (2.0 * p[0] * p[1] + p[0] * q[1] + q[0] * p[1] + 2.0 * q[0] * q[1]),
-            a / 6.0 * (p[1] * p[1] + p[1] * q[1] + q[1] * q[1]),
-        ],
+fn cross(p: V2, q: V2) -> f64 {
+    p[0] * q[1] - p[1] * q[0]
+}
+
+#[inline]
+fn lerp(p: V2, q: V2, t: f64) -> V2 {
+    [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+}
+
+/// Angle swept counter-clockwise from `p` to `q` about the origin, in [0, 2π).
+#[inline]
+fn sector_angle(p: V2, q: V2) -> f64 {
+    let theta = cross(p, q).atan2(p[0] * q[0] + p[1] * q[1]);
+    if theta < 0.0 {
+        theta + 2.0 * std::f64::consts::PI
+    } else {
+        theta
     }
 }
 
-/// Sector swept counter-clockwise from `p` to `q` on the circle of radius `rho`: area, first
-/// and second moments (`∫cos² dθ = θ/2 + sin 2θ/4`, `∫sin cos dθ = sin²θ/2`).
-#[inline]
-fn arc2(p: V2, q: V2, rho: f64) -> DiskMoments {
-    let mut theta = cross(p, q).atan2(p[0] * q[0] + p[1] * q[1]);
-    if theta < 0.0 {
-        theta += 2.0 * std::f64::consts::PI;
+/// The integrals [`Poly2::green_walk`] sums over its triangles (origin, p, q) and its sectors
+/// swept counter-clockwise from `p` to `q` on the circle of radius `rho`.
+trait DiskPieces: Default {
+    fn triangle(p: V2, q: V2) -> Self;
+    fn arc(p: V2, q: V2, rho: f64) -> Self;
+    fn full_disk(rho: f64) -> Self;
+    fn add(&mut self, o: Self);
+}
+
+/// Area (m²) and first moment (m³) about the origin.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct AreaMoment {
+    area: f64,
+    first: V2,
+}
+
+impl AreaMoment {
+    /// The sector from `p` to `q` (radius `rho`) whose angle `theta` is already known.
+    #[inline]
+    fn arc_with_angle(p: V2, q: V2, rho: f64, theta: f64) -> Self {
+        // ∫ (cos θ, sin θ) dθ = (Δ sin θ, -Δ cos θ), unit vectors p/ρ and q/ρ.
+        let k = rho * rho / 3.0;
+        Self {
+            area: 0.5 * rho * rho * theta,
+            first: [k * (q[1] - p[1]), -k * (q[0] - p[0])],
+        }
     }
-    let k = rho * rho / 3.0;
-    let r2 = rho * rho;
-    // unit vectors (cos, sin) at both ends
-    let (pc, ps) = (p[0] / rho, p[1] / rho);
-    let (qc, qs) = (q[0] / rho, q[1] / rho);
-    let ds2 = qc * qs - pc * ps; // Δ(sin 2θ)/2
-    let r4 = r2 * r2 / 8.0;
-    DiskMoments {
-        area: 0.5 * r2 * theta,
-        first: [k * (q[1] - p[1]), -k * (q[0] - p[0])],
-        second: [
-            r4 * (theta + ds2),
-            r4 * (qs * qs - ps * ps),
-            r4 * (theta - ds2),
-        ],
+}
+
+impl DiskPieces for AreaMoment {
+    #[inline]
+    fn triangle(p: V2, q: V2) -> Self {
+        let a = 0.5 * cross(p, q);
+        Self {
+            area: a,
+            first: [a * (p[0] + q[0]) / 3.0, a * (p[1] + q[1]) / 3.0],
+        }
+    }
+
+    #[inline]
+    fn arc(p: V2, q: V2, rho: f64) -> Self {
+        Self::arc_with_angle(p, q, rho, sector_angle(p, q))
+    }
+
+    #[inline]
+    fn full_disk(rho: f64) -> Self {
+        Self {
+            area: std::f64::consts::PI * (rho * rho),
+            first: [0.0; 2],
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, o: Self) {
+        self.area += o.area;
+        self.first[0] += o.first[0];
+        self.first[1] += o.first[1];
+    }
+}
+
+/// Area (m²), first moment (m³) and second moments `[∫x², ∫xy, ∫y²]` (m⁴), all about the
+/// origin, of a convex polygon ∩ the disk of radius `rho` centred at the origin.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct DiskMoments {
+    pub area: f64,
+    pub first: V2,
+    pub second: [f64; 3],
+}
+
+impl DiskPieces for DiskMoments {
+    #[inline]
+    fn triangle(p: V2, q: V2) -> Self {
+        let AreaMoment { area: a, first } = AreaMoment::triangle(p, q);
+        DiskMoments {
+            area: a,
+            first,
+            second: [
+                a / 6.0 * (p[0] * p[0] + p[0] * q[0] + q[0] * q[0]),
+                a / 12.0 * (2.0 * p[0] * p[1] + p[0] * q[1] + q[0] * p[1] + 2.0 * q[0] * q[1]),
+                a / 6.0 * (p[1] * p[1] + p[1] * q[1] + q[1] * q[1]),
+            ],
+        }
+    }
+
+    /// `∫cos² dθ = θ/2 + sin 2θ/4`, `∫sin cos dθ = sin²θ/2`.
+    #[inline]
+    fn arc(p: V2, q: V2, rho: f64) -> Self {
+        let theta = sector_angle(p, q);
+        let AreaMoment { area, first } = AreaMoment::arc_with_angle(p, q, rho, theta);
+        let r2 = rho * rho;
+        // unit vectors (cos, sin) at both ends
+        let (pc, ps) = (p[0] / rho, p[1] / rho);
+        let (qc, qs) = (q[0] / rho, q[1] / rho);
+        let ds2 = qc * qs - pc * ps; // Δ(sin 2θ)/2
+        let r4 = r2 * r2 / 8.0;
+        DiskMoments {
+            area,
+            first,
+            second: [
+                r4 * (theta + ds2),
+                r4 * (qs * qs - ps * ps),
+                r4 * (theta - ds2),
+            ],
+        }
+    }
+
+    #[inline]
+    fn full_disk(rho: f64) -> Self {
+        let rho2 = rho * rho;
+        let q = std::f64::consts::PI * rho2 * rho2 / 4.0;
+        DiskMoments {
+            area: std::f64::consts::PI * rho2,
+            first: [0.0; 2],
+            second: [q, 0.0, q],
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, o: Self) {
+        self.area += o.area;
+        self.first[0] += o.first[0];
+        self.first[1] += o.first[1];
+        self.second[0] += o.second[0];
+        self.second[1] += o.second[1];
+        self.second[2] += o.second[2];
     }
 }
 
