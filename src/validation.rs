@@ -289,8 +289,10 @@ pub fn sphere_area_anchor() -> Anchor {
     )
 }
 
-/// Torque-free tumbling body: relative energy drift over 10 s.
-pub fn torque_free_anchor() -> Anchor {
+/// A 1 kg asymmetric body (principal inertias 0.01, 0.02, 0.03 kg·m²) spinning at 5 rad/s near
+/// its intermediate axis (with 0.1 and 0.2 rad/s about the others), no gravity, no forces: it
+/// tumbles. Returns the system, its initial state and the body-frame inertia tensor.
+pub fn tumbler() -> (MultibodySystem, Vec<f64>, Matrix3<f64>) {
     let inertia = Matrix3::from_diagonal(&Vector3::new(0.01, 0.02, 0.03));
     let body = RigidBody {
         name: "tumbler".into(),
@@ -306,6 +308,12 @@ pub fn torque_free_anchor() -> Anchor {
         Vector3::zeros(),
         Vector3::new(0.1, 5.0, 0.2),
     );
+    (sys, y, inertia)
+}
+
+/// Torque-free tumbling body ([`tumbler`]): relative angular-momentum drift over 10 s.
+pub fn torque_free_anchor() -> Anchor {
+    let (sys, mut y, inertia) = tumbler();
     let l = |y: &[f64]| {
         let q = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
         q * (inertia * Vector3::new(y[10], y[11], y[12]))

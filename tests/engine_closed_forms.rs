@@ -1,7 +1,7 @@
 //! Engine verification against closed forms and thesis anchors (issue 2, items 1, 2, 4).
 
-use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
-use railwear::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
+use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+use railwear::physics::body::write_state;
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
@@ -9,7 +9,7 @@ use railwear::physics::simulate::{simulate, DivergenceLimits, StepView};
 use railwear::physics::step::StepKind;
 use railwear::physics::system::MultibodySystem;
 use railwear::pipeline::RunControl;
-use railwear::validation::{settle_penetration, sphere_on_floor, table_2_1_settle_impact};
+use railwear::validation::{settle_penetration, sphere_on_floor, table_2_1_settle_impact, tumbler};
 
 const G: f64 = 9.80665;
 fn settings(kind: IntegratorKind, rel: f64) -> IntegratorSettings {
@@ -42,21 +42,7 @@ fn initial(sys: &MultibodySystem, y0: f64, v0: f64) -> Vec<f64> {
 #[test]
 fn torque_free_spinning_body_conserves_energy_and_angular_momentum() {
     // Asymmetric body spinning near its intermediate axis (tumbling), no gravity.
-    let inertia = Matrix3::from_diagonal(&Vector3::new(0.01, 0.02, 0.03));
-    let body = RigidBody {
-        name: "tumbler".into(),
-        mass: MassProperties { mass: 1.0, inertia },
-        kind: BodyKind::Dynamic { offset: 0 },
-    };
-    let sys = MultibodySystem::new(vec![body], Vector3::zeros(), vec![], vec![]);
-    let mut y = vec![0.0; sys.state_len()];
-    write_state(
-        &mut y,
-        0,
-        &Isometry3::identity(),
-        Vector3::zeros(),
-        Vector3::new(0.1, 5.0, 0.2),
-    );
+    let (sys, mut y, inertia) = tumbler();
     let momentum = |y: &[f64]| {
         let q = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[3], y[4], y[5], y[6]));
         let wb = Vector3::new(y[10], y[11], y[12]);
