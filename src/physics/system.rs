@@ -252,11 +252,16 @@ mod tests {
     use crate::physics::contact::GeometryMode;
     use std::path::Path;
 
+    /// The reference model `configs/<name>.toml`.
+    fn reference_model(name: &str) -> crate::models::run::BuiltModel {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+        let case = crate::models::case::load_case(&dir.join(format!("{name}.toml"))).expect("case");
+        crate::models::case::build(&case, &dir).expect("model")
+    }
+
     /// Rattle box C with the cube tilted and pressed into the floor, spinning and sliding.
     fn pressed_cube() -> (MultibodySystem, Vec<f64>) {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
-        let case = crate::models::case::load_case(&dir.join("rattle-box-c.toml")).expect("case");
-        let model = crate::models::case::build(&case, &dir).expect("model");
+        let model = reference_model("rattle-box-c");
         let mut y = model.initial_state.clone();
         y[1] -= 3e-5; // 30 µm further into the floor
         let tilt = nalgebra::UnitQuaternion::from_euler_angles(2e-3, 1e-3, -4e-3);
@@ -298,9 +303,7 @@ mod tests {
 
     #[test]
     fn pose_columns_replay_only_contacts_of_other_bodies() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
-        let case = crate::models::case::load_case(&dir.join("launcher-design.toml")).expect("case");
-        let model = crate::models::case::build(&case, &dir).expect("model");
+        let model = reference_model("launcher-design");
         let (sys, y) = (model.system, model.initial_state);
         let mut ws = sys.workspace();
         let n = sys.state_len();
