@@ -6,7 +6,7 @@
 mod postgres_support;
 mod service_support;
 
-use service_support::{curl, tokens_env, wait_for, ENGINEER};
+use service_support::{curl, get_job, submit_job, tokens_env, wait_for, ENGINEER};
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -77,33 +77,9 @@ fn worker(db_url: &str, env: &[(&str, &str)]) -> Proc {
     proc
 }
 
-fn job(base: &str, id: &str) -> serde_json::Value {
-    let r = curl(
-        "GET",
-        &format!("{base}/v1/jobs/{id}"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
-    assert_eq!(r.status, 200, "{}", r.body);
-    r.json()
-}
-
-fn submit(base: &str, body: &str) -> String {
-    let r = curl(
-        "POST",
-        &format!("{base}/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(body),
-    );
-    assert_eq!(r.status, 201, "{}", r.body);
-    r.json()["id"].as_str().expect("job id").to_string()
-}
-
 fn wait_status(base: &str, id: &str, status: &str, timeout: Duration) -> serde_json::Value {
     wait_for(timeout, status, || {
-        let j = job(base, id);
+        let j = get_job(base, id);
         assert_ne!(j["status"], "failed", "job failed: {j}");
         (j["status"] == status).then_some(j)
     })
@@ -119,10 +95,10 @@ fn api_without_workers_and_a_worker_process_complete_a_job() {
         return;
     };
     let (_api, base) = api(&db.url, &[]);
-    let id = submit(&base, SHORT);
+    let id = submit_job(&base, SHORT);
     // The API runs no workers: the job stays queued.
     std::thread::sleep(Duration::from_millis(1500));
-    assert_eq!(job(&base, &id)["status"], "queued");
+    assert_eq!(get_job(&base, &id)["status"], "queued");
 
     let _worker = worker(&db.url, &[]);
     let done = wait_status(&base, &id, "succeeded", Duration::from_secs(300));
@@ -165,7 +141,7 @@ fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
     let (_api, base) = api(&db.url, &env);
     // Long enough to be caught running (cancelled at the end, so its length costs nothing).
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit(&base, long);
+    let id = submit_job(&base, long);
     let first = worker(&db.url, &env);
     let running = wait_status(&base, &id, "running", Duration::from_secs(60));
     assert_eq!(running["attempt"], 1);
@@ -173,7 +149,7 @@ fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
 
     let _second = worker(&db.url, &env);
     let retaken = wait_for(Duration::from_secs(60), "attempt 2", || {
-        let j = job(&base, &id);
+        let j = get_job(&base, &id);
         (j["status"] == "running" && j["attempt"] == 2).then_some(j)
     });
     assert_eq!(
@@ -239,11 +215,11 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         })
     };
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
-    let id = submit(&base, &body);
+    let id = submit_job(&base, &body);
     // The same sweep in one process on SQLite.
     let sqlite_dir = service_support::TempDir::new("fanout-sqlite");
     let single = service_support::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
-    let single_id = submit(&single.base, &body);
+    let single_id = submit_job(&single.base, &body);
 
     // SIGKILL the worker process that holds a running child.
     let victim_worker = wait_for(Duration::from_secs(120), "a running child", || {

@@ -9,29 +9,11 @@ mod service_support;
 use railwear::store::AttemptOutcome;
 use serde_json::{json, Value};
 use service_support::runner::{sample, start, test_config};
-use service_support::{curl, wait_for, TempDir, ENGINEER};
+use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::time::Duration;
 
-fn get(base: &str, path: &str) -> Value {
-    let r = curl("GET", &format!("{base}{path}"), Some(ENGINEER), &[], None);
-    assert_eq!(r.status, 200, "{path}: {}", r.body);
-    r.json()
-}
-
-fn submit(base: &str, body: &str) -> String {
-    let r = curl(
-        "POST",
-        &format!("{base}/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(body),
-    );
-    assert_eq!(r.status, 201, "{}", r.body);
-    r.json()["id"].as_str().expect("job id").to_string()
-}
-
 fn children(base: &str, id: &str) -> Vec<Value> {
-    get(base, &format!("/v1/jobs?parent={id}&limit=100"))["items"]
+    get_json(base, &format!("/v1/jobs?parent={id}&limit=100"))["items"]
         .as_array()
         .cloned()
         .unwrap_or_default()
@@ -51,9 +33,9 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
     let base = format!("http://{}", service.addr);
     let (id, child_ids) = tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":3,"step_ms":20,"seed":42}}"#;
-        let id = submit(&base, body);
+        let id = submit_job(&base, body);
         let done = wait_for(Duration::from_secs(30), "sweep success", || {
-            let j = get(&base, &format!("/v1/jobs/{id}"));
+            let j = get_job(&base, &id);
             assert_ne!(j["status"], "failed", "{j}");
             (j["status"] == "succeeded").then_some(j)
         });
@@ -84,13 +66,13 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
             assert_eq!(c["children"], Value::Null);
         }
         // Submitted jobs only: the children stay out of the top-level list.
-        let top = get(&base, "/v1/jobs?top_level=true")["items"].clone();
+        let top = get_json(&base, "/v1/jobs?top_level=true")["items"].clone();
         assert_eq!(top.as_array().map(Vec::len), Some(1));
         assert_eq!(top[0]["id"], id.as_str());
 
         // The assembled result lists the children's results in index order; each is the
         // runner's value for the sweep's seed and that point, so the seed reached every child.
-        let result = get(&base, &format!("/v1/jobs/{id}/result"));
+        let result = get_json(&base, &format!("/v1/jobs/{id}/result"));
         let points = result["summary"]["points"].as_array().unwrap().clone();
         assert_eq!(points.len(), 6);
         for (i, p) in points.iter().enumerate() {
@@ -140,9 +122,9 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":5,"step_ms":40,"fail_point":0,"seed":1}}"#;
-        let id = submit(&base, body);
+        let id = submit_job(&base, body);
         let failed = wait_for(Duration::from_secs(30), "sweep failure", || {
-            let j = get(&base, &format!("/v1/jobs/{id}"));
+            let j = get_job(&base, &id);
             assert_ne!(j["status"], "succeeded", "{j}");
             (j["status"] == "failed").then_some(j)
         });
@@ -168,7 +150,7 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
         assert_eq!(count(&kids, "failed"), 1);
         assert_eq!(count(&kids, "succeeded") + count(&kids, "cancelled"), 5);
         assert!(count(&kids, "cancelled") >= 3, "queued children were not cancelled");
-        let parent = get(&base, &format!("/v1/jobs/{id}"));
+        let parent = get_job(&base, &id);
         assert_eq!(parent["status"], "failed");
         assert_eq!(
             parent["children"],
@@ -201,12 +183,12 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
     tokio::task::spawn_blocking(move || {
         // 600 steps of 50 ms = 30 s per child if not cancelled.
         let body = r#"{"kind":"sweep","params":{"children":5,"steps":600,"step_ms":50}}"#;
-        let id = submit(&base, body);
+        let id = submit_job(&base, body);
         wait_for(Duration::from_secs(20), "two running children", || {
             let kids = children(&base, &id);
             (kids.len() == 5 && count(&kids, "running") == 2).then_some(())
         });
-        let waiting = get(&base, &format!("/v1/jobs/{id}"));
+        let waiting = get_job(&base, &id);
         assert_eq!(waiting["status"], "waiting");
         assert_eq!(waiting["worker"], Value::Null);
         assert_eq!(waiting["progress"]["fraction"], 0.0);
@@ -225,7 +207,7 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
             (count(&kids, "cancelled") == 5).then_some(kids)
         });
         assert!(kids.iter().all(|c| c["cancel_requested"] == true));
-        let parent = get(&base, &format!("/v1/jobs/{id}"));
+        let parent = get_job(&base, &id);
         assert_eq!(parent["status"], "cancelled");
         assert_eq!(parent["children"]["cancelled"], 5);
     })

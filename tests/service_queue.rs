@@ -6,20 +6,8 @@ mod service_support;
 
 use serde_json::json;
 use service_support::runner::{sample, start, test_config};
-use service_support::{curl, wait_for, TempDir, ENGINEER, PLANNER};
+use service_support::{curl, get_job, wait_for, TempDir, ENGINEER, PLANNER};
 use std::time::{Duration, Instant};
-
-fn job_status(base: &str, id: &str) -> serde_json::Value {
-    let r = curl(
-        "GET",
-        &format!("{base}/v1/jobs/{id}"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
-    assert_eq!(r.status, 200, "{}", r.body);
-    r.json()
-}
 
 fn job_count(base: &str) -> usize {
     let r = curl(
@@ -115,11 +103,11 @@ async fn cancel_stops_a_running_job_within_a_second() {
         );
         let id = r.json()["id"].as_str().unwrap().to_string();
         wait_for(Duration::from_secs(10), "progress", || {
-            let j = job_status(&base, &id);
+            let j = get_job(&base, &id);
             (j["status"] == "running" && j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0)
                 .then_some(())
         });
-        let job = job_status(&base, &id);
+        let job = get_job(&base, &id);
         assert!(job["progress"]["simulated_time_s"].as_f64().unwrap() > 0.0);
         assert!(job["progress"]["eta_s"].as_f64().unwrap() > 0.0);
 
@@ -133,7 +121,7 @@ async fn cancel_stops_a_running_job_within_a_second() {
         );
         assert_eq!(r.status, 202, "{}", r.body);
         wait_for(Duration::from_secs(5), "cancelled", || {
-            (job_status(&base, &id)["status"] == "cancelled").then_some(())
+            (get_job(&base, &id)["status"] == "cancelled").then_some(())
         });
         let took = asked.elapsed();
         assert!(took < Duration::from_millis(1500), "cancel took {took:?}");
@@ -179,9 +167,9 @@ async fn results_and_tracks_export_with_downsampling() {
         );
         let id = r.json()["id"].as_str().unwrap().to_string();
         wait_for(Duration::from_secs(20), "success", || {
-            (job_status(&base, &id)["status"] == "succeeded").then_some(())
+            (get_job(&base, &id)["status"] == "succeeded").then_some(())
         });
-        let job = job_status(&base, &id);
+        let job = get_job(&base, &id);
         assert_eq!(job["track_samples"], 2500);
         assert_eq!(job["progress"]["fraction"], 1.0);
 
@@ -301,7 +289,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
             );
             let id = r.json()["id"].as_str().unwrap().to_string();
             wait_for(Duration::from_secs(20), "reference", || {
-                (job_status(&base, &id)["status"] == "succeeded").then_some(())
+                (get_job(&base, &id)["status"] == "succeeded").then_some(())
             });
             let csv = curl(
                 "GET",
@@ -357,7 +345,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
         let id = id.clone();
         move || {
             let job = wait_for(Duration::from_secs(20), "recovered", || {
-                let j = job_status(&base, &id);
+                let j = get_job(&base, &id);
                 (j["status"] == "succeeded").then_some(j)
             });
             let csv = curl(

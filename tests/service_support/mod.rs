@@ -205,3 +205,28 @@ impl Drop for Binary {
         let _ = self.child.wait();
     }
 }
+
+/// `GET {base}{path}` as the engineer; asserts 200 and returns the JSON body.
+pub fn get_json(base: &str, path: &str) -> serde_json::Value {
+    let r = curl("GET", &format!("{base}{path}"), Some(ENGINEER), &[], None);
+    assert_eq!(r.status, 200, "{path}: {}", r.body);
+    r.json()
+}
+
+/// The job record `GET /v1/jobs/{id}` as the engineer.
+pub fn get_job(base: &str, id: &str) -> serde_json::Value {
+    get_json(base, &format!("/v1/jobs/{id}"))
+}
+
+/// `POST /v1/jobs` with `body` as the engineer; asserts 201 and returns the new job's id.
+pub fn submit_job(base: &str, body: &str) -> String {
+    let r = curl(
+        "POST",
+        &format!("{base}/v1/jobs"),
+        Some(ENGINEER),
+        &[],
+        Some(body),
+    );
+    assert_eq!(r.status, 201, "{}", r.body);
+    r.json()["id"].as_str().expect("job id").to_string()
+}
