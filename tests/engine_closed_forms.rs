@@ -19,6 +19,7 @@ fn settings(kind: IntegratorKind, rel: f64) -> IntegratorSettings {
         initial_step_s: 1e-7,
         max_step_s: 1e-3,
         min_step_s: 1e-16,
+        ..IntegratorSettings::default()
     }
 }
 

@@ -557,6 +557,7 @@ fn sphere_bounce(kind: IntegratorKind, duration: f64, budget: Duration) -> Outco
         initial_step_s: 1e-6,
         max_step_s: 1e-3,
         min_step_s: 1e-15,
+        ..IntegratorSettings::default()
     };
     let mut means = StepMeans::new(0.0, 2000.0);
     let (control, reached, stop) = budget_control(budget);

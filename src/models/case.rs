@@ -107,6 +107,7 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
     let a = case.simulation.abs_tolerance_m;
     Ok(IntegratorSettings {
         kind,
+        newton: case.simulation.newton_jacobian,
         tolerances: Tolerances {
             rel: case.simulation.rel_tolerance,
             abs_position_m: a,

@@ -364,6 +364,11 @@ pub struct SimulationSpec {
     /// Integrator name (lower case; default `trbdf2`, a stiff L-stable method, SPEC 2).
     #[serde(default = "default_integrator")]
     pub integrator: String,
+    /// Newton matrix of the implicit integrators: `contact_aware` (default; contacts
+    /// linearised at every Newton iterate) or `finite_difference` (whole Jacobian by finite
+    /// differences, reused across steps). Both solve the same equations to the same tolerance.
+    #[serde(default)]
+    pub newton_jacobian: crate::physics::integrator::NewtonJacobian,
     /// Relative local error tolerance, dimensionless (0 < tol < 1).
     #[serde(default = "default_rel_tolerance")]
     pub rel_tolerance: f64,

@@ -8,7 +8,7 @@ use super::forces::{apply, Wrench};
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use crate::geometry::{shape_halfspace_overlap, ConvexShape, HalfSpace, PlaneOverlap};
-use nalgebra::{Isometry3, Point3, Unit, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
 #[derive(Debug, Clone)]
@@ -63,6 +63,36 @@ impl TrackState {
             0.0
         }
     }
+}
+
+/// Local derivatives of one active track's force at one instant, for the contact-aware Newton
+/// matrix ([`MultibodySystem::contact_jacobian`](super::system::MultibodySystem::contact_jacobian)).
+///
+/// The force on body a is `F = n f_n(w, ẇ) + F_t(s, f_n)` at the overlap centroid `c` (−F on b),
+/// with `w` the penetration of the deepest point `p`, `ẇ` its rate and `s` the slip velocity at
+/// `c`. The contact point, centroid and normal are held fixed: the derivatives through `w`, `ẇ`
+/// and `s` are exact (the envelope theorem gives `∂w` from the deepest point's motion), the
+/// motion of the centroid over the face (a rocking face's restoring torque) is left out.
+#[derive(Debug, Clone, Copy)]
+pub struct TrackLinearization {
+    /// Body carrying the pieces (force +F).
+    pub body_a: usize,
+    /// Body carrying the faces (force −F).
+    pub body_b: usize,
+    /// Deepest point, world.
+    pub deepest_point: Point3<f64>,
+    /// Overlap centroid (where F acts), world.
+    pub point: Point3<f64>,
+    /// Contact normal (out of b), world.
+    pub normal: Vector3<f64>,
+    /// ∂f_n/∂w, N/m.
+    pub dfn_dw: f64,
+    /// ∂f_n/∂ẇ, N·s/m.
+    pub dfn_dwdot: f64,
+    /// ∂F/∂f_n: `n − μ ŝ` (dimensionless, world).
+    pub dforce_dfn: Vector3<f64>,
+    /// ∂F/∂s, N·s/m (world; zero without friction).
+    pub dforce_dslip: Matrix3<f64>,
 }
 
 /// What [`Contact::evaluate`] does with the overlap geometry of each (piece, face) pair.
@@ -140,11 +170,19 @@ impl Contact {
         wrenches: Option<&mut [Wrench]>,
         sink: &mut dyn FnMut(&TrackState),
     ) -> f64 {
-        self.evaluate_with(index, frames, wrenches, sink, &mut GeometryCache::default())
+        self.evaluate_with(
+            index,
+            frames,
+            wrenches,
+            sink,
+            &mut GeometryCache::default(),
+            None,
+        )
     }
 
     /// [`Contact::evaluate`] with the overlap geometry computed, recorded or replayed as
-    /// `geometry.mode` says.
+    /// `geometry.mode` says; pushes each active track's force derivatives to `linearizations`
+    /// when given.
     pub fn evaluate_with(
         &self,
         index: u32,
@@ -152,6 +190,7 @@ impl Contact {
         mut wrenches: Option<&mut [Wrench]>,
         sink: &mut dyn FnMut(&TrackState),
         geometry: &mut GeometryCache,
+        mut linearizations: Option<&mut Vec<TrackLinearization>>,
     ) -> f64 {
         let fa = &frames[self.body_a];
         let fb = &frames[self.body_b];
@@ -205,6 +244,24 @@ impl Contact {
                         force -= slip * (ft / speed);
                     }
                 }
+                if let Some(lin) = linearizations.as_deref_mut() {
+                    if fn_mag > 0.0 {
+                        let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
+                        let (dforce_dfn, dforce_dslip) =
+                            friction_derivatives(self.friction.as_ref(), &n_world, &slip, fn_mag);
+                        lin.push(TrackLinearization {
+                            body_a: self.body_a,
+                            body_b: self.body_b,
+                            deepest_point: ov.deepest_point,
+                            point: c,
+                            normal: n_world,
+                            dfn_dw,
+                            dfn_dwdot,
+                            dforce_dfn,
+                            dforce_dslip,
+                        });
+                    }
+                }
                 if let Some(wr) = wrenches.as_deref_mut() {
                     apply(wr, frames, self.body_a, &c, force);
                     apply(wr, frames, self.body_b, &c, -force);
@@ -226,5 +283,37 @@ impl Contact {
             }
         }
         energy
+    }
+}
+
+/// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
+/// and slip `slip` (tangential): `∂F/∂f_n = n − μ ŝ` and
+/// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
+/// `μ/|s| → μ'(0)` is used.
+fn friction_derivatives(
+    friction: Option<&FrictionParams>,
+    normal: &Vector3<f64>,
+    slip: &Vector3<f64>,
+    fn_mag: f64,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    let Some(fr) = friction else {
+        return (*normal, Matrix3::zeros());
+    };
+    let tangent = Matrix3::identity() - normal * normal.transpose();
+    let speed = slip.norm();
+    if speed > 0.0 {
+        let dir = slip / speed;
+        let along = dir * dir.transpose();
+        let mu = fr.coefficient(speed);
+        let dmu = fr.coefficient_derivative(speed);
+        (
+            normal - dir * mu,
+            -(along * dmu + (tangent - along) * (mu / speed)) * fn_mag,
+        )
+    } else {
+        (
+            *normal,
+            -tangent * (fr.coefficient_derivative(0.0) * fn_mag),
+        )
     }
 }

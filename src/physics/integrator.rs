@@ -92,11 +92,29 @@ impl Tolerances {
     }
 }
 
+/// How the implicit methods build the Newton matrix `I - h d J`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NewtonJacobian {
+    /// `J` split into a contact-free part (finite differences of the right-hand side without
+    /// contacts, no geometry) and the contacts' part, linearised analytically at every Newton
+    /// iterate ([`MultibodySystem::contact_jacobian`]): the matrix follows each contact as it
+    /// opens, closes, clamps or sticks inside the step (default).
+    #[default]
+    ContactAware,
+    /// `J` by finite differences of the whole right-hand side, reused across steps
+    /// (simplified Newton) and refreshed when Newton fails or slows.
+    FiniteDifference,
+}
+
 /// Integrator settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IntegratorSettings {
     /// Method.
     pub kind: IntegratorKind,
+    /// Newton matrix of the implicit methods.
+    #[serde(default)]
+    pub newton: NewtonJacobian,
     /// Error tolerances.
     pub tolerances: Tolerances,
     /// First step tried, s.
@@ -111,6 +129,7 @@ impl Default for IntegratorSettings {
     fn default() -> Self {
         Self {
             kind: IntegratorKind::Trbdf2,
+            newton: NewtonJacobian::default(),
             tolerances: Tolerances::default(),
             initial_step_s: 1e-6,
             max_step_s: 1e-3,
@@ -132,6 +151,9 @@ pub struct IntegratorStats {
     pub jacobians: u64,
     /// LU factorisations.
     pub factorizations: u64,
+    /// Right-hand sides without contacts (contact-free Jacobian part; no geometry).
+    #[serde(default)]
+    pub contact_free_rhs_evals: u64,
 }
 
 /// Why the integrator could not advance.
@@ -160,6 +182,14 @@ const SD_GAMMA: f64 = 1.0 - 1.0 / SQRT2;
 /// without refreshing it (measured alone on rattle box C: -50 % Jacobians, -20 % rejections).
 const YOUNG_JACOBIAN_STEPS: u32 = 2;
 
+/// Contact-aware Newton keeps its LU while every entry of the Newton matrix moved by less than
+/// this fraction of its size since the factorisation.
+const LU_REUSE_CHANGE: f64 = 0.05;
+
+/// Contact-aware Newton stops when the estimated distance to the solution, in units of the
+/// local error tolerance, is below this (Hairer-Wanner II IV.8 use 0.01-0.1).
+const NEWTON_KAPPA: f64 = 0.03;
+
 /// Integrator state and scratch memory (allocated once per run).
 pub struct Integrator {
     settings: IntegratorSettings,
@@ -178,8 +208,18 @@ pub struct Integrator {
     err: Vec<f64>,
     fz: Vec<f64>,
     tmp: Vec<f64>,
-    /// Jacobian df/dy, column-major `n × n`.
+    /// Jacobian df/dy, column-major `n × n` (contact-aware: its contact-free part).
     jac: Vec<f64>,
+    /// Contact-aware Newton: `jac` plus the contacts' Jacobian at the current iterate.
+    newton_jac: Vec<f64>,
+    /// Contact-aware Newton: the LU holds `I - h d jac` (no contact term).
+    lu_contact_free: bool,
+    /// Contact-aware Newton: the `J` the LU was made from.
+    lu_jac: Vec<f64>,
+    /// Contraction estimate θ/(1-θ) of the last Newton solve.
+    newton_eta: f64,
+    /// The last Newton solve stopped after an update: `fz` is not f at the accepted point.
+    newton_z_is_new: bool,
     jac_fresh: bool,
     jac_age: u32,
     /// Perturbed state and derivative for the finite differences (no allocation per call).
@@ -241,6 +281,11 @@ impl Integrator {
             fz: v(),
             tmp: v(),
             jac: vec![0.0; n * n],
+            newton_jac: vec![0.0; n * n],
+            lu_contact_free: false,
+            lu_jac: vec![0.0; n * n],
+            newton_eta: 1.0,
+            newton_z_is_new: false,
             jac_fresh: false,
             jac_age: u32::MAX,
             jac_y: v(),
@@ -283,7 +328,59 @@ impl Integrator {
         self.stats.rhs_evals += 1;
     }
 
+    fn contact_aware(&self) -> bool {
+        self.settings.newton == NewtonJacobian::ContactAware
+            && self.settings.kind != IntegratorKind::Dopri5
+    }
+
     fn compute_jacobian(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64]) {
+        if self.contact_aware() {
+            self.compute_contact_free_jacobian(sys, ws, t, y);
+        } else {
+            self.compute_full_jacobian(sys, ws, t, y);
+        }
+        self.stats.jacobians += 1;
+        self.jac_fresh = true;
+        self.jac_age = 0;
+        self.lu_valid = false;
+    }
+
+    /// Forward differences of the right-hand side without contacts: rigid-body kinematics,
+    /// gyroscopic terms and force elements (no overlap geometry, a small fraction of a full
+    /// right-hand side each).
+    fn compute_contact_free_jacobian(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &mut Workspace,
+        t: f64,
+        y: &[f64],
+    ) {
+        let n = self.n;
+        ws.skip_contacts = true;
+        sys.derivative(t, y, &mut self.tmp, ws);
+        self.jac_y.copy_from_slice(y);
+        for j in 0..n {
+            let scale = self.abs_tol[j] * 1e3;
+            let delta = 1.5e-8 * y[j].abs().max(scale);
+            self.jac_y[j] = y[j] + delta;
+            sys.derivative(t, &self.jac_y, &mut self.jac_f, ws);
+            let col = &mut self.jac[j * n..(j + 1) * n];
+            for i in 0..n {
+                col[i] = (self.jac_f[i] - self.tmp[i]) / delta;
+            }
+            self.jac_y[j] = y[j];
+        }
+        ws.skip_contacts = false;
+        self.stats.contact_free_rhs_evals += n as u64 + 1;
+    }
+
+    fn compute_full_jacobian(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &mut Workspace,
+        t: f64,
+        y: &[f64],
+    ) {
         // Forward differences around (t, y); f(t, y) is k[0] (valid: FSAL). A velocity column
         // leaves every pose unchanged and a pose column moves one body: contacts whose poses
         // are unchanged replay the geometry (bit-identical forces, no overlap computation).
@@ -320,10 +417,51 @@ impl Integrator {
             self.jac_y[j] = y[j];
         }
         ws.geometry.set_mode(GeometryMode::Compute);
-        self.stats.jacobians += 1;
-        self.jac_fresh = true;
-        self.jac_age = 0;
-        self.lu_valid = false;
+    }
+
+    /// Contact-aware Newton: factors `I - h d (J_free + J_contacts(z))` with the contacts'
+    /// Jacobian of the derivative just evaluated at the iterate `z` (`ws.linearize` set).
+    /// Without active tracks the contact-free matrix is kept while `h d` is unchanged.
+    fn factorize_at_iterate(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &Workspace,
+        hd: f64,
+        t: f64,
+    ) -> bool {
+        if ws.linearizations.is_empty() {
+            if self.lu_valid && self.lu_contact_free && self.lu_h == hd {
+                return true;
+            }
+            self.lu_contact_free = true;
+            self.lu_h = hd;
+            self.stats.factorizations += 1;
+            self.lu_valid = self.lu.factor_newton(&self.jac, hd);
+            return self.lu_valid;
+        }
+        self.newton_jac.copy_from_slice(&self.jac);
+        sys.contact_jacobian(&self.z, ws, &mut self.newton_jac);
+        if self.lu_valid && !self.lu_contact_free && self.lu_h == hd {
+            // Keep the factorisation while no entry of I - h d J moved by more than
+            // LU_REUSE_CHANGE of its size (persistent contact; Newton still contracts).
+            let close = self
+                .newton_jac
+                .iter()
+                .zip(&self.lu_jac)
+                .all(|(&a, &b)| hd * (a - b).abs() <= LU_REUSE_CHANGE * (1.0 + hd * b.abs()));
+            if close {
+                return true;
+            }
+        }
+        self.lu_jac.copy_from_slice(&self.newton_jac);
+        self.lu_h = hd;
+        self.lu_contact_free = false;
+        self.stats.factorizations += 1;
+        self.lu_valid = self.lu.factor_newton(&self.newton_jac, hd);
+        if !self.lu_valid {
+            tracing::debug!(t, "singular contact-aware Newton matrix");
+        }
+        self.lu_valid
     }
 
     fn factorize(&mut self, h: f64, diag: f64, t: f64) -> Result<(), IntegratorError> {
@@ -356,9 +494,13 @@ impl Integrator {
     ) -> bool {
         self.last_update = f64::INFINITY;
         let mut prev = f64::INFINITY;
+        let contact_aware = self.contact_aware();
+        self.newton_z_is_new = false;
         for iter in 0..10 {
             let mut fz = std::mem::take(&mut self.fz);
+            ws.linearize = contact_aware;
             sys.derivative(ts, &self.z, &mut fz, ws);
+            ws.linearize = false;
             self.stats.rhs_evals += 1;
             for i in 0..self.n {
                 self.tmp[i] = -(self.z[i] - hd * fz[i] - self.rhs[i]);
@@ -386,6 +528,9 @@ impl Integrator {
                     return true;
                 }
             }
+            if contact_aware && !self.factorize_at_iterate(sys, ws, hd, ts) {
+                return false;
+            }
             let mut dz = std::mem::take(&mut self.tmp);
             self.solve_in_place(&mut dz);
             for i in 0..self.n {
@@ -395,6 +540,30 @@ impl Integrator {
             self.tmp = dz;
             if !norm.is_finite() {
                 return false;
+            }
+            if contact_aware {
+                // Hairer-Wanner II IV.8: with contraction θ the distance of the new iterate
+                // to the solution is at most θ/(1-θ) times the update; at the first iteration
+                // θ comes from the previous solve.
+                let eta = if iter == 0 {
+                    self.newton_eta.max(1e-2).powf(0.8)
+                } else {
+                    let theta = norm / self.last_update;
+                    if theta >= 0.99 {
+                        return false;
+                    }
+                    theta / (1.0 - theta)
+                };
+                if iter > 0 {
+                    self.newton_eta = eta;
+                }
+                if eta * norm <= NEWTON_KAPPA {
+                    for i in 0..self.n {
+                        self.k[out_k][i] = (self.z[i] - self.rhs[i]) / hd;
+                    }
+                    self.newton_z_is_new = true;
+                    return true;
+                }
             }
             if iter > 1 && norm > 0.9 * self.last_update {
                 return false;
@@ -416,6 +585,10 @@ impl Integrator {
     ) -> Result<(), IntegratorError> {
         if self.jac_age > 20 {
             self.compute_jacobian(sys, ws, t, y);
+        }
+        if self.contact_aware() {
+            // Factored at every Newton iterate (`factorize_at_iterate`).
+            return Ok(());
         }
         if !self.lu_valid || self.lu_h != h {
             self.factorize(h, diag, t)?;
@@ -653,12 +826,20 @@ impl Integrator {
                 y.copy_from_slice(&self.ynew);
                 sys.normalize(y);
                 self.stats.accepted += 1;
-                // Explicit FSAL reuses the last stage; the implicit methods evaluate f afresh:
-                // their stage derivative (z - rhs)/(h d) carries the Newton error divided by
-                // h d, which would poison the next step after a tiny step.
+                // Explicit FSAL reuses the last stage. The implicit methods need f itself at
+                // the new point, not the stage derivative (z - rhs)/(h d), which carries the
+                // Newton error divided by h d and would poison the next step after a tiny
+                // step. The last Newton iteration evaluated f exactly there (the accepted z is
+                // the iterate whose residual passed); renormalising the quaternions changes no
+                // force (frames are built from normalised quaternions) and scales q' = q ⊗ ω/2
+                // by 1/|q|, applied here.
                 match self.settings.kind {
                     IntegratorKind::Dopri5 => self.k.swap(0, 6),
-                    _ => self.rhs(sys, ws, t_new, y, 0),
+                    _ if self.newton_z_is_new => self.rhs(sys, ws, t_new, y, 0),
+                    _ => {
+                        self.k[0].copy_from_slice(&self.fz);
+                        sys.rescale_quaternion_rates(&self.ynew, &mut self.k[0]);
+                    }
                 }
                 self.jac_fresh = false;
                 self.jac_age = self.jac_age.saturating_add(1);
@@ -715,11 +896,11 @@ impl DenseLu {
     /// Factors `I - scale * jac` (`jac` column-major). False when singular.
     fn factor_newton(&mut self, jac: &[f64], scale: f64) -> bool {
         let n = self.n;
-        for i in 0..n {
-            for j in 0..n {
-                let id = if i == j { 1.0 } else { 0.0 };
-                self.a[i * n + j] = id - scale * jac[j * n + i];
+        for (i, row) in self.a.chunks_exact_mut(n).enumerate() {
+            for (j, a) in row.iter_mut().enumerate() {
+                *a = -scale * jac[j * n + i];
             }
+            row[i] += 1.0;
         }
         for k in 0..n {
             let mut p = k;
@@ -736,17 +917,19 @@ impl DenseLu {
             }
             self.piv[k] = p;
             if p != k {
-                for j in 0..n {
-                    self.a.swap(k * n + j, p * n + j);
-                }
+                let (top, bottom) = self.a.split_at_mut(p * n);
+                top[k * n..(k + 1) * n].swap_with_slice(&mut bottom[..n]);
             }
-            let inv = 1.0 / self.a[k * n + k];
-            for i in k + 1..n {
-                let l = self.a[i * n + k] * inv;
-                self.a[i * n + k] = l;
+            // Rows below k subtract multiples of row k (slices: no index checks, vectorised).
+            let (upper, lower) = self.a.split_at_mut((k + 1) * n);
+            let pivot_row = &upper[k * n..];
+            let inv = 1.0 / pivot_row[k];
+            for row in lower.chunks_exact_mut(n) {
+                let l = row[k] * inv;
+                row[k] = l;
                 if l != 0.0 {
-                    for j in k + 1..n {
-                        self.a[i * n + j] -= l * self.a[k * n + j];
+                    for (x, &r) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                        *x -= l * r;
                     }
                 }
             }
@@ -757,25 +940,22 @@ impl DenseLu {
     /// Solves `A x = b` in place.
     fn solve(&self, b: &mut [f64]) {
         let n = self.n;
-        for k in 0..n {
-            let p = self.piv[k];
+        for (k, &p) in self.piv.iter().enumerate() {
             if p != k {
                 b.swap(k, p);
             }
         }
-        for i in 0..n {
-            let mut s = b[i];
-            for j in 0..i {
-                s -= self.a[i * n + j] * b[j];
-            }
-            b[i] = s;
+        for (i, row) in self.a.chunks_exact(n).enumerate() {
+            let s: f64 = row[..i].iter().zip(&b[..i]).map(|(a, x)| a * x).sum();
+            b[i] -= s;
         }
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..n {
-                s -= self.a[i * n + j] * b[j];
-            }
-            b[i] = s / self.a[i * n + i];
+        for (i, row) in self.a.chunks_exact(n).enumerate().rev() {
+            let s: f64 = row[i + 1..]
+                .iter()
+                .zip(&b[i + 1..])
+                .map(|(a, x)| a * x)
+                .sum();
+            b[i] = (b[i] - s) / row[i];
         }
     }
 }

@@ -91,6 +91,9 @@ pub fn simulate(
     let start = Instant::now();
     let mut integ = Integrator::new(system, settings);
     let mut ws = system.workspace();
+    // The integrator's last derivative evaluation of each step is at the accepted state: its
+    // tracks are those of the step, with no second overlap computation.
+    ws.keep_tracks = true;
     let mut tracks: Vec<TrackState> = Vec::with_capacity(16);
     let mut last_good = y.to_vec();
     let mut t = t0;
@@ -115,7 +118,7 @@ pub fn simulate(
                 return Err(diagnose(system, t, y, &mut ws, &e.to_string(), Some(&e)));
             }
         }
-        collect_tracks(system, t, y, &mut ws, &mut tracks);
+        std::mem::swap(&mut tracks, &mut ws.tracks);
         if let Some(tr) = tracks
             .iter()
             .find(|tr| tr.penetration > limits.max_penetration_m)

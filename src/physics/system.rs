@@ -2,9 +2,9 @@
 //! motion `dy/dt = f(t, y)` (Newton-Euler per body, quaternion kinematics).
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
-use super::contact::{Contact, GeometryCache, TrackState};
+use super::contact::{Contact, GeometryCache, TrackLinearization, TrackState};
 use super::forces::{ForceElement, Wrench};
-use nalgebra::{Matrix3, Quaternion, Vector3};
+use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
 
 /// The model the integrator advances.
 #[derive(Clone)]
@@ -30,6 +30,18 @@ pub struct Workspace {
     pub wrenches: Vec<Wrench>,
     /// Contact overlaps kept between derivative evaluations at the same poses.
     pub geometry: GeometryCache,
+    /// Record each active track's force derivatives during a derivative evaluation.
+    pub linearize: bool,
+    /// The tracks' force derivatives of the last evaluation (when `linearize`).
+    pub linearizations: Vec<TrackLinearization>,
+    /// Leave the contacts out of the derivative (the contact-free part of the Jacobian).
+    pub skip_contacts: bool,
+    /// Keep the active tracks of each derivative evaluation in `tracks`.
+    pub keep_tracks: bool,
+    /// Active tracks of the last derivative evaluation with contacts (when `keep_tracks`).
+    /// After [`Integrator::advance`](super::integrator::Integrator::advance) these are the
+    /// tracks at the accepted state: its last evaluation is there.
+    pub tracks: Vec<TrackState>,
 }
 
 /// Energy bookkeeping of a state, J.
@@ -93,6 +105,11 @@ impl MultibodySystem {
             frames: Vec::with_capacity(self.bodies.len()),
             wrenches: vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()],
             geometry: GeometryCache::default(),
+            linearize: false,
+            linearizations: Vec::new(),
+            skip_contacts: false,
+            keep_tracks: false,
+            tracks: Vec::new(),
         }
     }
 
@@ -138,14 +155,28 @@ impl MultibodySystem {
         for f in &self.forces {
             f.accumulate(&ws.frames, &mut ws.wrenches);
         }
-        for (ci, c) in self.contacts.iter().enumerate() {
-            c.evaluate_with(
-                ci as u32,
-                &ws.frames,
-                Some(&mut ws.wrenches),
-                on_track,
-                &mut ws.geometry,
-            );
+        ws.linearizations.clear();
+        if !ws.skip_contacts {
+            let keep = ws.keep_tracks;
+            let mut kept = std::mem::take(&mut ws.tracks);
+            kept.clear();
+            let mut sink = |tr: &TrackState| {
+                if keep {
+                    kept.push(*tr);
+                }
+                on_track(tr);
+            };
+            for (ci, c) in self.contacts.iter().enumerate() {
+                c.evaluate_with(
+                    ci as u32,
+                    &ws.frames,
+                    Some(&mut ws.wrenches),
+                    &mut sink,
+                    &mut ws.geometry,
+                    ws.linearize.then_some(&mut ws.linearizations),
+                );
+            }
+            ws.tracks = kept;
         }
         for (i, b) in self.bodies.iter().enumerate() {
             let BodyKind::Dynamic { offset } = b.kind else {
@@ -177,6 +208,79 @@ impl MultibodySystem {
             d[10] = wdot.x;
             d[11] = wdot.y;
             d[12] = wdot.z;
+        }
+    }
+
+    /// Adds the contact forces' Jacobian `∂(dy/dt)/∂y` (column-major `n × n`) at the state of
+    /// the last derivative evaluation, made with `ws.linearize` set, to `jac`.
+    ///
+    /// Per track (see [`TrackLinearization`]) the force derivative with respect to each dynamic
+    /// body's velocities and pose is mapped to the state: world linear velocity directly,
+    /// body-frame angular velocity through the rotation, position directly, and the quaternion
+    /// through `δθ = 2 vec(δq ⊗ q*)` (world small rotation); the force enters the linear
+    /// acceleration as `F/m` and the body-frame angular acceleration as `I⁻¹ Rᵀ (r × F)`.
+    /// The rotation of the body-frame torque and the gyroscopic term are not differentiated
+    /// (they are in the contact-free part).
+    pub fn contact_jacobian(&self, y: &[f64], ws: &Workspace, jac: &mut [f64]) {
+        let n = self.state_len;
+        for lin in &ws.linearizations {
+            let ends = [(lin.body_a, 1.0), (lin.body_b, -1.0)];
+            for &(k, sign_k) in &ends {
+                let BodyKind::Dynamic { offset: ok } = self.bodies[k].kind else {
+                    continue;
+                };
+                let fk = &ws.frames[k];
+                let r_deep = lin.deepest_point.coords - fk.position;
+                let r_point = lin.point.coords - fk.position;
+                let nrm = lin.normal;
+                // ∂w/∂(δx, δθ) and ∂ẇ/∂(v, ω_world): −σ (nᵀ, (r_deep × n)ᵀ).
+                let lever = r_deep.cross(&nrm);
+                let tangent = Matrix3::identity() - nrm * nrm.transpose();
+                // ∂s/∂v = σ P, ∂s/∂ω_world = −σ P [r_point]×.
+                let ds_dw = -tangent * r_point.cross_matrix() * sign_k;
+                let g = lin.dforce_dfn;
+                // dF/d(state of k), 3 × 13, in blocks.
+                let df_dx = g * (nrm.transpose() * (-sign_k * lin.dfn_dw));
+                let df_dtheta = g * (lever.transpose() * (-sign_k * lin.dfn_dw));
+                let df_dv = g * (nrm.transpose() * (-sign_k * lin.dfn_dwdot))
+                    + lin.dforce_dslip * tangent * sign_k;
+                let df_domega_world =
+                    g * (lever.transpose() * (-sign_k * lin.dfn_dwdot)) + lin.dforce_dslip * ds_dw;
+                let rot_k = fk.rotation.to_rotation_matrix().into_inner();
+                let df_domega_body = df_domega_world * rot_k;
+                let df_dq = df_dtheta * rotation_tangent(&y[ok + 3..ok + 7]);
+                for &(m, sign_m) in &ends {
+                    let BodyKind::Dynamic { offset: om } = self.bodies[m].kind else {
+                        continue;
+                    };
+                    let fm = &ws.frames[m];
+                    let inv_mass = sign_m / self.bodies[m].mass.mass;
+                    let rot_m = fm.rotation.to_rotation_matrix().into_inner();
+                    let to_omega_dot = self.inverse_inertia[m]
+                        * rot_m.transpose()
+                        * (lin.point.coords - fm.position).cross_matrix()
+                        * sign_m;
+                    let blocks: [(usize, &[f64]); 4] = [
+                        (0, df_dx.as_slice()),
+                        (3, df_dq.as_slice()),
+                        (7, df_dv.as_slice()),
+                        (10, df_domega_body.as_slice()),
+                    ];
+                    for (col0, block) in blocks {
+                        let cols = block.len() / 3;
+                        for c in 0..cols {
+                            let d = Vector3::new(block[3 * c], block[3 * c + 1], block[3 * c + 2]);
+                            let lin_acc = d * inv_mass;
+                            let ang_acc = to_omega_dot * d;
+                            let col = &mut jac[(ok + col0 + c) * n..(ok + col0 + c + 1) * n];
+                            for r in 0..3 {
+                                col[om + 7 + r] += lin_acc[r];
+                                col[om + 10 + r] += ang_acc[r];
+                            }
+                        }
+                    }
+                }
+            }
         }
     }
 
@@ -219,20 +323,28 @@ impl MultibodySystem {
 
     /// Renormalises every dynamic body's quaternion in place.
     pub fn normalize(&self, y: &mut [f64]) {
-        for b in &self.bodies {
-            if let BodyKind::Dynamic { offset } = b.kind {
-                let n = (y[offset + 3].powi(2)
-                    + y[offset + 4].powi(2)
-                    + y[offset + 5].powi(2)
-                    + y[offset + 6].powi(2))
-                .sqrt();
-                if n > 0.0 && n.is_finite() {
-                    for k in 3..7 {
-                        y[offset + k] /= n;
-                    }
-                }
+        for offset in self.dynamic_offsets() {
+            if let Some(n) = quaternion_norm(y, offset) {
+                y[offset + 3..offset + 7].iter_mut().for_each(|v| *v /= n);
             }
         }
+    }
+
+    /// Turns `dy = f(t, y)` into `f(t, normalize(y))`: only the quaternion rates depend on the
+    /// quaternions' length (`q' = q ⊗ ω/2`); every force uses the normalised rotation.
+    pub fn rescale_quaternion_rates(&self, y: &[f64], dy: &mut [f64]) {
+        for offset in self.dynamic_offsets() {
+            if let Some(n) = quaternion_norm(y, offset) {
+                dy[offset + 3..offset + 7].iter_mut().for_each(|v| *v /= n);
+            }
+        }
+    }
+
+    fn dynamic_offsets(&self) -> impl Iterator<Item = usize> + '_ {
+        self.bodies.iter().filter_map(|b| match b.kind {
+            BodyKind::Dynamic { offset } => Some(offset),
+            BodyKind::Kinematic(_) => None,
+        })
     }
 
     /// Which quantity each state entry holds: 0 position (m), 1 quaternion, 2 velocity (m/s),
@@ -244,6 +356,30 @@ impl MultibodySystem {
         }
         k
     }
+}
+
+/// Length of the quaternion of the body at `offset`, when positive and finite.
+fn quaternion_norm(y: &[f64], offset: usize) -> Option<f64> {
+    let n = y[offset + 3..offset + 7]
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
+    (n > 0.0 && n.is_finite()).then_some(n)
+}
+
+/// `∂θ/∂q` (3 × 4): the world small rotation `δθ = 2 vec(δq̂ ⊗ q̂*)` produced by a change `δq`
+/// of the (not necessarily unit) state quaternion `q = (w, u)`, normalised as the state reader
+/// does: `δθ = 2 (−δw u + w δu + u × δu) / |q|` with `(w, u)` of the unit quaternion.
+fn rotation_tangent(q: &[f64]) -> Matrix3x4<f64> {
+    let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    let s = 2.0 / (norm * norm);
+    let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
+    let block = (Matrix3::identity() * w + u.cross_matrix()) * s;
+    let mut m = Matrix3x4::zeros();
+    m.set_column(0, &(-u * s));
+    m.fixed_view_mut::<3, 3>(0, 1).copy_from(&block);
+    m
 }
 
 #[cfg(test)]
@@ -323,6 +459,160 @@ mod tests {
                 sys.derivative(0.0, &yp, &mut replayed, &mut ws);
                 assert_eq!(computed, replayed, "body {} column {j}", b.name);
             }
+        }
+    }
+
+    /// Forward-difference Jacobian of the derivative, column-major, with or without contacts.
+    fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64> {
+        let n = sys.state_len();
+        let mut ws = sys.workspace();
+        ws.skip_contacts = !with_contacts;
+        let (mut f0, mut f1) = (vec![0.0; n], vec![0.0; n]);
+        sys.derivative(0.0, y, &mut f0, &mut ws);
+        let mut jac = vec![0.0; n * n];
+        for j in 0..n {
+            // Central differences: the contact force is smooth away from the clamp.
+            let delta = 1e-7 * y[j].abs().max(1e-3);
+            let mut yp = y.to_vec();
+            yp[j] += delta;
+            sys.derivative(0.0, &yp, &mut f1, &mut ws);
+            yp[j] = y[j] - delta;
+            sys.derivative(0.0, &yp, &mut f0, &mut ws);
+            for i in 0..n {
+                jac[j * n + i] = (f1[i] - f0[i]) / (2.0 * delta);
+            }
+        }
+        jac
+    }
+
+    fn analytic_contact_jacobian(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, usize) {
+        let n = sys.state_len();
+        let mut ws = sys.workspace();
+        ws.linearize = true;
+        let mut f = vec![0.0; n];
+        sys.derivative(0.0, y, &mut f, &mut ws);
+        let mut jac = vec![0.0; n * n];
+        sys.contact_jacobian(y, &ws, &mut jac);
+        (jac, ws.linearizations.len())
+    }
+
+    #[test]
+    fn contact_jacobian_velocity_columns_equal_finite_differences() {
+        // A velocity change moves no pose, so the contact force's velocity derivatives are
+        // exactly those of the IMPACT damping and the friction law at fixed geometry.
+        let (sys, y) = pressed_cube();
+        let n = sys.state_len();
+        let (analytic, tracks) = analytic_contact_jacobian(&sys, &y);
+        assert!(tracks >= 1);
+        let full = fd_jacobian(&sys, &y, true);
+        let free = fd_jacobian(&sys, &y, false);
+        for j in 7..13 {
+            let col = |m: &[f64], i: usize| m[j * n + i];
+            let scale = (0..n).map(|i| col(&full, i).abs()).fold(0.0_f64, f64::max);
+            assert!(scale > 1e3, "column {j} must feel the contact damping");
+            for i in 0..n {
+                let contact_fd = col(&full, i) - col(&free, i);
+                let err = (contact_fd - col(&analytic, i)).abs();
+                assert!(
+                    err <= 1e-6 * scale,
+                    "d f[{i}] / d y[{j}]: finite differences {contact_fd:e}, analytic {:e}",
+                    col(&analytic, i)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn contact_jacobian_translation_columns_give_the_normal_force_derivative() {
+        // Translating the cube changes the floor penetration of its deepest point (a corner,
+        // the same material point) exactly as the analytic part says, so the normal (y) force
+        // row is exact. The friction rows are not: the overlap centroid, where the slip is
+        // taken, slides over the tilted face as the overlap grows (left out by design).
+        let (sys, y) = pressed_cube();
+        let n = sys.state_len();
+        let (analytic, _) = analytic_contact_jacobian(&sys, &y);
+        let full = fd_jacobian(&sys, &y, true);
+        let free = fd_jacobian(&sys, &y, false);
+        let scale = full[n + 8].abs();
+        assert!(
+            scale > 1e6,
+            "the floor's stiffness must show in d(v_y')/d(y)"
+        );
+        for j in 0..3 {
+            let contact_fd = full[j * n + 8] - free[j * n + 8];
+            let err = (contact_fd - analytic[j * n + 8]).abs();
+            assert!(
+                err <= 1e-5 * scale,
+                "d f[8] / d y[{j}]: finite differences {contact_fd:e}, analytic {:e}",
+                analytic[j * n + 8]
+            );
+        }
+    }
+
+    #[test]
+    fn rotation_tangent_is_the_world_small_rotation() {
+        // q' = normalise(q + δq) must rotate the frame by δθ = (∂θ/∂q) δq to first order,
+        // also for a state quaternion that drifted off unit length.
+        let q = nalgebra::UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1).into_inner() * 1.02;
+        let qs = [q.w, q.i, q.j, q.k];
+        let m = rotation_tangent(&qs);
+        let r0 = nalgebra::UnitQuaternion::new_normalize(q);
+        for k in 0..4 {
+            let mut dq = [0.0; 4];
+            dq[k] = 1e-7;
+            let q1 = Quaternion::new(qs[0] + dq[0], qs[1] + dq[1], qs[2] + dq[2], qs[3] + dq[3]);
+            let rel = nalgebra::UnitQuaternion::new_normalize(q1) * r0.inverse();
+            let theta = rel.scaled_axis();
+            let predicted = m.column(k) * 1e-7;
+            assert!(
+                (theta - predicted).norm() < 1e-12,
+                "column {k}: {theta:?} vs {predicted:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn integrator_leaves_the_tracks_of_the_accepted_state() {
+        // simulate() records each step's tracks from the integrator's last derivative
+        // evaluation instead of recomputing the overlaps: that evaluation must be at the
+        // accepted state, for every method and Newton matrix.
+        use crate::physics::integrator::{Integrator, IntegratorKind, NewtonJacobian};
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+        let case = crate::models::case::load_case(&dir.join("rattle-box-c.toml")).expect("case");
+        let base_settings = crate::models::case::integrator_settings(&case).expect("settings");
+        // Pressed in, spinning and sliding: the tracks change on every step.
+        let (sys, y0) = pressed_cube();
+        for (kind, newton) in [
+            (IntegratorKind::Trbdf2, NewtonJacobian::ContactAware),
+            (IntegratorKind::Trbdf2, NewtonJacobian::FiniteDifference),
+            (IntegratorKind::Sdirk2, NewtonJacobian::ContactAware),
+            (IntegratorKind::Dopri5, NewtonJacobian::ContactAware),
+        ] {
+            let mut settings = base_settings;
+            settings.kind = kind;
+            settings.newton = newton;
+            let mut integ = Integrator::new(&sys, settings);
+            let mut ws = sys.workspace();
+            ws.keep_tracks = true;
+            let mut check = sys.workspace();
+            let mut y = y0.clone();
+            let (mut t, mut steps_in_contact) = (0.0, 0);
+            while t < 2e-4 {
+                t = integ
+                    .advance(&sys, &mut ws, t, &mut y, 2e-4)
+                    .expect("advances");
+                let mut fresh = Vec::new();
+                sys.tracks(t, &y, &mut check, &mut |tr| fresh.push(*tr));
+                assert_eq!(fresh.len(), ws.tracks.len(), "{kind:?} {newton:?} t = {t}");
+                for (a, b) in fresh.iter().zip(&ws.tracks) {
+                    assert_eq!((a.contact, a.track), (b.contact, b.track));
+                    let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
+                    assert!(close(a.penetration, b.penetration), "{kind:?} t = {t}");
+                    assert!(close(a.normal_force, b.normal_force), "{kind:?} t = {t}");
+                }
+                steps_in_contact += usize::from(!fresh.is_empty());
+            }
+            assert!(steps_in_contact > 10, "the cube must touch the floor");
         }
     }
 }
