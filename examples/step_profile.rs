@@ -18,6 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let settings = integrator_settings(&case)?;
     let mut integ = Integrator::new(sys, settings);
     let mut ws = sys.workspace();
+    ws.keep_tracks = true; // as simulate() does: the step's tracks come with its last evaluation
     let mut y = m.initial_state.clone();
     let mut t = 0.0;
     // bins: 0 free, 1 N<1, 2 1..100, 3 >=100
@@ -28,18 +29,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut hhist = [0u64; 12];
     let mut prev = integ.stats;
     let mut prev_bin = 0usize;
+    let mut impacts = 0u64;
     let start = std::time::Instant::now();
     while t < m.end_time_s {
         let t0 = t;
         t = integ
             .advance(sys, &mut ws, t, &mut y, m.end_time_s)
             .expect("advance");
-        let mut maxn: f64 = -1.0;
-        let mut ntr = 0;
-        sys.tracks(t, &y, &mut ws, &mut |tr| {
-            ntr += 1;
-            maxn = maxn.max(tr.normal_force);
-        });
+        let ntr = ws.tracks.len();
+        let maxn = ws
+            .tracks
+            .iter()
+            .map(|tr| tr.normal_force)
+            .fold(-1.0, f64::max);
         let bin = if ntr == 0 {
             0
         } else if maxn < 1.0 {
@@ -51,6 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         // attribute work to the max of the bin before and after
         let b = bin.max(prev_bin);
+        if bin == 3 && prev_bin < 3 && t0 >= m.excitation_start_s {
+            impacts += 1;
+        }
         prev_bin = bin;
         if t0 >= m.excitation_start_s {
             let s = integ.stats;
@@ -74,6 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             steps[i], rej[i], rhs[i], simt[i]
         );
     }
+    println!("impacts (entries into N >= 100 N): {impacts}");
     for (i, c) in hhist.iter().enumerate() {
         println!("h in [1e-{}, 1e-{}): {}", i + 1, i, c);
     }

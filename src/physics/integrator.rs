@@ -145,6 +145,9 @@ pub struct IntegratorStats {
     pub accepted: u64,
     /// Rejected steps (error or Newton failure).
     pub rejected: u64,
+    /// Of the rejected steps, those whose Newton iteration failed.
+    #[serde(default)]
+    pub newton_failures: u64,
     /// Right-hand-side evaluations.
     pub rhs_evals: u64,
     /// Jacobian evaluations.
@@ -181,6 +184,15 @@ const SD_GAMMA: f64 = 1.0 - 1.0 / SQRT2;
 /// (an impact or a stick-slip reversal inside the step), not on the Jacobian: the step is cut
 /// without refreshing it (measured alone on rattle box C: -50 % Jacobians, -20 % rejections).
 const YOUNG_JACOBIAN_STEPS: u32 = 2;
+
+/// Contact-aware Newton: a failed Newton iteration halves the step, and the next
+/// `HOLD_STEPS_AFTER_NEWTON_FAILURE` accepted steps grow by at most `HELD_GROWTH` each, so the
+/// step creeps back instead of jumping straight into the next contact event (measured on the
+/// 2 s windows of rattle box C and the launcher: 0.25 without the hold 84 479 launcher
+/// right-hand sides, 0.5 with a 20-step hold at 1.2 74 064, 7 868 -> 3 756 rejections).
+const CONTACT_AWARE_NEWTON_CUT: f64 = 0.5;
+const HOLD_STEPS_AFTER_NEWTON_FAILURE: u32 = 20;
+const HELD_GROWTH: f64 = 1.2;
 
 /// Contact-aware Newton keeps its LU while every entry of the Newton matrix moved by less than
 /// this fraction of its size since the factorisation.
@@ -233,6 +245,8 @@ pub struct Integrator {
     pub stats: IntegratorStats,
     /// The last attempt was rejected (caps the next growth factor at 1).
     after_reject: bool,
+    /// Accepted steps left whose growth is capped after a Newton failure.
+    hold_steps: u32,
 }
 
 struct Attempt {
@@ -296,6 +310,7 @@ impl Integrator {
             last_update: f64::INFINITY,
             stats: IntegratorStats::default(),
             after_reject: false,
+            hold_steps: 0,
         }
     }
 
@@ -810,8 +825,18 @@ impl Integrator {
             };
             if attempt.newton_failed {
                 self.stats.rejected += 1;
+                self.stats.newton_failures += 1;
                 self.after_reject = true;
-                if self.jac_fresh || self.jac_age <= YOUNG_JACOBIAN_STEPS {
+                if self.contact_aware() {
+                    // The contacts' part of the matrix was current at every iterate: the
+                    // step is too long for the contact event inside it. The contact-free
+                    // part is refreshed too when it is not young.
+                    if !(self.jac_fresh || self.jac_age <= YOUNG_JACOBIAN_STEPS) {
+                        self.compute_jacobian(sys, ws, t, y);
+                    }
+                    self.h = h * CONTACT_AWARE_NEWTON_CUT;
+                    self.hold_steps = HOLD_STEPS_AFTER_NEWTON_FAILURE;
+                } else if self.jac_fresh || self.jac_age <= YOUNG_JACOBIAN_STEPS {
                     self.h = h * 0.25;
                 } else {
                     // Retry the same step with a fresh Jacobian first.
@@ -845,7 +870,14 @@ impl Integrator {
                 self.jac_age = self.jac_age.saturating_add(1);
                 // No growth right after a rejection (Hairer-Wanner II IV.8): growing back
                 // at once re-triggers the same failure (measured: -40 % rejections).
-                let fmax = if self.after_reject { 1.0 } else { facmax };
+                let fmax = if self.after_reject {
+                    1.0
+                } else if self.hold_steps > 0 {
+                    HELD_GROWTH
+                } else {
+                    facmax
+                };
+                self.hold_steps = self.hold_steps.saturating_sub(1);
                 self.after_reject = false;
                 let fac = if err == 0.0 {
                     fmax
