@@ -13,7 +13,9 @@ use railwear::models::run::{run_model, BuiltModel, ModelRunError, RunOptions, Ru
 use railwear::models::specs::CaseSpec;
 use railwear::physics::body::write_state;
 use railwear::physics::impact::ImpactParams;
-use railwear::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
+use railwear::physics::integrator::{
+    IntegratorKind, IntegratorSettings, NewtonJacobian, Tolerances,
+};
 use railwear::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use railwear::pipeline::{Progress, RunControl, RunError};
 use serde_json::{json, Value};
@@ -809,12 +811,22 @@ fn peers(
     } else {
         notes.push("no peer rows: pass --with-peers (or --peers-json FILE)".into());
     }
-    eprintln!("peers: railwear rattle box C ...");
-    let (_, model, options) = rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
-    let ours = run_model(&model, &options, &RunControl::silent())
-        .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
-    let rw_rtf = model.end_time_s / ours.wall_s.max(1e-9);
-    let rw_sps = ours.integrator.accepted as f64 / ours.wall_s.max(1e-9);
+    // railwear twice: the default contact-aware Newton, then the earlier finite-difference
+    // Newton matrix, so the engine change is measured in the same run as the peers.
+    let mut ours_rows = Vec::new();
+    for newton in [
+        NewtonJacobian::ContactAware,
+        NewtonJacobian::FiniteDifference,
+    ] {
+        eprintln!("peers: railwear rattle box C ({newton:?} Newton) ...");
+        let (_, model, mut options) =
+            rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
+        options.integrator.newton = newton;
+        let run = run_model(&model, &options, &RunControl::silent())
+            .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
+        ours_rows.push((newton, model.end_time_s, options, run));
+    }
+    let rw_rtf = ours_rows[0].1 / ours_rows[0].3.wall_s.max(1e-9);
     let mut table = Table::new(
         format!("Rattle box case C side by side (settle {settle} s, window {window} s, one run)"),
         &[
@@ -829,20 +841,27 @@ fn peers(
             ("ratio_vs_mujoco", "railwear RTF / this RTF"),
         ],
     );
-    table.row(vec![
-        Cell::text(format!("railwear {}", env!("CARGO_PKG_VERSION"))),
-        Cell::text("IMPACT eq. 2.1-2.3, Table 5.2 (k 1000 N/mm², e 2, c_max 500 N·s/mm, d 0.01 mm); ADAMS friction eq. 4.5"),
-        Cell::text(format!(
-            "trbdf2 {}",
-            tolerance_text(&options.integrator.tolerances)
-        )),
-        Cell::Num(rw_rtf),
-        Cell::text("-"),
-        Cell::Num(rw_sps),
-        Cell::Num(ours.mean_normal_force_n),
-        Cell::Num(ours.mean_friction_power_w),
-        Cell::text("1"),
-    ]);
+    for (newton, end_time_s, options, run) in &ours_rows {
+        let rtf = end_time_s / run.wall_s.max(1e-9);
+        let newton_name = match newton {
+            NewtonJacobian::ContactAware => "contact-aware Newton",
+            NewtonJacobian::FiniteDifference => "finite-difference Newton",
+        };
+        table.row(vec![
+            Cell::text(format!("railwear {}", env!("CARGO_PKG_VERSION"))),
+            Cell::text("IMPACT eq. 2.1-2.3, Table 5.2 (k 1000 N/mm², e 2, c_max 500 N·s/mm, d 0.01 mm); ADAMS friction eq. 4.5"),
+            Cell::text(format!(
+                "trbdf2 {}, {newton_name}",
+                tolerance_text(&options.integrator.tolerances)
+            )),
+            Cell::Num(rtf),
+            Cell::text("-"),
+            Cell::Num(run.integrator.accepted as f64 / run.wall_s.max(1e-9)),
+            Cell::Num(run.mean_normal_force_n),
+            Cell::Num(run.mean_friction_power_w),
+            Cell::Num(rw_rtf / rtf),
+        ]);
+    }
     let mut mujoco_best: Option<f64> = None;
     for p in &peer_rows {
         let engine = p.get("engine").and_then(Value::as_str).unwrap_or("?");

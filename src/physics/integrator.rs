@@ -21,6 +21,7 @@
 
 use super::body::{BodyKind, BODY_STATE_LEN};
 use super::contact::GeometryMode;
+use super::newton_matrix::NewtonLu;
 use super::system::{MultibodySystem, Workspace};
 use serde::{Deserialize, Serialize};
 
@@ -237,7 +238,7 @@ pub struct Integrator {
     /// Perturbed state and derivative for the finite differences (no allocation per call).
     jac_y: Vec<f64>,
     jac_f: Vec<f64>,
-    lu: DenseLu,
+    lu: NewtonLu,
     lu_valid: bool,
     lu_h: f64,
     last_update: f64,
@@ -304,7 +305,7 @@ impl Integrator {
             jac_age: u32::MAX,
             jac_y: v(),
             jac_f: v(),
-            lu: DenseLu::new(n),
+            lu: NewtonLu::new(n / BODY_STATE_LEN),
             lu_valid: false,
             lu_h: 0.0,
             last_update: f64::INFINITY,
@@ -490,7 +491,7 @@ impl Integrator {
         Ok(())
     }
 
-    fn solve_in_place(&self, v: &mut [f64]) {
+    fn solve_in_place(&mut self, v: &mut [f64]) {
         if self.lu_valid {
             self.lu.solve(v);
         }
@@ -903,91 +904,6 @@ impl Integrator {
                 0.1
             };
             self.h = h * fac;
-        }
-    }
-}
-
-/// Dense LU with partial pivoting of the Newton matrix `I - a J` (row-major, factored in place,
-/// allocated once): the matrices are small (13 per body) and refactored often, so nalgebra's
-/// allocating `lu()` and `DVector` per solve were measurable overhead.
-struct DenseLu {
-    n: usize,
-    a: Vec<f64>,
-    piv: Vec<usize>,
-}
-
-impl DenseLu {
-    fn new(n: usize) -> Self {
-        Self {
-            n,
-            a: vec![0.0; n * n],
-            piv: vec![0; n],
-        }
-    }
-
-    /// Factors `I - scale * jac` (`jac` column-major). False when singular.
-    fn factor_newton(&mut self, jac: &[f64], scale: f64) -> bool {
-        let n = self.n;
-        for (i, row) in self.a.chunks_exact_mut(n).enumerate() {
-            for (j, a) in row.iter_mut().enumerate() {
-                *a = -scale * jac[j * n + i];
-            }
-            row[i] += 1.0;
-        }
-        for k in 0..n {
-            let mut p = k;
-            let mut best = self.a[k * n + k].abs();
-            for i in k + 1..n {
-                let v = self.a[i * n + k].abs();
-                if v > best {
-                    best = v;
-                    p = i;
-                }
-            }
-            if best == 0.0 || !best.is_finite() {
-                return false;
-            }
-            self.piv[k] = p;
-            if p != k {
-                let (top, bottom) = self.a.split_at_mut(p * n);
-                top[k * n..(k + 1) * n].swap_with_slice(&mut bottom[..n]);
-            }
-            // Rows below k subtract multiples of row k (slices: no index checks, vectorised).
-            let (upper, lower) = self.a.split_at_mut((k + 1) * n);
-            let pivot_row = &upper[k * n..];
-            let inv = 1.0 / pivot_row[k];
-            for row in lower.chunks_exact_mut(n) {
-                let l = row[k] * inv;
-                row[k] = l;
-                if l != 0.0 {
-                    for (x, &r) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
-                        *x -= l * r;
-                    }
-                }
-            }
-        }
-        true
-    }
-
-    /// Solves `A x = b` in place.
-    fn solve(&self, b: &mut [f64]) {
-        let n = self.n;
-        for (k, &p) in self.piv.iter().enumerate() {
-            if p != k {
-                b.swap(k, p);
-            }
-        }
-        for (i, row) in self.a.chunks_exact(n).enumerate() {
-            let s: f64 = row[..i].iter().zip(&b[..i]).map(|(a, x)| a * x).sum();
-            b[i] -= s;
-        }
-        for (i, row) in self.a.chunks_exact(n).enumerate().rev() {
-            let s: f64 = row[i + 1..]
-                .iter()
-                .zip(&b[i + 1..])
-                .map(|(a, x)| a * x)
-                .sum();
-            b[i] = (b[i] - s) / row[i];
         }
     }
 }

@@ -6,6 +6,7 @@ pub mod forces;
 pub mod friction;
 pub mod impact;
 pub mod integrator;
+pub mod newton_matrix;
 pub mod simulate;
 pub mod step;
 pub mod system;
