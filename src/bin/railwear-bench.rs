@@ -974,18 +974,6 @@ fn launcher(
     if !(settle >= 0.0 && window > 0.0 && mem_window > 0.0) {
         bail!("--settle must be >= 0 and --window, --mem-window > 0");
     }
-    let case = launcher_case(configs_dir, settle, window)?;
-    eprintln!("launcher: timed run ...");
-    let (report, _) = run_case(&case, configs_dir, &RunControl::silent())
-        .map_err(|e| anyhow!("launcher run: {e}"))?;
-    let simulated = settle + window;
-    let wall = report.wall_s.max(1e-9);
-    let options = run_options(&case)?;
-    let rail = report
-        .bodies
-        .iter()
-        .find(|b| b.name == "rail")
-        .map(|b| b.mass_rate_mg_per_h);
     let mut t = Table::new(
         "Launcher reference run (launcher-design, AH-64 transverse profile)",
         &[
@@ -1001,18 +989,45 @@ fn launcher(
             ("rail_wear_mg_per_h", "rail wear mg/h"),
         ],
     );
-    t.row(vec![
-        Cell::text(format!("timed: settle {settle} s + window {window} s")),
-        Cell::Num(simulated),
-        Cell::text(tolerance_text(&options.integrator.tolerances)),
-        Cell::Num(simulated / wall),
-        Cell::Num(report.integrator.accepted as f64 / wall),
-        Cell::Int(report.integrator.accepted),
-        Cell::Int(report.integrator.rejected),
-        Cell::Int(report.tracks.len() as u64),
-        Cell::opt(vm_kb("VmHWM:").map(|k| k as f64 / 1024.0)),
-        Cell::opt(rail),
-    ]);
+    let case = launcher_case(configs_dir, settle, window)?;
+    let options = run_options(&case)?;
+    // The default contact-aware Newton, then the earlier finite-difference Newton matrix for
+    // the same-run comparison.
+    for newton in [
+        NewtonJacobian::ContactAware,
+        NewtonJacobian::FiniteDifference,
+    ] {
+        let mut variant = case.clone();
+        variant.simulation.newton_jacobian = newton;
+        eprintln!("launcher: timed run ({newton:?} Newton) ...");
+        let (report, _) = run_case(&variant, configs_dir, &RunControl::silent())
+            .map_err(|e| anyhow!("launcher run: {e}"))?;
+        let simulated = settle + window;
+        let wall = report.wall_s.max(1e-9);
+        let rail = report
+            .bodies
+            .iter()
+            .find(|b| b.name == "rail")
+            .map(|b| b.mass_rate_mg_per_h);
+        let newton_name = match newton {
+            NewtonJacobian::ContactAware => "contact-aware Newton",
+            NewtonJacobian::FiniteDifference => "finite-difference Newton",
+        };
+        t.row(vec![
+            Cell::text(format!(
+                "timed: settle {settle} s + window {window} s, {newton_name}"
+            )),
+            Cell::Num(simulated),
+            Cell::text(tolerance_text(&options.integrator.tolerances)),
+            Cell::Num(simulated / wall),
+            Cell::Num(report.integrator.accepted as f64 / wall),
+            Cell::Int(report.integrator.accepted),
+            Cell::Int(report.integrator.rejected),
+            Cell::Int(report.tracks.len() as u64),
+            Cell::opt(vm_kb("VmHWM:").map(|k| k as f64 / 1024.0)),
+            Cell::opt(rail),
+        ]);
+    }
     if !no_mem {
         eprintln!("launcher: memory run (settle {settle} s + window {mem_window} s) in a child process ...");
         let exe = std::env::current_exe().context("locating railwear-bench")?;
