@@ -68,9 +68,6 @@ impl NewtonLu {
         let np = POSE * nb;
         let m = VEL * nb;
         let at = |row: usize, col: usize| jac[col * n + row];
-        // State index of pose entry c and velocity entry r.
-        let pose_state = |c: usize| BODY_STATE_LEN * (c / POSE) + c % POSE;
-        let vel_state = |r: usize| BODY_STATE_LEN * (r / VEL) + POSE + r % VEL;
         self.scale = scale;
         for k in 0..nb {
             let base = BODY_STATE_LEN * k;
@@ -102,32 +99,30 @@ impl NewtonLu {
             }
             self.w[k] = w;
         }
-        for r in 0..m {
-            let row = vel_state(r);
-            for c in 0..np {
-                self.j_up[r * np + c] = at(row, pose_state(c));
-            }
-        }
         // S = I - a J_uu - a² J_up (P⁻¹ J_pu), with P⁻¹ J_pu block diagonal: X_v for v, W for ω.
         let a2 = scale * scale;
         let s = self.schur.matrix_mut();
         for r in 0..m {
-            let j_up_row = &self.j_up[r * np..(r + 1) * np];
-            for c in 0..m {
-                let k = c / VEL;
-                let j = c % VEL;
-                let coupled: f64 = if j < 3 {
-                    (0..3)
-                        .map(|i| j_up_row[POSE * k + i] * self.x_v[k][3 * i + j])
-                        .sum()
-                } else {
-                    (0..4)
-                        .map(|i| j_up_row[POSE * k + 3 + i] * self.w[k][3 * i + j - 3])
-                        .sum()
-                };
-                let id = if r == c { 1.0 } else { 0.0 };
-                s[r * m + c] = id - scale * at(vel_state(r), vel_state(c)) - a2 * coupled;
+            let row = BODY_STATE_LEN * (r / VEL) + POSE + r % VEL;
+            let j_up_row = &mut self.j_up[r * np..(r + 1) * np];
+            let s_row = &mut s[r * m..(r + 1) * m];
+            for k in 0..nb {
+                let base = BODY_STATE_LEN * k;
+                let mut jp = [0.0; POSE];
+                for (i, v) in jp.iter_mut().enumerate() {
+                    *v = at(row, base + i);
+                }
+                j_up_row[POSE * k..POSE * (k + 1)].copy_from_slice(&jp);
+                let (x_v, w) = (&self.x_v[k], &self.w[k]);
+                for j in 0..3 {
+                    let via_x = jp[0] * x_v[j] + jp[1] * x_v[3 + j] + jp[2] * x_v[6 + j];
+                    let via_q =
+                        jp[3] * w[j] + jp[4] * w[3 + j] + jp[5] * w[6 + j] + jp[6] * w[9 + j];
+                    s_row[VEL * k + j] = -scale * at(row, base + POSE + j) - a2 * via_x;
+                    s_row[VEL * k + 3 + j] = -scale * at(row, base + POSE + 3 + j) - a2 * via_q;
+                }
             }
+            s_row[r] += 1.0;
         }
         self.schur.factor_in_place()
     }
