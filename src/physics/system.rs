@@ -26,6 +26,8 @@ pub struct MultibodySystem {
 pub struct Workspace {
     /// Frames of all bodies at the evaluation instant.
     pub frames: Vec<BodyFrame>,
+    /// Instant of the kinematic bodies' frames in `frames`.
+    kinematic_time: Option<f64>,
     /// Accumulated wrenches.
     pub wrenches: Vec<Wrench>,
     /// Contact overlaps kept between derivative evaluations at the same poses.
@@ -103,6 +105,7 @@ impl MultibodySystem {
     pub fn workspace(&self) -> Workspace {
         Workspace {
             frames: Vec::with_capacity(self.bodies.len()),
+            kinematic_time: None,
             wrenches: vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()],
             geometry: GeometryCache::default(),
             linearize: false,
@@ -113,12 +116,14 @@ impl MultibodySystem {
         }
     }
 
-    /// Fills `ws.frames` with every body's pose and velocity at (t, y).
+    /// Fills `ws.frames` with every body's pose and velocity at (t, y). Prescribed motions are
+    /// evaluated once per instant: Newton iterations and Jacobian columns share `t`.
     pub fn frames(&self, t: f64, y: &[f64], ws: &mut Workspace) {
-        ws.frames.clear();
-        for b in &self.bodies {
+        let kinematic_cached = ws.kinematic_time == Some(t) && ws.frames.len() == self.bodies.len();
+        for (i, b) in self.bodies.iter().enumerate() {
             let f = match &b.kind {
                 BodyKind::Dynamic { offset } => frame_from_state(y, *offset),
+                BodyKind::Kinematic(_) if kinematic_cached => continue,
                 BodyKind::Kinematic(m) => {
                     let pose = m.pose(t);
                     let (v, w) = m.velocity(t);
@@ -130,8 +135,13 @@ impl MultibodySystem {
                     }
                 }
             };
-            ws.frames.push(f);
+            if i < ws.frames.len() {
+                ws.frames[i] = f;
+            } else {
+                ws.frames.push(f);
+            }
         }
+        ws.kinematic_time = Some(t);
     }
 
     /// Evaluates dy/dt into `dy`. Calls `on_track` for every active contact track.
