@@ -6,7 +6,7 @@
 //!   w* = w/w_c; eq. 2.21 is labelled P_c but is the critical load F_c. The thesis then
 //!   multiplies that load by the normalised area (eq. 2.33, 2.42), which is dimensionally a
 //!   force times an area; this module does not, and uses F = F_c F*(w*).
-//! - H_g in eq. 2.27 is not defined in the thesis; JG 2005 (thesis ref. [25]) give
+//! - H_g in eq. 2.27 is not defined in the thesis; JG 2005 (thesis ref. \[25\]) give
 //!   H_g/S_y = 2.84 - 0.92 (1 - cos(pi a/R)) with a the contact radius, used here.
 //! - KE's critical values are those of JG (the thesis says "the same normalized parameters");
 //!   KE's own K H = (0.454 + 0.41 nu) 2.8 S_y differs from JG's C S_y by under 0.1 % for nu = 0.33.

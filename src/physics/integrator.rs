@@ -13,8 +13,14 @@
 //! - [`IntegratorKind::Dopri5`]: explicit Dormand-Prince 5(4). Not stiff-capable; the reference
 //!   for smooth problems (torque-free body, undamped Hertz bounce).
 //!
-//! Newton iterations reuse a finite-difference Jacobian across steps and refresh it only when
-//! convergence slows; the LU factorisation is redone only when the step size changes.
+//! Newton matrix ([`NewtonJacobian`]): by default contact-aware, i.e. a finite-difference
+//! Jacobian of the contact-free right-hand side (refreshed every 20 steps or after a Newton
+//! failure) plus every active contact's analytic linearisation at each Newton iterate, so the
+//! matrix follows contacts that open, clamp or stick inside a step; the LU is kept while the
+//! matrix barely moves, and Newton stops on Hairer-Wanner's contraction estimate. The
+//! alternative reuses a finite-difference Jacobian of the whole right-hand side across steps
+//! and refreshes it only when convergence slows. Either way the Newton systems are solved by
+//! eliminating the pose entries ([`super::newton_matrix`]).
 
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
@@ -244,6 +250,8 @@ pub struct Integrator {
     jac_f: Vec<f64>,
     lu: NewtonLu,
     lu_valid: bool,
+    /// What the LU was factored for: the step `h` (finite-difference Newton) or `h d`
+    /// (contact-aware Newton, which factors per stage).
     lu_h: f64,
     last_update: f64,
     /// Counters.

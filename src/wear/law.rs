@@ -49,11 +49,11 @@ pub enum WearLaw {
     /// It feeds the normal force N, not the pressure, into K and scales C3 by 1e-3, which
     /// contradicts eq. 3.11. It has no cutoff and no clamp. Kept only to reproduce the thesis.
     LegacyAppendix {
-        /// C1 as passed on the command line (argv[4]).
+        /// C1 as passed on the command line (`argv[4]`).
         c1: f64,
-        /// C2 as passed on the command line (argv[5]); 0 gives Kw = 0 as in the code.
+        /// C2 as passed on the command line (`argv[5]`); 0 gives Kw = 0 as in the code.
         c2: f64,
-        /// C3 as passed on the command line (argv[6]).
+        /// C3 as passed on the command line (`argv[6]`).
         c3: f64,
         /// m/s per unit of the exported slip-speed column: ADAMS exports mm/s, so 1e-3.
         speed_unit_m_s: f64,
