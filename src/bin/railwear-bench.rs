@@ -1015,11 +1015,7 @@ fn launcher(
             .map_err(|e| anyhow!("launcher run: {e}"))?;
         let simulated = settle + window;
         let wall = report.wall_s.max(1e-9);
-        let rail = report
-            .bodies
-            .iter()
-            .find(|b| b.name == "rail")
-            .map(|b| b.mass_rate_mg_per_h);
+        let rail = rail_wear_mg_per_h(&report);
         let newton_name = match newton {
             NewtonJacobian::ContactAware => "contact-aware Newton",
             NewtonJacobian::FiniteDifference => "finite-difference Newton",
@@ -1113,6 +1109,15 @@ fn launcher(
     Ok(vec![t])
 }
 
+/// Wear rate of the launcher's rail body, mg/h.
+fn rail_wear_mg_per_h(report: &RunReport) -> Option<f64> {
+    report
+        .bodies
+        .iter()
+        .find(|b| b.name == "rail")
+        .map(|b| b.mass_rate_mg_per_h)
+}
+
 fn launcher_mem(configs_dir: &Path, settle: f64, window: f64) -> Result<()> {
     let baseline = vm_kb("VmHWM:");
     let case = launcher_case(configs_dir, settle, window)?;
@@ -1121,11 +1126,7 @@ fn launcher_mem(configs_dir: &Path, settle: f64, window: f64) -> Result<()> {
     let hwm = vm_kb("VmHWM:");
     let simulated = settle + window;
     let wall = report.wall_s.max(1e-9);
-    let rail = report
-        .bodies
-        .iter()
-        .find(|b| b.name == "rail")
-        .map(|b| b.mass_rate_mg_per_h);
+    let rail = rail_wear_mg_per_h(&report);
     println!(
         "{}",
         json!({

@@ -391,19 +391,13 @@ impl Integrator {
     ) {
         let n = self.n;
         ws.skip_contacts = true;
-        sys.derivative(t, y, &mut self.tmp, ws);
+        let mut reference = std::mem::take(&mut self.tmp);
+        sys.derivative(t, y, &mut reference, ws);
         self.jac_y.copy_from_slice(y);
         for j in 0..n {
-            let scale = self.abs_tol[j] * 1e3;
-            let delta = 1.5e-8 * y[j].abs().max(scale);
-            self.jac_y[j] = y[j] + delta;
-            sys.derivative(t, &self.jac_y, &mut self.jac_f, ws);
-            let col = &mut self.jac[j * n..(j + 1) * n];
-            for i in 0..n {
-                col[i] = (self.jac_f[i] - self.tmp[i]) / delta;
-            }
-            self.jac_y[j] = y[j];
+            self.difference_column(sys, ws, t, y, j, &reference);
         }
+        self.tmp = reference;
         ws.skip_contacts = false;
         self.stats.contact_free_rhs_evals += n as u64 + 1;
     }
@@ -420,13 +414,15 @@ impl Integrator {
         // are unchanged replay the geometry (bit-identical forces, no overlap computation).
         let n = self.n;
         self.jac_y.copy_from_slice(y);
+        let reference = std::mem::take(&mut self.k[0]);
         // Velocity columns first: the first records the geometry at the unperturbed poses.
         let mut recorded = false;
+        let velocity_column = std::mem::take(&mut self.velocity_column);
         let velocity_first = (0..n)
-            .filter(|&j| self.velocity_column[j])
-            .chain((0..n).filter(|&j| !self.velocity_column[j]));
+            .filter(|&j| velocity_column[j])
+            .chain((0..n).filter(|&j| !velocity_column[j]));
         for j in velocity_first {
-            let mode = if !self.velocity_column[j] {
+            let mode = if !velocity_column[j] {
                 if recorded {
                     GeometryMode::ReplayExcept(self.column_body[j])
                 } else {
@@ -439,18 +435,35 @@ impl Integrator {
                 GeometryMode::Record
             };
             ws.geometry.set_mode(mode);
-            let scale = self.abs_tol[j] * 1e3;
-            let delta = 1.5e-8 * y[j].abs().max(scale);
-            self.jac_y[j] = y[j] + delta;
-            sys.derivative(t, &self.jac_y, &mut self.jac_f, ws);
+            self.difference_column(sys, ws, t, y, j, &reference);
             self.stats.rhs_evals += 1;
-            let col = &mut self.jac[j * n..(j + 1) * n];
-            for i in 0..n {
-                col[i] = (self.jac_f[i] - self.k[0][i]) / delta;
-            }
-            self.jac_y[j] = y[j];
         }
+        self.velocity_column = velocity_column;
+        self.k[0] = reference;
         ws.geometry.set_mode(GeometryMode::Compute);
+    }
+
+    /// Column `j` of `jac` by a forward difference of the derivative around `(t, y)`, whose
+    /// value there is `reference`; `jac_y` holds `y` on entry and on return.
+    fn difference_column(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &mut Workspace,
+        t: f64,
+        y: &[f64],
+        j: usize,
+        reference: &[f64],
+    ) {
+        let n = self.n;
+        let scale = self.abs_tol[j] * 1e3;
+        let delta = 1.5e-8 * y[j].abs().max(scale);
+        self.jac_y[j] = y[j] + delta;
+        sys.derivative(t, &self.jac_y, &mut self.jac_f, ws);
+        let col = &mut self.jac[j * n..(j + 1) * n];
+        for i in 0..n {
+            col[i] = (self.jac_f[i] - reference[i]) / delta;
+        }
+        self.jac_y[j] = y[j];
     }
 
     /// Contact-aware Newton: factors `I - h d (J_free + J_contacts(z))` with the contacts'
