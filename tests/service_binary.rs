@@ -2,7 +2,7 @@
 
 mod service_support;
 
-use service_support::{curl, wait_for, Binary, TempDir, ADMIN, ENGINEER, PLANNER};
+use service_support::{curl, submit_job, wait_for, Binary, TempDir, ADMIN, ENGINEER, PLANNER};
 use std::process::Command;
 use std::time::Duration;
 
@@ -147,15 +147,7 @@ fn wait_succeeded(server: &Binary, id: &str, timeout: Duration) -> serde_json::V
 fn simulate_job_succeeds_with_results_and_tracks_csv() {
     let dir = TempDir::new("sim");
     let server = Binary::start(&dir.db_url(), &[]);
-    let r = curl(
-        "POST",
-        &server.url("/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(SHORT_SIMULATE),
-    );
-    assert_eq!(r.status, 201, "{}", r.body);
-    let id = r.json()["id"].as_str().unwrap().to_string();
+    let id = submit_job(&server.url(""), SHORT_SIMULATE);
     let job = wait_succeeded(&server, &id, Duration::from_secs(300));
     assert!(job["track_samples"].as_i64().unwrap() > 0);
     let result = curl(
@@ -187,14 +179,7 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     // Reference: uninterrupted run of the same seed.
     let ref_dir = TempDir::new("ref");
     let reference = Binary::start(&ref_dir.db_url(), &[]);
-    let r = curl(
-        "POST",
-        &reference.url("/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(SHORT_SIMULATE),
-    );
-    let ref_id = r.json()["id"].as_str().unwrap().to_string();
+    let ref_id = submit_job(&reference.url(""), SHORT_SIMULATE);
     wait_succeeded(&reference, &ref_id, Duration::from_secs(300));
     let ref_csv = curl(
         "GET",
@@ -217,14 +202,7 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     let dir = TempDir::new("crash");
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
     let server = Binary::start(&dir.db_url(), &env);
-    let r = curl(
-        "POST",
-        &server.url("/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(SHORT_SIMULATE),
-    );
-    let id = r.json()["id"].as_str().unwrap().to_string();
+    let id = submit_job(&server.url(""), SHORT_SIMULATE);
     wait_for(Duration::from_secs(60), "running", || {
         let j = curl(
             "GET",
@@ -268,14 +246,7 @@ fn cancel_a_running_simulation() {
     let dir = TempDir::new("bincancel");
     let server = Binary::start(&dir.db_url(), &[]);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let r = curl(
-        "POST",
-        &server.url("/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(long),
-    );
-    let id = r.json()["id"].as_str().unwrap().to_string();
+    let id = submit_job(&server.url(""), long);
     wait_for(Duration::from_secs(60), "running", || {
         let j = curl(
             "GET",

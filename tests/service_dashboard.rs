@@ -7,7 +7,7 @@ mod service_support;
 
 use serde_json::{json, Value};
 use service_support::runner::{start, test_config};
-use service_support::{curl, wait_for, TempDir, ENGINEER};
+use service_support::{curl, submit_job, wait_for, TempDir, ENGINEER};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
@@ -123,15 +123,7 @@ async fn dashboard_shows_a_job_reach_success() {
     tokio::task::spawn_blocking(move || {
         // 40 steps of 100 ms: long enough to be seen queued/running before it succeeds.
         let body = r#"{"kind":"simulate","params":{"steps":40,"step_ms":100,"samples":50}}"#;
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs"),
-            Some(ENGINEER),
-            &[],
-            Some(body),
-        );
-        assert_eq!(r.status, 201);
-        let id = r.json()["id"].as_str().unwrap().to_string();
+        let id = submit_job(&base, body);
 
         let driver = Driver::start(&chromium, &chromedriver);
         driver.goto(&format!("{base}/#token={ENGINEER}"));

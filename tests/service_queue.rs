@@ -6,7 +6,7 @@ mod service_support;
 
 use serde_json::json;
 use service_support::runner::{sample, start, test_config};
-use service_support::{curl, get_job, wait_for, TempDir, ENGINEER, PLANNER};
+use service_support::{curl, get_job, submit_job, wait_for, TempDir, ENGINEER, PLANNER};
 use std::time::{Duration, Instant};
 
 fn job_count(base: &str) -> usize {
@@ -94,14 +94,7 @@ async fn cancel_stops_a_running_job_within_a_second() {
     tokio::task::spawn_blocking(move || {
         // 600 steps of 50 ms = 30 s if not cancelled.
         let body = r#"{"kind":"simulate","params":{"steps":600,"step_ms":50}}"#;
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs"),
-            Some(ENGINEER),
-            &[],
-            Some(body),
-        );
-        let id = r.json()["id"].as_str().unwrap().to_string();
+        let id = submit_job(&base, body);
         wait_for(Duration::from_secs(10), "progress", || {
             let j = get_job(&base, &id);
             (j["status"] == "running" && j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0)
@@ -158,14 +151,7 @@ async fn results_and_tracks_export_with_downsampling() {
     tokio::task::spawn_blocking(move || {
         let body =
             r#"{"kind":"simulate","params":{"steps":3,"step_ms":10,"samples":2500,"seed":99}}"#;
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs"),
-            Some(ENGINEER),
-            &[],
-            Some(body),
-        );
-        let id = r.json()["id"].as_str().unwrap().to_string();
+        let id = submit_job(&base, body);
         wait_for(Duration::from_secs(20), "success", || {
             (get_job(&base, &id)["status"] == "succeeded").then_some(())
         });
@@ -280,14 +266,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
     let expected = tokio::task::spawn_blocking({
         let base = base.clone();
         move || {
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/jobs"),
-                Some(ENGINEER),
-                &[],
-                Some(body),
-            );
-            let id = r.json()["id"].as_str().unwrap().to_string();
+            let id = submit_job(&base, body);
             wait_for(Duration::from_secs(20), "reference", || {
                 (get_job(&base, &id)["status"] == "succeeded").then_some(())
             });
@@ -318,16 +297,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
     let base = format!("http://{}", api.addr);
     let id = tokio::task::spawn_blocking({
         let base = base.clone();
-        move || {
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/jobs"),
-                Some(ENGINEER),
-                &[],
-                Some(body),
-            );
-            r.json()["id"].as_str().unwrap().to_string()
-        }
+        move || submit_job(&base, body)
     })
     .await
     .unwrap();
@@ -579,14 +549,7 @@ async fn pagination_walks_every_job_once() {
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
         for _ in 0..7 {
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/jobs"),
-                Some(ENGINEER),
-                &[],
-                Some(r#"{"kind":"calibrate","params":{}}"#),
-            );
-            assert_eq!(r.status, 201);
+            submit_job(&base, r#"{"kind":"calibrate","params":{}}"#);
         }
         let mut seen = Vec::new();
         let mut cursor: Option<String> = None;
