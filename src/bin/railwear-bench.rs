@@ -14,7 +14,7 @@ use railwear::models::specs::CaseSpec;
 use railwear::physics::body::write_state;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{
-    IntegratorKind, IntegratorSettings, NewtonJacobian, Tolerances,
+    ContactPatches, IntegratorKind, IntegratorSettings, NewtonJacobian, Tolerances,
 };
 use railwear::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use railwear::pipeline::{Progress, RunControl, RunError};
@@ -162,6 +162,33 @@ enum Command {
         client_threads: usize,
     },
 }
+
+/// An engine configuration timed side by side with the others in the same run.
+struct EngineVariant {
+    name: &'static str,
+    newton: NewtonJacobian,
+    patches: ContactPatches,
+}
+
+/// The default engine first, then the earlier ones (issue 5's passes), so every table
+/// measures each engine change in one run.
+const ENGINE_VARIANTS: [EngineVariant; 3] = [
+    EngineVariant {
+        name: "contact-aware Newton, patches per step",
+        newton: NewtonJacobian::ContactAware,
+        patches: ContactPatches::PerStep,
+    },
+    EngineVariant {
+        name: "contact-aware Newton, patches per iterate",
+        newton: NewtonJacobian::ContactAware,
+        patches: ContactPatches::PerIterate,
+    },
+    EngineVariant {
+        name: "finite-difference Newton",
+        newton: NewtonJacobian::FiniteDifference,
+        patches: ContactPatches::PerIterate,
+    },
+];
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
@@ -811,20 +838,18 @@ fn peers(
     } else {
         notes.push("no peer rows: pass --with-peers (or --peers-json FILE)".into());
     }
-    // railwear twice: the default contact-aware Newton, then the earlier finite-difference
-    // Newton matrix, so the engine change is measured in the same run as the peers.
+    // railwear in each engine variant (the default first), so the engine changes are measured
+    // in the same run as the peers.
     let mut ours_rows = Vec::new();
-    for newton in [
-        NewtonJacobian::ContactAware,
-        NewtonJacobian::FiniteDifference,
-    ] {
-        eprintln!("peers: railwear rattle box C ({newton:?} Newton) ...");
+    for variant in ENGINE_VARIANTS {
+        eprintln!("peers: railwear rattle box C ({}) ...", variant.name);
         let (_, model, mut options) =
             rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
-        options.integrator.newton = newton;
+        options.integrator.newton = variant.newton;
+        options.integrator.patches = variant.patches;
         let run = run_model(&model, &options, &RunControl::silent())
             .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
-        ours_rows.push((newton, model.end_time_s, options, run));
+        ours_rows.push((variant, model.end_time_s, options, run));
     }
     let rw_rtf = ours_rows[0].1 / ours_rows[0].3.wall_s.max(1e-9);
     let mut table = Table::new(
@@ -841,12 +866,9 @@ fn peers(
             ("ratio_vs_mujoco", "railwear RTF / this RTF"),
         ],
     );
-    for (newton, end_time_s, options, run) in &ours_rows {
+    for (variant, end_time_s, options, run) in &ours_rows {
         let rtf = end_time_s / run.wall_s.max(1e-9);
-        let newton_name = match newton {
-            NewtonJacobian::ContactAware => "contact-aware Newton",
-            NewtonJacobian::FiniteDifference => "finite-difference Newton",
-        };
+        let newton_name = variant.name;
         table.row(vec![
             Cell::text(format!("railwear {}", env!("CARGO_PKG_VERSION"))),
             Cell::text("IMPACT eq. 2.1-2.3, Table 5.2 (k 1000 N/mm², e 2, c_max 500 N·s/mm, d 0.01 mm); ADAMS friction eq. 4.5"),
@@ -1002,24 +1024,18 @@ fn launcher(
     );
     let case = launcher_case(configs_dir, settle, window)?;
     let options = run_options(&case)?;
-    // The default contact-aware Newton, then the earlier finite-difference Newton matrix for
-    // the same-run comparison.
-    for newton in [
-        NewtonJacobian::ContactAware,
-        NewtonJacobian::FiniteDifference,
-    ] {
+    // Every engine variant (the default first) for the same-run comparison.
+    for engine in ENGINE_VARIANTS {
         let mut variant = case.clone();
-        variant.simulation.newton_jacobian = newton;
-        eprintln!("launcher: timed run ({newton:?} Newton) ...");
+        variant.simulation.newton_jacobian = engine.newton;
+        variant.simulation.contact_patches = engine.patches;
+        eprintln!("launcher: timed run ({}) ...", engine.name);
         let (report, _) = run_case(&variant, configs_dir, &RunControl::silent())
             .map_err(|e| anyhow!("launcher run: {e}"))?;
         let simulated = settle + window;
         let wall = report.wall_s.max(1e-9);
         let rail = rail_wear_mg_per_h(&report);
-        let newton_name = match newton {
-            NewtonJacobian::ContactAware => "contact-aware Newton",
-            NewtonJacobian::FiniteDifference => "finite-difference Newton",
-        };
+        let newton_name = engine.name;
         t.row(vec![
             Cell::text(format!(
                 "timed: settle {settle} s + window {window} s, {newton_name}"

@@ -53,6 +53,28 @@ pub fn shape_halfspace_overlap(
     })
 }
 
+/// Penetration (m) and deepest point (world) of `shape` placed by `pose` in the solid
+/// `half_space`, without the overlap volume: the same numbers as
+/// [`shape_halfspace_overlap`]'s `depth` and `deepest_point`, from the support function alone
+/// (a few dozen flops). `None` when the shape does not reach below the plane.
+pub fn shape_halfspace_depth(
+    shape: &ConvexShape,
+    pose: &Isometry3<f64>,
+    half_space: &HalfSpace,
+) -> Option<(f64, Point3<f64>)> {
+    let n_world = half_space.normal.into_inner();
+    let n = pose.rotation.inverse_transform_vector(&n_world);
+    let c = half_space.offset - n_world.dot(&pose.translation.vector);
+    let (depth, deepest) = match *shape {
+        ConvexShape::Sphere { radius } => sphere_support(radius, &n, c)?,
+        ConvexShape::RoundedBox {
+            half_extents,
+            roundover,
+        } => rounded_box_support(&half_extents, roundover, &n, c)?,
+    };
+    Some((depth, pose * Point3::from(deepest)))
+}
+
 /// Volume of a spherical cap of height `w` on a ball of radius `r`, m³.
 #[inline]
 pub(crate) fn cap_volume(r: f64, w: f64) -> f64 {
@@ -66,6 +88,16 @@ pub(crate) fn cap_centroid_distance(r: f64, w: f64) -> f64 {
     3.0 * t * t / (4.0 * (3.0 * r - w))
 }
 
+/// Depth and deepest point of a ball at the origin below the plane `n·x <= c` (shape frame).
+#[inline]
+fn sphere_support(r: f64, n: &Vector3<f64>, c: f64) -> Option<(f64, Vector3<f64>)> {
+    let depth = r + c; // centre at u = -c
+    if depth.is_nan() || depth <= 0.0 {
+        return None;
+    }
+    Some((depth, -n * r))
+}
+
 /// Depth, volume, centroid and deepest point for a ball at the origin (shape frame).
 #[inline]
 fn sphere_below_plane(
@@ -73,11 +105,7 @@ fn sphere_below_plane(
     n: &Vector3<f64>,
     c: f64,
 ) -> Option<(f64, f64, Vector3<f64>, Vector3<f64>)> {
-    let depth = r + c; // centre at u = -c
-    if depth.is_nan() || depth <= 0.0 {
-        return None;
-    }
-    let deepest = -n * r;
+    let (depth, deepest) = sphere_support(r, n, c)?;
     if depth >= 2.0 * r {
         return Some((depth, 4.0 / 3.0 * PI * r.powi(3), Vector3::zeros(), deepest));
     }
@@ -90,12 +118,16 @@ fn sphere_below_plane(
 /// the centre of a flat face (1e-12 rad of tilt moves the true support point by < 1e-12 m).
 const FLAT_TOLERANCE: f64 = 1e-12;
 
-fn rounded_box_below_plane(
+/// Depth and deepest point of a rounded box (outer half extents, roundover `r`) at the origin
+/// below the plane `n·x <= c` (shape frame): the support point of the inner box in `-n`, moved
+/// by `r` along `-n`; on a flat face the centre of that face.
+#[inline]
+fn rounded_box_support(
     outer: &Vector3<f64>,
     r: f64,
     n: &Vector3<f64>,
     c: f64,
-) -> Option<(f64, f64, Vector3<f64>, Vector3<f64>)> {
+) -> Option<(f64, Vector3<f64>)> {
     let h = outer - Vector3::repeat(r);
     let depth = c + n.x.abs() * h.x + n.y.abs() * h.y + n.z.abs() * h.z + r;
     if depth.is_nan() || depth <= 0.0 {
@@ -108,8 +140,20 @@ fn rounded_box_below_plane(
             -hi.copysign(ni)
         }
     };
-    let deepest = Vector3::new(support(n.x, h.x), support(n.y, h.y), support(n.z, h.z)) - n * r;
+    Some((
+        depth,
+        Vector3::new(support(n.x, h.x), support(n.y, h.y), support(n.z, h.z)) - n * r,
+    ))
+}
 
+fn rounded_box_below_plane(
+    outer: &Vector3<f64>,
+    r: f64,
+    n: &Vector3<f64>,
+    c: f64,
+) -> Option<(f64, f64, Vector3<f64>, Vector3<f64>)> {
+    let (depth, deepest) = rounded_box_support(outer, r, n, c)?;
+    let h = outer - Vector3::repeat(r);
     let mut acc = Accum::default();
     let (v, m) = box_below_plane(&Vector3::zeros(), &h, n, c);
     acc.add(v, m);

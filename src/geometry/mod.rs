@@ -29,6 +29,6 @@ mod steiner_pieces;
 #[cfg(test)]
 mod tests;
 
-pub use halfspace_overlap::{shape_halfspace_overlap, PlaneOverlap};
+pub use halfspace_overlap::{shape_halfspace_depth, shape_halfspace_overlap, PlaneOverlap};
 pub use shapes::{ConvexShape, GeometryError, HalfSpace};
 pub use sphere_sphere::{sphere_sphere_overlap, SphereOverlap};

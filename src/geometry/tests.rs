@@ -542,3 +542,49 @@ fn bench_tilted_cube() {
         println!("{name}: {:.2} µs/call (checksum {acc:e})", dt * 1e6);
     }
 }
+
+#[test]
+fn depth_query_matches_the_overlap_and_the_brute_force_depth() {
+    let (cube, a, r) = thesis_cube();
+    let outer = Vector3::repeat(a / 2.0);
+    let ball = ConvexShape::Sphere { radius: 0.75 * a };
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    for i in 0..200 {
+        let q = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        ));
+        // Depth set by brute force over the corners (pose_at_depth), from just touching to
+        // deeper than the roundover; every 10th pose lifted clear of the floor.
+        let w = r * 10f64.powf(rng.gen_range(-4.0..0.5));
+        let mut pose = pose_at_depth(q, outer, r, w);
+        if i % 10 == 0 {
+            pose.translation.vector.z += 2.0 * w;
+        }
+        for shape in [&cube, &ball] {
+            let depth = shape_halfspace_depth(shape, &pose, &floor());
+            let overlap = shape_halfspace_overlap(shape, &pose, &floor());
+            match (depth, overlap) {
+                (Some((d, p)), Some(o)) => {
+                    assert_eq!(d, o.depth);
+                    assert_eq!(p, o.deepest_point);
+                    // The deepest point lies at depth d below the floor.
+                    assert!((p.z + d).abs() < 1e-15, "{} vs {d}", p.z);
+                }
+                (None, None) => assert!(i % 10 == 0 || shape == &ball),
+                (d, o) => panic!("pose {i}: depth {d:?} but overlap {o:?}"),
+            }
+            if shape == &cube {
+                let expected = if i % 10 == 0 { None } else { Some(w) };
+                let got = depth.map(|(d, _)| d);
+                match (expected, got) {
+                    (Some(e), Some(g)) => assert!((g - e).abs() < 1e-15 + 1e-12 * e),
+                    (None, None) => {}
+                    _ => panic!("pose {i}: expected depth {expected:?}, got {got:?}"),
+                }
+            }
+        }
+    }
+}

@@ -108,6 +108,7 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
     Ok(IntegratorSettings {
         kind,
         newton: case.simulation.newton_jacobian,
+        patches: case.simulation.contact_patches,
         tolerances: Tolerances {
             rel: case.simulation.rel_tolerance,
             abs_position_m: a,

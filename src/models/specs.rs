@@ -369,6 +369,11 @@ pub struct SimulationSpec {
     /// differences, reused across steps). Both solve the same equations to the same tolerance.
     #[serde(default)]
     pub newton_jacobian: crate::physics::integrator::NewtonJacobian,
+    /// Contact patches (overlap centroid and area) of the contact-aware Newton: `per_step`
+    /// (default; computed at each step's start, the penetration exact at every iterate) or
+    /// `per_iterate` (computed at every Newton iterate).
+    #[serde(default)]
+    pub contact_patches: crate::physics::integrator::ContactPatches,
     /// Relative local error tolerance, dimensionless (0 < tol < 1).
     #[serde(default = "default_rel_tolerance")]
     pub rel_tolerance: f64,

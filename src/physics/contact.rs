@@ -7,7 +7,9 @@ use super::body::BodyFrame;
 use super::forces::{apply, Wrench};
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
-use crate::geometry::{shape_halfspace_overlap, ConvexShape, HalfSpace, PlaneOverlap};
+use crate::geometry::{
+    shape_halfspace_depth, shape_halfspace_overlap, ConvexShape, HalfSpace, PlaneOverlap,
+};
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
@@ -112,6 +114,11 @@ pub enum GeometryMode {
     Replay,
     /// Poses of all bodies but this one are the recorded ones: contacts not touching it replay.
     ReplayExcept(usize),
+    /// Poses near the recorded ones (the Newton iterates of one implicit step): penetration,
+    /// deepest point and hence the normal force are computed exactly from the support
+    /// function; the overlap's centroid (held fixed on the piece) and area are those recorded.
+    /// A pair that was apart when recorded and touches now is computed in full and remembered.
+    Frozen,
 }
 
 /// Overlaps remembered between a `Record` pass and replays over the same poses.
@@ -121,6 +128,8 @@ pub struct GeometryCache {
     pub mode: GeometryMode,
     /// Overlap of every (piece, face) pair of every contact, in evaluation order.
     entries: Vec<Option<PlaneOverlap>>,
+    /// Centroid of each recorded overlap in its piece's frame (for `Frozen`).
+    local_centroids: Vec<Point3<f64>>,
     /// Index of each contact's first entry.
     contact_start: Vec<usize>,
 }
@@ -131,6 +140,7 @@ impl GeometryCache {
         self.mode = mode;
         if mode == GeometryMode::Record {
             self.entries.clear();
+            self.local_centroids.clear();
             self.contact_start.clear();
         }
     }
@@ -148,7 +158,7 @@ impl GeometryCache {
                 self.contact_start[index] = self.entries.len();
                 false
             }
-            GeometryMode::Replay => true,
+            GeometryMode::Replay | GeometryMode::Frozen => true,
             GeometryMode::ReplayExcept(body) => body != a && body != b,
         };
         let start = *self.contact_start.get(index)?;
@@ -157,6 +167,32 @@ impl GeometryCache {
                 .checked_add(pairs)
                 .is_some_and(|end| end <= self.entries.len()))
         .then_some(start)
+    }
+
+    /// The overlap of entry `k` (piece placed by `pose`, face `hs`) in `Frozen` mode.
+    fn frozen(
+        &mut self,
+        k: usize,
+        shape: &ConvexShape,
+        pose: &Isometry3<f64>,
+        hs: &HalfSpace,
+    ) -> Option<PlaneOverlap> {
+        let (depth, deepest_point) = shape_halfspace_depth(shape, pose, hs)?;
+        match self.entries[k] {
+            Some(rec) => Some(PlaneOverlap {
+                depth,
+                volume: rec.volume,
+                area: rec.area,
+                centroid: pose * self.local_centroids[k],
+                deepest_point,
+            }),
+            None => {
+                let ov = shape_halfspace_overlap(shape, pose, hs)?;
+                self.entries[k] = Some(ov);
+                self.local_centroids[k] = pose.inverse_transform_point(&ov.centroid);
+                Some(ov)
+            }
+        }
     }
 }
 
@@ -204,6 +240,7 @@ impl Contact {
             self.body_b,
         );
         let recording = geometry.mode == GeometryMode::Record;
+        let frozen = geometry.mode == GeometryMode::Frozen;
         for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
             let pose = iso_a * piece_pose;
             for (jf, face) in self.faces_b.iter().enumerate() {
@@ -214,11 +251,18 @@ impl Contact {
                     offset: offset_world,
                 };
                 let ov = match replay_from {
+                    Some(start) if frozen => {
+                        geometry.frozen(start + ip * nfaces + jf, shape, &pose, &hs)
+                    }
                     Some(start) => geometry.entries[start + ip * nfaces + jf],
                     None => {
                         let ov = shape_halfspace_overlap(shape, &pose, &hs);
                         if recording {
                             geometry.entries.push(ov);
+                            geometry.local_centroids.push(match ov {
+                                Some(ov) => pose.inverse_transform_point(&ov.centroid),
+                                None => Point3::origin(),
+                            });
                         }
                         ov
                     }

@@ -396,6 +396,7 @@ fn rotation_tangent(q: &[f64]) -> Matrix3x4<f64> {
 mod tests {
     use super::*;
     use crate::physics::contact::GeometryMode;
+    use nalgebra::UnitQuaternion;
     use std::path::Path;
 
     /// The reference model `configs/<name>.toml`.
@@ -415,6 +416,80 @@ mod tests {
         y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
         y[7..13].copy_from_slice(&[0.3, -0.05, 0.1, 2.0, -1.0, 0.5]);
         (model.system, y)
+    }
+
+    /// The tracks of one derivative evaluation at `y` in geometry mode `mode`.
+    fn tracks_in_mode(
+        sys: &MultibodySystem,
+        ws: &mut Workspace,
+        y: &[f64],
+        mode: GeometryMode,
+    ) -> Vec<TrackState> {
+        let mut f = vec![0.0; sys.state_len()];
+        ws.keep_tracks = true;
+        ws.geometry.set_mode(mode);
+        sys.derivative(0.0, y, &mut f, ws);
+        ws.geometry.set_mode(GeometryMode::Compute);
+        std::mem::take(&mut ws.tracks)
+    }
+
+    #[test]
+    fn frozen_patches_keep_the_normal_force_exact_and_move_with_the_piece() {
+        let (sys, y) = pressed_cube();
+        let mut ws = sys.workspace();
+        let recorded = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Record);
+        assert!(!recorded.is_empty(), "the cube must touch the floor");
+        // Pressed 0.2 µm deeper, moving faster: penetration, its rate and the normal force
+        // come from the support function, bit for bit as a full evaluation.
+        let mut deeper = y.clone();
+        deeper[1] -= 2e-7;
+        deeper[8] -= 0.05;
+        let full = tracks_in_mode(&sys, &mut ws, &deeper, GeometryMode::Compute);
+        let frozen = tracks_in_mode(&sys, &mut ws, &deeper, GeometryMode::Frozen);
+        assert_eq!(full.len(), frozen.len());
+        for (a, b) in full.iter().zip(&frozen) {
+            assert_eq!((a.contact, a.track), (b.contact, b.track));
+            assert_eq!(a.penetration, b.penetration);
+            assert_eq!(a.penetration_rate, b.penetration_rate);
+            assert_eq!(a.normal_force, b.normal_force);
+            assert_ne!(a.area, b.area, "the area is the recorded one");
+        }
+        // Slid 0.1 mm along the floor and turned 0.01 rad about its normal: the overlap moves
+        // rigidly with the cube, so the held centroid is the true one (to round-off).
+        let mut slid = y.clone();
+        slid[0] += 1e-4;
+        slid[2] -= 5e-5;
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
+        let turned = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.01) * q;
+        slid[3..7].copy_from_slice(&[turned.w, turned.i, turned.j, turned.k]);
+        let _ = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Record);
+        let full = tracks_in_mode(&sys, &mut ws, &slid, GeometryMode::Compute);
+        let frozen = tracks_in_mode(&sys, &mut ws, &slid, GeometryMode::Frozen);
+        assert_eq!(full.len(), frozen.len());
+        for (a, b) in full.iter().zip(&frozen) {
+            assert!(
+                (a.point - b.point).norm() < 1e-12,
+                "{:?} vs {:?}",
+                a.point,
+                b.point
+            );
+            assert!((a.area - b.area).abs() < 1e-9 * a.area);
+            assert!((a.slip_velocity - b.slip_velocity).norm() < 1e-12);
+        }
+        // Recorded clear of the floor, evaluated touching it: the new patch is computed in full.
+        let mut above = y.clone();
+        above[1] += 1e-3;
+        let none = tracks_in_mode(&sys, &mut ws, &above, GeometryMode::Record);
+        assert!(none.is_empty());
+        let full = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Compute);
+        let frozen = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Frozen);
+        assert_eq!(full.len(), frozen.len());
+        for (a, b) in full.iter().zip(&frozen) {
+            assert_eq!(
+                (a.point, a.area, a.normal_force),
+                (b.point, b.area, b.normal_force)
+            );
+        }
     }
 
     #[test]
