@@ -310,8 +310,7 @@ impl Contact {
                     apply(wr, frames, self.body_a, &c, force);
                     apply(wr, frames, self.body_b, &c, -force);
                 }
-                let e = self.impact.exponent;
-                energy += self.impact.stiffness * w.powf(e + 1.0) / (e + 1.0);
+                energy += self.impact.potential(w);
                 sink(&TrackState {
                     contact: index,
                     track: (ip * nfaces + jf) as u32,
