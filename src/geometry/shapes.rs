@@ -102,6 +102,17 @@ impl ConvexShape {
         })
     }
 
+    /// Largest distance of a point of the piece from its frame origin, m.
+    pub fn bounding_radius(&self) -> f64 {
+        match *self {
+            Self::Sphere { radius } => radius,
+            Self::RoundedBox {
+                half_extents,
+                roundover,
+            } => (half_extents - Vector3::repeat(roundover)).norm() + roundover,
+        }
+    }
+
     /// Volume, m³ (exact, Steiner formula for the rounded box).
     pub fn volume(&self) -> f64 {
         match *self {

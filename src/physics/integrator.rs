@@ -397,7 +397,7 @@ impl Integrator {
     /// overlap for the step's Newton iterates.
     fn step_start_rhs(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64]) {
         if self.frozen_patches() {
-            ws.geometry.set_mode(GeometryMode::Record);
+            ws.geometry.set_mode(GeometryMode::Refresh);
             self.rhs(sys, ws, t, y, 0);
             ws.geometry.set_mode(GeometryMode::Compute);
         } else {

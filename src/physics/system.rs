@@ -493,6 +493,50 @@ mod tests {
     }
 
     #[test]
+    fn refreshed_patches_are_reused_within_their_bound_and_recomputed_beyond_it() {
+        use crate::physics::contact::PATCH_REUSE;
+        let (sys, y) = pressed_cube();
+        let mut ws = sys.workspace();
+        let recorded = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Refresh);
+        assert_eq!(recorded.len(), 1, "the cube rests on the floor only");
+        let (w, area) = (recorded[0].penetration, recorded[0].area);
+        let half: f64 = 0.0254 / 2.0;
+        let radius = (3.0 * half * half).sqrt();
+        // Pressed deeper by half the reuse bound: the patch is kept (area as recorded), within
+        // the bound's error of a full computation; the penetration is exact.
+        let mut near = y.clone();
+        near[1] -= 0.5 * PATCH_REUSE * w;
+        let full = tracks_in_mode(&sys, &mut ws, &near, GeometryMode::Compute);
+        let kept = tracks_in_mode(&sys, &mut ws, &near, GeometryMode::Refresh);
+        assert_eq!(kept[0].area, area);
+        assert_ne!(full[0].area, area);
+        assert_eq!(kept[0].penetration, full[0].penetration);
+        assert_eq!(kept[0].normal_force, full[0].normal_force);
+        assert!((kept[0].area - full[0].area).abs() <= 7.0 * PATCH_REUSE * full[0].area);
+        assert!((kept[0].point - full[0].point).norm() <= 12.0 * PATCH_REUSE * radius);
+        // Twice the bound further: recomputed, bit for bit a full computation.
+        let mut far = y.clone();
+        far[1] -= 2.0 * PATCH_REUSE * w;
+        let full = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Compute);
+        let redone = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Refresh);
+        assert_eq!(
+            (redone[0].area, redone[0].point),
+            (full[0].area, full[0].point)
+        );
+        // A tilt of the same size is caught through the bounding radius.
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(far[3], far[4], far[5], far[6]));
+        let tilt = 2.0 * PATCH_REUSE * w / radius;
+        let tilted = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), tilt) * q;
+        far[3..7].copy_from_slice(&[tilted.w, tilted.i, tilted.j, tilted.k]);
+        let full = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Compute);
+        let redone = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Refresh);
+        assert_eq!(
+            (redone[0].area, redone[0].point),
+            (full[0].area, full[0].point)
+        );
+    }
+
+    #[test]
     fn replayed_geometry_gives_the_same_derivative_for_velocity_changes() {
         let (sys, y) = pressed_cube();
         let mut ws = sys.workspace();
