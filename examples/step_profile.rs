@@ -79,6 +79,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             steps[i], rej[i], rhs[i], simt[i]
         );
     }
+    // Counted over the whole run, settle included.
+    let d = integ.diagnostics;
+    println!("rejections by what the contacts did within the attempt (whole run):");
+    for (name, row) in ["Newton failures", "error test"]
+        .iter()
+        .zip(d.rejections_by_event)
+    {
+        println!(
+            "{name:>16}: onset {} separation {} clamp switch {} same contact set {}",
+            row[0], row[1], row[2], row[3]
+        );
+    }
+    println!("attempts by step size and the state kind limiting the error (whole run):");
+    for (i, row) in d.limiting_kind.iter().enumerate() {
+        if row.iter().any(|&c| c > 0) {
+            println!(
+                "h in [1e-{}, 1e-{}): position {} rotation {} velocity {} angular velocity {}",
+                i + 1,
+                i,
+                row[0],
+                row[1],
+                row[2],
+                row[3]
+            );
+        }
+    }
     println!("impacts (entries into N >= 100 N): {impacts}");
     for (i, c) in hhist.iter().enumerate() {
         println!("h in [1e-{}, 1e-{}): {}", i + 1, i, c);

@@ -31,7 +31,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::body::{BodyKind, BODY_STATE_LEN};
-use super::contact::GeometryMode;
+use super::contact::{GeometryMode, TrackState};
 use super::newton_matrix::NewtonLu;
 use super::system::{MultibodySystem, Workspace};
 use serde::{Deserialize, Serialize};
@@ -197,6 +197,55 @@ pub struct IntegratorStats {
     pub contact_free_rhs_evals: u64,
 }
 
+/// Where the steps go (development diagnostics, printed by `examples/step_profile`; not part
+/// of a run's results). Counted for every attempt of the implicit methods, settle included.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StepDiagnostics {
+    /// Attempts that reached the error test, by step-size decade (`[k]` holds
+    /// `1e-(k+1) <= h < 1e-k` s, the last entry everything shorter) and by the kind of state
+    /// entry with the largest weighted error: 0 position, 1 rotation (quaternion),
+    /// 2 velocity, 3 angular velocity.
+    pub limiting_kind: [[u64; 4]; STEP_DECADES],
+    /// Rejected attempts, `[0]` Newton failures and `[1]` error-test failures, by what the
+    /// contacts did between the step start and the attempt's last evaluation: 0 a contact
+    /// patch appeared (onset), 1 one vanished (separation), 2 a patch's IMPACT force switched
+    /// between clamped at zero and positive, 3 none of these (same contact set).
+    pub rejections_by_event: [[u64; 4]; 2],
+}
+
+/// Step-size decades in [`StepDiagnostics::limiting_kind`].
+pub const STEP_DECADES: usize = 12;
+
+/// Contact set of a track list: (contact, track, force > 0), sorted.
+fn contact_set_into(tracks: &[TrackState], out: &mut Vec<(u32, u32, bool)>) {
+    out.clear();
+    out.extend(
+        tracks
+            .iter()
+            .map(|t| (t.contact, t.track, t.normal_force > 0.0)),
+    );
+    out.sort_unstable_by_key(|&(c, k, _)| (c, k));
+}
+
+/// What changed from contact set `a` to `b`: 0 onset, 1 separation, 2 clamp switch, 3 nothing.
+fn contact_change(a: &[(u32, u32, bool)], b: &[(u32, u32, bool)]) -> usize {
+    let find = |set: &[(u32, u32, bool)], x: &(u32, u32, bool)| {
+        set.binary_search_by_key(&(x.0, x.1), |&(c, k, _)| (c, k)).ok()
+    };
+    if b.iter().any(|x| find(a, x).is_none()) {
+        0
+    } else if a.iter().any(|x| find(b, x).is_none()) {
+        1
+    } else if a
+        .iter()
+        .any(|x| find(b, x).is_some_and(|i| b[i].2 != x.2))
+    {
+        2
+    } else {
+        3
+    }
+}
+
 /// Why the integrator could not advance.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IntegratorError {
@@ -287,6 +336,13 @@ pub struct Integrator {
     last_update: f64,
     /// Counters.
     pub stats: IntegratorStats,
+    /// Where the steps go (development diagnostics).
+    pub diagnostics: StepDiagnostics,
+    /// Kind of each state entry (0 position, 1 rotation, 2 velocity, 3 angular velocity).
+    state_kind: Vec<u8>,
+    /// Contact sets at the step start and at the attempt's end (diagnostics; reused buffers).
+    start_contacts: Vec<(u32, u32, bool)>,
+    end_contacts: Vec<(u32, u32, bool)>,
     /// The last attempt was rejected (caps the next growth factor at 1).
     after_reject: bool,
     /// Accepted steps left whose growth is capped after a Newton failure.
@@ -317,8 +373,8 @@ impl Integrator {
             }
         }
         let abs_tol = kinds
-            .into_iter()
-            .map(|k| match k {
+            .iter()
+            .map(|&k| match k {
                 0 => tol.abs_position_m,
                 1 => tol.abs_rotation,
                 2 => tol.abs_velocity_m_s,
@@ -356,6 +412,10 @@ impl Integrator {
             lu_h: 0.0,
             last_update: f64::INFINITY,
             stats: IntegratorStats::default(),
+            diagnostics: StepDiagnostics::default(),
+            state_kind: kinds,
+            start_contacts: Vec::new(),
+            end_contacts: Vec::new(),
             after_reject: false,
             hold_steps: 0,
             k_prev: v(),
@@ -376,14 +436,34 @@ impl Integrator {
     }
 
     fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        self.weighted_norm_and_worst(e, y0, y1).0
+    }
+
+    /// The weighted RMS norm and the entry with the largest weighted size.
+    fn weighted_norm_and_worst(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> (f64, usize) {
         let rel = self.settings.tolerances.rel;
         let mut s = 0.0;
+        let mut worst = (0.0, 0);
         for i in 0..self.n {
             let sc = self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs());
             let r = e[i] / sc;
             s += r * r;
+            if r * r > worst.0 {
+                worst = (r * r, i);
+            }
         }
-        (s / self.n.max(1) as f64).sqrt()
+        ((s / self.n.max(1) as f64).sqrt(), worst.1)
+    }
+
+    /// The error norm of an implicit attempt of size `h`, counted in the diagnostics by the
+    /// kind of the entry that limits it.
+    fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
+        let (norm, worst) = self.weighted_norm_and_worst(e, y0, &self.ynew);
+        if let Some(&kind) = self.state_kind.get(worst) {
+            let decade = (-h.log10()).floor().clamp(0.0, (STEP_DECADES - 1) as f64) as usize;
+            self.diagnostics.limiting_kind[decade][usize::from(kind.min(3))] += 1;
+        }
+        norm
     }
 
     fn rhs(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64], out_k: usize) {
@@ -749,7 +829,7 @@ impl Integrator {
         }
         let mut e = std::mem::take(&mut self.err);
         self.solve_in_place(&mut e);
-        let norm = self.weighted_norm(&e, y, &self.ynew);
+        let norm = self.error_norm(&e, y, h);
         self.err = e;
         Ok(Attempt {
             err_norm: norm,
@@ -794,7 +874,7 @@ impl Integrator {
         }
         let mut e = std::mem::take(&mut self.err);
         self.solve_in_place(&mut e);
-        let norm = self.weighted_norm(&e, y, &self.ynew);
+        let norm = self.error_norm(&e, y, h);
         self.err = e;
         Ok(Attempt {
             err_norm: norm,
@@ -900,6 +980,9 @@ impl Integrator {
             IntegratorKind::Sdirk2 => (0.5, 4.0),
             IntegratorKind::Dopri5 => (0.2, 5.0),
         };
+        if ws.keep_tracks {
+            contact_set_into(&ws.tracks, &mut self.start_contacts);
+        }
         loop {
             let remaining = t_end - t;
             let mut h = self.h.min(self.settings.max_step_s);
@@ -915,6 +998,14 @@ impl Integrator {
                 IntegratorKind::Sdirk2 => self.attempt_sdirk2(sys, ws, t, y, h)?,
                 IntegratorKind::Dopri5 => self.attempt_dopri5(sys, ws, t, y, h),
             };
+            let passed = attempt.err_norm.is_finite() && attempt.err_norm <= 1.0;
+            let rejected = attempt.newton_failed || !passed;
+            if rejected && ws.keep_tracks {
+                contact_set_into(&ws.tracks, &mut self.end_contacts);
+                let change = contact_change(&self.start_contacts, &self.end_contacts);
+                let test = usize::from(!attempt.newton_failed);
+                self.diagnostics.rejections_by_event[test][change] += 1;
+            }
             if attempt.newton_failed {
                 self.stats.rejected += 1;
                 self.stats.newton_failures += 1;
@@ -1000,5 +1091,22 @@ impl Integrator {
             };
             self.h = h * fac;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::contact_change;
+
+    #[test]
+    fn contact_changes_are_classified_onset_first() {
+        let a = [(0, 1, true), (2, 0, false)];
+        assert_eq!(contact_change(&a, &a), 3);
+        assert_eq!(contact_change(&a, &[(0, 1, true), (1, 0, true), (2, 0, false)]), 0);
+        assert_eq!(contact_change(&a, &[(0, 1, true)]), 1);
+        assert_eq!(contact_change(&a, &[(0, 1, true), (2, 0, true)]), 2);
+        // A patch replaced by another is an onset (the new one) before a separation.
+        assert_eq!(contact_change(&a, &[(0, 1, true), (3, 0, true)]), 0);
+        assert_eq!(contact_change(&[], &[]), 3);
     }
 }
