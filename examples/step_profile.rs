@@ -17,6 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sys = &m.system;
     let settings = integrator_settings(&case)?;
     let mut integ = Integrator::new(sys, settings);
+    integ.diagnose = true;
     let mut ws = sys.workspace();
     ws.keep_tracks = true; // as simulate() does: the step's tracks come with its last evaluation
     let mut y = m.initial_state.clone();

@@ -9,7 +9,7 @@ use railwear::physics::integrator::{Integrator, IntegratorKind, IntegratorSettin
 use railwear::validation::sphere_on_floor;
 
 /// A 10 mm sphere dropped at 0.5 m/s onto the floor with the thesis' Table 5.2 contact, 0.2 s.
-fn run(kind: IntegratorKind) -> Integrator {
+fn run(kind: IntegratorKind, diagnose: bool) -> Integrator {
     let (sys, _) = sphere_on_floor(0.01, ImpactParams::thesis_table_5_2(), 0.0);
     let mut y = vec![0.0; sys.state_len()];
     // Released 1 mm above contact, falling straight down: no torque can arise.
@@ -29,11 +29,14 @@ fn run(kind: IntegratorKind) -> Integrator {
         ..IntegratorSettings::default()
     };
     let mut integ = Integrator::new(&sys, settings);
+    integ.diagnose = diagnose;
     let mut ws = sys.workspace();
     ws.keep_tracks = true;
     let mut t = 0.0;
     while t < 0.2 {
-        t = integ.advance(&sys, &mut ws, t, &mut y, 0.2).expect("advances");
+        t = integ
+            .advance(&sys, &mut ws, t, &mut y, 0.2)
+            .expect("advances");
     }
     integ
 }
@@ -41,7 +44,7 @@ fn run(kind: IntegratorKind) -> Integrator {
 #[test]
 fn every_rejection_and_error_test_is_counted_once() {
     for kind in [IntegratorKind::Trbdf2, IntegratorKind::Sdirk2] {
-        let integ = run(kind);
+        let integ = run(kind, true);
         let (s, d) = (integ.stats, integ.diagnostics);
         assert!(s.accepted > 50, "{kind:?}: the drop takes steps: {s:?}");
         let rejections: u64 = d.rejections_by_event.iter().flatten().sum();
@@ -50,15 +53,31 @@ fn every_rejection_and_error_test_is_counted_once() {
         assert_eq!(newton, s.newton_failures, "{kind:?}");
         // Every attempt whose Newton solve converged reached the error test.
         let tested: u64 = d.limiting_kind.iter().flatten().sum();
-        assert_eq!(tested, s.accepted + s.rejected - s.newton_failures, "{kind:?}");
+        assert_eq!(
+            tested,
+            s.accepted + s.rejected - s.newton_failures,
+            "{kind:?}"
+        );
     }
 }
 
 #[test]
 fn a_straight_drop_is_never_limited_by_rotation() {
-    let d = run(IntegratorKind::Trbdf2).diagnostics;
+    let d = run(IntegratorKind::Trbdf2, true).diagnostics;
     let by_kind = |k: usize| d.limiting_kind.iter().map(|row| row[k]).sum::<u64>();
     assert_eq!(by_kind(1), 0, "quaternion entries limited a step: {d:?}");
-    assert_eq!(by_kind(3), 0, "angular velocity entries limited a step: {d:?}");
+    assert_eq!(
+        by_kind(3),
+        0,
+        "angular velocity entries limited a step: {d:?}"
+    );
     assert!(by_kind(0) + by_kind(2) > 0);
+}
+
+#[test]
+fn diagnostics_are_off_by_default_and_change_no_step() {
+    let off = run(IntegratorKind::Trbdf2, false);
+    let on = run(IntegratorKind::Trbdf2, true);
+    assert_eq!(off.diagnostics, Default::default());
+    assert_eq!(off.stats, on.stats);
 }

@@ -230,16 +230,14 @@ fn contact_set_into(tracks: &[TrackState], out: &mut Vec<(u32, u32, bool)>) {
 /// What changed from contact set `a` to `b`: 0 onset, 1 separation, 2 clamp switch, 3 nothing.
 fn contact_change(a: &[(u32, u32, bool)], b: &[(u32, u32, bool)]) -> usize {
     let find = |set: &[(u32, u32, bool)], x: &(u32, u32, bool)| {
-        set.binary_search_by_key(&(x.0, x.1), |&(c, k, _)| (c, k)).ok()
+        set.binary_search_by_key(&(x.0, x.1), |&(c, k, _)| (c, k))
+            .ok()
     };
     if b.iter().any(|x| find(a, x).is_none()) {
         0
     } else if a.iter().any(|x| find(b, x).is_none()) {
         1
-    } else if a
-        .iter()
-        .any(|x| find(b, x).is_some_and(|i| b[i].2 != x.2))
-    {
+    } else if a.iter().any(|x| find(b, x).is_some_and(|i| b[i].2 != x.2)) {
         2
     } else {
         3
@@ -336,7 +334,10 @@ pub struct Integrator {
     last_update: f64,
     /// Counters.
     pub stats: IntegratorStats,
-    /// Where the steps go (development diagnostics).
+    /// Count [`Self::diagnostics`] (off by default: costs a sort per step and a `log10` per
+    /// attempt). Rejections are classified only when the workspace keeps its tracks.
+    pub diagnose: bool,
+    /// Where the steps go (development diagnostics, when `diagnose`).
     pub diagnostics: StepDiagnostics,
     /// Kind of each state entry (0 position, 1 rotation, 2 velocity, 3 angular velocity).
     state_kind: Vec<u8>,
@@ -412,6 +413,7 @@ impl Integrator {
             lu_h: 0.0,
             last_update: f64::INFINITY,
             stats: IntegratorStats::default(),
+            diagnose: false,
             diagnostics: StepDiagnostics::default(),
             state_kind: kinds,
             start_contacts: Vec::new(),
@@ -455,9 +457,12 @@ impl Integrator {
         ((s / self.n.max(1) as f64).sqrt(), worst.1)
     }
 
-    /// The error norm of an implicit attempt of size `h`, counted in the diagnostics by the
-    /// kind of the entry that limits it.
+    /// The error norm of an implicit attempt of size `h`; with `diagnose`, counted by the kind
+    /// of the entry that limits it.
     fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
+        if !self.diagnose {
+            return self.weighted_norm(e, y0, &self.ynew);
+        }
         let (norm, worst) = self.weighted_norm_and_worst(e, y0, &self.ynew);
         if let Some(&kind) = self.state_kind.get(worst) {
             let decade = (-h.log10()).floor().clamp(0.0, (STEP_DECADES - 1) as f64) as usize;
@@ -980,7 +985,8 @@ impl Integrator {
             IntegratorKind::Sdirk2 => (0.5, 4.0),
             IntegratorKind::Dopri5 => (0.2, 5.0),
         };
-        if ws.keep_tracks {
+        let classify = self.diagnose && ws.keep_tracks;
+        if classify {
             contact_set_into(&ws.tracks, &mut self.start_contacts);
         }
         loop {
@@ -1000,7 +1006,7 @@ impl Integrator {
             };
             let passed = attempt.err_norm.is_finite() && attempt.err_norm <= 1.0;
             let rejected = attempt.newton_failed || !passed;
-            if rejected && ws.keep_tracks {
+            if rejected && classify {
                 contact_set_into(&ws.tracks, &mut self.end_contacts);
                 let change = contact_change(&self.start_contacts, &self.end_contacts);
                 let test = usize::from(!attempt.newton_failed);
@@ -1102,7 +1108,10 @@ mod tests {
     fn contact_changes_are_classified_onset_first() {
         let a = [(0, 1, true), (2, 0, false)];
         assert_eq!(contact_change(&a, &a), 3);
-        assert_eq!(contact_change(&a, &[(0, 1, true), (1, 0, true), (2, 0, false)]), 0);
+        assert_eq!(
+            contact_change(&a, &[(0, 1, true), (1, 0, true), (2, 0, false)]),
+            0
+        );
         assert_eq!(contact_change(&a, &[(0, 1, true)]), 1);
         assert_eq!(contact_change(&a, &[(0, 1, true), (2, 0, true)]), 2);
         // A patch replaced by another is an onset (the new one) before a separation.
