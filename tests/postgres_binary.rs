@@ -6,7 +6,7 @@
 mod postgres_support;
 mod service_support;
 
-use service_support::{curl, get_job, submit_job, tokens_env, wait_for, ENGINEER};
+use service_support::{curl, get_job, get_json, submit_job, tokens_env, wait_for, ENGINEER};
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -278,6 +278,17 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     // moved on from the child seen running, the child it moved on to).
     assert_eq!(lost.len(), 1, "{lost:?}");
     assert_eq!(lost[0].1, victim_worker);
+    // The same log over HTTP: the re-run child shows the killed worker's lost attempt, then
+    // the success by another worker.
+    let rerun = get_json(&base, &format!("/v1/jobs/{}/attempts", lost[0].0));
+    let rows = rerun.as_array().expect("an array of attempts");
+    let outcomes: Vec<&str> = rows.iter().filter_map(|a| a["outcome"].as_str()).collect();
+    assert_eq!(outcomes, ["lost", "succeeded"], "{rerun}");
+    assert_eq!(rows[0]["attempt"], 1);
+    assert_eq!(rows[0]["worker"], victim_worker.as_str());
+    assert_eq!(rows[1]["attempt"], 2);
+    assert_ne!(rows[1]["worker"], victim_worker.as_str());
+    assert!(rows[1]["ended_at"].is_string(), "{rerun}");
     // Fanned out once, assembled once.
     let parent_attempts = rt.block_on(store.attempts(id)).expect("attempts");
     assert_eq!(

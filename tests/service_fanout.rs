@@ -83,6 +83,37 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
             );
         }
         assert_eq!(result["plots"][0]["name"], "penalization.svg");
+        // The attempt log over HTTP: fanned out once, assembled once, both ended.
+        let log = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
+        let outcomes: Vec<&str> = log
+            .as_array()
+            .map(|rows| rows.iter().filter_map(|a| a["outcome"].as_str()).collect())
+            .unwrap_or_default();
+        assert_eq!(outcomes, ["fanned_out", "succeeded"], "{log}");
+        assert_eq!(log[0]["attempt"], 1);
+        assert_eq!(log[1]["attempt"], 2);
+        assert!(log[1]["ended_at"].is_string(), "{log}");
+        assert_eq!(
+            done["links"]["attempts"],
+            format!("/v1/jobs/{id}/attempts").as_str()
+        );
+        let missing = curl(
+            "GET",
+            &format!("{base}/v1/jobs/{}/attempts", uuid::Uuid::new_v4()),
+            Some(ENGINEER),
+            &[],
+            None,
+        );
+        assert_eq!(missing.status, 404, "{}", missing.body);
+        let malformed = curl(
+            "GET",
+            &format!("{base}/v1/jobs/not-a-uuid/attempts"),
+            Some(ENGINEER),
+            &[],
+            None,
+        );
+        assert_eq!(malformed.status, 400, "{}", malformed.body);
+        assert!(malformed.body.contains("id"), "{}", malformed.body);
         let child_ids: Vec<uuid::Uuid> = kids
             .iter()
             .map(|c| c["id"].as_str().unwrap().parse().unwrap())

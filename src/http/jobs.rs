@@ -6,7 +6,7 @@ use super::problem::{ApiJson, Problem};
 use super::AppState;
 use crate::jobs::{ChildCounts, JobKind, JobProgress, JobRecord, JobStatus, SubmitError};
 use crate::physics::track::TrackSample;
-use crate::store::{clock, tracks, Submitted};
+use crate::store::{clock, tracks, AttemptRecord, Submitted};
 use axum::extract::{Path, Query, State};
 use axum::http::{header, HeaderMap, HeaderValue, Method, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -22,6 +22,7 @@ pub fn router() -> Router<AppState> {
         .route("/v1/jobs", post(submit_job).get(list_jobs))
         .route("/v1/jobs/{id}", get(get_job))
         .route("/v1/jobs/{id}/cancel", post(cancel_job))
+        .route("/v1/jobs/{id}/attempts", get(get_attempts))
         .route("/v1/jobs/{id}/result", get(get_result))
         .route("/v1/jobs/{id}/tracks", get(get_tracks))
         .route("/v1/jobs/{id}/plots/{name}", get(get_plot))
@@ -83,9 +84,39 @@ pub struct JobView {
     /// Jobs that fanned out (sweeps): how their children stand. The job waits while they run,
     /// its progress is the fraction that succeeded, and its result is assembled once all have.
     pub children: Option<ChildCounts>,
-    /// Related URLs: `self`, `result`, `tracks_csv`, `tracks_json`, `cancel`, and `children`
-    /// for a job that fanned out.
+    /// Related URLs: `self`, `result`, `tracks_csv`, `tracks_json`, `cancel`, `attempts`, and
+    /// `children` for a job that fanned out.
     pub links: JobLinks,
+}
+
+/// One attempt of a job, from the attempt log: which worker ran it, when, and how it ended.
+/// Written in the same transactions as the job row, so it shows every claim and every end that
+/// took effect (a lost attempt is one whose lease expired; the job was re-queued).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct AttemptView {
+    /// Attempt number, from 1 (the job's `attempt` is the latest).
+    pub attempt: i64,
+    /// Lease owner: `<host>-<pid>-<n>` for a `railwear worker` or a service worker.
+    pub worker: String,
+    /// RFC 3339 UTC time of the claim.
+    pub started_at: String,
+    /// RFC 3339 UTC time the attempt ended; absent while it runs.
+    pub ended_at: Option<String>,
+    /// `running`, `succeeded`, `failed`, `cancelled`, `fanned_out` (made the job's children
+    /// and left it waiting for them) or `lost` (lease expired).
+    pub outcome: String,
+}
+
+impl From<AttemptRecord> for AttemptView {
+    fn from(a: AttemptRecord) -> Self {
+        AttemptView {
+            attempt: a.attempt,
+            worker: a.worker,
+            started_at: clock::rfc3339(a.started_ms),
+            ended_at: a.ended_ms.map(clock::rfc3339),
+            outcome: a.outcome.as_str().to_string(),
+        }
+    }
 }
 
 /// URLs of a job's resources.
@@ -97,6 +128,8 @@ pub struct JobLinks {
     pub result: String,
     pub tracks_csv: String,
     pub tracks_json: String,
+    /// The attempt log (`/v1/jobs/<id>/attempts`).
+    pub attempts: String,
     /// The job's children (`/v1/jobs?parent=<id>`), for a job that fanned out.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub children: Option<String>,
@@ -131,6 +164,7 @@ impl From<JobRecord> for JobView {
                 result: format!("{base}/result"),
                 tracks_csv: format!("{base}/tracks?format=csv"),
                 tracks_json: format!("{base}/tracks?format=json"),
+                attempts: format!("{base}/attempts"),
                 children: j
                     .children
                     .map(|_| format!("/v1/jobs?parent={}&limit=100", j.id)),
@@ -361,6 +395,29 @@ pub async fn get_job(
 ) -> Result<Json<JobView>, Problem> {
     caller.require(Area::Jobs, &Method::GET)?;
     Ok(Json(load_job(&state, &id).await?.into()))
+}
+
+/// The job's attempt log, oldest first: every claim by a worker and how it ended. A job that
+/// was never claimed has none; a job re-run after its worker died shows the lost attempt.
+#[utoipa::path(
+    get, path = "/v1/jobs/{id}/attempts", tag = "jobs",
+    params(("id" = Uuid, Path)),
+    responses(
+        (status = 200, body = Vec<AttemptView>),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn get_attempts(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+) -> Result<Json<Vec<AttemptView>>, Problem> {
+    caller.require(Area::Jobs, &Method::GET)?;
+    let job = load_job(&state, &id).await?;
+    let attempts = state.store.attempts(job.id).await?;
+    Ok(Json(attempts.into_iter().map(AttemptView::from).collect()))
 }
 
 /// Cancel a job: a queued job is cancelled at once, a running one stops within a second.

@@ -24,7 +24,8 @@ impl Modify for BearerAuth {
         description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs), admin (tokens)."
     ),
     paths(
-        jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::cancel_job, jobs::get_result,
+        jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::get_attempts, jobs::cancel_job,
+        jobs::get_result,
         jobs::get_tracks, jobs::get_plot,
         rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
         rails::get_report,
@@ -34,6 +35,7 @@ impl Modify for BearerAuth {
     components(schemas(
         problem::Problem,
         jobs::JobRequest, jobs::JobView, jobs::JobLinks, jobs::JobResultView, jobs::PlotLink,
+        jobs::AttemptView,
         pagination::PageView<jobs::JobView>, pagination::PageView<rails::RailView>,
         pagination::PageView<rails::MeasurementView>,
         crate::jobs::JobKind, crate::jobs::JobStatus, crate::jobs::JobProgress,
