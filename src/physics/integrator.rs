@@ -198,7 +198,8 @@ pub struct IntegratorStats {
 }
 
 /// Where the steps go (development diagnostics, printed by `examples/step_profile`; not part
-/// of a run's results). Counted for every attempt of the implicit methods, settle included.
+/// of a run's results), settle included. The limiting kinds are counted for the implicit
+/// methods; rejections for every method.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct StepDiagnostics {
     /// Attempts that reached the error test, by step-size decade (`[k]` holds
@@ -296,8 +297,6 @@ pub struct Integrator {
     settings: IntegratorSettings,
     n: usize,
     abs_tol: Vec<f64>,
-    /// State entries that are velocities (their Jacobian columns keep all poses).
-    velocity_column: Vec<bool>,
     /// Body owning each state entry.
     column_body: Vec<usize>,
     h: f64,
@@ -339,7 +338,8 @@ pub struct Integrator {
     pub diagnose: bool,
     /// Where the steps go (development diagnostics, when `diagnose`).
     pub diagnostics: StepDiagnostics,
-    /// Kind of each state entry (0 position, 1 rotation, 2 velocity, 3 angular velocity).
+    /// Kind of each state entry (0 position, 1 rotation, 2 velocity, 3 angular velocity):
+    /// velocity columns of the Jacobian keep all poses; the diagnostics name the limiting kind.
     state_kind: Vec<u8>,
     /// Contact sets at the step start and at the attempt's end (diagnostics; reused buffers).
     start_contacts: Vec<(u32, u32, bool)>,
@@ -364,7 +364,6 @@ impl Integrator {
         let n = system.state_len();
         let tol = settings.tolerances;
         let kinds = system.state_kinds();
-        let velocity_column = kinds.iter().map(|&k| k >= 2).collect();
         let mut column_body = vec![0; n];
         for (i, b) in system.bodies.iter().enumerate() {
             if let BodyKind::Dynamic { offset } = b.kind {
@@ -387,7 +386,6 @@ impl Integrator {
             settings,
             n,
             abs_tol,
-            velocity_column,
             column_body,
             h: settings.initial_step_s,
             k: [v(), v(), v(), v(), v(), v(), v()],
@@ -437,41 +435,38 @@ impl Integrator {
         self.jac_age = u32::MAX;
     }
 
-    fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+    /// Entry `i` of `e` in units of its tolerance between states `y0` and `y1`.
+    #[inline]
+    fn weighted_entry(&self, i: usize, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
         let rel = self.settings.tolerances.rel;
+        e[i] / (self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs()))
+    }
+
+    fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
         let mut s = 0.0;
         for i in 0..self.n {
-            let sc = self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs());
-            let r = e[i] / sc;
+            let r = self.weighted_entry(i, e, y0, y1);
             s += r * r;
         }
         (s / self.n.max(1) as f64).sqrt()
     }
 
-    /// [`Self::weighted_norm`] and the entry with the largest weighted size (diagnostics).
-    fn weighted_norm_and_worst(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> (f64, usize) {
-        let rel = self.settings.tolerances.rel;
-        let mut s = 0.0;
-        let mut worst = (0.0, 0);
-        for i in 0..self.n {
-            let sc = self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs());
-            let r = e[i] / sc;
-            s += r * r;
-            if r * r > worst.0 {
-                worst = (r * r, i);
-            }
-        }
-        ((s / self.n.max(1) as f64).sqrt(), worst.1)
-    }
-
     /// The error norm of an implicit attempt of size `h`; with `diagnose`, counted by the kind
     /// of the entry that limits it.
     fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
+        let norm = self.weighted_norm(e, y0, &self.ynew);
         if !self.diagnose {
-            return self.weighted_norm(e, y0, &self.ynew);
+            return norm;
         }
-        let (norm, worst) = self.weighted_norm_and_worst(e, y0, &self.ynew);
-        if let Some(&kind) = self.state_kind.get(worst) {
+        // The first entry of largest weighted size.
+        let mut worst = (0.0, 0);
+        for i in 0..self.n {
+            let r = self.weighted_entry(i, e, y0, &self.ynew).abs();
+            if r > worst.0 {
+                worst = (r, i);
+            }
+        }
+        if let Some(&kind) = self.state_kind.get(worst.1) {
             let decade = (-h.log10()).floor().clamp(0.0, (STEP_DECADES - 1) as f64) as usize;
             self.diagnostics.limiting_kind[decade][usize::from(kind.min(3))] += 1;
         }
@@ -556,12 +551,14 @@ impl Integrator {
         let reference = std::mem::take(&mut self.k[0]);
         // Velocity columns first: the first records the geometry at the unperturbed poses.
         let mut recorded = false;
-        let velocity_column = std::mem::take(&mut self.velocity_column);
+        // Velocity entries (kinds 2 and 3): their columns keep all poses.
+        let kind = std::mem::take(&mut self.state_kind);
+        let velocity_column = |j: usize| kind[j] >= 2;
         let velocity_first = (0..n)
-            .filter(|&j| velocity_column[j])
-            .chain((0..n).filter(|&j| !velocity_column[j]));
+            .filter(|&j| velocity_column(j))
+            .chain((0..n).filter(|&j| !velocity_column(j)));
         for j in velocity_first {
-            let mode = if !velocity_column[j] {
+            let mode = if !velocity_column(j) {
                 if recorded {
                     GeometryMode::ReplayExcept(self.column_body[j])
                 } else {
@@ -577,7 +574,7 @@ impl Integrator {
             self.difference_column(sys, ws, t, y, j, &reference);
             self.stats.rhs_evals += 1;
         }
-        self.velocity_column = velocity_column;
+        self.state_kind = kind;
         self.k[0] = reference;
         ws.geometry.set_mode(GeometryMode::Compute);
     }
