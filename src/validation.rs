@@ -42,7 +42,7 @@ pub struct Anchor {
     pub pass: bool,
 }
 
-fn anchor(
+pub(crate) fn anchor(
     name: &str,
     source: &str,
     unit: &str,
@@ -72,6 +72,7 @@ pub fn run_all(slow: bool, configs_dir: &Path) -> Vec<Anchor> {
     out.push(wear_integral_anchor());
     out.push(synthesis_anchor());
     out.extend(friction_calibration_anchors());
+    out.extend(crate::validation_energy::energy_anchors(configs_dir));
     if slow {
         out.extend(crate::validation_slow::run(configs_dir));
     }
@@ -152,15 +153,15 @@ pub fn sphere_on_floor(r: f64, impact: ImpactParams, load_n: f64) -> (MultibodyS
         mass: MassProperties::solid_sphere(r, 2810.0),
         kind: BodyKind::Dynamic { offset: 0 },
     };
-    let contact = Contact {
-        name: "sphere-floor".into(),
-        body_a: 0,
-        pieces_a: vec![(Isometry3::identity(), ConvexShape::Sphere { radius: r })],
-        body_b: 1,
-        faces_b: vec![floor()],
+    let contact = Contact::new(
+        "sphere-floor",
+        0,
+        vec![(Isometry3::identity(), ConvexShape::Sphere { radius: r })],
+        1,
+        vec![floor()],
         impact,
-        friction: None,
-    };
+        None,
+    );
     let forces = vec![ForceElement::ConstantForce(ConstantForce {
         name: "load".into(),
         a: Attachment {
@@ -370,15 +371,15 @@ pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
         })
         .collect();
     let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
-    let contact = Contact {
-        name: "sled-incline".into(),
-        body_a: 0,
-        pieces_a: pieces,
-        body_b: 1,
-        faces_b: vec![floor()],
-        impact: ImpactParams::thesis_table_5_2(),
-        friction: Some(FrictionParams::thesis_table_5_2()),
-    };
+    let contact = Contact::new(
+        "sled-incline",
+        0,
+        pieces,
+        1,
+        vec![floor()],
+        ImpactParams::thesis_table_5_2(),
+        Some(FrictionParams::thesis_table_5_2()),
+    );
     let sys = MultibodySystem::new(
         vec![
             sled,

@@ -545,7 +545,7 @@ impl StepMeans {
         let p: f64 = v
             .tracks
             .iter()
-            .map(|t| t.normal_force * t.slip_velocity.norm())
+            .map(|t| t.normal_force * t.slip_speed)
             .sum();
         if let Some((tp, np, pp)) = self.prev {
             let dt = v.t - tp;

@@ -19,8 +19,10 @@
 //!
 //! Hot path (about 10⁶ calls per simulated second): no heap allocation, fixed-size arrays only.
 
+pub mod bounded_face;
 mod disk_polygon;
 pub mod halfspace_overlap;
+pub mod lattice;
 mod polytope_clip;
 mod quadrature;
 pub mod shapes;
@@ -29,6 +31,8 @@ mod steiner_pieces;
 #[cfg(test)]
 mod tests;
 
+pub use bounded_face::{FaceExtent, PlacedFace};
 pub use halfspace_overlap::{shape_halfspace_depth, shape_halfspace_overlap, PlaneOverlap};
+pub use lattice::{contact_points, ContactPoint, DEFAULT_POINTS_PER_EDGE};
 pub use shapes::{ConvexShape, GeometryError, HalfSpace};
 pub use sphere_sphere::{sphere_sphere_overlap, SphereOverlap};

@@ -199,6 +199,7 @@ pub fn package(
         "mean_friction_power_w": r.mean_friction_power_w,
         "contacts": r.contacts,
         "bodies": r.bodies,
+        "energy": r.energy,
         "response": {
             "body": model.system.bodies[model.response_body].name,
             "vdv_x_m_s2": vdv,

@@ -20,7 +20,7 @@ use super::rattle_box::material;
 use super::run::BuiltModel;
 use super::specs::{CaseSpec, LatchJoint, LauncherSpec, PlanarFace, RoundedBoxSpec};
 use crate::excitation::BaseMotion;
-use crate::geometry::{ConvexShape, HalfSpace};
+use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};
 use crate::models::motion::TranslatingBase;
 use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
 use crate::physics::contact::Contact;
@@ -97,9 +97,35 @@ fn half_space(f: &PlanarFace) -> HalfSpace {
     }
 }
 
-/// The rail half-spaces a launcher part can touch.
+/// A lip top as a bounded face: its plane, and its extent in the rail frame, bounded along the
+/// channel (z) and at the slot edge (the real edge the shoe head overhangs); open towards the
+/// chamber wall, whose corner with the lip is solid.
+fn lip_face(f: &PlanarFace) -> (HalfSpace, FaceExtent) {
+    let n = v3(f.normal);
+    let tangent = Unit::new_normalize(v3(f.tangent));
+    // t runs along normal × tangent (+x for the lip tops); the slot is on the side facing x = 0.
+    let across = n.cross(&tangent);
+    let slot_side_positive = across.dot(&v3(f.centre_m)) < 0.0;
+    let t_range = if slot_side_positive {
+        (f64::NEG_INFINITY, f.half_width_m)
+    } else {
+        (-f.half_width_m, f64::INFINITY)
+    };
+    (
+        half_space(f),
+        FaceExtent {
+            origin: Point3::from(v3(f.centre_m)),
+            tangent,
+            s_range_m: (-f.half_length_m, f.half_length_m),
+            t_range_m: t_range,
+        },
+    )
+}
+
+/// The rail faces a launcher part can touch.
 struct RailPlanes {
-    floor: HalfSpace,
+    /// The two lip tops (left, right), bounded at the slot.
+    floor: [(HalfSpace, FaceExtent); 2],
     roof: HalfSpace,
     wall_left: HalfSpace,
     wall_right: HalfSpace,
@@ -123,8 +149,15 @@ fn rail_planes(spec: &LauncherSpec) -> Result<RailPlanes, RunError> {
     } else {
         roof_r
     };
+    let lip = |name: &str| {
+        faces
+            .iter()
+            .find(|f| f.name == name)
+            .map(lip_face)
+            .ok_or_else(|| invalid("launcher.rail", format!("rail face `{name}` missing")))
+    };
     Ok(RailPlanes {
-        floor: get("lip_top_left")?,
+        floor: [lip("lip_top_left")?, lip("lip_top_right")?],
         roof,
         wall_left: get("chamber_wall_left")?,
         wall_right: get("chamber_wall_right")?,
@@ -419,10 +452,20 @@ pub fn build(
     let planes = rail_planes(spec)?;
     let chamber = || {
         vec![
-            planes.floor,
+            planes.floor[0].0,
+            planes.floor[1].0,
             planes.roof,
             planes.wall_left,
             planes.wall_right,
+        ]
+    };
+    let chamber_extents = || {
+        vec![
+            Some(planes.floor[0].1),
+            Some(planes.floor[1].1),
+            None,
+            None,
+            None,
         ]
     };
     let friction = Some(spec.friction.to_friction_params());
@@ -437,55 +480,58 @@ pub fn build(
         )
     })?;
     let contacts = vec![
-        Contact {
-            name: CONTACT_NAMES[0].into(),
-            body_a: MISSILE,
-            pieces_a: vec![piece(&spec.front_pad)],
-            body_b: RAIL,
-            faces_b: vec![planes.bottom],
-            impact: c.missile_rail.to_impact_params(),
+        Contact::new(
+            CONTACT_NAMES[0],
+            MISSILE,
+            vec![piece(&spec.front_pad)],
+            RAIL,
+            vec![planes.bottom],
+            c.missile_rail.to_impact_params(),
             friction,
-        },
-        Contact {
-            name: CONTACT_NAMES[1].into(),
-            body_a: LATCH,
-            pieces_a: vec![piece(tooth)],
-            body_b: RAIL,
-            faces_b: chamber(),
-            impact: c.latch_rail.to_impact_params(),
+        ),
+        Contact::new(
+            CONTACT_NAMES[1],
+            LATCH,
+            vec![piece(tooth)],
+            RAIL,
+            chamber(),
+            c.latch_rail.to_impact_params(),
             friction,
-        },
-        Contact {
-            name: CONTACT_NAMES[2].into(),
-            body_a: MISSILE,
-            pieces_a: vec![piece(&spec.mid_shoe.head_box(d))],
-            body_b: RAIL,
-            faces_b: chamber(),
-            impact: c.mid_shoe_rail.to_impact_params(),
+        )
+        .with_face_extents(chamber_extents()),
+        Contact::new(
+            CONTACT_NAMES[2],
+            MISSILE,
+            vec![piece(&spec.mid_shoe.head_box(d))],
+            RAIL,
+            chamber(),
+            c.mid_shoe_rail.to_impact_params(),
             friction,
-        },
-        Contact {
-            name: CONTACT_NAMES[3].into(),
-            body_a: MISSILE,
-            pieces_a: vec![piece(&protrusion)],
-            body_b: LATCH,
+        )
+        .with_face_extents(chamber_extents()),
+        Contact::new(
+            CONTACT_NAMES[3],
+            MISSILE,
+            vec![piece(&protrusion)],
+            LATCH,
             // The tooth's rear face: normal -z out of the tooth, plane z = tooth_rear_z.
-            faces_b: vec![HalfSpace {
+            vec![HalfSpace {
                 normal: Unit::new_normalize(-Vector3::z()),
                 offset: -tooth_rear_z,
             }],
-            impact: c.mid_shoe_latch.to_impact_params(),
+            c.mid_shoe_latch.to_impact_params(),
             friction,
-        },
-        Contact {
-            name: CONTACT_NAMES[4].into(),
-            body_a: MISSILE,
-            pieces_a: vec![piece(&spec.rear_shoe.head_box(d))],
-            body_b: RAIL,
-            faces_b: chamber(),
-            impact: c.rear_shoe_rail.to_impact_params(),
+        ),
+        Contact::new(
+            CONTACT_NAMES[4],
+            MISSILE,
+            vec![piece(&spec.rear_shoe.head_box(d))],
+            RAIL,
+            chamber(),
+            c.rear_shoe_rail.to_impact_params(),
             friction,
-        },
+        )
+        .with_face_extents(chamber_extents()),
     ];
 
     let system = MultibodySystem::new(

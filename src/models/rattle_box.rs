@@ -4,14 +4,14 @@
 use super::run::BuiltModel;
 use super::specs::{CaseSpec, MaterialSpec, RattleBoxSpec};
 use crate::excitation::BaseMotion;
-use crate::geometry::{ConvexShape, HalfSpace};
+use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};
 use crate::models::motion::TranslatingBase;
 use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
 use crate::physics::contact::Contact;
 use crate::physics::system::MultibodySystem;
 use crate::units::STANDARD_GRAVITY;
 use crate::wear::material::Material;
-use nalgebra::{Isometry3, Matrix3, Unit, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 use std::sync::Arc;
 
 /// Converts a config material to the wear module's material.
@@ -24,6 +24,10 @@ pub fn material(m: &MaterialSpec) -> Material {
         brinell_hardness_hb: m.brinell_hardness,
     }
 }
+
+/// Wall thickness of the rattle-box tube, m (estimate: 1/8 in; it only sets how far each
+/// wall's face extends past the inner corners, so that the corners are solid).
+pub const TUBE_WALL_THICKNESS_M: f64 = 3.175e-3;
 
 /// Half-space whose solid lies beyond `offset` along `-inward` (wall faces of a cavity):
 /// `inward` points from the wall into the cavity.
@@ -60,6 +64,7 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
             motion,
         })),
     };
+    let lz = 0.5 * spec.tube_length_m;
     let mut faces = vec![
         wall(-Vector3::x(), l),
         wall(Vector3::x(), l),
@@ -67,26 +72,47 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         wall(Vector3::y(), l),
     ];
     if spec.end_caps {
-        let lz = 0.5 * spec.tube_length_m;
         faces.push(wall(-Vector3::z(), lz));
         faces.push(wall(Vector3::z(), lz));
     }
+    // Each wall is the tube's real face: as wide as the tube's outside (so the corners are
+    // solid) and as long as the tube.
+    let outer = l + TUBE_WALL_THICKNESS_M;
+    let extent = |origin: Vector3<f64>, tangent: Vector3<f64>, t_half: f64| {
+        Some(FaceExtent {
+            origin: Point3::from(origin),
+            tangent: Unit::new_normalize(tangent),
+            s_range_m: (-outer, outer),
+            t_range_m: (-t_half, t_half),
+        })
+    };
+    let mut extents = vec![
+        extent(Vector3::new(l, 0.0, 0.0), Vector3::y(), lz),
+        extent(Vector3::new(-l, 0.0, 0.0), Vector3::y(), lz),
+        extent(Vector3::new(0.0, l, 0.0), Vector3::x(), lz),
+        extent(Vector3::new(0.0, -l, 0.0), Vector3::x(), lz),
+    ];
+    if spec.end_caps {
+        extents.push(extent(Vector3::new(0.0, 0.0, lz), Vector3::x(), outer));
+        extents.push(extent(Vector3::new(0.0, 0.0, -lz), Vector3::x(), outer));
+    }
     let impact = spec.contact.to_impact_params();
-    let contact = Contact {
-        name: "cube-tube".into(),
-        body_a: 0,
-        pieces_a: vec![(
+    let contact = Contact::new(
+        "cube-tube",
+        0,
+        vec![(
             Isometry3::identity(),
             ConvexShape::RoundedBox {
                 half_extents: Vector3::new(half, half, half),
                 roundover: spec.edge_radius_m,
             },
         )],
-        body_b: 1,
-        faces_b: faces,
+        1,
+        faces,
         impact,
-        friction: Some(spec.friction.to_friction_params()),
-    };
+        Some(spec.friction.to_friction_params()),
+    )
+    .with_face_extents(extents);
     let system = MultibodySystem::new(
         vec![cube, tube],
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),

@@ -4,6 +4,7 @@
 
 use crate::physics::body::BodyKind;
 use crate::physics::contact::TrackState;
+use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
 use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use crate::physics::system::MultibodySystem;
@@ -121,6 +122,8 @@ pub struct RunReport {
     pub base_acceleration: Vec<[f64; 3]>,
     /// Cumulative wear volume per contact versus time: (time s, volume m³ per contact).
     pub wear_history: Vec<(f64, Vec<f64>)>,
+    /// The run's energy account (settle and excitation).
+    pub energy: Option<EnergyAudit>,
 }
 
 /// Why a run failed.
@@ -187,7 +190,7 @@ pub fn run_model(
         for tr in v.tracks {
             let c = tr.contact as usize;
             n_sum[c] += tr.normal_force;
-            p_sum[c] += tr.normal_force * tr.slip_velocity.norm();
+            p_sum[c] += tr.normal_force * tr.slip_speed;
             peak[c] = peak[c].max(tr.normal_force);
         }
         if let Some((tp, np, pp)) = &prev_sums {
@@ -219,7 +222,7 @@ pub fn run_model(
             entry.open = true;
             if let Err(e) = entry
                 .acc
-                .push(v.t, tr.normal_force, tr.slip_velocity.norm(), tr.area)
+                .push(v.t, tr.normal_force, tr.slip_speed, tr.area)
             {
                 wear_error.get_or_insert(e);
             }
@@ -348,6 +351,7 @@ pub fn run_model(
         response_rate_hz: options.response_rate_hz,
         base_acceleration,
         wear_history,
+        energy: stats.energy,
     })
 }
 
@@ -387,7 +391,7 @@ fn track_sample(
         track: tr.track,
         normal_force_n: tr.normal_force,
         slip_velocity_m_s: [tr.slip_velocity.x, tr.slip_velocity.y, tr.slip_velocity.z],
-        slip_speed_m_s: tr.slip_velocity.norm(),
+        slip_speed_m_s: tr.slip_speed,
         penetration_m: tr.penetration,
         penetration_rate_m_s: tr.penetration_rate,
         area_m2: tr.area,

@@ -1,14 +1,32 @@
-//! Contact between a body's convex pieces and another body's planar faces (thesis 2.5, 6.5):
-//! IMPACT normal force (eq. 2.1-2.3) at the centroid of the overlap volume, ADAMS Coulomb
-//! friction (eq. 4.5) opposite the slip velocity, and the contact area as overlap volume /
-//! penetration depth. Each touching (piece, face) pair is one track.
+//! Contact between a body's convex pieces and another body's planar faces (thesis 2.5, 6.5;
+//! SPEC §2 "Passivity"; docs/models.md "Contact formulation").
+//!
+//! Each piece carries fixed contact points on its surface ([`crate::geometry::lattice`]): small
+//! balls whose stiffness and damping shares `β` sum to 1 over any face of the piece. Every
+//! point that penetrates a face's solid ([`PlacedFace`], bounded or not) by `w` gets its own
+//! IMPACT force (eq. 2.1-2.3) `β max(0, k w^e + c STEP(w) ẇ)` along the solid's outward normal
+//! and ADAMS Coulomb friction (eq. 4.5) opposite its own slip, both applied at the point's
+//! ball surface, with `w`, `ẇ` and the slip of that same material point. Hence:
+//! - the elastic force is the exact gradient of the stored energy
+//!   `U = Σ β k w^(e+1)/(e+1)`, continuous in the configuration (each `w` is a continuous
+//!   function of the poses: a ball's depth into a convex solid);
+//! - damping does the work `−β c STEP ẇ² <= 0` (or `−β k w^e ẇ <= 0` while the clamp holds),
+//!   friction `−μ N |v_slip| <= 0`: the contact is passive by construction;
+//! - a face pressed uniformly by `w` gives `Σ β k w^e = k w^e`, the thesis' law for the face.
+//!
+//! Each touching (piece, face) pair is one track: its normal force is the points' sum, its
+//! contact point their centre of pressure, its slip the force-weighted mean slip (and the
+//! force-weighted mean slip speed, so `N · slip_speed` is the friction work rate over μ), its
+//! area the thesis 2.5 area (overlap volume of the piece with the face's plane / depth) scaled
+//! to the face's extent, its penetration the deepest point's.
 
 use super::body::BodyFrame;
-use super::forces::{apply, Wrench};
+use super::forces::Wrench;
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use crate::geometry::{
-    shape_halfspace_depth, shape_halfspace_overlap, ConvexShape, HalfSpace, PlaneOverlap,
+    contact_points, shape_halfspace_depth, shape_halfspace_overlap, ContactPoint, ConvexShape,
+    FaceExtent, HalfSpace, PlacedFace, PlaneOverlap, DEFAULT_POINTS_PER_EDGE,
 };
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
@@ -25,10 +43,67 @@ pub struct Contact {
     pub body_b: usize,
     /// Faces of body b as half-spaces in b's frame (normal out of the material).
     pub faces_b: Vec<HalfSpace>,
-    /// Normal force law.
+    /// In-plane extent of each face in b's frame (`None`: unbounded); empty: all unbounded.
+    pub face_extents: Vec<Option<FaceExtent>>,
+    /// Normal force law (the whole face's: each contact point carries its share).
     pub impact: ImpactParams,
     /// Friction law (None: frictionless).
     pub friction: Option<FrictionParams>,
+    /// Contact points of each piece, in the piece's frame.
+    points: Vec<Vec<ContactPoint>>,
+}
+
+impl Contact {
+    /// A contact with unbounded faces and [`DEFAULT_POINTS_PER_EDGE`] contact points per box
+    /// edge.
+    pub fn new(
+        name: impl Into<String>,
+        body_a: usize,
+        pieces_a: Vec<(Isometry3<f64>, ConvexShape)>,
+        body_b: usize,
+        faces_b: Vec<HalfSpace>,
+        impact: ImpactParams,
+        friction: Option<FrictionParams>,
+    ) -> Self {
+        let mut c = Self {
+            name: name.into(),
+            body_a,
+            pieces_a,
+            body_b,
+            faces_b,
+            face_extents: Vec::new(),
+            impact,
+            friction,
+            points: Vec::new(),
+        };
+        c.set_points_per_edge(DEFAULT_POINTS_PER_EDGE);
+        c
+    }
+
+    /// Bounds the faces: one entry per face of `faces_b`, `None` leaving a face unbounded.
+    pub fn with_face_extents(mut self, extents: Vec<Option<FaceExtent>>) -> Self {
+        self.face_extents = extents;
+        self
+    }
+
+    /// Contact points per box edge (see [`crate::geometry::lattice`]).
+    pub fn with_points_per_edge(mut self, n: usize) -> Self {
+        self.set_points_per_edge(n);
+        self
+    }
+
+    fn set_points_per_edge(&mut self, n: usize) {
+        self.points = self
+            .pieces_a
+            .iter()
+            .map(|(_, shape)| contact_points(shape, n))
+            .collect();
+    }
+
+    /// Contact points of piece `i`, in its frame.
+    pub fn points(&self, piece: usize) -> &[ContactPoint] {
+        &self.points[piece]
+    }
 }
 
 /// State of one active track at one instant.
@@ -46,14 +121,21 @@ pub struct TrackState {
     pub area: f64,
     /// Normal force magnitude, N.
     pub normal_force: f64,
-    /// Tangential slip velocity of a relative to b at the contact point, m/s, world.
+    /// Force-weighted mean tangential slip velocity of a relative to b, m/s, world.
     pub slip_velocity: Vector3<f64>,
-    /// Contact point (overlap centroid), world.
+    /// Force-weighted mean slip speed `Σ N_i |v_i| / N`, m/s (`N · slip_speed` is the
+    /// friction work rate divided by μ; the wear law's `N v_slip`, eq. 3.13).
+    pub slip_speed: f64,
+    /// Centre of pressure of the track's point forces (the deepest point when N = 0), world.
     pub point: Point3<f64>,
     /// Contact normal (out of b, pushing a), world.
     pub normal: Vector3<f64>,
-    /// Friction force magnitude, N.
+    /// Sum of the points' friction force magnitudes, N.
     pub friction_force: f64,
+    /// Power dissipated by the IMPACT damping (and the force clamp), W (>= 0).
+    pub damping_power: f64,
+    /// Power dissipated by friction `Σ μ_i N_i |v_i|`, W (>= 0).
+    pub friction_power: f64,
 }
 
 impl TrackState {
@@ -67,23 +149,24 @@ impl TrackState {
     }
 }
 
-/// Local derivatives of one active track's force at one instant, for the contact-aware Newton
+/// Local derivatives of one contact point's force at one instant, for the contact-aware Newton
 /// matrix ([`MultibodySystem::contact_jacobian`](super::system::MultibodySystem::contact_jacobian)).
 ///
-/// The force on body a is `F = n f_n(w, ẇ) + F_t(s, f_n)` at the overlap centroid `c` (−F on b),
-/// with `w` the penetration of the deepest point `p`, `ẇ` its rate and `s` the slip velocity at
-/// `c`. The contact point, centroid and normal are held fixed: the derivatives through `w`, `ẇ`
-/// and `s` are exact (the envelope theorem gives `∂w` from the deepest point's motion), the
-/// motion of the centroid over the face (a rocking face's restoring torque) is left out.
+/// The force on body a is `F = n f_n(w, ẇ) + F_t(s, f_n)` at the point `p` (−F on b), with `w`
+/// the penetration of the point's ball, `ẇ` its rate and `s` the slip velocity at `p`: force,
+/// point and rates belong to the same material point, so the derivatives through `w`, `ẇ` and
+/// `s` are exact. Held fixed (second-order geometric terms, of relative size `F / (k_eff r)`
+/// against the contact stiffness, about 1e-4 on the rattle box): the turn of the normal at a
+/// face's edge, the lever of `p` in the torque, and the turn of the slip's lever.
 #[derive(Debug, Clone, Copy)]
 pub struct TrackLinearization {
     /// Body carrying the pieces (force +F).
     pub body_a: usize,
     /// Body carrying the faces (force −F).
     pub body_b: usize,
-    /// Deepest point, world.
+    /// Deepest point of the ball (where F acts and `w` is measured), world.
     pub deepest_point: Point3<f64>,
-    /// Overlap centroid (where F acts), world.
+    /// Where F acts (the same point), world.
     pub point: Point3<f64>,
     /// Contact normal (out of b), world.
     pub normal: Vector3<f64>,
@@ -328,6 +411,7 @@ impl Contact {
         let fa = &frames[self.body_a];
         let fb = &frames[self.body_b];
         let iso_a = fa.isometry();
+        let iso_b = fb.isometry();
         let mut energy = 0.0;
         let nfaces = self.faces_b.len();
         let replay_from = geometry.begin(
@@ -348,6 +432,8 @@ impl Contact {
                     normal: Unit::new_unchecked(n_world),
                     offset: offset_world,
                 };
+                // The piece's overlap with the face's plane: the gate (no point of a piece
+                // clear of the plane can touch the face's solid) and the thesis 2.5 area.
                 let ov = match replay_from {
                     Some(start) if frozen => {
                         geometry.frozen(start + ip * nfaces + jf, shape, &pose, &hs)
@@ -367,62 +453,167 @@ impl Contact {
                 let Some(ov) = ov else {
                     continue;
                 };
-                let w = ov.depth;
-                // Penetration rate from the material point at the deepest point (envelope).
-                let v_rel_deep =
-                    fa.point_velocity(&ov.deepest_point) - fb.point_velocity(&ov.deepest_point);
-                let wdot = -v_rel_deep.dot(&n_world);
-                let fn_mag = self.impact.force(w, wdot);
-                let c = ov.centroid;
-                let v_rel = fa.point_velocity(&c) - fb.point_velocity(&c);
-                let slip = v_rel - n_world * v_rel.dot(&n_world);
-                let speed = slip.norm();
-                let mut ft = 0.0;
-                let mut force = n_world * fn_mag;
-                if let Some(fr) = &self.friction {
-                    if speed > 0.0 && fn_mag > 0.0 {
-                        ft = fr.coefficient(speed) * fn_mag;
-                        force -= slip * (ft / speed);
+                let placed = PlacedFace::new(
+                    hs,
+                    self.face_extents.get(jf).and_then(Option::as_ref),
+                    &iso_b,
+                );
+                let mut track = TrackSum::default();
+                for point in &self.points[ip] {
+                    let centre = pose * point.local;
+                    let (distance, normal) = placed.signed_distance(&centre);
+                    let w = point.radius - distance;
+                    if w <= 0.0 {
+                        continue;
                     }
+                    let p = centre - normal * point.radius;
+                    let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
+                    let wdot = -v_rel.dot(&normal);
+                    let beta = point.weight;
+                    let fn_mag = beta * self.impact.force(w, wdot);
+                    let elastic = beta * self.impact.elastic_force(w);
+                    let slip = v_rel - normal * v_rel.dot(&normal);
+                    let speed = slip.norm();
+                    let mut ft = 0.0;
+                    let mut force = normal * fn_mag;
+                    if let Some(fr) = &self.friction {
+                        if speed > 0.0 && fn_mag > 0.0 {
+                            ft = fr.coefficient(speed) * fn_mag;
+                            force -= slip * (ft / speed);
+                        }
+                    }
+                    if let Some(lin) = linearizations.as_deref_mut() {
+                        if fn_mag > 0.0 {
+                            let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
+                            let (dforce_dfn, dforce_dslip) =
+                                friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag);
+                            lin.push(TrackLinearization {
+                                body_a: self.body_a,
+                                body_b: self.body_b,
+                                deepest_point: p,
+                                point: p,
+                                normal,
+                                dfn_dw: beta * dfn_dw,
+                                dfn_dwdot: beta * dfn_dwdot,
+                                dforce_dfn,
+                                dforce_dslip,
+                            });
+                        }
+                    }
+                    energy += beta * self.impact.potential(w);
+                    track.add(&PointForce {
+                        point: p,
+                        force,
+                        normal,
+                        normal_force: fn_mag,
+                        penetration: w,
+                        penetration_rate: wdot,
+                        slip,
+                        speed,
+                        friction_force: ft,
+                        damping_power: (fn_mag - elastic) * wdot,
+                        lever_a: p.coords - fa.position,
+                        lever_b: p.coords - fb.position,
+                    });
                 }
-                if let Some(lin) = linearizations.as_deref_mut() {
-                    if fn_mag > 0.0 {
-                        let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
-                        let (dforce_dfn, dforce_dslip) =
-                            friction_derivatives(self.friction.as_ref(), &n_world, &slip, fn_mag);
-                        lin.push(TrackLinearization {
-                            body_a: self.body_a,
-                            body_b: self.body_b,
-                            deepest_point: ov.deepest_point,
-                            point: c,
-                            normal: n_world,
-                            dfn_dw,
-                            dfn_dwdot,
-                            dforce_dfn,
-                            dforce_dslip,
-                        });
-                    }
+                if !track.touching {
+                    continue;
                 }
                 if let Some(wr) = wrenches.as_deref_mut() {
-                    apply(wr, frames, self.body_a, &c, force);
-                    apply(wr, frames, self.body_b, &c, -force);
+                    wr[self.body_a].0 += track.force;
+                    wr[self.body_a].1 += track.torque_a;
+                    wr[self.body_b].0 -= track.force;
+                    wr[self.body_b].1 -= track.torque_b;
                 }
-                energy += self.impact.potential(w);
+                let n_total = track.normal_force;
+                let (slip_velocity, slip_speed, point) = if n_total > 0.0 {
+                    (
+                        track.weighted_slip / n_total,
+                        track.weighted_speed / n_total,
+                        Point3::from(track.weighted_point / n_total),
+                    )
+                } else {
+                    (Vector3::zeros(), 0.0, track.deepest_point)
+                };
                 sink(&TrackState {
                     contact: index,
                     track: (ip * nfaces + jf) as u32,
-                    penetration: w,
-                    penetration_rate: wdot,
-                    area: ov.area,
-                    normal_force: fn_mag,
-                    slip_velocity: slip,
-                    point: c,
-                    normal: n_world,
-                    friction_force: ft,
+                    penetration: track.penetration,
+                    penetration_rate: track.penetration_rate,
+                    area: ov.area * placed.coverage(shape, &pose),
+                    normal_force: n_total,
+                    slip_velocity,
+                    slip_speed,
+                    point,
+                    normal: track.normal,
+                    friction_force: track.friction_force,
+                    damping_power: track.damping_power,
+                    friction_power: track.friction_power,
                 });
             }
         }
         energy
+    }
+}
+
+/// One contact point's force and rates (an input of [`TrackSum::add`]).
+struct PointForce {
+    point: Point3<f64>,
+    force: Vector3<f64>,
+    normal: Vector3<f64>,
+    normal_force: f64,
+    penetration: f64,
+    penetration_rate: f64,
+    slip: Vector3<f64>,
+    speed: f64,
+    friction_force: f64,
+    damping_power: f64,
+    lever_a: Vector3<f64>,
+    lever_b: Vector3<f64>,
+}
+
+/// A track's sums over its contact points. Points arrive in mirror pairs
+/// ([`crate::geometry::lattice`]), so in a configuration symmetric about a piece's mid-plane
+/// the out-of-plane sums cancel pair by pair, exactly.
+#[derive(Default)]
+struct TrackSum {
+    touching: bool,
+    force: Vector3<f64>,
+    torque_a: Vector3<f64>,
+    torque_b: Vector3<f64>,
+    normal_force: f64,
+    weighted_slip: Vector3<f64>,
+    weighted_speed: f64,
+    weighted_point: Vector3<f64>,
+    friction_force: f64,
+    damping_power: f64,
+    friction_power: f64,
+    penetration: f64,
+    penetration_rate: f64,
+    deepest_point: Point3<f64>,
+    normal: Vector3<f64>,
+}
+
+impl TrackSum {
+    #[inline]
+    fn add(&mut self, p: &PointForce) {
+        self.touching = true;
+        self.force += p.force;
+        self.torque_a += p.lever_a.cross(&p.force);
+        self.torque_b += p.lever_b.cross(&p.force);
+        self.normal_force += p.normal_force;
+        self.weighted_slip += p.slip * p.normal_force;
+        self.weighted_speed += p.speed * p.normal_force;
+        self.weighted_point += p.point.coords * p.normal_force;
+        self.friction_force += p.friction_force;
+        self.damping_power += p.damping_power;
+        self.friction_power += p.friction_force * p.speed;
+        if p.penetration > self.penetration {
+            self.penetration = p.penetration;
+            self.penetration_rate = p.penetration_rate;
+            self.deepest_point = p.point;
+            self.normal = p.normal;
+        }
     }
 }
 

@@ -80,6 +80,18 @@ impl ImpactParams {
         (self.stiffness * power(w, self.exponent) + self.damping_at(w) * wdot).max(0.0)
     }
 
+    /// Elastic part `k w^e` of the force (N) at penetration `w` (m): the derivative of
+    /// [`ImpactParams::potential`]. `force - elastic_force` is the damping part after the clamp,
+    /// whose power `(force - elastic_force) · ẇ` is what the contact dissipates (>= 0).
+    #[inline]
+    pub fn elastic_force(&self, w: f64) -> f64 {
+        if w <= 0.0 {
+            0.0
+        } else {
+            self.stiffness * power(w, self.exponent)
+        }
+    }
+
     /// Partial derivatives (dF/dw, dF/dwdot) of [`ImpactParams::force`], zero where clamped.
     #[inline]
     pub fn force_gradient(&self, w: f64, wdot: f64) -> (f64, f64) {
@@ -100,14 +112,17 @@ impl ImpactParams {
         )
     }
 
-    /// Static penetration under a steady load `f` (N): `(f/k)^(1/e)`.
     /// Elastic energy stored at penetration `w`, J: `∫ k w^e dw = k w^(e+1) / (e+1)`.
     #[inline]
     pub fn potential(&self, w: f64) -> f64 {
+        if w <= 0.0 {
+            return 0.0;
+        }
         let e = self.exponent;
         self.stiffness * power(w, e) * w / (e + 1.0)
     }
 
+    /// Static penetration under a steady load `f` (N): `(f/k)^(1/e)`.
     pub fn static_penetration(&self, f: f64) -> f64 {
         (f.max(0.0) / self.stiffness).powf(1.0 / self.exponent)
     }

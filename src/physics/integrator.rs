@@ -351,6 +351,23 @@ pub struct Integrator {
     /// f at the start of the last accepted step and that step's size (stage predictors).
     k_prev: Vec<f64>,
     prev_h: f64,
+    /// Power terms at the last attempt's interior stage (TR-BDF2: t + γh), for the energy
+    /// account's quadrature ([`Integrator::interior_stage`]).
+    stage: Option<InteriorStage>,
+}
+
+/// The power terms at a step's interior stage and the method's quadrature weights: the
+/// energy account integrates each power as `h (w0 P(t) + w1 P(stage) + w2 P(t + h))`, the
+/// weights with which the method advanced the state itself (TR-BDF2: `(√2/4, √2/4, 1 − √2/2)`),
+/// so the works follow the same quadrature as the momenta.
+#[derive(Debug, Clone, Default)]
+pub struct InteriorStage {
+    /// Weights of the start, the stage and the end (sum 1).
+    pub weights: [f64; 3],
+    /// Power terms at the stage (its last Newton iterate).
+    pub power: super::system::PowerBalance,
+    /// Contact damping and friction power per contact at the stage, W.
+    pub contacts: Vec<[f64; 2]>,
 }
 
 struct Attempt {
@@ -420,7 +437,14 @@ impl Integrator {
             hold_steps: 0,
             k_prev: v(),
             prev_h: 0.0,
+            stage: None,
         }
+    }
+
+    /// The interior stage of the last accepted TR-BDF2 step (None for the other methods, whose
+    /// works the account integrates by the trapezoid rule).
+    pub fn interior_stage(&self) -> Option<&InteriorStage> {
+        self.stage.as_ref()
     }
 
     /// Step size the next attempt will use, s.
@@ -814,6 +838,7 @@ impl Integrator {
                 newton_failed: true,
             });
         }
+        self.capture_stage(sys, ws);
         // Stage 3 (BDF2 to t + h).
         for i in 0..n {
             self.rhs[i] = y[i] + h * TRB_W * (self.k[0][i] + self.k[1][i]);
@@ -844,6 +869,22 @@ impl Integrator {
             err_norm: norm,
             newton_failed: false,
         })
+    }
+
+    /// Keeps the power terms of the stage just solved (the workspace holds its last Newton
+    /// iterate's evaluation).
+    fn capture_stage(&mut self, sys: &MultibodySystem, ws: &Workspace) {
+        let stage = self.stage.get_or_insert_with(InteriorStage::default);
+        stage.weights = [TRB_W, TRB_W, TRB_D];
+        stage.power = ws.power;
+        stage.contacts.clear();
+        stage.contacts.resize(sys.contacts.len(), [0.0; 2]);
+        for tr in &ws.tracks {
+            if let Some(c) = stage.contacts.get_mut(tr.contact as usize) {
+                c[0] += tr.damping_power;
+                c[1] += tr.friction_power;
+            }
+        }
     }
 
     fn attempt_sdirk2(

@@ -2,6 +2,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod energy;
 pub mod forces;
 pub mod friction;
 pub mod impact;

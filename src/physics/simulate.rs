@@ -4,7 +4,10 @@
 
 use super::body::BodyKind;
 use super::contact::TrackState;
-use super::integrator::{Integrator, IntegratorError, IntegratorSettings, IntegratorStats};
+use super::energy::{EnergyAudit, EnergyMeter};
+use super::integrator::{
+    Integrator, IntegratorError, IntegratorSettings, IntegratorStats, InteriorStage,
+};
 use super::system::{MultibodySystem, Workspace};
 use crate::pipeline::{Progress, RunControl};
 use std::time::{Duration, Instant};
@@ -68,12 +71,14 @@ pub enum SimError {
 }
 
 /// Summary of a finished run.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct RunStats {
     /// Integrator counters.
     pub integrator: IntegratorStats,
     /// Wall-clock time spent, s.
     pub wall_s: f64,
+    /// The run's energy account.
+    pub energy: Option<EnergyAudit>,
 }
 
 /// Integrates `system` from `t0` to `t_end`, updating `y` in place.
@@ -98,7 +103,12 @@ pub fn simulate(
     let mut last_good = y.to_vec();
     let mut t = t0;
     let mut last_progress = Instant::now();
-    collect_tracks(system, t, y, &mut ws, &mut tracks);
+    let mut meter = EnergyMeter::new(system.contacts.iter().map(|c| c.name.clone()).collect());
+    // One evaluation at the start: its tracks, stored energy and powers open the account.
+    let mut dy = vec![0.0; y.len()];
+    system.derivative(t, y, &mut dy, &mut ws);
+    std::mem::swap(&mut tracks, &mut ws.tracks);
+    record_energy(system, &mut meter, t, y, &mut ws, &tracks, None);
     observer(&StepView {
         t_prev: t,
         t,
@@ -119,6 +129,15 @@ pub fn simulate(
             }
         }
         std::mem::swap(&mut tracks, &mut ws.tracks);
+        record_energy(
+            system,
+            &mut meter,
+            t,
+            y,
+            &mut ws,
+            &tracks,
+            integ.interior_stage(),
+        );
         if let Some(tr) = tracks
             .iter()
             .find(|tr| tr.penetration > limits.max_penetration_m)
@@ -180,7 +199,30 @@ pub fn simulate(
     Ok(RunStats {
         integrator: integ.stats,
         wall_s: start.elapsed().as_secs_f64(),
+        energy: Some(meter.audit()),
     })
+}
+
+/// Adds the accepted state `(t, y)` to the energy account; `ws` holds its last derivative
+/// evaluation (stored energy and power terms).
+fn record_energy(
+    system: &MultibodySystem,
+    meter: &mut EnergyMeter,
+    t: f64,
+    y: &[f64],
+    ws: &mut Workspace,
+    tracks: &[TrackState],
+    stage: Option<&InteriorStage>,
+) {
+    let power = ws.power;
+    let motion = system.motion_energy(t, y, ws);
+    meter.record(
+        t,
+        motion.kinetic + motion.gravitational + power.elastic_energy,
+        &power,
+        tracks,
+        stage,
+    );
 }
 
 fn collect_tracks(

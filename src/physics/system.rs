@@ -40,10 +40,39 @@ pub struct Workspace {
     pub skip_contacts: bool,
     /// Keep the active tracks of each derivative evaluation in `tracks`.
     pub keep_tracks: bool,
+    /// Stored energy and power terms of the last derivative evaluation with contacts (like
+    /// `tracks`, those of the accepted state after a step).
+    pub power: PowerBalance,
     /// Active tracks of the last derivative evaluation with contacts (when `keep_tracks`).
     /// After [`Integrator::advance`](super::integrator::Integrator::advance) these are the
     /// tracks at the accepted state: its last evaluation is there.
     pub tracks: Vec<TrackState>,
+}
+
+/// The stored elastic energy and the power terms of one derivative evaluation, for the energy
+/// account `E_mech + W_dissipated - W_drive - W_applied = E_mech(0)` (SPEC §2).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PowerBalance {
+    /// Elastic energy stored in contacts and force elements, J.
+    pub elastic_energy: f64,
+    /// Power dissipated by contact damping (IMPACT damping and its clamp), W.
+    pub contact_damping: f64,
+    /// Power dissipated by contact friction, W.
+    pub contact_friction: f64,
+    /// Power dissipated by force elements (dampers, bushings, a clamped one-sided spring), W.
+    pub element_dissipation: f64,
+    /// Power the prescribed motion of the kinematic bodies delivers to the system: minus the
+    /// power of the forces acting on them, W.
+    pub drive: f64,
+    /// Power of applied loads (constant forces), W.
+    pub applied: f64,
+}
+
+impl PowerBalance {
+    /// Total dissipated power, W.
+    pub fn dissipation(&self) -> f64 {
+        self.contact_damping + self.contact_friction + self.element_dissipation
+    }
 }
 
 /// Energy bookkeeping of a state, J.
@@ -112,6 +141,7 @@ impl MultibodySystem {
             linearizations: Vec::new(),
             skip_contacts: false,
             keep_tracks: false,
+            power: PowerBalance::default(),
             tracks: Vec::new(),
         }
     }
@@ -162,22 +192,29 @@ impl MultibodySystem {
                 ws.wrenches[i].0 += self.gravity * b.mass.mass;
             }
         }
+        let mut power = PowerBalance::default();
         for f in &self.forces {
-            f.accumulate(&ws.frames, &mut ws.wrenches);
+            let p = f.accumulate_with_power(&ws.frames, &mut ws.wrenches);
+            power.elastic_energy += p.potential;
+            power.element_dissipation += p.dissipation;
+            power.applied += p.applied;
         }
         ws.linearizations.clear();
         if !ws.skip_contacts {
             let keep = ws.keep_tracks;
             let mut kept = std::mem::take(&mut ws.tracks);
             kept.clear();
+            let (mut damping, mut friction) = (0.0, 0.0);
             let mut sink = |tr: &TrackState| {
+                damping += tr.damping_power;
+                friction += tr.friction_power;
                 if keep {
                     kept.push(*tr);
                 }
                 on_track(tr);
             };
             for (ci, c) in self.contacts.iter().enumerate() {
-                c.evaluate_with(
+                power.elastic_energy += c.evaluate_with(
                     ci as u32,
                     &ws.frames,
                     Some(&mut ws.wrenches),
@@ -186,7 +223,18 @@ impl MultibodySystem {
                     ws.linearize.then_some(&mut ws.linearizations),
                 );
             }
+            power.contact_damping = damping;
+            power.contact_friction = friction;
             ws.tracks = kept;
+            // The kinematic bodies' motion delivers minus the power of the forces on them.
+            for (i, b) in self.bodies.iter().enumerate() {
+                if matches!(b.kind, BodyKind::Kinematic(_)) {
+                    let (force, torque) = ws.wrenches[i];
+                    let f = &ws.frames[i];
+                    power.drive -= force.dot(&f.velocity) + torque.dot(&f.angular_velocity);
+                }
+            }
+            ws.power = power;
         }
         for (i, b) in self.bodies.iter().enumerate() {
             let BodyKind::Dynamic { offset } = b.kind else {
@@ -309,6 +357,21 @@ impl MultibodySystem {
 
     /// Mechanical energy of the state (kinematic bodies excluded from kinetic energy).
     pub fn energy(&self, t: f64, y: &[f64], ws: &mut Workspace) -> Energy {
+        let mut e = self.motion_energy(t, y, ws);
+        let mut wr = vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()];
+        for f in &self.forces {
+            e.elastic += f.accumulate(&ws.frames, &mut wr);
+        }
+        for (ci, c) in self.contacts.iter().enumerate() {
+            e.elastic += c.evaluate(ci as u32, &ws.frames, None, &mut |_| {});
+        }
+        e
+    }
+
+    /// Kinetic and gravitational energy of the state (`elastic` left at zero; the last
+    /// derivative evaluation's [`PowerBalance::elastic_energy`] completes it without a second
+    /// contact evaluation). Leaves the state's frames in `ws`.
+    pub fn motion_energy(&self, t: f64, y: &[f64], ws: &mut Workspace) -> Energy {
         self.frames(t, y, ws);
         let mut e = Energy::default();
         for (i, b) in self.bodies.iter().enumerate() {
@@ -320,13 +383,6 @@ impl MultibodySystem {
             e.kinetic += 0.5 * b.mass.mass * f.velocity.norm_squared()
                 + 0.5 * wb.dot(&(b.mass.inertia * wb));
             e.gravitational -= b.mass.mass * self.gravity.dot(&f.position);
-        }
-        let mut wr = vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()];
-        for f in &self.forces {
-            e.elastic += f.accumulate(&ws.frames, &mut wr);
-        }
-        for (ci, c) in self.contacts.iter().enumerate() {
-            e.elastic += c.evaluate(ci as u32, &ws.frames, None, &mut |_| {});
         }
         e
     }
