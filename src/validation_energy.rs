@@ -14,8 +14,8 @@ use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use crate::physics::system::MultibodySystem;
 use crate::pipeline::{RunControl, RunError};
 use crate::units::STANDARD_GRAVITY;
-use nalgebra::{UnitQuaternion, Vector3};
 use crate::validation::{anchor, Anchor};
+use nalgebra::{UnitQuaternion, Vector3};
 use std::path::Path;
 
 /// Largest admissible rise of `E_mech` above its running minimum without drive, as a share of
@@ -110,9 +110,9 @@ pub fn energy_run(
         },
     )?;
     Ok(EnergyRun {
-        audit: stats.energy.unwrap_or_else(|| {
-            crate::physics::energy::EnergyMeter::new(Vec::new()).audit()
-        }),
+        audit: stats
+            .energy
+            .unwrap_or_else(|| crate::physics::energy::EnergyMeter::new(Vec::new()).audit()),
         peak_normal_force_n: peak,
         max_lift_m: lift,
         state: y,

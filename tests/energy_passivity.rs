@@ -4,12 +4,12 @@
 //! Every bound is the ("Passive contact", item 4) and fixed by physics, not by output.
 
 use nalgebra::UnitQuaternion;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use railwear::validation_energy::{
     energy_run, motionless_tube, spinning_cube, tilted_cube, MotionlessTube, BALANCE_TOLERANCE,
     PASSIVITY_TOLERANCE,
 };
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
 fn configs() -> &'static Path {
@@ -33,7 +33,10 @@ fn available_energy(t: &MotionlessTube, y: &[f64]) -> f64 {
 fn spin_on_the_floor_only_decays() {
     let t = tube();
     let (y, spin_energy) = spinning_cube(&t, 2.0);
-    assert!((spin_energy - 9.9e-6).abs() < 0.05e-6, "the issue's 9.9e-6 J");
+    assert!(
+        (spin_energy - 9.9e-6).abs() < 0.05e-6,
+        "the issue's 9.9e-6 J"
+    );
     let run = energy_run(&t.system, &y, t.settings, 0.05).expect("runs");
     let a = &run.audit;
     eprintln!(
@@ -45,7 +48,11 @@ fn spin_on_the_floor_only_decays() {
     // Spinning about its normal changes no penetration: the floor carries the weight
     // (0.45 N) and nothing more, and the cube does not leave the floor.
     let weight = t.cube_mass_kg * 9.80665;
-    assert!(run.peak_normal_force_n < 1.01 * weight, "peak {}", run.peak_normal_force_n);
+    assert!(
+        run.peak_normal_force_n < 1.01 * weight,
+        "peak {}",
+        run.peak_normal_force_n
+    );
     assert!(run.max_lift_m < 1e-9, "lift {}", run.max_lift_m);
     // Friction (the only loss) took the spin energy it could: the spin decays.
     assert!(a.dissipated_j > 0.0 && a.dissipated_j <= spin_energy * (1.0 + 1e-3));
@@ -59,7 +66,11 @@ fn tilted_drop_loses_its_drop_energy() {
     let a = &run.audit;
     eprintln!(
         "drop: rise {:.3e} J of {:.3e}, residual {:.3e} J, dissipated {:.3e} J, peak N {:.1} N",
-        a.max_rise_without_drive_j, drop_energy, a.residual_j, a.dissipated_j, run.peak_normal_force_n
+        a.max_rise_without_drive_j,
+        drop_energy,
+        a.residual_j,
+        a.dissipated_j,
+        run.peak_normal_force_n
     );
     let available = available_energy(&t, &y);
     assert!(a.max_rise_without_drive_j <= PASSIVITY_TOLERANCE * available + 1e-12);
@@ -133,9 +144,19 @@ fn five_hundred_random_cube_states_never_gain_energy() {
                 eprintln!("PROBE {residual:.3e} {:.3e} {:.3e}", a.dissipated_j, rise);
                 if residual > 1e-2 {
                     for f in [1.0, 0.1, 0.01] {
-                        let mut st = t.settings; st.tolerances.rel *= f; st.tolerances.abs_position_m *= f; st.tolerances.abs_velocity_m_s *= f; st.tolerances.abs_rotation *= f; st.tolerances.abs_angular_velocity_rad_s *= f;
+                        let mut st = t.settings;
+                        st.tolerances.rel *= f;
+                        st.tolerances.abs_position_m *= f;
+                        st.tolerances.abs_velocity_m_s *= f;
+                        st.tolerances.abs_rotation *= f;
+                        st.tolerances.abs_angular_velocity_rad_s *= f;
                         let r2 = energy_run(&t.system, y, st, 4e-3).expect("runs");
-                        eprintln!("TOL {f} residual {:.3e} diss {:.3e} rise {:.3e}", r2.audit.residual_j, r2.audit.dissipated_j, r2.audit.max_rise_without_drive_j);
+                        eprintln!(
+                            "TOL {f} residual {:.3e} diss {:.3e} rise {:.3e}",
+                            r2.audit.residual_j,
+                            r2.audit.dissipated_j,
+                            r2.audit.max_rise_without_drive_j
+                        );
                     }
                 }
                 continue;

@@ -542,11 +542,7 @@ impl StepMeans {
             return;
         }
         let n: f64 = v.tracks.iter().map(|t| t.normal_force).sum();
-        let p: f64 = v
-            .tracks
-            .iter()
-            .map(|t| t.normal_force * t.slip_speed)
-            .sum();
+        let p: f64 = v.tracks.iter().map(|t| t.normal_force * t.slip_speed).sum();
         if let Some((tp, np, pp)) = self.prev {
             let dt = v.t - tp;
             self.normal_int += 0.5 * dt * (np + n);

@@ -221,8 +221,8 @@ mod tests {
             t_range_m: (f64::NEG_INFINITY, f64::INFINITY),
         };
         let f = PlacedFace::new(plane, Some(&extent), &Isometry3::identity());
-        let head = ConvexShape::rounded_box(Vector3::new(19.05e-3, 4.8e-3, 40e-3), 5e-4)
-            .expect("head");
+        let head =
+            ConvexShape::rounded_box(Vector3::new(19.05e-3, 4.8e-3, 40e-3), 5e-4).expect("head");
         let share = f.coverage(&head, &Isometry3::translation(0.0, 4.8e-3, 0.0));
         let exact = (19.05 - 5.115) / 38.1;
         assert!((share - exact).abs() < 1e-12, "{share} vs {exact}");

@@ -115,7 +115,10 @@ mod tests {
                         .filter(|p| p.local[axis] == side * inner[axis])
                         .map(|p| p.weight)
                         .sum();
-                    assert!((sum - 1.0).abs() < 1e-14, "n {n} axis {axis} side {side}: {sum}");
+                    assert!(
+                        (sum - 1.0).abs() < 1e-14,
+                        "n {n} axis {axis} side {side}: {sum}"
+                    );
                 }
             }
             assert!(pts.iter().all(|p| p.radius == 5e-4));

@@ -220,10 +220,7 @@ pub fn run_model(
                 },
             };
             entry.open = true;
-            if let Err(e) = entry
-                .acc
-                .push(v.t, tr.normal_force, tr.slip_speed, tr.area)
-            {
+            if let Err(e) = entry.acc.push(v.t, tr.normal_force, tr.slip_speed, tr.area) {
                 wear_error.get_or_insert(e);
             }
         }

@@ -155,9 +155,8 @@ impl TrackState {
 /// The force on body a is `F = n f_n(w, ẇ) + F_t(s, f_n)` at the point `p` (−F on b), with `w`
 /// the penetration of the point's ball, `ẇ` its rate and `s` the slip velocity at `p`: force,
 /// point and rates belong to the same material point, so the derivatives through `w`, `ẇ` and
-/// `s` are exact. Held fixed (second-order geometric terms, of relative size `F / (k_eff r)`
-/// against the contact stiffness, about 1e-4 on the rattle box): the turn of the normal at a
-/// face's edge, the lever of `p` in the torque, and the turn of the slip's lever.
+/// `s` are exact, and [`MultibodySystem::contact_jacobian`](super::system::MultibodySystem::contact_jacobian) adds the terms through the point's
+/// motion. Held fixed: the turn of the normal at a face's edge or with body b.
 #[derive(Debug, Clone, Copy)]
 pub struct TrackLinearization {
     /// Body carrying the pieces (force +F).
@@ -168,6 +167,10 @@ pub struct TrackLinearization {
     pub deepest_point: Point3<f64>,
     /// Where F acts (the same point), world.
     pub point: Point3<f64>,
+    /// Centre of the point's ball (the material point of body a), world.
+    pub centre: Point3<f64>,
+    /// The force on body a, N, world.
+    pub force: Vector3<f64>,
     /// Contact normal (out of b), world.
     pub normal: Vector3<f64>,
     /// ∂f_n/∂w, N/m.
@@ -485,13 +488,19 @@ impl Contact {
                     if let Some(lin) = linearizations.as_deref_mut() {
                         if fn_mag > 0.0 {
                             let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
-                            let (dforce_dfn, dforce_dslip) =
-                                friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag);
+                            let (dforce_dfn, dforce_dslip) = friction_derivatives(
+                                self.friction.as_ref(),
+                                &normal,
+                                &slip,
+                                fn_mag,
+                            );
                             lin.push(TrackLinearization {
                                 body_a: self.body_a,
                                 body_b: self.body_b,
                                 deepest_point: p,
                                 point: p,
+                                centre,
+                                force,
                                 normal,
                                 dfn_dw: beta * dfn_dw,
                                 dfn_dwdot: beta * dfn_dwdot,

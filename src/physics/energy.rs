@@ -233,7 +233,13 @@ mod tests {
         assert!(a.residual_j.abs() < 1e-6 && a.balanced);
         assert_eq!(a.max_rise_without_drive_j, 0.0);
         // Energy that appears from nowhere: unbalanced, and the rise is measured.
-        m.record(1.001, (-1.0f64).exp() + 0.1, &PowerBalance::default(), &[], None);
+        m.record(
+            1.001,
+            (-1.0f64).exp() + 0.1,
+            &PowerBalance::default(),
+            &[],
+            None,
+        );
         let a = m.audit();
         assert!(!a.balanced);
         assert!((a.max_rise_without_drive_j - 0.1).abs() < 1e-3);

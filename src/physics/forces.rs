@@ -301,8 +301,8 @@ impl ForceElement {
                 // torque doing −dU/dt is −(w Kθ + v × Kθ) (−Kθ alone creates energy at third
                 // order in the angle).
                 let k_theta = s.rotational_stiffness.component_mul(&theta);
-                let t_local = -(k_theta * w + v.cross(&k_theta))
-                    - s.rotational_damping.component_mul(&wrel);
+                let t_local =
+                    -(k_theta * w + v.cross(&k_theta)) - s.rotational_damping.component_mul(&wrel);
                 let t = rj_b * t_local;
                 wrenches[s.a.body].1 += t;
                 wrenches[s.b.body].1 -= t;
