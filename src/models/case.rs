@@ -115,6 +115,7 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
             abs_rotation: a / 0.01,
             abs_velocity_m_s: a * 1e3,
             abs_angular_velocity_rad_s: a * 1e5,
+            ..Tolerances::default()
         },
         initial_step_s: 1e-6,
         max_step_s: 1e-3,

@@ -77,6 +77,21 @@ pub struct Tolerances {
     pub abs_velocity_m_s: f64,
     /// Absolute tolerance on angular velocities, rad/s. Default 1e-3 rad/s.
     pub abs_angular_velocity_rad_s: f64,
+    /// Relative tolerance on each step's dissipated and drive work (TR-BDF2), dimensionless:
+    /// the energy account's works are quadratures of the power terms like the state's own
+    /// (the integrator's weights at the step's start, stage and end), and a step is accepted
+    /// only if the embedded estimate of that quadrature's error is within this share of the
+    /// step's work (+ [`ENERGY_ABS_TOLERANCE_J`]). Default 1e-3, so the account closes to
+    /// well within 0.5 % of the dissipated work; 0 switches the check off.
+    #[serde(default = "default_energy_rel")]
+    pub energy_rel: f64,
+}
+
+/// Absolute floor of the per-step work tolerance, J (a picojoule per step needs no resolving).
+pub const ENERGY_ABS_TOLERANCE_J: f64 = 1e-12;
+
+fn default_energy_rel() -> f64 {
+    1e-3
 }
 
 impl Default for Tolerances {
@@ -87,6 +102,7 @@ impl Default for Tolerances {
             abs_rotation: 1e-7,
             abs_velocity_m_s: 1e-5,
             abs_angular_velocity_rad_s: 1e-3,
+            energy_rel: default_energy_rel(),
         }
     }
 }
@@ -100,6 +116,7 @@ impl Tolerances {
             abs_rotation: self.abs_rotation * factor,
             abs_velocity_m_s: self.abs_velocity_m_s * factor,
             abs_angular_velocity_rad_s: self.abs_angular_velocity_rad_s * factor,
+            energy_rel: self.energy_rel * factor,
         }
     }
 }
@@ -354,6 +371,8 @@ pub struct Integrator {
     /// Power terms at the last attempt's interior stage (TR-BDF2: t + γh), for the energy
     /// account's quadrature ([`Integrator::interior_stage`]).
     stage: Option<InteriorStage>,
+    /// Power terms at the start of the current step (the accepted state).
+    power_start: super::system::PowerBalance,
 }
 
 /// The power terms at a step's interior stage and the method's quadrature weights: the
@@ -438,6 +457,7 @@ impl Integrator {
             k_prev: v(),
             prev_h: 0.0,
             stage: None,
+            power_start: Default::default(),
         }
     }
 
@@ -514,6 +534,7 @@ impl Integrator {
         } else {
             self.rhs(sys, ws, t, y, 0);
         }
+        self.power_start = ws.power;
     }
 
     fn frozen_patches(&self) -> bool {
@@ -865,10 +886,36 @@ impl Integrator {
         self.solve_in_place(&mut e);
         let norm = self.error_norm(&e, y, h);
         self.err = e;
+        let energy = self.energy_error_norm(ws, h, [TRB_W - b1, TRB_W - b2, TRB_D - b3]);
         Ok(Attempt {
-            err_norm: norm,
+            err_norm: norm.max(energy),
             newton_failed: false,
         })
+    }
+
+    /// The energy account's quadrature error on this attempt over its tolerance
+    /// ([`Tolerances::energy_rel`]): the embedded estimate `h Σ (w_i − b_i) P_i` of the
+    /// dissipated and the drive power against the step's work. `ws.power` holds the attempt's
+    /// last evaluation (its end).
+    fn energy_error_norm(&self, ws: &Workspace, h: f64, err_weights: [f64; 3]) -> f64 {
+        let rel = self.settings.tolerances.energy_rel;
+        let Some(stage) = self.stage.as_ref().filter(|_| rel > 0.0) else {
+            return 0.0;
+        };
+        let p = [self.power_start, stage.power, ws.power];
+        let [w0, w1, w2] = stage.weights;
+        let mut err = 0.0;
+        let mut work = 0.0;
+        for term in [
+            |q: &super::system::PowerBalance| q.dissipation(),
+            |q: &super::system::PowerBalance| q.drive,
+        ] {
+            let v = [term(&p[0]), term(&p[1]), term(&p[2])];
+            err +=
+                (h * (err_weights[0] * v[0] + err_weights[1] * v[1] + err_weights[2] * v[2])).abs();
+            work += h * (w0 * v[0].abs() + w1 * v[1].abs() + w2 * v[2].abs());
+        }
+        err / (rel * work + ENERGY_ABS_TOLERANCE_J)
     }
 
     /// Keeps the power terms of the stage just solved (the workspace holds its last Newton
@@ -1102,6 +1149,8 @@ impl Integrator {
                     _ => {
                         self.k[0].copy_from_slice(&self.fz);
                         sys.rescale_quaternion_rates(&self.ynew, &mut self.k[0]);
+                        // The last Newton evaluation was at the accepted state.
+                        self.power_start = ws.power;
                     }
                 }
                 self.jac_fresh = false;
