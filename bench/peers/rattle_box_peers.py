@@ -455,7 +455,11 @@ def main():
     ap.add_argument("--drake-hc", type=float, default=50.0, help="Hunt-Crossley dissipation, s/m")
     ap.add_argument("--drake-approx", default="lagged", help="discrete contact approximation")
     ap.add_argument("--repeats", type=int, default=3, help="MuJoCo timing repeats (best is reported)")
+    ap.add_argument("--inner-side-in", type=float, default=1.25,
+                    help="tube inner side, in (thesis Table 5.1: A 2.0, B 1.5, C 1.25, D 1.125)")
     args = ap.parse_args()
+    global TUBE_INNER
+    TUBE_INNER = args.inner_side_in * 0.0254
 
     core = pin_one_core()
     log(f"pinned to core {core}" if core is not None else "could not pin to one core")
