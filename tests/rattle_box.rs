@@ -43,6 +43,23 @@ fn halving_tolerances_changes_friction_power_by_less_than_two_percent() {
     });
     let change =
         (p2.mean_friction_power_w - p1.mean_friction_power_w).abs() / p1.mean_friction_power_w;
+    let (w1, w2) = (
+        p1.contacts[0].mass_rate_mg_per_h,
+        p2.contacts[0].mass_rate_mg_per_h,
+    );
+    let wear_change = (w2 - w1).abs() / w1;
+    eprintln!(
+        "16 s halving: friction power {:.5} / {:.5} W ({:.2} %), wear {w1:.5} / {w2:.5} mg/h ({:.2} %)",
+        p1.mean_friction_power_w,
+        p2.mean_friction_power_w,
+        100.0 * change,
+        100.0 * wear_change
+    );
+    assert!(
+        wear_change < 0.02,
+        "wear per contact changes by {:.2} %",
+        100.0 * wear_change
+    );
     assert!(
         change < 0.02,
         "friction power {} W vs {} W: {:.2} %",

@@ -534,6 +534,10 @@ pub fn build(
         .with_face_extents(chamber_extents()),
     ];
 
+    let contacts = contacts
+        .into_iter()
+        .map(|c| c.with_points_per_edge(case.simulation.contact_points_per_edge))
+        .collect();
     let system = MultibodySystem::new(
         vec![missile, latch, rail],
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),

@@ -112,7 +112,8 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         impact,
         Some(spec.friction.to_friction_params()),
     )
-    .with_face_extents(extents);
+    .with_face_extents(extents)
+    .with_points_per_edge(case.simulation.contact_points_per_edge);
     let system = MultibodySystem::new(
         vec![cube, tube],
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),

@@ -368,7 +368,7 @@ impl MultibodySystem {
                         dtau_dtheta += tau.cross_matrix();
                     }
                     let dtau_dq = dtau_dtheta * theta_of_q;
-                    let blocks: [(usize, &[f64], Option<&[f64]>); 4] = [
+                    let blocks: [JacobianBlock; 4] = [
                         (0, df_dx.as_slice(), Some(dtau_dx.as_slice())),
                         (3, df_dq.as_slice(), Some(dtau_dq.as_slice())),
                         (7, df_dv.as_slice(), None),
@@ -477,6 +477,10 @@ impl MultibodySystem {
         k
     }
 }
+
+/// A block of state columns (first column, the force's 3 × c derivative, column-major, and the
+/// torque's at fixed force when the lever moves) in [`MultibodySystem::contact_jacobian`].
+type JacobianBlock<'a> = (usize, &'a [f64], Option<&'a [f64]>);
 
 /// Length of the quaternion of the body at `offset`, when positive and finite.
 fn quaternion_norm(y: &[f64], offset: usize) -> Option<f64> {
