@@ -57,8 +57,9 @@ pub trait CaseRunner: Send + Sync {
         control: &RunControl,
     ) -> Result<JobOutput, RunError>;
 
-    /// Cheap check at submission so a bad request gets a 422 naming the field instead of a
-    /// failed job. The default accepts everything and leaves checks to [`CaseRunner::run`].
+    /// Check at submission (on a blocking thread) so a bad request gets a 422 naming the field
+    /// instead of a failed job. It should be the same parse [`CaseRunner::run`] does
+    /// ([`LibraryRunner::plan`]). The default accepts everything.
     fn validate(&self, _kind: &JobKind, _params: &serde_json::Value) -> Result<(), RunError> {
         Ok(())
     }
