@@ -155,6 +155,27 @@ async fn shutdown_signal() {
     let _ = tokio::signal::ctrl_c().await;
 }
 
+/// Resolve the configs directory to an absolute path and log it with the database URL
+/// (password redacted); warn when the directory holds no model configs (started outside the
+/// repository without `RAILWEAR_CONFIGS_DIR`).
+fn log_start_up(config: &mut ServiceConfig) {
+    config.configs_dir = config.resolved_configs_dir();
+    let models = railwear::config::reference_config_names(&config.configs_dir);
+    tracing::info!(
+        database = %config.redacted_database_url(),
+        configs_dir = %config.configs_dir.display(),
+        model_configs = models.len(),
+        "settings resolved"
+    );
+    if models.is_empty() {
+        tracing::warn!(
+            configs_dir = %config.configs_dir.display(),
+            "no model configs in the configs directory: jobs naming a config will be refused; \
+             set RAILWEAR_CONFIGS_DIR or configs_dir"
+        );
+    }
+}
+
 async fn serve(
     mut config: ServiceConfig,
     listen: Option<String>,
@@ -168,6 +189,7 @@ async fn serve(
         config.workers = workers;
     }
     init_logging(config.log_format == "json");
+    log_start_up(&mut config);
     let runner = Arc::new(LibraryRunner {
         configs_dir: config.configs_dir.clone(),
     });
@@ -194,6 +216,7 @@ async fn worker(
         config.workers = workers;
     }
     init_logging(config.log_format == "json");
+    log_start_up(&mut config);
     let store = railwear::store::open(&config.database_url)
         .await
         .context("opening the job database")?;

@@ -92,12 +92,203 @@ pub fn merge_json(base: &mut serde_json::Value, patch: &serde_json::Value) {
     }
 }
 
-/// Resolves job parameters to a case: `{"config": "<reference name>" | {inline case},
-/// "overrides": {...}, "seed": n}`. Overrides deep-merge into the case (e.g.
-/// `{"simulation": {"duration_s": 0.5}}`); `seed` sets `simulation.seed`.
-pub fn case_from_params(
+/// Bounds on job parameters, each with its physical or operational reason. They are checked
+/// by the parsers below, which both the submission (422 before anything is stored) and the
+/// worker call: one set of rules.
+pub mod limits {
+    /// Longest excited duration of a job, s: 24 h of simulated time. The thesis' longest run is
+    /// the 12 h launcher validation (6.7); beyond a day a run is a typing error (1e308 s was
+    /// once accepted and grew memory without end).
+    pub const MAX_DURATION_S: f64 = 86_400.0;
+    /// Longest settle phase, s: ten minutes, well past the tens-of-seconds creep time constant
+    /// of a body resting on a face (SPEC 8); the thesis settles for 2 s (6.6.1).
+    pub const MAX_SETTLE_S: f64 = 600.0;
+    /// Shortest track-record interval, s: 1 us resolves a 500 Hz excitation 2000 times over;
+    /// finer only multiplies stored samples.
+    pub const MIN_RECORD_INTERVAL_S: f64 = 1.0e-6;
+    /// Most recorded time points of one run (`(settle_s + duration_s) / record_interval_s`):
+    /// tracks are held in memory until stored, about 150 bytes a sample and contact.
+    pub const MAX_RECORDED_POINTS: f64 = 1.0e7;
+    /// Relative error tolerance range: looser than 10 % is no error control; tighter than
+    /// 1e-10 is below what double precision holds over a run.
+    pub const REL_TOLERANCE_RANGE: (f64, f64) = (1.0e-10, 0.1);
+    /// Absolute position tolerance range, m: coarser than 0.1 mm does not resolve the 0.2 mm
+    /// clearance of the tight rail; finer than 1e-15 m is below double precision on metres.
+    pub const ABS_TOLERANCE_M_RANGE: (f64, f64) = (1.0e-15, 1.0e-4);
+    /// Points of a tolerance sweep: at least 2 (a curve needs two ends), at most 50 (each
+    /// point is a full launcher simulation).
+    pub const SWEEP_POINTS: std::ops::RangeInclusive<u64> = 2..=50;
+    /// Largest seed, 2^53 - 1: every seed a JSON reader parses into a double (JavaScript, jq)
+    /// is then exact, so a run can be reproduced from what a dashboard shows.
+    pub const MAX_SEED: u64 = (1 << 53) - 1;
+    /// Material density range of a wear calibration, kg/m³: from polymers to the densest
+    /// metals (osmium 22 590).
+    pub const DENSITY_KG_M3_RANGE: (f64, f64) = (500.0, 25_000.0);
+    /// Largest wear-law cutoff pressure, Pa: 10 GPa, above the hardness of any engineering
+    /// alloy (7075-T73: 2 S_y = 870 MPa).
+    pub const MAX_CUTOFF_PRESSURE_PA: f64 = 1.0e10;
+    /// Most records of one calibration data set (a request body holds them anyway).
+    pub const MAX_CALIBRATION_RECORDS: usize = 100_000;
+}
+
+/// Parameters of a simulate job.
+pub const SIMULATE_KEYS: &[&str] = &["config", "overrides", "seed"];
+/// Parameters of a sweep job (`point` only in the `sweep_point` children the sweep creates).
+pub const SWEEP_KEYS: &[&str] = &[
+    "config",
+    "overrides",
+    "seed",
+    "points",
+    "vehicle_profile",
+    "environment",
+    "wear_law",
+];
+/// Parameters of a calibrate job.
+pub const CALIBRATE_KEYS: &[&str] = &["friction", "wear_law", "seed"];
+
+/// The params object, refusing keys outside `allowed` (a typo such as `confg` is an error,
+/// not silently ignored).
+pub fn check_keys<'a>(
+    value: &'a serde_json::Value,
+    field: &str,
+    allowed: &[&str],
+) -> Result<&'a serde_json::Map<String, serde_json::Value>, RunError> {
+    let map = value
+        .as_object()
+        .ok_or_else(|| invalid(field, "must be a JSON object"))?;
+    for key in map.keys() {
+        if !allowed.contains(&key.as_str()) {
+            let path = if field == "params" {
+                key.clone()
+            } else {
+                format!("{field}.{key}")
+            };
+            return Err(invalid(
+                &path,
+                format!("is not a known parameter (known: {})", allowed.join(", ")),
+            ));
+        }
+    }
+    Ok(map)
+}
+
+/// A seed: an integer in [0, 2^53).
+pub fn parse_seed(value: &serde_json::Value) -> Result<u64, RunError> {
+    value
+        .as_u64()
+        .filter(|s| *s <= limits::MAX_SEED)
+        .ok_or_else(|| {
+            invalid(
+                "seed",
+                "must be an integer in [0, 2^53) (JavaScript reads larger integers inexactly)",
+            )
+        })
+}
+
+/// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
+fn sets_path(value: &serde_json::Value, path: &str) -> bool {
+    let mut v = value;
+    for part in path.split('.') {
+        match v.get(part) {
+            Some(next) => v = next,
+            None => return false,
+        }
+    }
+    true
+}
+
+/// Where a case field's value came from, as a params path: the overrides when they set it (or
+/// a parent of it), otherwise the config.
+fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
+    let field = case_field.trim_matches('.');
+    if field.is_empty() || field == "toml" {
+        return "config".into();
+    }
+    if let Some(over) = overrides {
+        let parts: Vec<&str> = field.split('.').collect();
+        for n in (1..=parts.len()).rev() {
+            if sets_path(over, &parts[..n].join(".")) {
+                return format!("overrides.{field}");
+            }
+        }
+    }
+    format!("config.{field}")
+}
+
+/// Checks the run-control bounds of [`limits`]; the error's field is a case path.
+fn check_simulation_bounds(case: &CaseSpec) -> Result<(), (String, String)> {
+    let s = &case.simulation;
+    let bad = |field: &str, rule: String| Err((format!("simulation.{field}"), rule));
+    if !(s.duration_s.is_finite() && s.duration_s > 0.0 && s.duration_s <= limits::MAX_DURATION_S) {
+        return bad(
+            "duration_s",
+            format!(
+                "must be > 0 and <= {} s (24 h of simulated time), got {}",
+                limits::MAX_DURATION_S,
+                s.duration_s
+            ),
+        );
+    }
+    if !(s.settle_s.is_finite() && s.settle_s >= 0.0 && s.settle_s <= limits::MAX_SETTLE_S) {
+        return bad(
+            "settle_s",
+            format!(
+                "must be >= 0 and <= {} s (past the contact creep time constant), got {}",
+                limits::MAX_SETTLE_S,
+                s.settle_s
+            ),
+        );
+    }
+    let (lo, hi) = limits::REL_TOLERANCE_RANGE;
+    if !(s.rel_tolerance >= lo && s.rel_tolerance <= hi) {
+        return bad(
+            "rel_tolerance",
+            format!("must lie in [{lo:e}, {hi}], got {}", s.rel_tolerance),
+        );
+    }
+    let (lo, hi) = limits::ABS_TOLERANCE_M_RANGE;
+    if !(s.abs_tolerance_m >= lo && s.abs_tolerance_m <= hi) {
+        return bad(
+            "abs_tolerance_m",
+            format!("must lie in [{lo:e}, {hi:e}] m, got {}", s.abs_tolerance_m),
+        );
+    }
+    let dt = s.record_interval_s;
+    if !(dt.is_finite() && dt >= limits::MIN_RECORD_INTERVAL_S && dt <= s.duration_s) {
+        return bad(
+            "record_interval_s",
+            format!(
+                "must lie in [{:e} s, duration_s], got {dt}",
+                limits::MIN_RECORD_INTERVAL_S
+            ),
+        );
+    }
+    let points = (s.settle_s + s.duration_s) / dt;
+    if points > limits::MAX_RECORDED_POINTS {
+        return bad(
+            "record_interval_s",
+            format!(
+                "records {points:.3e} time points over settle_s + duration_s; at most {:e} \
+                 are kept in memory: raise record_interval_s or shorten the run",
+                limits::MAX_RECORDED_POINTS
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
+/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check). Overrides
+/// deep-merge into the case (e.g. `{"simulation": {"duration_s": 0.5}}`); `seed` sets
+/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
+/// excitation). The case is checked completely: unknown keys anywhere, the model's own rules,
+/// the bounds of [`limits`], and the model is built once (excitation, geometry, integrator),
+/// so an accepted job does not fail on its configuration later. Errors name the params path
+/// (`config`, `config.<path>` or `overrides.<path>`).
+pub fn resolve_case(
     params: &serde_json::Value,
     configs_dir: &Path,
+    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
 ) -> Result<CaseSpec, RunError> {
     let mut value = match params.get("config") {
         Some(serde_json::Value::String(name)) => {
@@ -120,25 +311,51 @@ pub fn case_from_params(
             ))
         }
     };
-    if let Some(over) = params.get("overrides") {
+    let overrides = params.get("overrides");
+    if let Some(over) = overrides {
         if !over.is_object() {
             return Err(invalid("overrides", "must be an object"));
         }
         merge_json(&mut value, over);
     }
     if let Some(seed) = params.get("seed") {
-        let seed = seed
-            .as_u64()
-            .ok_or_else(|| invalid("seed", "must be a non-negative integer"))?;
+        let seed = parse_seed(seed)?;
         merge_json(
             &mut value,
             &serde_json::json!({"simulation": {"seed": seed}}),
         );
     }
-    let case: CaseSpec =
-        serde_json::from_value(value).map_err(|e| invalid("config", e.to_string()))?;
-    case.validate()?;
+    let mut case: CaseSpec = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        invalid(&locate(&path, overrides), e.into_inner().to_string())
+    })?;
+    adjust(&mut case)?;
+    let relocate = |e: RunError| match e {
+        RunError::InvalidConfig { field, rule } => RunError::InvalidConfig {
+            field: locate(&field, overrides),
+            rule,
+        },
+        other => other,
+    };
+    case.validate().map_err(|e| relocate(e.into()))?;
+    check_simulation_bounds(&case).map_err(|(field, rule)| relocate(invalid(&field, rule)))?;
+    crate::models::case::run_options(&case).map_err(relocate)?;
+    crate::models::case::build(&case, configs_dir).map_err(relocate)?;
     Ok(case)
+}
+
+/// [`resolve_case`] without adjustment (the params' other keys are not checked).
+pub fn case_from_params(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+) -> Result<CaseSpec, RunError> {
+    resolve_case(params, configs_dir, |_| Ok(()))
+}
+
+/// A simulate job's params, parsed and checked: [`SIMULATE_KEYS`] only, `config` required.
+pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
+    check_keys(params, "params", SIMULATE_KEYS)?;
+    case_from_params(params, configs_dir)
 }
 
 /// A simulate job: one case end to end.
@@ -147,7 +364,7 @@ pub fn simulate(
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<CaseOutcome, RunError> {
-    let case = case_from_params(params, configs_dir)?;
+    let case = simulate_case(params, configs_dir)?;
     let (_, outcome) = run_case(&case, configs_dir, control)?;
     Ok(outcome)
 }
@@ -185,40 +402,211 @@ pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Vehicle profile of a sweep when its params name none (the service fills in its own default
+/// from `[report]` before storing a sweep).
+pub const DEFAULT_VEHICLE_PROFILE: &str = "ah64";
+/// Environment of a sweep when its params name none.
+pub const DEFAULT_ENVIRONMENT: &str = "clean";
+/// Wear law of a sweep when its params name none.
+pub const DEFAULT_WEAR_LAW: &str = "modified-archard";
+/// Vehicle-profile names that are not file stems: `ah64` is the AH-64 transverse
+/// sine-on-random of `configs/profiles/ah64-transverse.toml`.
+pub const VEHICLE_PROFILE_ALIASES: &[(&str, &str)] = &[("ah64", "ah64-transverse")];
+/// Environments the wear model represents: only clean, dry contacts (third-body abrasion by
+/// sand or dust is not modelled, SPEC 7).
+pub const ENVIRONMENTS: &[&str] = &["clean"];
+/// Wear-law names of a sweep and what they select: `modified-archard` (eq. 3.10-3.15; Table
+/// 4.3 unless the config gives other constants), `archard` (eq. 3.8; the config or overrides
+/// must give `wear.law = {kind = "archard", coefficient_m2_per_n = ..}`), `legacy-appendix`
+/// (the thesis' appendix C code with Table 4.3).
+pub const WEAR_LAWS: &[&str] = &["modified-archard", "archard", "legacy-appendix"];
+
+/// Vehicle profiles a sweep may name: the aliases and every profile file in
+/// `<configs_dir>/profiles`, sorted.
+pub fn vehicle_profile_names(configs_dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = VEHICLE_PROFILE_ALIASES
+        .iter()
+        .map(|(alias, _)| alias.to_string())
+        .collect();
+    names.extend(crate::config::reference_config_names(
+        &configs_dir.join("profiles"),
+    ));
+    names.sort();
+    names.dedup();
+    names
+}
+
+/// The profile file stem (`configs/profiles/<stem>.toml`) a vehicle-profile name selects.
+pub fn vehicle_profile_file(configs_dir: &Path, name: &str) -> Result<String, RunError> {
+    let stem = VEHICLE_PROFILE_ALIASES
+        .iter()
+        .find(|(alias, _)| *alias == name)
+        .map_or(name, |(_, stem)| stem);
+    let dir = configs_dir.join("profiles");
+    match crate::config::reference_config_path(&dir, stem) {
+        Ok(_) => Ok(stem.to_string()),
+        Err(_) => Err(invalid(
+            "vehicle_profile",
+            format!(
+                "`{name}` is not a vehicle profile in {} (known: {})",
+                dir.display(),
+                vehicle_profile_names(configs_dir).join(", ")
+            ),
+        )),
+    }
+}
+
+/// The wear-law name of a law (see [`WEAR_LAWS`]).
+pub fn wear_law_name(law: &crate::wear::law::WearLaw) -> &'static str {
+    use crate::wear::law::WearLaw;
+    match law {
+        WearLaw::Modified { .. } => "modified-archard",
+        WearLaw::Archard { .. } => "archard",
+        WearLaw::LegacyAppendix { .. } => "legacy-appendix",
+    }
+}
+
+/// Makes the case's wear law the one `name` selects: a case whose law already is of that kind
+/// keeps its constants; a case on one of the Table 4.3 presets moves to the other preset;
+/// anything else (an Archard law without a coefficient) is refused.
+fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
+    use crate::wear::law::WearLaw;
+    if !WEAR_LAWS.contains(&name) {
+        return Err(invalid(
+            "wear_law",
+            format!(
+                "`{name}` is not a wear law (known: {})",
+                WEAR_LAWS.join(", ")
+            ),
+        ));
+    }
+    let current = case.wear.law;
+    if wear_law_name(&current) == name {
+        return Ok(());
+    }
+    let preset = current == WearLaw::table_4_3() || current == WearLaw::legacy_table_4_3();
+    case.wear.law = match name {
+        "modified-archard" if preset => WearLaw::table_4_3(),
+        "legacy-appendix" if preset => WearLaw::legacy_table_4_3(),
+        _ => {
+            return Err(invalid(
+                "wear_law",
+                format!(
+                    "`{name}` does not match the config's wear law ({}); give its constants in \
+                     overrides.wear.law (e.g. {{\"kind\": \"archard\", \
+                     \"coefficient_m2_per_n\": 1e-15}})",
+                    wear_law_name(&current)
+                ),
+            ))
+        }
+    };
+    Ok(())
+}
+
 /// A planned tolerance sweep: the launcher case every point starts from and the
 /// material-condition offsets of its points. Built from a sweep job's params alone, so the
 /// sequential [`sweep`] and each `sweep_point` child job of a fanned-out sweep agree on it.
 #[derive(Debug, Clone)]
 pub struct SweepPlan {
     /// The launcher case of `params.config` (default `launcher-design`) with `overrides` and
-    /// `seed` applied; each point replaces its launcher dimensions.
+    /// `seed` applied, its excitation the vehicle profile's and its wear law the one named;
+    /// each point replaces its launcher dimensions.
     pub base: CaseSpec,
     /// Material-condition offsets of the points, mm, tight to loose ([`sweep_offsets_mm`]).
     pub offsets_mm: Vec<f64>,
     /// Rattle space of the design dimensions (eq. 6.1-6.3), dimensionless.
     pub design_rattle_space: f64,
+    /// Vehicle profile (excitation) name, e.g. `ah64`.
+    pub vehicle_profile: String,
+    /// Environment name (`clean`).
+    pub environment: String,
+    /// Wear-law name ([`WEAR_LAWS`]).
+    pub wear_law: String,
+    /// `sweep_point` children: the point this child runs.
+    pub point: Option<usize>,
 }
 
 impl SweepPlan {
-    /// Plan the sweep of `params`: `config` (default `launcher-design`, must be a launcher case),
-    /// `overrides`, `seed`, `points` (default 5, 2..=50).
+    /// Plan the sweep of `params` ([`SWEEP_KEYS`], plus `point` for a child): `config`
+    /// (default `launcher-design`, must be a launcher case), `overrides`, `seed`, `points`
+    /// (default 5, [`limits::SWEEP_POINTS`]), `vehicle_profile` (selects the excitation: a
+    /// profile in `configs/profiles`, see [`vehicle_profile_file`]), `environment`
+    /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`resolve_case`]
+    /// applies to the base case.
     pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
-        let mut p = params.clone();
-        if p.get("config").is_none() {
-            merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
+        let mut keys = SWEEP_KEYS.to_vec();
+        keys.push("point");
+        check_keys(params, "params", &keys)?;
+        let text = |name: &str, default: &str| -> Result<String, RunError> {
+            match params.get(name) {
+                None => Ok(default.to_string()),
+                Some(serde_json::Value::String(s)) => Ok(s.clone()),
+                Some(_) => Err(invalid(name, "must be a string")),
+            }
+        };
+        let vehicle_profile = text("vehicle_profile", DEFAULT_VEHICLE_PROFILE)?;
+        let environment = text("environment", DEFAULT_ENVIRONMENT)?;
+        let wear_law = text("wear_law", DEFAULT_WEAR_LAW)?;
+        let profile_file = vehicle_profile_file(configs_dir, &vehicle_profile)?;
+        if !ENVIRONMENTS.contains(&environment.as_str()) {
+            return Err(invalid(
+                "environment",
+                format!(
+                    "`{environment}` is not modelled (known: {}; sand or dust abrasion is not \
+                     part of the wear model)",
+                    ENVIRONMENTS.join(", ")
+                ),
+            ));
         }
-        let base = case_from_params(&p, configs_dir)?;
-        if base.launcher.is_none() {
-            return Err(invalid("config", "a sweep needs a launcher case"));
+        if params
+            .get("overrides")
+            .is_some_and(|o| o.get("excitation").is_some())
+        {
+            return Err(invalid(
+                "overrides.excitation",
+                "a sweep's excitation is its vehicle_profile; remove it (or run simulate jobs)",
+            ));
         }
         let n = match params.get("points") {
             None => 5,
             Some(v) => v
                 .as_u64()
-                .filter(|n| (2..=50).contains(n))
-                .ok_or_else(|| invalid("points", "must be an integer in 2..=50"))?
-                as usize,
+                .filter(|n| limits::SWEEP_POINTS.contains(n))
+                .ok_or_else(|| {
+                    invalid(
+                        "points",
+                        format!(
+                            "must be an integer in {}..={}",
+                            limits::SWEEP_POINTS.start(),
+                            limits::SWEEP_POINTS.end()
+                        ),
+                    )
+                })? as usize,
         };
+        let point = match params.get("point") {
+            None => None,
+            Some(v) => Some(
+                v.as_u64()
+                    .filter(|i| *i < n as u64)
+                    .ok_or_else(|| invalid("point", format!("must be an integer below {n}")))?
+                    as usize,
+            ),
+        };
+        let mut p = params.clone();
+        if p.get("config").is_none() {
+            merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
+        }
+        let base = resolve_case(&p, configs_dir, |case| {
+            if case.launcher.is_none() {
+                return Err(invalid(
+                    "config",
+                    "a sweep varies launcher rail dimensions: it needs a launcher case \
+                     (launcher-tight, launcher-design, launcher-loose or an inline launcher)",
+                ));
+            }
+            case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
+            select_wear_law(case, &wear_law)
+        })?;
         let design_rattle_space = crate::analysis::rattle_space::LauncherDimensions::design()
             .rattle_space()
             .map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
@@ -226,6 +614,10 @@ impl SweepPlan {
             base,
             offsets_mm: sweep_offsets_mm(n),
             design_rattle_space,
+            vehicle_profile,
+            environment,
+            wear_law,
+            point,
         })
     }
 
@@ -318,6 +710,15 @@ pub fn sweep(
     control: &RunControl,
 ) -> Result<(serde_json::Value, SweepOutcome), RunError> {
     let plan = SweepPlan::from_params(params, configs_dir)?;
+    run_sweep(&plan, configs_dir, control)
+}
+
+/// Runs every point of a planned sweep in this process, tight to loose (see [`sweep`]).
+pub fn run_sweep(
+    plan: &SweepPlan,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<(serde_json::Value, SweepOutcome), RunError> {
     let total = plan.len() as f64;
     let mut points = Vec::with_capacity(plan.len());
     for i in 0..plan.len() {
@@ -335,27 +736,197 @@ pub fn sweep(
                 })
             }),
         };
-        points.push(sweep_point(&plan, i, configs_dir, &sub)?);
+        points.push(sweep_point(plan, i, configs_dir, &sub)?);
     }
     let outcome = plan.outcome(points);
     let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }
 
-/// A calibrate job (thesis 4.3-4.4). `{"friction": {"fixture": {...}, "records": [...]}}` fits
-/// eq. 4.5 to torque records (eq. 4.1-4.4); `{"wear_law": {"density_kg_m3": .., "cutoff_pressure_pa": ..,
-/// "records": [...]}}` fits K(sigma) (eq. 4.16-4.18). Either or both.
+/// Friction data of a calibrate job (thesis 4.3): the fixture and its torque records.
+#[derive(Debug, Clone)]
+pub struct FrictionData {
+    pub fixture: crate::analysis::calibration::Fixture,
+    pub records: Vec<crate::analysis::calibration::TorqueRecord>,
+}
+
+/// Wear-law data of a calibrate job (thesis 4.4): material density, cutoff and wear tests.
+#[derive(Debug, Clone)]
+pub struct WearLawData {
+    /// kg/m³ (default 2810, 7075-T73), within [`limits::DENSITY_KG_M3_RANGE`].
+    pub density_kg_m3: f64,
+    /// Pa (default 870e6, 2 S_y of 7075-T73), in (0, [`limits::MAX_CUTOFF_PRESSURE_PA`]].
+    pub cutoff_pressure_pa: f64,
+    pub records: Vec<crate::analysis::calibration::WearTestRecord>,
+}
+
+/// A calibrate job's params, parsed and checked ([`CALIBRATE_KEYS`]).
+#[derive(Debug, Clone)]
+pub struct CalibrateParams {
+    pub friction: Option<FrictionData>,
+    pub wear_law: Option<WearLawData>,
+}
+
+/// Typed records at `field` (an array of objects with exactly `keys`), 1 to
+/// [`limits::MAX_CALIBRATION_RECORDS`] of them.
+fn parse_records<T: serde::de::DeserializeOwned>(
+    value: Option<&serde_json::Value>,
+    field: &str,
+    keys: &[&str],
+) -> Result<Vec<T>, RunError> {
+    let items = value
+        .ok_or_else(|| invalid(field, "is required (an array of records)"))?
+        .as_array()
+        .ok_or_else(|| invalid(field, "must be an array of records"))?;
+    if items.is_empty() || items.len() > limits::MAX_CALIBRATION_RECORDS {
+        return Err(invalid(
+            field,
+            format!(
+                "must hold 1 to {} records, got {}",
+                limits::MAX_CALIBRATION_RECORDS,
+                items.len()
+            ),
+        ));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let at = format!("{field}[{i}]");
+            check_keys(item, &at, keys)?;
+            serde_json::from_value(item.clone()).map_err(|e| invalid(&at, e.to_string()))
+        })
+        .collect()
+}
+
+/// A number at `field` in `[lo, hi]`, or `default` when absent.
+fn bounded_number(
+    map: &serde_json::Map<String, serde_json::Value>,
+    name: &str,
+    field: &str,
+    default: f64,
+    (lo, hi): (f64, f64),
+    why: &str,
+) -> Result<f64, RunError> {
+    match map.get(name) {
+        None => Ok(default),
+        Some(v) => v
+            .as_f64()
+            .filter(|x| *x >= lo && *x <= hi)
+            .ok_or_else(|| invalid(field, format!("must be a number in [{lo}, {hi}] ({why})"))),
+    }
+}
+
+impl CalibrateParams {
+    /// `{"friction": {"fixture": {...}, "records": [...]}}` and/or `{"wear_law":
+    /// {"density_kg_m3": .., "cutoff_pressure_pa": .., "records": [...]}}`; unknown keys at
+    /// any level are refused, numbers bounded ([`limits`]), friction records checked as the
+    /// fit reads them (eq. 4.1-4.4) and at least 8 of them (the fit's minimum).
+    pub fn parse(params: &serde_json::Value) -> Result<Self, RunError> {
+        use crate::analysis::calibration as cal;
+        let map = check_keys(params, "params", CALIBRATE_KEYS)?;
+        if let Some(seed) = map.get("seed") {
+            parse_seed(seed)?;
+        }
+        let friction = match map.get("friction") {
+            None => None,
+            Some(f) => {
+                let f = check_keys(f, "friction", &["fixture", "records"])?;
+                let fixture_value = f
+                    .get("fixture")
+                    .ok_or_else(|| invalid("friction.fixture", "is required"))?;
+                check_keys(
+                    fixture_value,
+                    "friction.fixture",
+                    &["polar_inertia_kg_m2", "mean_radius_m"],
+                )?;
+                let fixture: cal::Fixture = serde_json::from_value(fixture_value.clone())
+                    .map_err(|e| invalid("friction.fixture", e.to_string()))?;
+                let records: Vec<cal::TorqueRecord> = parse_records(
+                    f.get("records"),
+                    "friction.records",
+                    &[
+                        "time_s",
+                        "angle_rad",
+                        "angular_velocity_rad_s",
+                        "normal_load_n",
+                        "input_torque_n_m",
+                    ],
+                )?;
+                if records.len() < 8 {
+                    return Err(invalid(
+                        "friction.records",
+                        "need at least 8 records (the friction fit's minimum)",
+                    ));
+                }
+                cal::friction_samples(&records, &fixture)
+                    .map_err(|e| invalid("friction.records", e.to_string()))?;
+                Some(FrictionData { fixture, records })
+            }
+        };
+        let wear_law = match map.get("wear_law") {
+            None => None,
+            Some(w) => {
+                let w = check_keys(
+                    w,
+                    "wear_law",
+                    &["density_kg_m3", "cutoff_pressure_pa", "records"],
+                )?;
+                let density_kg_m3 = bounded_number(
+                    w,
+                    "density_kg_m3",
+                    "wear_law.density_kg_m3",
+                    2810.0,
+                    limits::DENSITY_KG_M3_RANGE,
+                    "kg/m³, polymers to the densest metals",
+                )?;
+                let cutoff_pressure_pa = bounded_number(
+                    w,
+                    "cutoff_pressure_pa",
+                    "wear_law.cutoff_pressure_pa",
+                    870e6,
+                    (1.0, limits::MAX_CUTOFF_PRESSURE_PA),
+                    "Pa, up to 10 GPa, above any engineering alloy's hardness",
+                )?;
+                let records = parse_records(
+                    w.get("records"),
+                    "wear_law.records",
+                    &[
+                        "normal_load_n",
+                        "contact_pressure_pa",
+                        "sliding_distance_m",
+                        "wear_mass_kg",
+                    ],
+                )?;
+                Some(WearLawData {
+                    density_kg_m3,
+                    cutoff_pressure_pa,
+                    records,
+                })
+            }
+        };
+        if friction.is_none() && wear_law.is_none() {
+            return Err(invalid(
+                "params",
+                "give `friction` and/or `wear_law` calibration data",
+            ));
+        }
+        Ok(Self { friction, wear_law })
+    }
+}
+
+/// A calibrate job (thesis 4.3-4.4): [`CalibrateParams::parse`], then [`run_calibration`].
 pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunError> {
+    run_calibration(&CalibrateParams::parse(params)?)
+}
+
+/// Fits eq. 4.5 to torque records (eq. 4.1-4.4) and/or K(sigma) to wear tests (eq.
+/// 4.16-4.18).
+pub fn run_calibration(params: &CalibrateParams) -> Result<serde_json::Value, RunError> {
     use crate::analysis::calibration as cal;
     let mut out = serde_json::Map::new();
-    if let Some(f) = params.get("friction") {
-        let fixture: cal::Fixture =
-            serde_json::from_value(f.get("fixture").cloned().unwrap_or_default())
-                .map_err(|e| invalid("friction.fixture", e.to_string()))?;
-        let records: Vec<cal::TorqueRecord> =
-            serde_json::from_value(f.get("records").cloned().unwrap_or_default())
-                .map_err(|e| invalid("friction.records", e.to_string()))?;
-        let samples = cal::friction_samples(&records, &fixture)
+    if let Some(f) = &params.friction {
+        let samples = cal::friction_samples(&f.records, &f.fixture)
             .map_err(|e| invalid("friction.records", e.to_string()))?;
         let fit = cal::fit_friction(&samples, crate::physics::step::StepKind::Cycloidal)
             .map_err(|e| invalid("friction", e.to_string()))?;
@@ -364,30 +935,13 @@ pub fn calibrate(params: &serde_json::Value) -> Result<serde_json::Value, RunErr
             serde_json::to_value(fit).map_err(|e| invalid("friction", e.to_string()))?,
         );
     }
-    if let Some(w) = params.get("wear_law") {
-        let records: Vec<cal::WearTestRecord> =
-            serde_json::from_value(w.get("records").cloned().unwrap_or_default())
-                .map_err(|e| invalid("wear_law.records", e.to_string()))?;
-        let density = w
-            .get("density_kg_m3")
-            .and_then(serde_json::Value::as_f64)
-            .unwrap_or(2810.0);
-        let cutoff = w
-            .get("cutoff_pressure_pa")
-            .and_then(serde_json::Value::as_f64)
-            .unwrap_or(870e6);
-        let fit = cal::fit_wear_law(&records, density, cutoff)
+    if let Some(w) = &params.wear_law {
+        let fit = cal::fit_wear_law(&w.records, w.density_kg_m3, w.cutoff_pressure_pa)
             .map_err(|e| invalid("wear_law", e.to_string()))?;
         out.insert(
             "wear_law".into(),
             serde_json::to_value(fit).map_err(|e| invalid("wear_law", e.to_string()))?,
         );
-    }
-    if out.is_empty() {
-        return Err(invalid(
-            "params",
-            "give `friction` and/or `wear_law` calibration data",
-        ));
     }
     Ok(serde_json::Value::Object(out))
 }

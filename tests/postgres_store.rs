@@ -499,7 +499,13 @@ async fn script(store: &dyn Store) -> Vec<String> {
     assert_eq!(cancelled.items.len(), 3);
     log("counts", format!("{:?}", store.job_counts().await.unwrap()));
 
-    // Rails and measurements.
+    // Rails and measurements. The third is a back-filled older reading: recorded last,
+    // measured first; the latest measurement is still the first one (issue 17).
+    let measured = [
+        ("2024-01-02", 1_704_153_600_000_i64),
+        ("2024-01-02", 1_704_153_600_000),
+        ("2019-03-04", 1_551_657_600_000),
+    ];
     for (i, serial) in ["R-1", "R-2", "R-1"].iter().enumerate() {
         let m = store
             .add_measurement(NewMeasurement {
@@ -507,7 +513,8 @@ async fn script(store: &dyn Store) -> Vec<String> {
                 serial: serial.to_string(),
                 dimensions_mm: serde_json::json!({"w": 10.25 + i as f64}),
                 measured_by: "insp".into(),
-                measured_at: "2024-01-02".into(),
+                measured_at: measured[i].0.into(),
+                measured_ms: measured[i].1,
                 location: "depot".into(),
                 rattle_space: 0.01 * (i + 1) as f64,
                 recorded_by: "eng".into(),
@@ -551,7 +558,8 @@ async fn script(store: &dyn Store) -> Vec<String> {
         ),
     );
     let latest = store.latest_measurement("R-1").await.unwrap().unwrap();
-    assert_eq!(latest.id, Uuid::from_u128(0xabc2));
+    assert_eq!(latest.id, Uuid::from_u128(0xabc0));
+    assert_eq!(latest.measured_at, "2024-01-02");
 
     // Tokens (their ids are random: compare the rest).
     let t = store

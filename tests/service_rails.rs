@@ -197,6 +197,51 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
             ),
             (with(&|v| v["measured_by"] = json!("  ")), "measured_by"),
             (with(&|v| v["location"] = json!("")), "location"),
+            // Issue 17: days that do not exist, dates in the future.
+            (
+                with(&|v| v["measured_at"] = json!("2024-02-30")),
+                "measured_at",
+            ),
+            (
+                with(&|v| v["measured_at"] = json!("9999-12-31")),
+                "measured_at",
+            ),
+            // Issue 17: the shoe head narrower than the rail slot (the missile falls out).
+            (
+                with(&|v| v["dimensions_mm"]["a_shoe_mm"] = json!(10.0)),
+                "dimensions_mm.a_shoe_mm",
+            ),
+            // Issue 17: a 170 mm slot (and head) is not this rail class.
+            (
+                with(&|v| {
+                    v["dimensions_mm"]["b_rail_mm"] = json!(170.0);
+                    v["dimensions_mm"]["a_shoe_mm"] = json!(175.0);
+                }),
+                "dimensions_mm",
+            ),
+            // Issue 17: dimensions as an undocumented positional array of 14 numbers.
+            (
+                with(&|v| {
+                    let d = LauncherDimensions::design();
+                    v["dimensions_mm"] = json!([
+                        d.a_shoe_mm,
+                        d.f_shoe_mm,
+                        d.g_shoe_mm,
+                        d.h_shoe_mm,
+                        d.i_shoe_mm,
+                        d.j_shoe_mm,
+                        d.k_shoe_mm,
+                        d.l_shoe_mm,
+                        d.m_shoe_mm,
+                        d.n_shoe_mm,
+                        d.o_shoe_mm,
+                        d.b_rail_mm,
+                        d.n_rail_mm,
+                        d.q_rail_mm
+                    ]);
+                }),
+                "dimensions_mm",
+            ),
         ];
         for (body, field) in cases {
             let p = curl("POST", &url, Some(PLANNER), &[], Some(&body)).problem(422);
@@ -214,6 +259,28 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
             Some(&body),
         )
         .problem(400);
+        // Issue 17: "." and ".." (and anything not starting with a letter or digit) are not
+        // serials: a URL path resolves them away, so their report URL was unreachable.
+        for serial in ["%2E", "%2E%2E", ".hidden", "-R1"] {
+            let p = curl(
+                "POST",
+                &format!("{base}/v1/rails/{serial}/measurements"),
+                Some(PLANNER),
+                &[],
+                Some(&body),
+            )
+            .problem(400);
+            assert_eq!(p["field"], "serial", "{serial}: {p}");
+        }
+        let p = curl(
+            "POST",
+            &url,
+            Some(PLANNER),
+            &[],
+            Some(&with(&|v| v["dimensions_mm"] = json!([38.1, 16.23]))),
+        )
+        .problem(422);
+        assert!(p["detail"].as_str().unwrap().contains("positional"), "{p}");
         curl("POST", &url, Some(ENGINEER), &[], Some(&body)).problem(403);
         curl("POST", &url, None, &[], Some(&body)).problem(401);
         curl(
@@ -231,6 +298,48 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
         );
         let rails = curl("GET", &format!("{base}/v1/rails"), Some(PLANNER), &[], None).json();
         assert_eq!(rails["items"].as_array().unwrap().len(), 1);
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
+    let dir = TempDir::new("latest");
+    let service = start(test_config(&dir.db_url()), false).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let url = format!("{base}/v1/rails/R-7/measurements");
+        let post = |dims: LauncherDimensions, measured_at: &str| {
+            let mut v: serde_json::Value = serde_json::from_str(&measurement(dims)).unwrap();
+            v["measured_at"] = json!(measured_at);
+            let r = curl("POST", &url, Some(PLANNER), &[], Some(&v.to_string()));
+            assert_eq!(r.status, 201, "{}", r.body);
+            r.json()
+        };
+        let current = post(LauncherDimensions::loose(), "2024-05-01T08:30:00Z");
+        // A 2019 paper reading back-filled afterwards: recorded last, measured first.
+        let old = post(LauncherDimensions::design(), "2019-03-04");
+        let report = curl(
+            "GET",
+            &format!("{base}/v1/rails/R-7/report"),
+            Some(PLANNER),
+            &[],
+            None,
+        );
+        assert_eq!(report.status, 200, "{}", report.body);
+        let report = report.json();
+        assert_eq!(report["measurement"]["id"], current["id"], "{report}");
+        assert_eq!(report["rattle_space"], current["rattle_space"]);
+        // History shows both times for each measurement.
+        let history = curl("GET", &url, Some(PLANNER), &[], None).json();
+        let items = history["items"].as_array().unwrap();
+        assert_eq!(items.len(), 2);
+        for item in items {
+            assert!(item["measured_at"].is_string() && item["recorded_at"].is_string());
+        }
+        assert!(items.iter().any(|i| i["id"] == old["id"]));
     })
     .await
     .unwrap();

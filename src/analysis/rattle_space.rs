@@ -102,6 +102,13 @@ pub const MIN_PLAUSIBLE_DIMENSION_MM: f64 = 2.0;
 /// a shoe or channel dimension (most likely micrometres, or a typing error).
 pub const MAX_PLAUSIBLE_DIMENSION_MM: f64 = 178.0;
 
+/// Plausible range of each measured dimension, as a fraction of its design value
+/// ([`LauncherDimensions::design`]): every field must lie within ±50 % of it. Far wider than
+/// the manufacturing tolerance (±0.2 mm, [`TIGHT_MATERIAL_CONDITION_MM`] to
+/// [`LOOSE_MATERIAL_CONDITION_MM`]) and any wear, narrow enough to refuse another rail class
+/// or a slipped digit (a 170 mm slot in a rail designed for 10.23 mm).
+pub const PLAUSIBLE_FRACTION_OF_DESIGN: f64 = 0.5;
+
 /// Tolerance (material condition) offset of the tightest in-tolerance rail, mm
 /// (see [`LauncherDimensions::with_material_condition`]). Solved so that eq. 6.1-6.3 give the
 /// thesis' tight rattle space 0.8317 (thesis 6.4.2) to four decimals.
@@ -240,10 +247,12 @@ impl LauncherDimensions {
     ///    probably inches or metres entered as mm; above: larger than the missile);
     /// 3. the shoe is a T: head thickness < overall height at each station (`G < F`, `I < H`,
     ///    `K < J`, `M < L`) and neck width < head width (`N < A`, `O < A`);
-    /// 4. no interference: the neck is narrower than the slot (`N < B_rail`, `O < B_rail`, which
+    /// 4. the shoe is held: its head is wider than the slot (`A > B_rail`), or it pulls out;
+    /// 5. no interference: the neck is narrower than the slot (`N < B_rail`, `O < B_rail`, which
     ///    also makes the head narrower than the chamber, whose eq. 6.1 width is
     ///    `B_rail + A - mean(N, O)`), and the head is thinner than the chamber is high
-    ///    (`G, I, K, M < min(N_rail, Q_rail)`).
+    ///    (`G, I, K, M < min(N_rail, Q_rail)`);
+    /// 6. every field lies within [`PLAUSIBLE_FRACTION_OF_DESIGN`] (±50 %) of its design value.
     pub fn validate(&self) -> Result<(), RattleSpaceError> {
         for (field, value) in self.named_fields() {
             positive_finite(field, value)?;
@@ -285,6 +294,16 @@ impl LauncherDimensions {
                 ));
             }
         }
+        if self.a_shoe_mm <= self.b_rail_mm {
+            return Err(invalid(
+                "a_shoe_mm",
+                format!(
+                    "shoe head width {} mm must be wider than the rail slot b_rail_mm = {} mm: \
+                     a narrower head pulls out through the slot (the missile falls out)",
+                    self.a_shoe_mm, self.b_rail_mm
+                ),
+            ));
+        }
         for (neck_name, neck) in [("n_shoe_mm", self.n_shoe_mm), ("o_shoe_mm", self.o_shoe_mm)] {
             if neck >= self.a_shoe_mm {
                 return Err(invalid(
@@ -314,6 +333,20 @@ impl LauncherDimensions {
                     format!(
                         "interference: shoe head thickness {thick} mm must be smaller than the \
                          rail chamber height min(n_rail_mm, q_rail_mm) = {chamber} mm"
+                    ),
+                ));
+            }
+        }
+        let design = Self::design().named_fields();
+        for ((field, value), (_, nominal)) in self.named_fields().into_iter().zip(design) {
+            let lo = nominal * (1.0 - PLAUSIBLE_FRACTION_OF_DESIGN);
+            let hi = nominal * (1.0 + PLAUSIBLE_FRACTION_OF_DESIGN);
+            if !(lo..=hi).contains(&value) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{value} mm is outside the plausible range [{lo:.2}, {hi:.2}] mm (design \
+                         {nominal} mm +-50 %) of this rail class: a typing error or another rail"
                     ),
                 ));
             }
@@ -572,6 +605,35 @@ mod tests {
         .validate()
         .unwrap_err();
         assert!(err.to_string().contains("interference"), "{err}");
+    }
+
+    #[test]
+    fn assembly_and_plausible_ranges() {
+        let field_of = |d: LauncherDimensions| match d.validate().unwrap_err() {
+            RattleSpaceError::InvalidDimension { field, rule } => (field, rule),
+        };
+        let base = LauncherDimensions::design();
+        // Issue 17: a 10.0 mm head in a 10.23 mm slot falls out (neck 9.53 still fits).
+        let (field, rule) = field_of(LauncherDimensions {
+            a_shoe_mm: 10.0,
+            ..base
+        });
+        assert_eq!(field, "a_shoe_mm");
+        assert!(rule.contains("b_rail_mm"), "{rule}");
+        // A 170 mm slot: within the global [2, 178] mm but not this rail class.
+        let (field, rule) = field_of(LauncherDimensions {
+            b_rail_mm: 170.0,
+            a_shoe_mm: 175.0,
+            ..base
+        });
+        assert!(
+            field == "b_rail_mm" || field == "a_shoe_mm",
+            "{field}: {rule}"
+        );
+        assert!(rule.contains("plausible"), "{rule}");
+        // The named tolerance extremes stay valid.
+        assert!(LauncherDimensions::tight().validate().is_ok());
+        assert!(LauncherDimensions::loose().validate().is_ok());
     }
 
     #[test]

@@ -9,10 +9,19 @@ pub enum ReferenceError {
     /// Names are file stems: letters, digits, `-` and `_` only (no paths).
     #[error("config name `{0}` must use only letters, digits, '-' and '_'")]
     BadName(String),
-    /// No `<name>.toml` in the configs directory.
-    #[error("no reference config named `{0}`")]
-    Unknown(String),
+    /// No `<name>.toml` in the configs directory (`service` is the service's settings, not a
+    /// model). Names the directory searched and what it holds.
+    #[error("no reference config named `{name}` in {} (known: {})", dir.display(), if known.is_empty() { "none: is the configs directory right? set RAILWEAR_CONFIGS_DIR".to_string() } else { known.join(", ") })]
+    Unknown {
+        name: String,
+        dir: PathBuf,
+        known: Vec<String>,
+    },
 }
+
+/// Stem of the service settings file that shares the configs directory (`service.toml`): not
+/// a model config.
+pub const SERVICE_SETTINGS_STEM: &str = "service";
 
 /// Path of the reference config `name` (`<dir>/<name>.toml`), refusing anything that is not a
 /// plain file stem so a request cannot read outside the directory.
@@ -25,10 +34,14 @@ pub fn reference_config_path(dir: &Path, name: &str) -> Result<PathBuf, Referenc
         return Err(ReferenceError::BadName(name.to_string()));
     }
     let path = dir.join(format!("{name}.toml"));
-    if path.is_file() {
+    if name != SERVICE_SETTINGS_STEM && path.is_file() {
         Ok(path)
     } else {
-        Err(ReferenceError::Unknown(name.to_string()))
+        Err(ReferenceError::Unknown {
+            name: name.to_string(),
+            dir: dir.to_path_buf(),
+            known: reference_config_names(dir),
+        })
     }
 }
 
@@ -45,7 +58,7 @@ pub fn reference_config_names(dir: &Path) -> Vec<String> {
                 return None;
             }
             let stem = path.file_stem()?.to_str()?.to_string();
-            (stem != "service").then_some(stem)
+            (stem != SERVICE_SETTINGS_STEM).then_some(stem)
         })
         .collect();
     names.sort();
@@ -69,7 +82,24 @@ mod tests {
         ));
         assert!(matches!(
             reference_config_path(dir, "no-such-config"),
-            Err(ReferenceError::Unknown(_))
+            Err(ReferenceError::Unknown { .. })
         ));
+    }
+
+    #[test]
+    fn service_settings_are_not_a_model_and_the_error_names_the_directory() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+        assert!(dir.join("service.toml").is_file());
+        let err = reference_config_path(&dir, "service").unwrap_err();
+        assert!(matches!(err, ReferenceError::Unknown { .. }));
+        let text = err.to_string();
+        assert!(text.contains(&dir.display().to_string()), "{text}");
+        assert!(text.contains("rattle-box-c"), "{text}");
+        let empty = std::env::temp_dir().join(format!("railwear-noconfigs-{}", std::process::id()));
+        let text = reference_config_path(&empty, "rattle-box-c")
+            .unwrap_err()
+            .to_string();
+        assert!(text.contains(&empty.display().to_string()), "{text}");
+        assert!(text.contains("RAILWEAR_CONFIGS_DIR"), "{text}");
     }
 }

@@ -288,6 +288,24 @@ impl ServiceConfig {
         Ok(())
     }
 
+    /// `database_url` without its password (`postgres://user:***@host/db`), for logs.
+    pub fn redacted_database_url(&self) -> String {
+        redact_url_password(&self.database_url)
+    }
+
+    /// `configs_dir` made absolute (against the working directory) so logs and errors name
+    /// the directory actually searched.
+    pub fn resolved_configs_dir(&self) -> PathBuf {
+        let dir = if self.configs_dir.is_absolute() {
+            self.configs_dir.clone()
+        } else {
+            std::env::current_dir()
+                .map(|cwd| cwd.join(&self.configs_dir))
+                .unwrap_or_else(|_| self.configs_dir.clone())
+        };
+        dir.canonicalize().unwrap_or(dir)
+    }
+
     /// Number of worker threads to run (`workers`, or one per core when 0).
     pub fn worker_count(&self) -> usize {
         if self.workers > 0 {
@@ -297,6 +315,22 @@ impl ServiceConfig {
                 .map(|n| n.get())
                 .unwrap_or(1)
         }
+    }
+}
+
+/// A URL with the password of its userinfo replaced by `***` (no userinfo: unchanged).
+pub fn redact_url_password(url: &str) -> String {
+    let Some((scheme, rest)) = url.split_once("://") else {
+        return url.to_string();
+    };
+    let authority_end = rest.find(['/', '?', '#']).unwrap_or(rest.len());
+    let (authority, tail) = rest.split_at(authority_end);
+    match authority.rsplit_once('@') {
+        Some((userinfo, host)) => match userinfo.split_once(':') {
+            Some((user, _password)) => format!("{scheme}://{user}:***@{host}{tail}"),
+            None => url.to_string(),
+        },
+        None => url.to_string(),
     }
 }
 
@@ -341,5 +375,23 @@ mod tests {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/service.toml");
         let config = ServiceConfig::load(&path, true, |_| None).unwrap();
         assert_eq!(config.database_url, "sqlite://railwear.db?mode=rwc");
+    }
+
+    #[test]
+    fn database_url_passwords_are_not_logged() {
+        assert_eq!(
+            redact_url_password(
+                "postgres://railwear:s3cr%40t@db-host:5432/railwear?sslmode=require"
+            ),
+            "postgres://railwear:***@db-host:5432/railwear?sslmode=require"
+        );
+        assert_eq!(
+            redact_url_password("postgres://railwear@db-host/railwear"),
+            "postgres://railwear@db-host/railwear"
+        );
+        assert_eq!(
+            redact_url_password("sqlite://railwear.db?mode=rwc"),
+            "sqlite://railwear.db?mode=rwc"
+        );
     }
 }

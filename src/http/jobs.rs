@@ -2,7 +2,7 @@
 
 use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
-use super::problem::{ApiJson, Problem};
+use super::problem::{read_json, Problem};
 use super::AppState;
 use crate::jobs::{ChildCounts, JobKind, JobProgress, JobRecord, JobStatus, SubmitError};
 use crate::physics::track::TrackSample;
@@ -34,12 +34,24 @@ pub fn router() -> Router<AppState> {
 pub struct JobRequest {
     /// What to run.
     pub kind: JobKind,
-    /// Kind-specific parameters (JSON object). `simulate`: `{"config": "<reference name>" or
-    /// {inline config}, "overrides": {...}, "seed": u64}`. `sweep` also takes `points` (2..=50,
-    /// default 5) and `vehicle_profile`, `environment`, `wear_law` (the penalization-curve key;
-    /// defaults from the service settings); it fans out into one `sweep_point` child job per
-    /// point (`sweep_point` jobs cannot be submitted). `seed` is drawn at submission when
-    /// absent.
+    /// Kind-specific parameters (JSON object), checked completely at submission (a broken
+    /// rule is a 422 naming the field, e.g. `params.overrides.simulation.duration_s`, and
+    /// nothing is stored); the worker runs them through the same parser. Unknown keys are
+    /// refused at every level.
+    /// `simulate`: `{"config": "<reference name>" or {inline config}, "overrides": {...},
+    /// "seed": n}`; `config` is required, `overrides` must be an object that deep-merges into
+    /// the config. Bounds: `simulation.duration_s` in (0, 86400] s (24 h), `settle_s` in [0,
+    /// 600] s, `rel_tolerance` in [1e-10, 0.1], `abs_tolerance_m` in [1e-15, 1e-4] m,
+    /// `record_interval_s` in [1e-6 s, duration_s] and at most 1e7 recorded time points.
+    /// `seed` is an integer in [0, 2^53), drawn at submission (also below 2^53) when absent.
+    /// `sweep` takes the same keys (config default `launcher-design`; it must be a launcher
+    /// case) plus `points` (2..=50, default 5), `vehicle_profile` (selects the excitation:
+    /// `ah64` or a profile in `configs/profiles`), `environment` (`clean`) and `wear_law`
+    /// (`modified-archard`, `archard` or `legacy-appendix`, matching the config's wear law);
+    /// the three default to the service's `[report]` settings and form the penalization-curve
+    /// key. A sweep fans out into one `sweep_point` child job per point (`sweep_point` jobs
+    /// cannot be submitted). `calibrate`: `{"friction": {"fixture": {...}, "records":
+    /// [...]}}` and/or `{"wear_law": {"density_kg_m3", "cutoff_pressure_pa", "records"}}`.
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
 }
@@ -50,7 +62,8 @@ pub struct JobView {
     pub id: Uuid,
     pub kind: JobKind,
     pub status: JobStatus,
-    /// Parameters exactly as submitted.
+    /// Parameters as submitted (a sweep's `vehicle_profile`, `environment` and `wear_law`
+    /// filled in from the defaults when absent).
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
     /// Seed the run uses (from `params.seed` or drawn at submission).
@@ -308,9 +321,10 @@ pub async fn submit_job(
     State(state): State<AppState>,
     caller: Caller,
     headers: HeaderMap,
-    ApiJson(request): ApiJson<JobRequest>,
+    body: axum::extract::Request,
 ) -> Result<Response, Problem> {
     caller.require(Area::Jobs, &Method::POST)?;
+    let request: JobRequest = read_json(body).await?;
     let key = idempotency_key(&headers)?;
     let submitted = state
         .jobs

@@ -62,11 +62,34 @@ pub fn app(state: AppState) -> Router {
                 "this resource does not support that method",
             )
         })
+        .layer(middleware::from_fn_with_state(state.clone(), http_metrics))
         .layer(DefaultBodyLimit::max(limit))
         .layer(RequestBodyLimitLayer::new(limit))
-        .layer(middleware::map_response(problem::problem_for_bare_413))
+        .layer(middleware::map_response(problem::problem_for_bare_errors))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
+}
+
+/// Counts each request and its latency per method and matched route (`/metrics`).
+async fn http_metrics(
+    axum::extract::State(state): axum::extract::State<AppState>,
+    request: axum::extract::Request,
+    next: middleware::Next,
+) -> axum::response::Response {
+    let method = request.method().as_str().to_string();
+    let route = request
+        .extensions()
+        .get::<axum::extract::MatchedPath>()
+        .map_or_else(|| "unmatched".to_string(), |p| p.as_str().to_string());
+    let started = std::time::Instant::now();
+    let response = next.run(request).await;
+    state.jobs.metrics.http_request(
+        &method,
+        &route,
+        response.status().as_u16(),
+        started.elapsed().as_secs_f64(),
+    );
+    response
 }
 
 /// Why the service could not start.

@@ -209,13 +209,26 @@ where
     }
 }
 
-/// Turn any 413 without a problem body (e.g. from tower-http's length check) into one.
-pub async fn problem_for_bare_413(response: Response) -> Response {
+/// Read a JSON body with [`ApiJson`]'s rules after the handler has checked the caller's role,
+/// so a caller without the role gets 403 whatever the body holds.
+pub async fn read_json<T: DeserializeOwned>(request: Request) -> Result<T, Problem> {
+    let ApiJson(value) = ApiJson::<T>::from_request(request, &()).await?;
+    Ok(value)
+}
+
+/// Turn every error answer without a problem body (axum's own rejections: a path with invalid
+/// percent-encoding, a query with a repeated key, tower-http's length check, ...) into
+/// problem+json, keeping its status and its text as `detail`.
+pub async fn problem_for_bare_errors(response: Response) -> Response {
     let is_problem = response
         .headers()
         .get(header::CONTENT_TYPE)
         .is_some_and(|v| v.as_bytes() == b"application/problem+json");
-    if response.status() == StatusCode::PAYLOAD_TOO_LARGE && !is_problem {
+    let status = response.status();
+    if is_problem || !(status.is_client_error() || status.is_server_error()) {
+        return response;
+    }
+    if status == StatusCode::PAYLOAD_TOO_LARGE {
         return Problem::new(
             StatusCode::PAYLOAD_TOO_LARGE,
             "body-too-large",
@@ -224,5 +237,69 @@ pub async fn problem_for_bare_413(response: Response) -> Response {
         )
         .into_response();
     }
-    response
+    let text = match axum::body::to_bytes(response.into_body(), 16 * 1024).await {
+        Ok(bytes) => String::from_utf8_lossy(&bytes).trim().to_string(),
+        Err(_) => String::new(),
+    };
+    bare_error_problem(status, &text).into_response()
+}
+
+/// The problem for an error answer whose body was `text` (plain text from axum).
+pub fn bare_error_problem(status: StatusCode, text: &str) -> Problem {
+    let detail = if text.is_empty() {
+        status
+            .canonical_reason()
+            .unwrap_or("request refused")
+            .to_string()
+    } else {
+        text.to_string()
+    };
+    // serde_urlencoded names a repeated or unknown query key in backticks.
+    let named = |marker: &str| {
+        text.split_once(marker)
+            .and_then(|(_, rest)| rest.split_once('`'))
+            .map(|(name, _)| name.to_string())
+    };
+    if status == StatusCode::BAD_REQUEST {
+        if let Some(field) = named("duplicate field `") {
+            return Problem::bad_parameter(field, "must be given once");
+        }
+        if let Some(field) = named("unknown field `") {
+            return Problem::bad_parameter(field, "is not a parameter of this resource");
+        }
+        let (slug, title) = if text.contains("query string") {
+            ("bad-query", "Malformed query string")
+        } else if text.contains("URL") || text.contains("path") {
+            ("bad-path", "Malformed path")
+        } else {
+            ("bad-request", "Bad request")
+        };
+        return Problem::new(status, slug, title, detail);
+    }
+    let title = status.canonical_reason().unwrap_or("Error");
+    let slug = title.to_ascii_lowercase().replace(' ', "-");
+    Problem::new(status, &slug, title, detail)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bare_query_and_path_errors_become_problems_naming_the_key() {
+        let p = bare_error_problem(
+            StatusCode::BAD_REQUEST,
+            "Failed to deserialize query string: duplicate field `limit`",
+        );
+        assert_eq!(p.status, 400);
+        assert_eq!(p.field.as_deref(), Some("limit"));
+        let p = bare_error_problem(
+            StatusCode::BAD_REQUEST,
+            "Invalid URL: Cannot parse `%FF` to a `String`",
+        );
+        assert_eq!(p.problem_type, "urn:railwear:problem:bad-path");
+        let p = bare_error_problem(StatusCode::BAD_GATEWAY, "");
+        assert_eq!(p.status, 502);
+        assert!(!p.detail.is_empty());
+    }
 }

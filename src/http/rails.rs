@@ -5,7 +5,7 @@
 
 use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
-use super::problem::{ApiJson, Problem};
+use super::problem::{read_json, Problem};
 use super::AppState;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::analysis::rattle_space::LauncherDimensions;
@@ -73,14 +73,75 @@ pub struct CurvePointView {
 #[derive(Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeasurementRequest {
-    /// Rear-shoe and rail dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm.
+    /// Rear-shoe and rail dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm, as an
+    /// object of named fields (a positional array is refused: its order is not documented).
+    /// Checked for assembly: shoe head wider than the rail slot, neck narrower than it, each
+    /// value in its plausible range (docs/launcher-dimensions.md).
+    #[serde(deserialize_with = "named_dimensions")]
     pub dimensions_mm: LauncherDimensions,
     /// Who measured (name or badge), 1-200 characters.
     pub measured_by: String,
-    /// When, ISO 8601 date or RFC 3339 date-time.
+    /// When, ISO 8601 date (2024-05-01) or RFC 3339 date-time (2024-05-01T08:30:00Z): a day
+    /// that exists, from 1970 on and not in the future. The report uses the measurement with
+    /// the latest `measured_at`, whatever order they were recorded in.
     pub measured_at: String,
     /// Where (depot, vehicle, station), 1-200 characters.
     pub location: String,
+}
+
+/// `dimensions_mm` as an object of named fields only: serde would also read the struct from a
+/// positional array of 14 numbers, whose order is nowhere documented for users.
+fn named_dimensions<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<LauncherDimensions, D::Error> {
+    struct Named;
+    impl<'de> serde::de::Visitor<'de> for Named {
+        type Value = LauncherDimensions;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str(
+                "an object of named dimensions in mm ({\"a_shoe_mm\": 38.1, ..., \"q_rail_mm\": \
+                 10.13}), not a positional array",
+            )
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+            LauncherDimensions::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    deserializer.deserialize_map(Named)
+}
+
+/// Earliest accepted `measured_at`: 1970-01-01 (before any Hellfire-class rail was made; an
+/// earlier date is a typing error).
+pub const EARLIEST_MEASURED_MS: i64 = 0;
+/// How far `measured_at` may lie ahead of the server clock: 14 h, the furthest time zone ahead
+/// of UTC (a date alone is read as midnight UTC, so a local "today" may be ahead of it).
+pub const FUTURE_ALLOWANCE_MS: i64 = 14 * 3_600_000;
+
+/// `measured_at` as Unix ms, or the rule it breaks.
+fn check_measured_at(text: &str, now_ms: i64) -> Result<i64, Problem> {
+    let ms = clock::parse_iso8601_ms(text).ok_or_else(|| {
+        Problem::invalid_field(
+            "measured_at",
+            "must be an ISO 8601 date (2024-05-01) or RFC 3339 date-time \
+             (2024-05-01T08:30:00Z) naming a day that exists",
+        )
+    })?;
+    if ms < EARLIEST_MEASURED_MS {
+        return Err(Problem::invalid_field(
+            "measured_at",
+            "must not be before 1970-01-01",
+        ));
+    }
+    if ms > now_ms + FUTURE_ALLOWANCE_MS {
+        return Err(Problem::invalid_field(
+            "measured_at",
+            format!(
+                "must not be in the future (server time {})",
+                clock::rfc3339(now_ms)
+            ),
+        ));
+    }
+    Ok(ms)
 }
 
 /// A stored measurement.
@@ -92,11 +153,14 @@ pub struct MeasurementView {
     #[schema(value_type = Object)]
     pub dimensions_mm: serde_json::Value,
     pub measured_by: String,
+    /// When the rail was measured, as posted.
     pub measured_at: String,
     pub location: String,
     /// Rattle space k_rs = A_ti / A_encl (eq. 6.1-6.3), dimensionless.
     pub rattle_space: f64,
+    /// Token name of who recorded it.
     pub recorded_by: String,
+    /// When the service recorded it (RFC 3339 UTC); history is listed in this order.
     pub recorded_at: String,
     /// The rail's report.
     pub report_url: String,
@@ -175,7 +239,8 @@ pub struct MissingCurve {
 #[derive(Debug, Serialize, ToSchema)]
 pub struct ReportView {
     pub serial: String,
-    /// The measurement the report is based on (the latest).
+    /// The measurement the report is based on: the latest `measured_at` (ties: the last
+    /// recorded), not the last one recorded.
     pub measurement: MeasurementView,
     /// Rattle space k_rs of that measurement, dimensionless.
     pub rattle_space: f64,
@@ -206,17 +271,28 @@ pub struct ReportQuery {
     pub design_life_h: Option<f64>,
 }
 
+/// Pattern of a rail serial: a letter or digit, then up to 63 letters, digits, `-`, `_` or
+/// `.`. Starting with a letter or digit rules out `.` and `..`, which a URL path would resolve
+/// away (their report URL was unreachable).
+pub const SERIAL_PATTERN: &str = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$";
+
+/// True when `serial` matches [`SERIAL_PATTERN`].
+pub fn is_valid_serial(serial: &str) -> bool {
+    let mut chars = serial.chars();
+    serial.len() <= 64
+        && chars.next().is_some_and(|c| c.is_ascii_alphanumeric())
+        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+}
+
 fn check_serial(serial: &str) -> Result<(), Problem> {
-    let ok = (1..=64).contains(&serial.len())
-        && serial
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
-    if ok {
+    if is_valid_serial(serial) {
         Ok(())
     } else {
         Err(Problem::bad_parameter(
             "serial",
-            "must be 1-64 characters of letters, digits, '-', '_' or '.'",
+            format!(
+                "must match {SERIAL_PATTERN}: 1-64 characters, letters, digits, '-', '_' or '.',                  starting with a letter or digit"
+            ),
         ))
     }
 }
@@ -234,7 +310,7 @@ fn check_text(field: &str, value: &str) -> Result<String, Problem> {
 /// at once.
 #[utoipa::path(
     post, path = "/v1/rails/{serial}/measurements", tag = "rails",
-    params(("serial" = String, Path, description = "Rail serial number")),
+    params(("serial" = String, Path, description = "Rail serial number: a letter or digit, then up to 63 letters, digits, '-', '_' or '.'", pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")),
     request_body = MeasurementRequest,
     responses(
         (status = 201, body = MeasurementView),
@@ -248,19 +324,16 @@ pub async fn post_measurement(
     State(state): State<AppState>,
     caller: Caller,
     Path(serial): Path<String>,
-    ApiJson(request): ApiJson<MeasurementRequest>,
+    body: axum::extract::Request,
 ) -> Result<Response, Problem> {
     caller.require(Area::Rails, &Method::POST)?;
     check_serial(&serial)?;
+    let request: MeasurementRequest = read_json(body).await?;
     let measured_by = check_text("measured_by", &request.measured_by)?;
     let location = check_text("location", &request.location)?;
     let measured_at = request.measured_at.trim().to_string();
-    if !clock::is_iso8601(&measured_at) {
-        return Err(Problem::invalid_field(
-            "measured_at",
-            "must be an ISO 8601 date (2024-05-01) or RFC 3339 date-time (2024-05-01T08:30:00Z)",
-        ));
-    }
+    let recorded_ms = clock::now_ms();
+    let measured_ms = check_measured_at(&measured_at, recorded_ms)?;
     let rattle_space = seam::rattle_space(&request.dimensions_mm)
         .map_err(|(field, rule)| Problem::invalid_field(format!("dimensions_mm.{field}"), rule))?;
     let dimensions_mm =
@@ -273,10 +346,11 @@ pub async fn post_measurement(
             dimensions_mm,
             measured_by,
             measured_at,
+            measured_ms,
             location,
             rattle_space,
             recorded_by: caller.name,
-            recorded_ms: clock::now_ms(),
+            recorded_ms,
         })
         .await?;
     let location_header = format!("/v1/rails/{}/measurements", record.serial);
@@ -318,7 +392,7 @@ async fn load_rail(state: &AppState, serial: &str) -> Result<RailRecord, Problem
 /// One rail.
 #[utoipa::path(
     get, path = "/v1/rails/{serial}", tag = "rails",
-    params(("serial" = String, Path)),
+    params(("serial" = String, Path, pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")),
     responses((status = 200, body = RailView), (status = 404, body = Problem, content_type = "application/problem+json")),
     security(("bearer" = []))
 )]
@@ -331,10 +405,11 @@ pub async fn get_rail(
     Ok(Json(load_rail(&state, &serial).await?.into()))
 }
 
-/// A rail's measurement history, newest first.
+/// A rail's measurement history, newest recorded first; each shows when it was measured
+/// (`measured_at`) and when it was recorded (`recorded_at`).
 #[utoipa::path(
     get, path = "/v1/rails/{serial}/measurements", tag = "rails",
-    params(("serial" = String, Path), PageQuery),
+    params(("serial" = String, Path, pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$"), PageQuery),
     responses((status = 200, body = PageView<MeasurementView>), (status = 404, body = Problem, content_type = "application/problem+json")),
     security(("bearer" = []))
 )]
@@ -351,10 +426,10 @@ pub async fn list_measurements(
     Ok(Json(PageView::from_page(page, MeasurementView::from)))
 }
 
-/// The rail's service-life report from its latest measurement.
+/// The rail's service-life report from its latest measurement (latest `measured_at`).
 #[utoipa::path(
     get, path = "/v1/rails/{serial}/report", tag = "rails",
-    params(("serial" = String, Path), ReportQuery),
+    params(("serial" = String, Path, pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$"), ReportQuery),
     responses(
         (status = 200, description = "Report; `service_life` when a curve covers the rail, otherwise `missing_curve` says which sweep to run", body = ReportView),
         (status = 404, body = Problem, content_type = "application/problem+json"),

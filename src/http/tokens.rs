@@ -1,7 +1,7 @@
 //! `/v1/tokens` (admin): create, list and revoke API tokens.
 
 use super::auth::{generate_token, token_sha256, Area, Caller};
-use super::problem::{ApiJson, Problem};
+use super::problem::{read_json, Problem};
 use super::AppState;
 use crate::config::Role;
 use crate::store::{clock, TokenRecord};
@@ -73,9 +73,10 @@ impl From<TokenRecord> for TokenView {
 pub async fn create_token(
     State(state): State<AppState>,
     caller: Caller,
-    ApiJson(request): ApiJson<TokenRequest>,
+    body: axum::extract::Request,
 ) -> Result<(StatusCode, Json<CreatedToken>), Problem> {
     caller.require(Area::Tokens, &Method::POST)?;
+    let request: TokenRequest = read_json(body).await?;
     let name = request.name.trim();
     if name.is_empty() || name.chars().count() > 100 {
         return Err(Problem::invalid_field(

@@ -17,9 +17,30 @@ struct Histogram {
     sum_s: f64,
 }
 
+/// Upper bounds of the HTTP request-latency histogram buckets, s.
+const HTTP_BUCKETS_S: [f64; 12] = [
+    0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 10.0,
+];
+
+#[derive(Default)]
+struct HttpHistogram {
+    counts: [u64; HTTP_BUCKETS_S.len()],
+    count: u64,
+    sum_s: f64,
+}
+
+/// A number as Prometheus text, never `-0` (an empty float sum is -0.0 in Rust).
+fn num(x: f64) -> f64 {
+    x + 0.0
+}
+
 #[derive(Default)]
 struct Inner {
     durations: HashMap<(&'static str, &'static str), Histogram>,
+    /// HTTP requests by (method, route template): latency histogram.
+    http_latency: HashMap<(String, String), HttpHistogram>,
+    /// HTTP requests by (method, route template, status code).
+    http_requests: HashMap<(String, String, u16), u64>,
     simulated_s_total: f64,
     /// Running attempts in this process: (start, simulated seconds reached).
     running: HashMap<Uuid, (Instant, f64)>,
@@ -79,6 +100,27 @@ impl Metrics {
         });
     }
 
+    /// One HTTP request answered: `route` is the matched route template (`/v1/jobs/{id}`), or
+    /// `unmatched`, so the label set stays bounded.
+    pub fn http_request(&self, method: &str, route: &str, status: u16, seconds: f64) {
+        self.with(|m| {
+            *m.http_requests
+                .entry((method.to_string(), route.to_string(), status))
+                .or_default() += 1;
+            let h = m
+                .http_latency
+                .entry((method.to_string(), route.to_string()))
+                .or_default();
+            for (slot, bound) in h.counts.iter_mut().zip(HTTP_BUCKETS_S) {
+                if seconds <= bound {
+                    *slot += 1;
+                }
+            }
+            h.count += 1;
+            h.sum_s += seconds;
+        });
+    }
+
     /// Prometheus text with the given job counts per status (queue depth from the store).
     pub fn render(&self, counts: &[(JobStatus, i64)]) -> String {
         let mut out = String::new();
@@ -124,7 +166,11 @@ impl Metrics {
                     "railwear_job_duration_seconds_bucket{{{labels},le=\"+Inf\"}} {}",
                     h.count
                 );
-                let _ = writeln!(out, "railwear_job_duration_seconds_sum{{{labels}}} {}", h.sum_s);
+                let _ = writeln!(
+                    out,
+                    "railwear_job_duration_seconds_sum{{{labels}}} {}",
+                    num(h.sum_s)
+                );
                 let _ = writeln!(out, "railwear_job_duration_seconds_count{{{labels}}} {}", h.count);
             }
             let _ = writeln!(
@@ -132,28 +178,77 @@ impl Metrics {
                 "# HELP railwear_simulated_seconds_total Simulated time advanced by this process, s."
             );
             let _ = writeln!(out, "# TYPE railwear_simulated_seconds_total counter");
-            let _ = writeln!(out, "railwear_simulated_seconds_total {}", m.simulated_s_total);
-            let rate: f64 = m
-                .running
-                .values()
-                .map(|(start, sim)| {
-                    let wall = start.elapsed().as_secs_f64();
-                    if wall > 0.0 {
-                        sim / wall
-                    } else {
-                        0.0
-                    }
-                })
-                .sum();
+            let _ = writeln!(
+                out,
+                "railwear_simulated_seconds_total {}",
+                num(m.simulated_s_total)
+            );
+            let rate = m.running.values().fold(0.0, |acc, (start, sim)| {
+                let wall = start.elapsed().as_secs_f64();
+                if wall > 0.0 {
+                    acc + sim / wall
+                } else {
+                    acc
+                }
+            });
             let _ = writeln!(
                 out,
                 "# HELP railwear_simulated_seconds_per_second Simulated seconds per wall second, summed over running attempts."
             );
             let _ = writeln!(out, "# TYPE railwear_simulated_seconds_per_second gauge");
-            let _ = writeln!(out, "railwear_simulated_seconds_per_second {rate}");
+            let _ = writeln!(out, "railwear_simulated_seconds_per_second {}", num(rate));
             let _ = writeln!(out, "# HELP railwear_running_attempts Attempts running in this process.");
             let _ = writeln!(out, "# TYPE railwear_running_attempts gauge");
             let _ = writeln!(out, "railwear_running_attempts {}", m.running.len());
+            let _ = writeln!(
+                out,
+                "# HELP railwear_http_requests_total HTTP requests answered by this process, by method, route and status."
+            );
+            let _ = writeln!(out, "# TYPE railwear_http_requests_total counter");
+            let mut keys: Vec<_> = m.http_requests.keys().cloned().collect();
+            keys.sort();
+            for key in keys {
+                let n = m.http_requests.get(&key).copied().unwrap_or(0);
+                let _ = writeln!(
+                    out,
+                    "railwear_http_requests_total{{method=\"{}\",route=\"{}\",status=\"{}\"}} {n}",
+                    key.0, key.1, key.2
+                );
+            }
+            let _ = writeln!(
+                out,
+                "# HELP railwear_http_request_duration_seconds Latency of HTTP requests answered by this process, by method and route."
+            );
+            let _ = writeln!(out, "# TYPE railwear_http_request_duration_seconds histogram");
+            let mut keys: Vec<_> = m.http_latency.keys().cloned().collect();
+            keys.sort();
+            for key in keys {
+                let Some(h) = m.http_latency.get(&key) else {
+                    continue;
+                };
+                let labels = format!("method=\"{}\",route=\"{}\"", key.0, key.1);
+                for (count, bound) in h.counts.iter().zip(HTTP_BUCKETS_S) {
+                    let _ = writeln!(
+                        out,
+                        "railwear_http_request_duration_seconds_bucket{{{labels},le=\"{bound}\"}} {count}"
+                    );
+                }
+                let _ = writeln!(
+                    out,
+                    "railwear_http_request_duration_seconds_bucket{{{labels},le=\"+Inf\"}} {}",
+                    h.count
+                );
+                let _ = writeln!(
+                    out,
+                    "railwear_http_request_duration_seconds_sum{{{labels}}} {}",
+                    num(h.sum_s)
+                );
+                let _ = writeln!(
+                    out,
+                    "railwear_http_request_duration_seconds_count{{{labels}}} {}",
+                    h.count
+                );
+            }
         });
         out
     }
@@ -181,5 +276,32 @@ mod tests {
             "railwear_job_duration_seconds_count{kind=\"simulate\",status=\"succeeded\"} 1"
         ));
         assert!(text.contains("railwear_running_attempts 0"));
+    }
+
+    #[test]
+    fn idle_metrics_never_print_negative_zero() {
+        let text = Metrics::default().render(&[]);
+        assert!(
+            text.contains("railwear_simulated_seconds_per_second 0\n"),
+            "{text}"
+        );
+        assert!(!text.contains("-0"), "{text}");
+    }
+
+    #[test]
+    fn http_requests_are_counted_per_route_with_a_latency_histogram() {
+        let metrics = Metrics::default();
+        metrics.http_request("GET", "/v1/jobs/{id}", 200, 0.003);
+        metrics.http_request("GET", "/v1/jobs/{id}", 404, 0.2);
+        let text = metrics.render(&[]);
+        assert!(text.contains(
+            "railwear_http_requests_total{method=\"GET\",route=\"/v1/jobs/{id}\",status=\"200\"} 1"
+        ));
+        assert!(text.contains(
+            "railwear_http_request_duration_seconds_bucket{method=\"GET\",route=\"/v1/jobs/{id}\",le=\"0.005\"} 1"
+        ));
+        assert!(text.contains(
+            "railwear_http_request_duration_seconds_count{method=\"GET\",route=\"/v1/jobs/{id}\"} 2"
+        ));
     }
 }

@@ -125,15 +125,52 @@ impl Jobs {
             });
         }
         let seed = match params.get("seed") {
-            None => u64::from_le_bytes(Uuid::new_v4().as_bytes()[..8].try_into().unwrap_or([0; 8])),
-            Some(value) => value.as_u64().ok_or_else(|| SubmitError::Invalid {
-                field: "params.seed".into(),
-                rule: "must be an integer in [0, 2^64)".into(),
-            })?,
+            None => draw_seed(),
+            Some(value) => {
+                crate::pipeline::parse_seed(value).map_err(|_| SubmitError::Invalid {
+                    field: "params.seed".into(),
+                    rule: "must be an integer in [0, 2^53) (JavaScript reads larger integers \
+                       inexactly)"
+                        .into(),
+                })?
+            }
         };
-        self.runner.validate(&kind, &params).map_err(|e| match e {
+        // The request as submitted is what an Idempotency-Key is compared against.
+        let canonical = serde_json::json!({ "kind": kind, "params": params }).to_string();
+        // A sweep's curve selectors are stored with it, defaults filled in, so the curve key,
+        // the submission check and the worker all read the same names.
+        let mut params = params;
+        if kind == JobKind::Sweep {
+            if let Some(map) = params.as_object_mut() {
+                let defaults = [
+                    ("vehicle_profile", &self.curve_defaults.vehicle_profile),
+                    ("environment", &self.curve_defaults.environment),
+                    ("wear_law", &self.curve_defaults.wear_law),
+                ];
+                for (name, default) in defaults {
+                    map.entry(name)
+                        .or_insert_with(|| serde_json::Value::from(default.as_str()));
+                }
+            }
+        }
+        // The same parse the worker runs (one set of rules); it may build the model, so it
+        // runs on a blocking thread.
+        let runner = Arc::clone(&self.runner);
+        let (check_kind, check_params) = (kind, params.clone());
+        let checked =
+            tokio::task::spawn_blocking(move || runner.validate(&check_kind, &check_params))
+                .await
+                .map_err(|e| SubmitError::Invalid {
+                    field: "params".into(),
+                    rule: format!("could not be checked: {e}"),
+                })?;
+        checked.map_err(|e| match e {
             crate::pipeline::RunError::InvalidConfig { field, rule } => SubmitError::Invalid {
-                field: format!("params.{field}"),
+                field: if field == "params" {
+                    field
+                } else {
+                    format!("params.{field}")
+                },
                 rule,
             },
             other => SubmitError::Invalid {
@@ -142,22 +179,21 @@ impl Jobs {
             },
         })?;
         let curve_key = (kind == JobKind::Sweep).then(|| {
-            let part = |name: &str, default: &str| {
+            let part = |name: &str| {
                 params
                     .get(name)
                     .and_then(|v| v.as_str())
-                    .unwrap_or(default)
+                    .unwrap_or_default()
                     .to_string()
             };
             curve_key(
-                &part("vehicle_profile", &self.curve_defaults.vehicle_profile),
-                &part("environment", &self.curve_defaults.environment),
-                &part("wear_law", &self.curve_defaults.wear_law),
+                &part("vehicle_profile"),
+                &part("environment"),
+                &part("wear_law"),
             )
         });
         let idempotency = idempotency_key.map(|key| {
             // serde_json maps are sorted, so this text is canonical for equal bodies.
-            let canonical = serde_json::json!({ "kind": kind, "params": params }).to_string();
             let sha = Sha256::digest(canonical.as_bytes());
             (key, hex(&sha))
         });
@@ -198,6 +234,15 @@ impl Jobs {
         }
         Ok(record)
     }
+}
+
+/// A seed drawn for a job that names none: 53 random bits, so it is below 2^53 and every
+/// JSON reader (JavaScript, jq) reads it exactly.
+pub fn draw_seed() -> u64 {
+    // A v4 UUID's fixed version and variant bits sit in different halves: XOR-ing the halves
+    // gives 64 uniformly random bits.
+    let v = Uuid::new_v4().as_u128();
+    ((v >> 64) as u64 ^ v as u64) & crate::pipeline::limits::MAX_SEED
 }
 
 /// Lower-case hex of bytes.

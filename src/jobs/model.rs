@@ -124,7 +124,8 @@ pub struct JobRecord {
     pub seq: i64,
     pub kind: JobKind,
     pub status: JobStatus,
-    /// Parameters exactly as submitted.
+    /// Parameters as submitted (a sweep's `vehicle_profile`, `environment` and `wear_law`
+    /// filled in from the defaults when absent).
     pub params: serde_json::Value,
     /// Seed handed to the run (from `params.seed`, or drawn at submission).
     pub seed: u64,

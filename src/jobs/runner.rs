@@ -4,9 +4,9 @@
 
 use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
-use crate::config::reference_config_path;
+use crate::models::specs::CaseSpec;
 use crate::physics::track::TrackSample;
-use crate::pipeline::{RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
+use crate::pipeline::{CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
 use std::path::PathBuf;
 
 /// What a finished job produces.
@@ -57,8 +57,9 @@ pub trait CaseRunner: Send + Sync {
         control: &RunControl,
     ) -> Result<JobOutput, RunError>;
 
-    /// Cheap check at submission so a bad request gets a 422 naming the field instead of a
-    /// failed job. The default accepts everything and leaves checks to [`CaseRunner::run`].
+    /// Check at submission (on a blocking thread) so a bad request gets a 422 naming the field
+    /// instead of a failed job. It should be the same parse [`CaseRunner::run`] does
+    /// ([`LibraryRunner::plan`]). The default accepts everything.
     fn validate(&self, _kind: &JobKind, _params: &serde_json::Value) -> Result<(), RunError> {
         Ok(())
     }
@@ -90,6 +91,21 @@ pub trait CaseRunner: Send + Sync {
     }
 }
 
+/// A job's params parsed and checked for its kind: what the worker runs. Built by
+/// [`LibraryRunner::plan`], which submission ([`CaseRunner::validate`]) and every worker call,
+/// so an accepted job's params are never re-interpreted by a second set of rules.
+#[derive(Debug, Clone)]
+pub enum JobPlan {
+    /// The case to simulate.
+    Simulate(Box<CaseSpec>),
+    /// The sweep to fan out (or run in one process).
+    Sweep(Box<SweepPlan>),
+    /// One point of a sweep: the sweep's plan and the point's index.
+    SweepPoint(Box<SweepPlan>, usize),
+    /// The calibration data.
+    Calibrate(CalibrateParams),
+}
+
 /// The production runner: calls `railwear::pipeline` with reference configs from `configs_dir`.
 pub struct LibraryRunner {
     /// Directory of the reference model configs (`configs/`).
@@ -97,24 +113,37 @@ pub struct LibraryRunner {
 }
 
 impl LibraryRunner {
-    fn check_config_name(&self, params: &serde_json::Value) -> Result<(), RunError> {
-        match params.get("config") {
-            None => Ok(()),
-            Some(serde_json::Value::String(name)) => {
-                reference_config_path(&self.configs_dir, name).map_err(|e| {
-                    RunError::InvalidConfig {
-                        field: "config".into(),
-                        rule: e.to_string(),
-                    }
-                })?;
-                Ok(())
+    /// Parse and check `params` for `kind` (the one set of rules; see [`JobPlan`]). Errors
+    /// name the params field (`config`, `overrides.simulation.duration_s`, `points`, ...).
+    pub fn plan(&self, kind: &JobKind, params: &serde_json::Value) -> Result<JobPlan, RunError> {
+        let dir = &self.configs_dir;
+        match kind {
+            JobKind::Simulate => Ok(JobPlan::Simulate(Box::new(crate::pipeline::simulate_case(
+                params, dir,
+            )?))),
+            JobKind::Sweep => {
+                if params.get("point").is_some() {
+                    return Err(RunError::InvalidConfig {
+                        field: "point".into(),
+                        rule: format!(
+                            "is not a known parameter (known: {})",
+                            crate::pipeline::SWEEP_KEYS.join(", ")
+                        ),
+                    });
+                }
+                Ok(JobPlan::Sweep(Box::new(SweepPlan::from_params(
+                    params, dir,
+                )?)))
             }
-            // An inline config object is the library's to validate.
-            Some(serde_json::Value::Object(_)) => Ok(()),
-            Some(_) => Err(RunError::InvalidConfig {
-                field: "config".into(),
-                rule: "must be a reference config name or a config object".into(),
-            }),
+            JobKind::SweepPoint => {
+                let plan = SweepPlan::from_params(params, dir)?;
+                let index = plan.point.ok_or_else(|| RunError::InvalidConfig {
+                    field: "point".into(),
+                    rule: "is required (a non-negative integer)".into(),
+                })?;
+                Ok(JobPlan::SweepPoint(Box::new(plan), index))
+            }
+            JobKind::Calibrate => Ok(JobPlan::Calibrate(CalibrateParams::parse(params)?)),
         }
     }
 }
@@ -126,10 +155,9 @@ impl CaseRunner for LibraryRunner {
         params: &serde_json::Value,
         control: &RunControl,
     ) -> Result<JobOutput, RunError> {
-        self.validate(kind, params)?;
-        match kind {
-            JobKind::Simulate => {
-                let out = crate::pipeline::simulate(params, &self.configs_dir, control)?;
+        match self.plan(kind, params)? {
+            JobPlan::Simulate(case) => {
+                let (_, out) = crate::models::case::run_case(&case, &self.configs_dir, control)?;
                 Ok(JobOutput {
                     summary: out.summary,
                     tracks: out.tracks,
@@ -137,28 +165,26 @@ impl CaseRunner for LibraryRunner {
                     penalization: None,
                 })
             }
-            JobKind::Sweep => {
-                let (_, sweep) = crate::pipeline::sweep(params, &self.configs_dir, control)?;
+            JobPlan::Sweep(plan) => {
+                let (_, sweep) = crate::pipeline::run_sweep(&plan, &self.configs_dir, control)?;
                 sweep_output(&sweep)
             }
-            JobKind::SweepPoint => {
-                let plan = SweepPlan::from_params(params, &self.configs_dir)?;
-                let index = crate::pipeline::sweep_point_index(params)?;
+            JobPlan::SweepPoint(plan, index) => {
                 let point = crate::pipeline::sweep_point(&plan, index, &self.configs_dir, control)?;
                 Ok(JobOutput {
                     summary: sweep_point_summary(index, &point),
                     ..JobOutput::default()
                 })
             }
-            JobKind::Calibrate => Ok(JobOutput {
-                summary: crate::pipeline::calibrate(params)?,
+            JobPlan::Calibrate(data) => Ok(JobOutput {
+                summary: crate::pipeline::run_calibration(&data)?,
                 ..JobOutput::default()
             }),
         }
     }
 
-    fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
-        self.check_config_name(params)
+    fn validate(&self, kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
+        self.plan(kind, params).map(|_| ())
     }
 
     /// A sweep fans out into one `sweep_point` child per point.
@@ -170,8 +196,9 @@ impl CaseRunner for LibraryRunner {
         if *kind != JobKind::Sweep {
             return Ok(None);
         }
-        self.validate(kind, params)?;
-        let plan = SweepPlan::from_params(params, &self.configs_dir)?;
+        let JobPlan::Sweep(plan) = self.plan(kind, params)? else {
+            return Ok(None);
+        };
         Ok(Some(FanOutPlan {
             children: (0..plan.len())
                 .map(|index| ChildJob {

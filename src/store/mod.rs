@@ -264,6 +264,8 @@ pub struct NewMeasurement {
     pub dimensions_mm: serde_json::Value,
     pub measured_by: String,
     pub measured_at: String,
+    /// `measured_at` as Unix ms (what "latest" is ordered by).
+    pub measured_ms: i64,
     pub location: String,
     /// Rattle space k_rs computed from the dimensions (eq. 6.1-6.3), dimensionless.
     pub rattle_space: f64,
@@ -280,6 +282,8 @@ pub struct MeasurementRecord {
     pub dimensions_mm: serde_json::Value,
     pub measured_by: String,
     pub measured_at: String,
+    /// `measured_at` as Unix ms.
+    pub measured_ms: i64,
     pub location: String,
     pub rattle_space: f64,
     pub recorded_by: String,
@@ -389,6 +393,8 @@ pub trait Store: Send + Sync {
         serial: &str,
         page: PageRequest,
     ) -> StoreFuture<'_, Page<MeasurementRecord>>;
+    /// The measurement with the latest `measured_at` (ties: the last recorded), whatever order
+    /// they were recorded in (a back-filled old reading does not become the latest).
     fn latest_measurement(&self, serial: &str) -> StoreFuture<'_, Option<MeasurementRecord>>;
     fn get_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>>;
 

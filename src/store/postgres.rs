@@ -300,6 +300,7 @@ fn measurement_from_row(row: &PgRow) -> Result<MeasurementRecord, StoreError> {
         dimensions_mm: parse_json(&dims, "measurement dimensions")?,
         measured_by: row.try_get("measured_by")?,
         measured_at: row.try_get("measured_at")?,
+        measured_ms: row.try_get("measured_ms")?,
         location: row.try_get("location")?,
         rattle_space: row.try_get("rattle_space")?,
         recorded_by: row.try_get("recorded_by")?,
@@ -967,8 +968,8 @@ impl Store for PgStore {
             .await?;
             let row = sqlx::query(
                 "INSERT INTO rail_measurements (id, serial, dimensions_mm, measured_by, measured_at, \
-                 location, rattle_space, recorded_by, recorded_ms) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9) RETURNING *",
+                 location, rattle_space, recorded_by, recorded_ms, measured_ms) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING *",
             )
             .bind(m.id)
             .bind(&m.serial)
@@ -979,6 +980,7 @@ impl Store for PgStore {
             .bind(m.rattle_space)
             .bind(&m.recorded_by)
             .bind(m.recorded_ms)
+            .bind(m.measured_ms)
             .fetch_one(&mut *tx)
             .await?;
             let record = measurement_from_row(&row)?;
@@ -1049,7 +1051,8 @@ impl Store for PgStore {
         let serial = serial.to_string();
         Box::pin(async move {
             let row = sqlx::query(
-                "SELECT * FROM rail_measurements WHERE serial = $1 ORDER BY seq DESC LIMIT 1",
+                "SELECT * FROM rail_measurements WHERE serial = $1 \
+                 ORDER BY measured_ms DESC, seq DESC LIMIT 1",
             )
             .bind(serial)
             .fetch_optional(&self.pool)

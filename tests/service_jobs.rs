@@ -1,0 +1,303 @@
+//! Issue 17 over HTTP (curl) against an in-process service with the production runner
+//! (`LibraryRunner`, the shipped `configs/`) and no workers, so nothing runs: job parameters
+//! are checked completely at submission (422 problem+json naming the field, nothing stored),
+//! authorization comes before body parsing, every error is problem+json, drawn seeds are
+//! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
+
+mod service_support;
+
+use railwear::jobs::LibraryRunner;
+use serde_json::json;
+use service_support::runner::test_config;
+use service_support::{curl, TempDir, ENGINEER, PLANNER};
+use std::path::Path;
+use std::sync::Arc;
+
+async fn start_library(dir: &TempDir) -> railwear::http::RunningService {
+    let config = test_config(&dir.db_url());
+    let runner = Arc::new(LibraryRunner {
+        configs_dir: Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
+    });
+    railwear::http::start(config, runner, false)
+        .await
+        .expect("service starts")
+}
+
+fn stored_jobs(base: &str) -> usize {
+    let r = curl(
+        "GET",
+        &format!("{base}/v1/jobs?limit=100"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()["items"].as_array().map_or(0, Vec::len)
+}
+
+/// A short simulate request on rattle-box-c with `simulation` overrides merged in.
+fn simulate_with(simulation: serde_json::Value) -> String {
+    let mut sim = json!({"settle_s": 0.05, "duration_s": 0.05, "record_interval_s": 0.01});
+    if let (Some(base), Some(extra)) = (sim.as_object_mut(), simulation.as_object()) {
+        for (k, v) in extra {
+            base.insert(k.clone(), v.clone());
+        }
+    }
+    json!({"kind": "simulate", "params": {"config": "rattle-box-c", "seed": 1,
+        "overrides": {"simulation": sim}}})
+    .to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
+    let dir = TempDir::new("jobs-validate");
+    let service = start_library(&dir).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let jobs = format!("{base}/v1/jobs");
+        let rejected = |body: &str, field: &str| -> serde_json::Value {
+            let r = curl("POST", &jobs, Some(ENGINEER), &[], Some(body));
+            let p = r.problem(422);
+            assert_eq!(p["field"], field, "{body}: {p}");
+            p
+        };
+        let sim = |s: serde_json::Value| simulate_with(s);
+
+        // Durations: not positive, absurd (1e308 once ran with eta 1.8e307 s).
+        for d in [json!(-1.0), json!(0.0), json!(1e308), json!(86_401.0)] {
+            rejected(
+                &sim(json!({"duration_s": d})),
+                "params.overrides.simulation.duration_s",
+            );
+        }
+        rejected(
+            &sim(json!({"settle_s": 1e6})),
+            "params.overrides.simulation.settle_s",
+        );
+        rejected(
+            &sim(json!({"rel_tolerance": 0.5})),
+            "params.overrides.simulation.rel_tolerance",
+        );
+        rejected(
+            &sim(json!({"abs_tolerance_m": 1.0})),
+            "params.overrides.simulation.abs_tolerance_m",
+        );
+        rejected(
+            &sim(json!({"record_interval_s": 1e-9})),
+            "params.overrides.simulation.record_interval_s",
+        );
+        // 24 h at the default 0.1 ms interval records far more than memory holds.
+        rejected(
+            &json!({"kind": "simulate", "params": {"config": "rattle-box-c",
+                "overrides": {"simulation": {"duration_s": 86_400.0}}}})
+            .to_string(),
+            "params.overrides.simulation.record_interval_s",
+        );
+        // A typo in an override key, overrides that are not an object, unknown params.
+        let p = rejected(
+            &sim(json!({"durationn_s": 1.0})),
+            "params.overrides.simulation.durationn_s",
+        );
+        assert!(p["detail"].as_str().unwrap().contains("durationn_s"), "{p}");
+        rejected(
+            r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":[1,2]}}"#,
+            "params.overrides",
+        );
+        rejected(
+            r#"{"kind":"simulate","params":{"confg":"rattle-box-c"}}"#,
+            "params.confg",
+        );
+        rejected(
+            r#"{"kind":"simulate","params":{"seed":3}}"#,
+            "params.config",
+        );
+        let p = rejected(
+            r#"{"kind":"simulate","params":{"config":"service"}}"#,
+            "params.config",
+        );
+        assert!(
+            p["detail"].as_str().unwrap().contains("configs"),
+            "names the directory searched: {p}"
+        );
+        rejected(
+            r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#,
+            "params.config",
+        );
+        let p = curl(
+            "POST",
+            &jobs,
+            Some(ENGINEER),
+            &[],
+            Some(r#"{"kind":"simulate","params":{"config":{"garbage":true}}}"#),
+        )
+        .problem(422);
+        assert!(
+            p["field"].as_str().unwrap().starts_with("params.config"),
+            "{p}"
+        );
+        rejected(
+            r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9007199254740992}}"#,
+            "params.seed",
+        );
+
+        // Sweeps: point counts, launcher-only, labels that must select something real.
+        for points in [1, 500] {
+            rejected(
+                &json!({"kind": "sweep", "params": {"points": points}}).to_string(),
+                "params.points",
+            );
+        }
+        rejected(
+            r#"{"kind":"sweep","params":{"config":"rattle-box-c"}}"#,
+            "params.config",
+        );
+        let p = rejected(
+            r#"{"kind":"sweep","params":{"vehicle_profile":"uh60"}}"#,
+            "params.vehicle_profile",
+        );
+        assert!(p["detail"].as_str().unwrap().contains("ah64"), "{p}");
+        rejected(
+            r#"{"kind":"sweep","params":{"wear_law":"totally-made-up"}}"#,
+            "params.wear_law",
+        );
+        // `archard` is a real law but needs its coefficient: the default config has none.
+        rejected(
+            r#"{"kind":"sweep","params":{"wear_law":"archard"}}"#,
+            "params.wear_law",
+        );
+        rejected(
+            r#"{"kind":"sweep","params":{"environment":"desert-sand"}}"#,
+            "params.environment",
+        );
+        rejected(r#"{"kind":"sweep","params":{"point":0}}"#, "params.point");
+        rejected(
+            r#"{"kind":"sweep","params":{"overrides":{"simulation":{"duration_s":-2}}}}"#,
+            "params.overrides.simulation.duration_s",
+        );
+
+        // Calibration data: required, typed, no unknown keys.
+        rejected(r#"{"kind":"calibrate","params":{}}"#, "params");
+        rejected(
+            r#"{"kind":"calibrate","params":{"wear_law":{"records":[],"densty":1}}}"#,
+            "params.wear_law.densty",
+        );
+        rejected(
+            r#"{"kind":"calibrate","params":{"wear_law":{"density_kg_m3":1e9,"records":[]}}}"#,
+            "params.wear_law.density_kg_m3",
+        );
+
+        assert_eq!(stored_jobs(&base), 0, "a rejected job stores nothing");
+
+        // What is valid is accepted: the sweep's curve selectors are stored with it.
+        let r = curl(
+            "POST",
+            &jobs,
+            Some(ENGINEER),
+            &[],
+            Some(&simulate_with(json!({}))),
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let r = curl(
+            "POST",
+            &jobs,
+            Some(ENGINEER),
+            &[],
+            Some(r#"{"kind":"sweep","params":{"points":3}}"#),
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let sweep = r.json();
+        assert_eq!(sweep["curve_key"], "ah64/clean/modified-archard");
+        assert_eq!(sweep["params"]["vehicle_profile"], "ah64");
+        // Drawn seeds are below 2^53: JSON readers that use doubles read them exactly.
+        let seed = sweep["seed"].as_u64().expect("seed");
+        assert!(seed < 1 << 53, "{seed}");
+        assert_eq!(stored_jobs(&base), 2);
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn drawn_seeds_are_below_two_to_the_53() {
+    for _ in 0..1000 {
+        assert!(railwear::jobs::draw_seed() < 1 << 53);
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
+    let dir = TempDir::new("jobs-errors");
+    let service = start_library(&dir).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let jobs = format!("{base}/v1/jobs");
+        // A planner may not submit jobs, whatever the body holds.
+        curl("POST", &jobs, Some(PLANNER), &[], Some("{not json")).problem(403);
+        curl(
+            "POST",
+            &jobs,
+            Some(PLANNER),
+            &[("Content-Type", "text/plain")],
+            Some("x"),
+        )
+        .problem(403);
+        // An engineer may not record measurements, whatever the body holds.
+        curl(
+            "POST",
+            &format!("{base}/v1/rails/R-1/measurements"),
+            Some(ENGINEER),
+            &[],
+            Some("[1,2"),
+        )
+        .problem(403);
+        // A repeated query key and invalid percent-encoding answer problem+json.
+        let p = curl(
+            "GET",
+            &format!("{jobs}?limit=1&limit=2"),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .problem(400);
+        assert_eq!(p["field"], "limit", "{p}");
+        curl(
+            "GET",
+            &format!("{base}/v1/rails/%FF%FE/report"),
+            Some(PLANNER),
+            &[],
+            None,
+        )
+        .problem(400);
+        curl(
+            "GET",
+            &format!("{base}/v1/jobs/%FF"),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .problem(400);
+
+        // /metrics: never -0, and HTTP requests per route with a latency histogram.
+        let r = curl("GET", &format!("{base}/metrics"), None, &[], None);
+        assert_eq!(r.status, 200);
+        assert!(!r.body.contains(" -0"), "{}", r.body);
+        assert!(
+            r.body.contains(
+                "railwear_http_requests_total{method=\"POST\",route=\"/v1/jobs\",status=\"403\"} 2"
+            ),
+            "{}",
+            r.body
+        );
+        assert!(
+            r.body.contains(
+                "railwear_http_request_duration_seconds_count{method=\"GET\",route=\"/v1/jobs\"} 1"
+            ),
+            "{}",
+            r.body
+        );
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
