@@ -92,6 +92,22 @@ pub fn run(
     for b in &report.bodies {
         println!("{:<18} {:>12.5}", b.name, b.mass_rate_mg_per_h);
     }
+    if let Some(e) = &report.energy {
+        println!(
+            "energy: drive {:.4e} J, dissipated {:.4e} J, E {:.4e} -> {:.4e} J, residual {:.2e} J ({:.2e} of the throughput){}",
+            e.drive_work_j,
+            e.dissipated_j,
+            e.initial_energy_j,
+            e.final_energy_j,
+            e.residual_j,
+            e.residual_relative,
+            if e.balanced {
+                ""
+            } else {
+                "  WARNING: the energy account does not close; results are suspect"
+            }
+        );
+    }
     println!("results in {}", dir.display());
     Ok(())
 }

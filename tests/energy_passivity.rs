@@ -439,3 +439,21 @@ fn a_kicked_missile_settles_back_and_dissipates_the_kick() {
         a.dissipated_j
     );
 }
+
+#[test]
+fn validate_reports_the_energy_anchors_and_they_pass() {
+    let anchors = railwear::validation_energy::energy_anchors(configs());
+    assert_eq!(
+        anchors.len(),
+        4,
+        "spin and tilted drop, rise and residual each"
+    );
+    for a in &anchors {
+        assert!(a.name.starts_with("energy: "), "{}", a.name);
+        assert!(
+            a.pass,
+            "{} measured {} (tolerance {})",
+            a.name, a.measured, a.tolerance
+        );
+    }
+}

@@ -275,6 +275,14 @@ pub fn run_model(
     if let Some(e) = wear_error {
         return Err(e.into());
     }
+    if let Some(e) = stats.energy.as_ref().filter(|e| !e.balanced) {
+        tracing::warn!(
+            case = %model.name,
+            residual_j = e.residual_j,
+            residual_relative = e.residual_relative,
+            "the energy account does not close within its bound: results are suspect"
+        );
+    }
     let window = (model.end_time_s - t0).max(f64::MIN_POSITIVE);
     let mut contacts = Vec::with_capacity(ncontacts);
     let mut body_mass = vec![0.0; sys.bodies.len()];
