@@ -117,7 +117,10 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
             abs_angular_velocity_rad_s: a * 1e5,
             // The work quadrature follows the state's tolerance (1e-3 at the default 1e-4), so
             // a tolerance-halving study halves it too.
-            energy_rel: 10.0 * case.simulation.rel_tolerance,
+            energy_rel: case
+                .simulation
+                .energy_rel_tolerance
+                .unwrap_or(10.0 * case.simulation.rel_tolerance),
         },
         initial_step_s: 1e-6,
         max_step_s: 1e-3,
