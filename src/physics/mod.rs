@@ -2,6 +2,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod control;
 pub mod energy;
 pub mod forces;
 pub mod friction;

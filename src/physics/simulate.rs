@@ -4,12 +4,12 @@
 
 use super::body::BodyKind;
 use super::contact::TrackState;
+use super::control::{Progress, RunControl};
 use super::energy::{EnergyAudit, EnergyMeter};
 use super::integrator::{
     Integrator, IntegratorError, IntegratorSettings, IntegratorStats, InteriorStage,
 };
 use super::system::{MultibodySystem, Workspace};
-use crate::pipeline::{Progress, RunControl};
 use std::time::{Duration, Instant};
 
 /// Limits beyond which a run is declared diverged.
