@@ -166,7 +166,7 @@ pub fn compare_rattle_box(
     out: &Path,
     configs_dir: &Path,
 ) -> Result<()> {
-    use crate::validation_slow::TABLE_5_4_ADAMS_MG_PER_H;
+    use crate::validation::slow::TABLE_5_4_ADAMS_MG_PER_H;
     use crate::wear::law::WearLaw;
     let mut rows = Vec::new();
     for (i, (letter, adams)) in TABLE_5_4_ADAMS_MG_PER_H.iter().enumerate() {

@@ -28,6 +28,4 @@ pub mod pipeline;
 pub mod store;
 pub mod units;
 pub mod validation;
-pub mod validation_energy;
-pub mod validation_slow;
 pub mod wear;

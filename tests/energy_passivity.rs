@@ -4,7 +4,7 @@
 //! Every bound is the ("Passive contact", item 4) and fixed by physics, not by output.
 
 use nalgebra::UnitQuaternion;
-use railwear::validation_energy::{
+use railwear::validation::energy::{
     energy_run, motionless_tube, spinning_cube, tilted_cube, MotionlessTube, BALANCE_TOLERANCE,
     PASSIVITY_TOLERANCE,
 };
@@ -442,7 +442,7 @@ fn a_kicked_missile_settles_back_and_dissipates_the_kick() {
 
 #[test]
 fn validate_reports_the_energy_anchors_and_they_pass() {
-    let anchors = railwear::validation_energy::energy_anchors(configs());
+    let anchors = railwear::validation::energy::energy_anchors(configs());
     assert_eq!(
         anchors.len(),
         4,

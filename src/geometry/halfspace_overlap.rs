@@ -6,6 +6,7 @@
 
 use super::polytope_clip::box_below_plane;
 use super::shapes::{ConvexShape, HalfSpace};
+use super::sphere_cap::{cap_centroid_distance, cap_volume};
 use super::steiner_pieces::{add_edges, add_vertices, Accum};
 use nalgebra::{Isometry3, Point3, Vector3};
 use std::f64::consts::PI;
@@ -73,19 +74,6 @@ pub fn shape_halfspace_depth(
         } => rounded_box_support(&half_extents, roundover, &n, c)?,
     };
     Some((depth, pose * Point3::from(deepest)))
-}
-
-/// Volume of a spherical cap of height `w` on a ball of radius `r`, m³.
-#[inline]
-pub(crate) fn cap_volume(r: f64, w: f64) -> f64 {
-    PI * w * w * (r - w / 3.0)
-}
-
-/// Distance from the ball centre to the centroid of a cap of height `w`, m.
-#[inline]
-pub(crate) fn cap_centroid_distance(r: f64, w: f64) -> f64 {
-    let t = 2.0 * r - w;
-    3.0 * t * t / (4.0 * (3.0 * r - w))
 }
 
 /// Depth and deepest point of a ball at the origin below the plane `n·x <= c` (shape frame).

@@ -26,6 +26,7 @@ pub mod lattice;
 mod polytope_clip;
 mod quadrature;
 pub mod shapes;
+mod sphere_cap;
 pub mod sphere_sphere;
 mod steiner_pieces;
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! Sphere–sphere overlap (lens), closed form.
 
-use super::halfspace_overlap::{cap_centroid_distance, cap_volume};
+use super::sphere_cap::{cap_centroid_distance, cap_volume};
 use nalgebra::{Point3, Unit, Vector3};
 use std::f64::consts::PI;
 

@@ -9,8 +9,8 @@
 //! (the overlap is `u <= 0`).
 
 use super::disk_polygon::Poly2;
-use super::halfspace_overlap::{cap_centroid_distance, cap_volume};
 use super::quadrature::{gauss3, Breaks};
+use super::sphere_cap::{cap_centroid_distance, cap_volume};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 

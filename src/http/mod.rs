@@ -53,6 +53,7 @@ pub fn app(state: AppState) -> Router {
         .merge(rails::router())
         .merge(tokens::router())
         .merge(ops::router())
+        .merge(openapi::router())
         .fallback(|| async { Problem::not_found("no such resource") })
         .method_not_allowed_fallback(|| async {
             Problem::new(

@@ -1,7 +1,11 @@
 //! The OpenAPI document, generated from the handlers' annotations. `api/openapi.json` is a copy
 //! kept in sync by a test (`railwear openapi > api/openapi.json` regenerates it).
 
-use super::{jobs, ops, pagination, problem, rails, tokens};
+use super::{jobs, ops, pagination, problem, rails, tokens, AppState};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use axum::routing::get;
+use axum::Router;
 use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityScheme};
 use utoipa::{Modify, OpenApi};
 
@@ -30,7 +34,7 @@ impl Modify for BearerAuth {
         rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
         rails::get_report,
         tokens::create_token, tokens::list_tokens, tokens::revoke_token,
-        ops::healthz, ops::readyz, ops::metrics, ops::openapi,
+        ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
     components(schemas(
         problem::Problem,
@@ -57,6 +61,18 @@ pub struct ApiDoc;
 
 /// The OpenAPI document as pretty JSON with a trailing newline (the exact text of
 /// `api/openapi.json`).
+/// Serves the document (no token).
+pub fn router() -> Router<AppState> {
+    Router::new().route("/v1/openapi.json", get(openapi))
+}
+
+/// This API's OpenAPI 3.1 document.
+#[utoipa::path(get, path = "/v1/openapi.json", tag = "ops", responses((status = 200, description = "OpenAPI document", content_type = "application/json")))]
+pub async fn openapi() -> Response {
+    ([(header::CONTENT_TYPE, "application/json")], openapi_json()).into_response()
+}
+
+/// The document as pretty JSON text.
 pub fn openapi_json() -> String {
     let mut doc = ApiDoc::openapi();
     doc.info.version = env!("CARGO_PKG_VERSION").to_string();

@@ -1,7 +1,6 @@
-//! Operational endpoints (no token): health, readiness, metrics, the OpenAPI document, the
-//! interactive API page and the dashboard.
+//! Operational endpoints (no token): health, readiness, metrics, the interactive API page and
+//! the dashboard (the OpenAPI document is served by `openapi`).
 
-use super::openapi::openapi_json;
 use super::problem::Problem;
 use super::AppState;
 use axum::extract::State;
@@ -17,7 +16,6 @@ pub fn router() -> Router<AppState> {
         .route("/healthz", get(healthz))
         .route("/readyz", get(readyz))
         .route("/metrics", get(metrics))
-        .route("/v1/openapi.json", get(openapi))
 }
 
 async fn dashboard() -> Html<&'static str> {
@@ -67,10 +65,4 @@ pub async fn metrics(State(state): State<AppState>) -> Result<Response, Problem>
         text,
     )
         .into_response())
-}
-
-/// This API's OpenAPI 3.1 document.
-#[utoipa::path(get, path = "/v1/openapi.json", tag = "ops", responses((status = 200, description = "OpenAPI document", content_type = "application/json")))]
-pub async fn openapi() -> Response {
-    ([(header::CONTENT_TYPE, "application/json")], openapi_json()).into_response()
 }

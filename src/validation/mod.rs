@@ -19,47 +19,14 @@ use crate::units::{inch, STANDARD_GRAVITY};
 use crate::wear::integrate::WearAccumulator;
 use crate::wear::law::WearLaw;
 use nalgebra::{Isometry3, Matrix3, Point3, Quaternion, Unit, UnitQuaternion, Vector3};
-use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
 
-/// One anchor's outcome.
-#[derive(Debug, Clone, Serialize)]
-pub struct Anchor {
-    /// What is checked.
-    pub name: String,
-    /// Where the expected number comes from.
-    pub source: String,
-    /// Unit of expected/measured/tolerance.
-    pub unit: String,
-    /// Expected value.
-    pub expected: f64,
-    /// Measured value.
-    pub measured: f64,
-    /// Admissible |measured - expected|.
-    pub tolerance: f64,
-    /// Verdict.
-    pub pass: bool,
-}
+mod anchor;
+pub mod energy;
+pub mod slow;
 
-pub(crate) fn anchor(
-    name: &str,
-    source: &str,
-    unit: &str,
-    expected: f64,
-    measured: f64,
-    tolerance: f64,
-) -> Anchor {
-    Anchor {
-        name: name.into(),
-        source: source.into(),
-        unit: unit.into(),
-        expected,
-        measured,
-        tolerance,
-        pass: measured.is_finite() && (measured - expected).abs() <= tolerance,
-    }
-}
+pub use anchor::{anchor, Anchor};
 
 /// Runs every fast anchor (and the slow ones with `slow`).
 pub fn run_all(slow: bool, configs_dir: &Path) -> Vec<Anchor> {
@@ -72,9 +39,9 @@ pub fn run_all(slow: bool, configs_dir: &Path) -> Vec<Anchor> {
     out.push(wear_integral_anchor());
     out.push(synthesis_anchor());
     out.extend(friction_calibration_anchors());
-    out.extend(crate::validation_energy::energy_anchors(configs_dir));
+    out.extend(energy::energy_anchors(configs_dir));
     if slow {
-        out.extend(crate::validation_slow::run(configs_dir));
+        out.extend(slow::run(configs_dir));
     }
     out
 }

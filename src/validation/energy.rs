@@ -7,6 +7,7 @@
 //! contact"): a resting cube given a spin about the vertical gained more energy than the spin
 //! had; a cube dropped 0.5 mm with a 0.02 rad tilt gained 9 % of the drop energy.
 
+use super::{anchor, Anchor};
 use crate::models::case::{build, integrator_settings, load_case};
 use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::IntegratorSettings;
@@ -14,7 +15,6 @@ use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use crate::physics::system::MultibodySystem;
 use crate::pipeline::{RunControl, RunError};
 use crate::units::STANDARD_GRAVITY;
-use crate::validation::{anchor, Anchor};
 use nalgebra::{UnitQuaternion, Vector3};
 use std::path::Path;
 
