@@ -325,7 +325,7 @@ pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<C
 }
 
 /// A simulate job: one case end to end.
-pub fn simulate(
+pub fn simulate_job(
     params: &serde_json::Value,
     configs_dir: &Path,
     control: &RunControl,
@@ -471,7 +471,7 @@ fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
 
 /// A planned tolerance sweep: the launcher case every point starts from and the
 /// material-condition offsets of its points. Built from a sweep job's params alone, so the
-/// sequential [`sweep`] and each `sweep_point` child job of a fanned-out sweep agree on it.
+/// sequential [`sweep_job`] and each `sweep_point` child job of a fanned-out sweep agree on it.
 #[derive(Debug, Clone)]
 pub struct SweepPlan {
     /// The launcher case of `params.config` (default `launcher-design`) with `overrides` and
@@ -613,7 +613,7 @@ impl SweepPlan {
 
 /// Point `index` of a planned sweep: the base case with the design dimensions moved by the
 /// point's material-condition offset, run to the end; the rail's wear rate there. The
-/// sequential [`sweep`] and a fanned-out sweep's `sweep_point` child jobs both call this, so a
+/// sequential [`sweep_job`] and a fanned-out sweep's `sweep_point` child jobs both call this, so a
 /// point depends only on the sweep's params and seed.
 pub fn sweep_point(
     plan: &SweepPlan,
@@ -670,7 +670,7 @@ pub fn sweep_point_index(params: &serde_json::Value) -> Result<usize, RunError> 
 /// `points` (default 5, at least 2) dimension sets from tight to loose, same seed, one after the
 /// other; returns the rail wear rate versus rattle space for the penalization curve (eq. 6.4).
 /// The service fans the same points out to child jobs instead (see ARCHITECTURE.md).
-pub fn sweep(
+pub fn sweep_job(
     params: &serde_json::Value,
     configs_dir: &Path,
     control: &RunControl,
@@ -679,7 +679,7 @@ pub fn sweep(
     run_sweep(&plan, configs_dir, control)
 }
 
-/// Runs every point of a planned sweep in this process, tight to loose (see [`sweep`]).
+/// Runs every point of a planned sweep in this process, tight to loose (see [`sweep_job`]).
 pub fn run_sweep(
     plan: &SweepPlan,
     configs_dir: &Path,

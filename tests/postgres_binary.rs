@@ -186,7 +186,7 @@ fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
 /// Every child ends with exactly one succeeded attempt (the killed one is logged lost and its
 /// child re-run elsewhere), the sweep is fanned out once and assembled once, and its result
 /// equals bit for bit both the same sweep run by a single `railwear serve` process on SQLite
-/// (fanned out to its embedded workers) and the sequential in-process `pipeline::sweep`.
+/// (fanned out to its embedded workers) and the sequential in-process `pipeline::sweep_job`.
 #[test]
 fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     use railwear::store::AttemptOutcome;
@@ -210,8 +210,12 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         let params = params.clone();
         std::thread::spawn(move || {
             let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
-            railwear::pipeline::sweep(&params, &configs, &railwear::pipeline::RunControl::silent())
-                .expect("sequential sweep")
+            railwear::pipeline::sweep_job(
+                &params,
+                &configs,
+                &railwear::pipeline::RunControl::silent(),
+            )
+            .expect("sequential sweep")
         })
     };
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();

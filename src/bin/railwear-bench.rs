@@ -103,7 +103,7 @@ enum Command {
         #[arg(long)]
         window: f64,
     },
-    /// Tolerance sweeps (pipeline::sweep) with 1 worker vs 2 workers: simulations per minute.
+    /// Tolerance sweeps (pipeline::sweep_job) with 1 worker vs 2 workers: simulations per minute.
     Sweep {
         /// Points per sweep (tight to loose).
         #[arg(long, default_value_t = 5)]
@@ -1215,9 +1215,12 @@ fn timed_sweeps(
                 s.spawn(move || -> Result<usize, String> {
                     let mut done = 0;
                     while next.fetch_add(1, Ordering::Relaxed) < sweeps {
-                        let (_, out) =
-                            railwear::pipeline::sweep(params, configs_dir, &RunControl::silent())
-                                .map_err(|e: RunError| e.to_string())?;
+                        let (_, out) = railwear::pipeline::sweep_job(
+                            params,
+                            configs_dir,
+                            &RunControl::silent(),
+                        )
+                        .map_err(|e: RunError| e.to_string())?;
                         done += out.points.len();
                     }
                     Ok(done)
@@ -1263,7 +1266,7 @@ fn sweep(configs_dir: &Path, b: SweepBench) -> Result<Vec<Table>> {
     });
     let mut t = Table::new(
         format!(
-            "Tolerance sweep throughput ({points}-point pipeline::sweep of launcher-design, settle {settle} s + window {window} s per point, {sweeps} sweeps per setting, median of {repeats} interleaved pairs)"
+            "Tolerance sweep throughput ({points}-point pipeline::sweep_job of launcher-design, settle {settle} s + window {window} s per point, {sweeps} sweeps per setting, median of {repeats} interleaved pairs)"
         ),
         &[
             ("workers", "workers"),
