@@ -12,9 +12,9 @@
 //! - sphere: cap volume `π w² (R - w/3)` and cap centroid, closed form;
 //! - rounded box = inner box ⊕ ball(r), split by its normal cones into the inner box, 6 face
 //!   slabs, 12 edge pieces and 8 ball octants (disjoint). Boxes are clipped exactly
-//!   ([`polytope_clip`]); edge and vertex pieces are integrated along one coordinate of closed
-//!   form sections (disk ∩ convex polygon, [`disk_polygon`]) with Gauss–Legendre on sub-intervals
-//!   split at every kink and with node clustering at tangencies ([`quadrature`]), which is
+//!   (`polytope_clip`); edge and vertex pieces are integrated along one coordinate of closed
+//!   form sections (disk ∩ convex polygon, `disk_polygon`) with Gauss–Legendre on sub-intervals
+//!   split at every kink and with node clustering at tangencies (`quadrature`), which is
 //!   exact to round-off in the tests (see docs/geometry.md for the measured bounds).
 //!
 //! Hot path (about 10⁶ calls per simulated second): no heap allocation, fixed-size arrays only.
