@@ -1,0 +1,184 @@
+//! `peers`: railwear beside MuJoCo and Drake on rattle box C (bench/peers).
+
+use super::*;
+
+pub(crate) fn peers(
+    configs_dir: &Path,
+    with_peers: bool,
+    peers_json: Option<&Path>,
+    settle: f64,
+    window: f64,
+    peer_args: &str,
+) -> Result<Vec<Table>> {
+    let mut peer_rows: Vec<Value> = Vec::new();
+    let mut notes = Vec::new();
+    if with_peers {
+        let script = Path::new("bench/peers/run_peers.sh");
+        let mut cmd = std::process::Command::new("bash");
+        cmd.arg(script)
+            .args([
+                "--window",
+                &window.to_string(),
+                "--settle",
+                &settle.to_string(),
+            ])
+            .args(peer_args.split_whitespace())
+            .stderr(std::process::Stdio::inherit());
+        eprintln!("peers: running {} (MuJoCo, Drake) ...", script.display());
+        let out = cmd.output().context("running bench/peers/run_peers.sh")?;
+        if !out.status.success() {
+            notes.push(format!("run_peers.sh exited with {}", out.status));
+        }
+        peer_rows.extend(parse_json_lines(&String::from_utf8_lossy(&out.stdout)));
+        notes.push(format!(
+            "peers measured in this run by bench/peers/run_peers.sh --window {window} --settle {settle} {peer_args}"
+        ));
+    } else if let Some(path) = peers_json {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        peer_rows.extend(parse_json_lines(&text));
+        notes.push(format!(
+            "peer rows read from {} (an earlier run), not measured in this run",
+            path.display()
+        ));
+    } else {
+        notes.push("no peer rows: pass --with-peers (or --peers-json FILE)".into());
+    }
+    // railwear in each engine variant (the default first), so the engine changes are measured
+    // in the same run as the peers.
+    let mut ours_rows = Vec::new();
+    for variant in ENGINE_VARIANTS {
+        eprintln!("peers: railwear rattle box C ({}) ...", variant.name);
+        let (_, model, mut options) =
+            rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
+        options.integrator.newton = variant.newton;
+        options.integrator.patches = variant.patches;
+        let run = run_model(&model, &options, &RunControl::silent())
+            .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
+        ours_rows.push((variant, model.end_time_s, options, run));
+    }
+    let rw_rtf = ours_rows[0].1 / ours_rows[0].3.wall_s.max(1e-9);
+    let mut table = Table::new(
+        format!("Rattle box case C side by side (settle {settle} s, window {window} s, one run)"),
+        &[
+            ("engine", "engine"),
+            ("contact_law", "contact law"),
+            ("step_or_tolerance", "step or tolerance"),
+            ("real_time_factor", "real-time factor"),
+            ("real_time_factor_cpu", "real-time factor (CPU time)"),
+            ("steps_per_s", "steps/s"),
+            ("mean_normal_force_n", "mean normal force N"),
+            ("mean_friction_power_w", "mean N·\\|v_slip\\| W"),
+            ("ratio_vs_mujoco", "railwear RTF / this RTF"),
+        ],
+    );
+    for (variant, end_time_s, options, run) in &ours_rows {
+        let rtf = end_time_s / run.wall_s.max(1e-9);
+        let newton_name = variant.name;
+        table.row(vec![
+            Cell::text(format!("railwear {}", env!("CARGO_PKG_VERSION"))),
+            Cell::text("IMPACT eq. 2.1-2.3, Table 5.2 (k 1000 N/mm², e 2, c_max 500 N·s/mm, d 0.01 mm); ADAMS friction eq. 4.5"),
+            Cell::text(format!(
+                "trbdf2 {}, {newton_name}",
+                tolerance_text(&options.integrator.tolerances)
+            )),
+            Cell::Num(rtf),
+            Cell::text("-"),
+            Cell::Num(run.integrator.accepted as f64 / run.wall_s.max(1e-9)),
+            Cell::Num(run.mean_normal_force_n),
+            Cell::Num(run.mean_friction_power_w),
+            Cell::Num(rw_rtf / rtf),
+        ]);
+    }
+    let mut mujoco_best: Option<f64> = None;
+    let mut mujoco_converged: Option<f64> = None;
+    for p in &peer_rows {
+        let engine = p.get("engine").and_then(Value::as_str).unwrap_or("?");
+        let status = p.get("status").and_then(Value::as_str);
+        if let Some(st) = status {
+            let reason = p.get("reason").and_then(Value::as_str).unwrap_or("");
+            table.row(vec![
+                Cell::text(engine),
+                Cell::text(format!("{st}: {reason}")),
+                Cell::text(
+                    p.get("step_s")
+                        .and_then(Value::as_f64)
+                        .map(|s| format!("step {s:e} s"))
+                        .unwrap_or_else(|| "-".into()),
+                ),
+                Cell::text("-"),
+                Cell::text("-"),
+                Cell::text("-"),
+                Cell::text("-"),
+                Cell::text("-"),
+                Cell::text("-"),
+            ]);
+            continue;
+        }
+        let f = |k: &str| p.get(k).and_then(Value::as_f64);
+        let version = p.get("version").and_then(Value::as_str).unwrap_or("");
+        let drive = p.get("drive").and_then(Value::as_str).unwrap_or("");
+        let mocap = drive.starts_with("mocap");
+        let rtf = f("real_time_factor");
+        if engine == "mujoco" && !mocap {
+            if let Some(r) = rtf {
+                mujoco_best = Some(mujoco_best.map_or(r, |b: f64| b.max(r)));
+                // The step at which MuJoCo's friction power has converged (issue 5: 5e-5 s).
+                if f("step_s").is_some_and(|s| (s - 5e-5).abs() < 1e-12) {
+                    mujoco_converged = Some(r);
+                }
+            }
+        }
+        table.row(vec![
+            Cell::text(format!(
+                "{engine} {version}{}",
+                if mocap { " (mocap drive)" } else { "" }
+            )),
+            Cell::text(p.get("contact_law").and_then(Value::as_str).unwrap_or("?")),
+            Cell::text(
+                f("step_s")
+                    .map(|s| format!("step {s:e} s"))
+                    .unwrap_or_else(|| "-".into()),
+            ),
+            Cell::opt(rtf),
+            Cell::opt(f("real_time_factor_cpu")),
+            Cell::opt(f("steps_per_s")),
+            Cell::opt(f("mean_normal_force_n")),
+            Cell::opt(f("mean_friction_power_w")),
+            Cell::opt(rtf.filter(|r| *r > 0.0).map(|r| rw_rtf / r)),
+        ]);
+    }
+    for n in notes {
+        table.note(n);
+    }
+    if let Some(m) = mujoco_converged {
+        table.note(format!(
+            "railwear / MuJoCo at its converged 5e-5 s step, real-time factor: {:.2} (issue 5 target >= 3)",
+            rw_rtf / m
+        ));
+    }
+    if let Some(m) = mujoco_best {
+        table.note(format!(
+            "railwear / MuJoCo (fastest accelerating-frame row, the strictest reading) real-time factor: {:.2}",
+            rw_rtf / m
+        ));
+    }
+    table.note(
+        "railwear solves the thesis' IMPACT law (near-plastic nanosecond impacts); MuJoCo and Drake \
+         use their own softer contact tuned to near-zero rebound (bench/peers/README.md). The \
+         rattle is chaotic: window means scatter 10-20 % between engines and settings",
+    );
+    table.note(
+        "railwear's wall time is the whole run (settle + window) in this process, one thread, no \
+         track recording; the peers' is their compiled stepping loop (rollout / AdvanceTo)",
+    );
+    table.note(machine_note());
+    Ok(vec![table])
+}
+
+pub(crate) fn parse_json_lines(text: &str) -> Vec<Value> {
+    text.lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l.trim()).ok())
+        .filter(|v| v.is_object())
+        .collect()
+}
