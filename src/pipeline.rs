@@ -842,7 +842,7 @@ impl CalibrateParams {
                     w,
                     "density_kg_m3",
                     "wear_law.density_kg_m3",
-                    2810.0,
+                    crate::wear::material::Material::aluminium_7075_t73().density_kg_m3,
                     limits::DENSITY_KG_M3_RANGE,
                     "kg/m³, polymers to the densest metals",
                 )?;
@@ -850,7 +850,7 @@ impl CalibrateParams {
                     w,
                     "cutoff_pressure_pa",
                     "wear_law.cutoff_pressure_pa",
-                    870e6,
+                    2.0 * crate::wear::material::Material::aluminium_7075_t73().yield_strength_pa,
                     (1.0, limits::MAX_CUTOFF_PRESSURE_PA),
                     "Pa, up to 10 GPa, above any engineering alloy's hardness",
                 )?;

@@ -259,13 +259,16 @@ pub struct MaterialSpec {
 }
 
 impl Default for MaterialSpec {
+    /// 7075-T73, from the one source of the thesis' material
+    /// ([`Material::aluminium_7075_t73`](crate::wear::material::Material::aluminium_7075_t73)).
     fn default() -> Self {
+        let m = crate::wear::material::Material::aluminium_7075_t73();
         Self {
-            density_kg_per_m3: 2810.0,
-            yield_strength_pa: 435.0e6,
-            youngs_modulus_pa: 72.0e9,
-            poisson_ratio: 0.33,
-            brinell_hardness: 135.0,
+            density_kg_per_m3: m.density_kg_m3,
+            yield_strength_pa: m.yield_strength_pa,
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            poisson_ratio: m.poisson_ratio,
+            brinell_hardness: m.brinell_hardness_hb,
         }
     }
 }
