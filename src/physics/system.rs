@@ -5,6 +5,7 @@ use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_L
 use super::contact::{Contact, GeometryCache, TrackLinearization, TrackState};
 use super::forces::{ForceElement, Wrench};
 use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
+use std::ops::AddAssign;
 
 /// The model the integrator advances.
 #[derive(Clone)]
@@ -284,6 +285,11 @@ impl MultibodySystem {
     /// part). Checked against finite differences on every column (`physics::system` tests).
     pub fn contact_jacobian(&self, y: &[f64], ws: &Workspace, jac: &mut [f64]) {
         let n = self.state_len;
+        let nb = self.bodies.len();
+        // Per (source body k, target body m): the force and the torque about m's centre of
+        // mass on m, differentiated by k's [δx, δθ, δv, δω_world]. The points' blocks are summed
+        // here (in the points' order: mirror pairs cancel exactly) and mapped to the state once.
+        let mut blocks: Vec<Option<Matrix6x12>> = vec![None; nb * nb];
         for lin in &ws.linearizations {
             let ends = [(lin.body_a, 1.0), (lin.body_b, -1.0)];
             let nrm = lin.normal;
@@ -291,16 +297,15 @@ impl MultibodySystem {
             let g = lin.dforce_dfn;
             // ∂F/∂v_rel at the point: through ẇ = −n·v_rel and s = P v_rel.
             let df_dvrel = g * (nrm.transpose() * (-lin.dfn_dwdot)) + lin.dforce_dslip * tangent;
-            // The force itself (for the torque's lever), world.
             let omega_a = ws.frames[lin.body_a].angular_velocity;
             let omega_b = ws.frames[lin.body_b].angular_velocity;
             let r_centre = lin.centre.coords - ws.frames[lin.body_a].position;
             let r_centre_x = r_centre.cross_matrix();
             let force_x = lin.force.cross_matrix();
             for &(k, sign_k) in &ends {
-                let BodyKind::Dynamic { offset: ok } = self.bodies[k].kind else {
+                if !matches!(self.bodies[k].kind, BodyKind::Dynamic { .. }) {
                     continue;
-                };
+                }
                 let fk = &ws.frames[k];
                 let r_deep = lin.deepest_point.coords - fk.position;
                 let r_point = lin.point.coords - fk.position;
@@ -319,18 +324,23 @@ impl MultibodySystem {
                 } else {
                     (omega_b.cross_matrix(), Matrix3::zeros())
                 };
-                // dF/d(state of k), 3 × 13, in blocks.
-                let df_dx = g * (nrm.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dx;
-                let df_dtheta =
-                    g * (lever.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dtheta;
-                let df_dv = g * (nrm.transpose() * (-sign_k * lin.dfn_dwdot))
-                    + lin.dforce_dslip * tangent * sign_k;
-                let df_domega_world =
-                    g * (lever.transpose() * (-sign_k * lin.dfn_dwdot)) + lin.dforce_dslip * ds_dw;
-                let rot_k = fk.rotation.to_rotation_matrix().into_inner();
-                let df_domega_body = df_domega_world * rot_k;
-                let theta_of_q = rotation_tangent(&y[ok + 3..ok + 7]);
-                let df_dq = df_dtheta * theta_of_q;
+                // dF/d(k's δx, δθ, δv, δω_world), 3 × 12.
+                let mut df = nalgebra::Matrix3x6::<f64>::zeros();
+                let mut df_rates = nalgebra::Matrix3x6::<f64>::zeros();
+                df.fixed_view_mut::<3, 3>(0, 0).copy_from(
+                    &(g * (nrm.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dx),
+                );
+                df.fixed_view_mut::<3, 3>(0, 3).copy_from(
+                    &(g * (lever.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dtheta),
+                );
+                df_rates.fixed_view_mut::<3, 3>(0, 0).copy_from(
+                    &(g * (nrm.transpose() * (-sign_k * lin.dfn_dwdot))
+                        + lin.dforce_dslip * tangent * sign_k),
+                );
+                df_rates.fixed_view_mut::<3, 3>(0, 3).copy_from(
+                    &(g * (lever.transpose() * (-sign_k * lin.dfn_dwdot))
+                        + lin.dforce_dslip * ds_dw),
+                );
                 // Torque change through the lever (p − o_m) at fixed force, per target body m.
                 let (dtau_a_dx, dtau_a_dtheta, dtau_b_dx, dtau_b_dtheta) = if sign_k > 0.0 {
                     (
@@ -348,15 +358,10 @@ impl MultibodySystem {
                     )
                 };
                 for &(m, sign_m) in &ends {
-                    let BodyKind::Dynamic { offset: om } = self.bodies[m].kind else {
+                    if !matches!(self.bodies[m].kind, BodyKind::Dynamic { .. }) {
                         continue;
-                    };
-                    let fm = &ws.frames[m];
-                    let inv_mass = sign_m / self.bodies[m].mass.mass;
-                    let rot_m = fm.rotation.to_rotation_matrix().into_inner();
-                    let to_body = self.inverse_inertia[m] * rot_m.transpose();
-                    let to_omega_dot =
-                        to_body * (lin.point.coords - fm.position).cross_matrix() * sign_m;
+                    }
+                    let r_m = (lin.point.coords - ws.frames[m].position).cross_matrix();
                     let (dtau_dx, mut dtau_dtheta) = if sign_m > 0.0 {
                         (dtau_a_dx, dtau_a_dtheta)
                     } else {
@@ -364,33 +369,61 @@ impl MultibodySystem {
                     };
                     if m == k {
                         // The body-frame torque Rᵀ τ turns with the body: δ(Rᵀ τ) = Rᵀ [τ]× δθ.
-                        let tau = (lin.point.coords - fm.position).cross(&(lin.force * sign_m));
+                        let tau =
+                            (lin.point.coords - ws.frames[m].position).cross(&(lin.force * sign_m));
                         dtau_dtheta += tau.cross_matrix();
                     }
-                    let dtau_dq = dtau_dtheta * theta_of_q;
-                    let blocks: [JacobianBlock; 4] = [
-                        (0, df_dx.as_slice(), Some(dtau_dx.as_slice())),
-                        (3, df_dq.as_slice(), Some(dtau_dq.as_slice())),
-                        (7, df_dv.as_slice(), None),
-                        (10, df_domega_body.as_slice(), None),
-                    ];
-                    for (col0, block, torque) in blocks {
-                        let cols = block.len() / 3;
-                        for c in 0..cols {
-                            let d = Vector3::new(block[3 * c], block[3 * c + 1], block[3 * c + 2]);
-                            let lin_acc = d * inv_mass;
-                            let mut ang_acc = to_omega_dot * d;
-                            if let Some(t) = torque {
-                                let dt = Vector3::new(t[3 * c], t[3 * c + 1], t[3 * c + 2]);
-                                ang_acc += to_body * dt;
-                            }
-                            let col = &mut jac[(ok + col0 + c) * n..(ok + col0 + c + 1) * n];
-                            for r in 0..3 {
-                                col[om + 7 + r] += lin_acc[r];
-                                col[om + 10 + r] += ang_acc[r];
-                            }
-                        }
+                    let block = blocks[k * nb + m].get_or_insert_with(Matrix6x12::zeros);
+                    let force = df * sign_m;
+                    let force_rates = df_rates * sign_m;
+                    let mut torque = r_m * force;
+                    torque.fixed_view_mut::<3, 3>(0, 0).add_assign(&dtau_dx);
+                    torque.fixed_view_mut::<3, 3>(0, 3).add_assign(&dtau_dtheta);
+                    block.fixed_view_mut::<3, 6>(0, 0).add_assign(&force);
+                    block.fixed_view_mut::<3, 6>(0, 6).add_assign(&force_rates);
+                    block.fixed_view_mut::<3, 6>(3, 0).add_assign(&torque);
+                    block
+                        .fixed_view_mut::<3, 6>(3, 6)
+                        .add_assign(&(r_m * force_rates));
+                }
+            }
+        }
+        for k in 0..nb {
+            let BodyKind::Dynamic { offset: ok } = self.bodies[k].kind else {
+                continue;
+            };
+            let theta_of_q = rotation_tangent(&y[ok + 3..ok + 7]);
+            let rot_k = ws.frames[k].rotation.to_rotation_matrix().into_inner();
+            for m in 0..nb {
+                let Some(block) = &blocks[k * nb + m] else {
+                    continue;
+                };
+                let BodyKind::Dynamic { offset: om } = self.bodies[m].kind else {
+                    continue;
+                };
+                let inv_mass = 1.0 / self.bodies[m].mass.mass;
+                let rot_m = ws.frames[m].rotation.to_rotation_matrix().into_inner();
+                let to_body = self.inverse_inertia[m] * rot_m.transpose();
+                // Columns of k's state: position, quaternion (through δθ), velocity, body-frame
+                // angular velocity (through the rotation).
+                let dq = block.fixed_view::<6, 3>(0, 3) * theta_of_q;
+                let domega = block.fixed_view::<6, 3>(0, 9) * rot_k;
+                let mut column = |state_col: usize, d: nalgebra::Vector6<f64>| {
+                    let lin_acc = d.fixed_rows::<3>(0) * inv_mass;
+                    let ang_acc = to_body * d.fixed_rows::<3>(3);
+                    let col = &mut jac[state_col * n..(state_col + 1) * n];
+                    for r in 0..3 {
+                        col[om + 7 + r] += lin_acc[r];
+                        col[om + 10 + r] += ang_acc[r];
                     }
+                };
+                for c in 0..3 {
+                    column(ok + c, block.column(c).into_owned());
+                    column(ok + 7 + c, block.column(6 + c).into_owned());
+                    column(ok + 10 + c, domega.column(c).into_owned());
+                }
+                for c in 0..4 {
+                    column(ok + 3 + c, dq.column(c).into_owned());
                 }
             }
         }
@@ -478,9 +511,10 @@ impl MultibodySystem {
     }
 }
 
-/// A block of state columns (first column, the force's 3 × c derivative, column-major, and the
-/// torque's at fixed force when the lever moves) in [`MultibodySystem::contact_jacobian`].
-type JacobianBlock<'a> = (usize, &'a [f64], Option<&'a [f64]>);
+/// The force (rows 0-2) and the torque about the target's centre of mass (rows 3-5) on one body,
+/// differentiated by another body's `[δx, δθ, δv, δω_world]` (columns), in
+/// [`MultibodySystem::contact_jacobian`].
+type Matrix6x12 = nalgebra::SMatrix<f64, 6, 12>;
 
 /// Length of the quaternion of the body at `offset`, when positive and finite.
 fn quaternion_norm(y: &[f64], offset: usize) -> Option<f64> {
