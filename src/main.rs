@@ -390,7 +390,14 @@ async fn main() -> Result<()> {
                     json,
                     configs_dir,
                 },
-        } => railwear::cli::campaign_check(file, *json, configs_dir),
+        } => {
+            // A refused campaign is an answer, not a crash: the message names field and row.
+            if let Err(e) = railwear::cli::campaign_check(file, *json, configs_dir) {
+                eprintln!("error: {e:#}");
+                std::process::exit(1);
+            }
+            Ok(())
+        }
         Command::Rig {
             base,
             effects,
