@@ -56,6 +56,10 @@ fn library_is_complete_and_bounded() {
     let e = Effect::parse("third_body=1e-3,min_pressure_pa=1e5").unwrap();
     assert_eq!(e.parameters["k_abrasive"], 1e-3);
     assert_eq!(e.parameters["min_pressure_pa"], 1e5);
+    assert_eq!(
+        Effect::parse("third_body=1e-3").unwrap().parameters["min_pressure_pa"],
+        1e4
+    );
     assert_eq!(e.parameters["min_slip_m_s"], 1e-3);
 }
 
@@ -180,8 +184,8 @@ fn third_body_raises_k_only_where_pressure_and_slip_allow() {
         (w - base - added).abs() <= 1e-12 * w,
         "{w} - {base} vs {added}"
     );
-    // Below the 1 MPa default threshold: particles roll, nothing added.
-    let light = track_at(1.0e5);
+    // Below the 10 kPa default threshold: particles roll, nothing added.
+    let light = track_at(5.0e3);
     assert_eq!(
         wear(&light, &[t.as_ref()], SlipHistory::default()),
         wear(&light, &[], SlipHistory::default())
