@@ -265,3 +265,108 @@ fn splice_generated(existing: Option<String>, section: &str) -> String {
     }
     format!("# Rattle box: railwear vs ADAMS (thesis Table 5.4) vs measured (Table 5.3)\n\n{block}")
 }
+
+/// `railwear campaign check <file>`: loads and validates a campaign; prints a summary (or, with
+/// `json`, the campaign's JSON form). The error names the field and, for CSV data, the row.
+pub fn campaign_check(file: &Path, json: bool, configs_dir: &Path) -> Result<()> {
+    use crate::gap::Campaign;
+    let campaign = Campaign::load(file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    campaign
+        .validate(configs_dir)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&campaign)?);
+        return Ok(());
+    }
+    let (tests, specimens, increments, records) = campaign.counts();
+    println!(
+        "{}: valid (format {}), {tests} tests, {specimens} specimens, {increments} increments, \
+         {records} accelerometer records",
+        campaign.name, campaign.format_version
+    );
+    println!(
+        "{:<8} {:<16} {:>6} {:>10} {:>10} {:>9}  mass loss per increment, mg (rate mg/h)",
+        "test", "config", "k_rs", "drive", "incr. h", "res. mg"
+    );
+    for (ti, t) in campaign.tests.iter().enumerate() {
+        let case = t.case(ti, configs_dir)?;
+        let k_rs = crate::gap::campaign::CampaignTest::rattle_space_of(&case)
+            .map_or("-".to_string(), |k| format!("{k:.3}"));
+        let drive = t.drive.as_ref().map_or("config".to_string(), |d| {
+            match (&d.profile, d.level_g, d.frequency_hz) {
+                (Some(p), _, _) => p.clone(),
+                (None, g, f) => format!(
+                    "{}g@{}Hz",
+                    g.map_or("-".into(), |g| g.to_string()),
+                    f.map_or("-".into(), |f| f.to_string())
+                ),
+            }
+        });
+        let hours = t.increment_duration_s / crate::units::S_PER_H;
+        for s in &t.specimens {
+            let masses: Vec<String> = s
+                .increments
+                .iter()
+                .map(|inc| {
+                    inc.mass_loss_mg
+                        .iter()
+                        .map(|(c, m)| format!("{c} {m} ({:.4})", m / hours))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                })
+                .collect();
+            println!(
+                "{:<8} {:<16} {:>6} {:>10} {:>10.3} {:>9}  {}: {}",
+                t.id,
+                t.config,
+                k_rs,
+                drive,
+                hours,
+                t.scale_resolution_mg,
+                s.id,
+                masses.join(" | ")
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The thesis campaign, built in (`railwear rig --base thesis`).
+pub const BUILTIN_THESIS_CAMPAIGN: &str = include_str!("../campaigns/thesis-rattle-box.toml");
+
+/// `railwear rig`: writes `<out>/campaign.toml` (+ CSVs) and `<out>/truth.json`.
+pub fn rig(
+    base: &Path,
+    effects: &[String],
+    options: crate::gap::rig::RigOptions,
+    out: &Path,
+    configs_dir: &Path,
+) -> Result<()> {
+    use crate::gap::Campaign;
+    let campaign = if base == Path::new("thesis") {
+        Campaign::from_toml_str(BUILTIN_THESIS_CAMPAIGN, Path::new("."))?
+    } else {
+        Campaign::load(base).map_err(|e| anyhow::anyhow!("{}: {e}", base.display()))?
+    };
+    let (lib, hidden) = crate::gap::rig::parse_effects(effects)?;
+    let options = crate::gap::rig::RigOptions {
+        effects: lib,
+        hidden,
+        ..options
+    };
+    let (result, truth) =
+        crate::gap::rig::run(&campaign, configs_dir, &options, &RunControl::silent())?;
+    result.write_dir(out)?;
+    std::fs::write(
+        out.join("truth.json"),
+        serde_json::to_string_pretty(&truth)?,
+    )
+    .with_context(|| format!("writing {}", out.join("truth.json").display()))?;
+    let (tests, specimens, increments, records) = result.counts();
+    println!(
+        "wrote {} ({tests} tests, {specimens} specimens, {increments} increments, {records} \
+         accelerometer records) and truth.json",
+        out.join("campaign.toml").display()
+    );
+    Ok(())
+}

@@ -93,6 +93,53 @@ enum Command {
         #[arg(long, default_value = "configs")]
         configs_dir: PathBuf,
     },
+    /// Test campaigns (measured data for the sim-to-real gap diagnosis).
+    Campaign {
+        #[command(subcommand)]
+        command: CampaignCommand,
+    },
+    /// Virtual shaker rig: a campaign from the model plus hidden effects, scatter and noise;
+    /// writes <out>/campaign.toml (+ CSVs, no word of the effect) and <out>/truth.json.
+    Rig {
+        /// Base campaign manifest (its measurements are ignored), or `thesis` for the built-in
+        /// campaigns/thesis-rattle-box.toml.
+        #[arg(long)]
+        base: PathBuf,
+        /// Hidden effect `<name>=<magnitude>[,<param>=<value>...]`, repeatable; `none` makes a
+        /// control. Library effects and the rig-only `surface_oxide`, `work_hardening`.
+        #[arg(long = "effect", required = true)]
+        effects: Vec<String>,
+        /// Relative measurement noise of each weighed mass (standard deviation / mass).
+        #[arg(long, default_value_t = 0.0)]
+        noise: f64,
+        /// Specimen-to-specimen scatter of the wear (log-normal sigma).
+        #[arg(long, default_value_t = 0.0)]
+        scatter: f64,
+        /// Seed of every random draw.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Simulated excitation per segment, s (it stands for the segment's test time).
+        #[arg(long, default_value_t = 2.0)]
+        window_s: f64,
+        /// Settle time before each segment, s.
+        #[arg(long, default_value_t = 0.5)]
+        settle_s: f64,
+        /// Segments per increment (dynamics effects update between segments).
+        #[arg(long, default_value_t = 1)]
+        segments_per_increment: usize,
+        /// Also write input and response accelerometer records at this rate, Hz.
+        #[arg(long)]
+        accelerometer_rate_hz: Option<f64>,
+        /// Sensor noise of those records, RMS m/s².
+        #[arg(long, default_value_t = 0.0)]
+        sensor_noise_m_s2: f64,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
     /// Run the thesis anchors and print expected vs measured vs verdict.
     Validate {
         /// One JSON object per anchor (name, expected, measured, tolerance, pass).
@@ -101,6 +148,22 @@ enum Command {
         /// Also run the slow anchors (rattle box and launcher simulations, minutes).
         #[arg(long)]
         slow: bool,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
+}
+
+#[derive(Subcommand)]
+enum CampaignCommand {
+    /// Load and validate a campaign; print a summary, or the error naming field and row (exit
+    /// status 1).
+    Check {
+        /// Campaign manifest (TOML, CSV files beside it).
+        file: PathBuf,
+        /// Print the campaign's JSON form instead of the summary.
+        #[arg(long)]
+        json: bool,
         /// Directory of reference configs and profiles.
         #[arg(long, default_value = "configs")]
         configs_dir: PathBuf,
@@ -319,6 +382,49 @@ async fn main() -> Result<()> {
                 std::process::exit(1);
             }
             Ok(())
+        }
+        Command::Campaign {
+            command:
+                CampaignCommand::Check {
+                    file,
+                    json,
+                    configs_dir,
+                },
+        } => {
+            // A refused campaign is an answer, not a crash: the message names field and row.
+            if let Err(e) = railwear::cli::campaign_check(file, *json, configs_dir) {
+                eprintln!("error: {e:#}");
+                std::process::exit(1);
+            }
+            Ok(())
+        }
+        Command::Rig {
+            base,
+            effects,
+            noise,
+            scatter,
+            seed,
+            out,
+            window_s,
+            settle_s,
+            segments_per_increment,
+            accelerometer_rate_hz,
+            sensor_noise_m_s2,
+            configs_dir,
+        } => {
+            init_logging(false);
+            let options = railwear::gap::rig::RigOptions {
+                noise_rel: *noise,
+                scatter_rel: *scatter,
+                seed: *seed,
+                window_s: *window_s,
+                settle_s: *settle_s,
+                segments_per_increment: *segments_per_increment,
+                accelerometer_rate_hz: *accelerometer_rate_hz,
+                sensor_noise_m_s2: *sensor_noise_m_s2,
+                ..Default::default()
+            };
+            railwear::cli::rig(base, effects, options, out, configs_dir)
         }
         Command::Migrate => {
             let config = load_config(&cli)?;

@@ -148,6 +148,19 @@ pub fn run_model(
     options: &RunOptions,
     control: &RunControl,
 ) -> Result<RunReport, ModelRunError> {
+    run_model_observed(model, options, control, &mut |_| {})
+}
+
+/// [`run_model`], also handing every accepted step of the excitation window (`t >=`
+/// excitation start) to `extra` before the run's own post-processing sees it. The gap
+/// diagnosis keeps each step's contact tracks this way, on the integrator's own time grid, so
+/// that wear-law variants can be re-integrated exactly as the run integrates wear.
+pub fn run_model_observed(
+    model: &BuiltModel,
+    options: &RunOptions,
+    control: &RunControl,
+    extra: &mut dyn FnMut(&StepView),
+) -> Result<RunReport, ModelRunError> {
     let sys = &model.system;
     let t0 = model.excitation_start_s;
     let ncontacts = sys.contacts.len();
@@ -184,6 +197,7 @@ pub fn run_model(
         if v.t < t0 {
             return;
         }
+        extra(v);
         // Friction power and normal force, trapezoid between step ends.
         let mut n_sum = vec![0.0; ncontacts];
         let mut p_sum = vec![0.0; ncontacts];
