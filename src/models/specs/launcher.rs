@@ -1,0 +1,605 @@
+//! Chapter 6: the launcher, its lettered dimensions and the derived geometry (rail faces, shoe heads).
+
+use super::*;
+
+/// Rail extrusion layout (kinematic body, driven at its centre of mass, thesis 6.5). The channel
+/// cross-section comes from [`LauncherDimensions`]; this places it in the rail frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RailSpec {
+    /// Length of the channel along z, m. Estimate.
+    pub channel_length_m: f64,
+    /// z of the channel's mid-length in the rail frame, m. Estimate.
+    pub channel_centre_z_m: f64,
+    /// y of the lip top faces (the chamber floor the shoe heads rest on), m. Estimate.
+    pub lip_top_y_m: f64,
+    /// Lip thickness (slot depth), m; the rail's bottom face is at `lip_top_y_m` minus this.
+    /// Must be smaller than the shoes' neck height. Estimate.
+    pub lip_thickness_m: f64,
+    /// Half width of the rail's bottom face (from the channel centreline to the outer edge), m.
+    /// Estimate.
+    pub bottom_half_width_m: f64,
+}
+
+/// The missile body (rigid, carrying the shoes and the front bearing pad). Missile frame: origin
+/// at its centre of mass, axes parallel to the rail frame at assembly (z along the missile axis).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MissileSpec {
+    /// Mass, kg. SPEC 4: about 45 kg (Hellfire class; not given in the thesis).
+    pub mass_kg: f64,
+    /// Body length, m. SPEC 4: 1.63 m.
+    pub length_m: f64,
+    /// Body diameter, m. SPEC 4: 0.178 m.
+    pub diameter_m: f64,
+    /// Principal moments (x, y, z) about the centre of mass, kg·m². Omitted: a solid cylinder of
+    /// the given mass, length and diameter (estimate; the thesis gives no inertia).
+    #[serde(default)]
+    pub inertia_kg_m2: Option<[f64; 3]>,
+    /// z of the missile's centre of mass in the rail frame at assembly, m. Estimate. (x is 0;
+    /// y follows from the rear shoe resting on the lips, [`LauncherSpec::missile_com_in_rail_m`].)
+    pub com_z_in_rail_m: f64,
+}
+
+impl MissileSpec {
+    /// Principal moments, kg·m²: the given ones or a solid cylinder's
+    /// (`I_xx = I_yy = m (3 r² + L²) / 12`, `I_zz = m r² / 2`).
+    pub fn inertia_kg_m2(&self) -> [f64; 3] {
+        self.inertia_kg_m2.unwrap_or_else(|| {
+            let r = 0.5 * self.diameter_m;
+            let transverse = self.mass_kg * (3.0 * r * r + self.length_m * self.length_m) / 12.0;
+            [transverse, transverse, 0.5 * self.mass_kg * r * r]
+        })
+    }
+}
+
+/// A shoe (mid or rear), rigidly fastened to the missile (thesis 6.5: locked joints). Its T-head
+/// and neck cross-sections come from [`LauncherDimensions`]; this places it on the missile.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShoeSpec {
+    /// Centre of the head's underside (the face that rests on the rail lips), m, missile frame.
+    pub head_base_in_missile_m: [f64; 3],
+    /// Shoe length along z, m. Estimate.
+    pub length_m: f64,
+    /// Edge roundover, m (thesis 6.5: "a small roundover specified in the design"). Estimate.
+    pub edge_radius_m: f64,
+    /// Extra contact piece, missile frame: the mid shoe's front protrusion that enlarges the
+    /// latch interface (thesis 6.2.3). None for the rear shoe.
+    #[serde(default)]
+    pub protrusion: Option<RoundedBoxSpec>,
+}
+
+impl ShoeSpec {
+    /// The T-head as a rounded box in the missile frame: width `A`, thickness `K`, this length.
+    pub fn head_box(&self, d: &LauncherDimensions) -> RoundedBoxSpec {
+        let t = units::mm(d.k_shoe_mm);
+        let b = self.head_base_in_missile_m;
+        RoundedBoxSpec {
+            centre_m: [b[0], b[1] + 0.5 * t, b[2]],
+            half_extents_m: [0.5 * units::mm(d.a_shoe_mm), 0.5 * t, 0.5 * self.length_m],
+            edge_radius_m: self.edge_radius_m,
+        }
+    }
+
+    /// The neck as a rounded box in the missile frame: width `mean(N, O)`, height
+    /// `mean(F-G, H-I, J-K, L-M)`, below the head.
+    pub fn neck_box(&self, d: &LauncherDimensions) -> RoundedBoxSpec {
+        let h = units::mm(d.mean_neck_height_mm());
+        let b = self.head_base_in_missile_m;
+        RoundedBoxSpec {
+            centre_m: [b[0], b[1] - 0.5 * h, b[2]],
+            half_extents_m: [
+                0.5 * units::mm(d.mean_neck_width_mm()),
+                0.5 * h,
+                0.5 * self.length_m,
+            ],
+            edge_radius_m: self.edge_radius_m,
+        }
+    }
+
+    /// Centre of the head's top face, missile frame, m (where the leaf spring bears).
+    pub fn head_top_in_missile_m(&self, d: &LauncherDimensions) -> [f64; 3] {
+        let b = self.head_base_in_missile_m;
+        [b[0], b[1] + units::mm(d.k_shoe_mm), b[2]]
+    }
+}
+
+/// Joint of the latch on the rail.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LatchJoint {
+    /// Rotation about and translation along the hinge axis (thesis 6.5).
+    Cylindrical,
+    /// Rotation only (translation locked): for builders that prefer to bound the axial slide.
+    Revolute,
+}
+
+/// The latch rocker (thesis 6.2.3, Figures 6.9-6.10): pivots on the rail, its tooth bears on the
+/// mid shoe's front to retain the missile longitudinally, and rests on the rail lips (the
+/// latch-rail contact stops its rotation). Latch frame: origin at its centre of mass, axes
+/// parallel to the rail frame at assembly.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatchSpec {
+    /// Mass, kg. Estimate.
+    pub mass_kg: f64,
+    /// Principal moments about the centre of mass along the latch frame axes, kg·m². Estimate.
+    pub inertia_kg_m2: [f64; 3],
+    /// Centre of mass in the rail frame at assembly, m. Estimate.
+    pub com_in_rail_m: [f64; 3],
+    /// A point on the hinge axis, rail frame, m. Estimate.
+    pub hinge_point_in_rail_m: [f64; 3],
+    /// Hinge axis direction (unit), rail frame. Transverse (x) by the latch's function.
+    pub hinge_axis: [f64; 3],
+    /// Joint type (thesis 6.5: cylindrical).
+    pub joint: LatchJoint,
+    /// The tooth (contact piece bearing on the mid shoe and on the rail), latch frame.
+    pub tooth: RoundedBoxSpec,
+}
+
+impl LatchSpec {
+    /// Tooth centre in the rail frame at assembly, m.
+    pub fn tooth_centre_in_rail_m(&self) -> [f64; 3] {
+        add3(self.com_in_rail_m, self.tooth.centre_m)
+    }
+}
+
+pub(super) fn add3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+pub(super) fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The latch coil springs (two concentric springs, thesis 6.2.3, modelled as one two-point coil
+/// spring, thesis 6.5). Compression spring: the force pushes the two points apart,
+/// `F = preload + k (L_installed - L) - c dL/dt`, with `L_installed` the distance at assembly.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoilSpringSpec {
+    /// Combined stiffness k, N/m. Estimate.
+    pub stiffness_n_per_m: f64,
+    /// Damping c, N·s/m. Estimate.
+    pub damping_ns_per_m: f64,
+    /// Force at the installed length, N (> 0: compressed at assembly). Estimate.
+    pub preload_n: f64,
+    /// Attachment on the rail (latch cover), rail frame, m. Estimate.
+    pub point_on_rail_m: [f64; 3],
+    /// Attachment on the latch, latch frame, m. Estimate.
+    pub point_on_latch_m: [f64; 3],
+}
+
+/// A constant point force on the missile (a double-barrel spring, thesis 6.5: "modeled as
+/// constant point forces because of the small displacements").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantForceSpec {
+    /// Label, e.g. `double_barrel_left`.
+    pub name: String,
+    /// Force magnitude, N. Estimate.
+    pub force_n: f64,
+    /// Point of application on the mid shoe, missile frame, m. Estimate.
+    pub point_in_missile_m: [f64; 3],
+    /// Direction (unit), fixed in the rail frame: +z, opposite the latch (thesis 6.2.3).
+    pub direction_in_rail: [f64; 3],
+}
+
+/// The rear leaf spring (thesis 6.2.3, 6.5): fixed to the rail above the rear shoe, it presses
+/// the shoe head down onto the lips. Modelled as a vertical one-sided point force with a smooth
+/// engagement: with `c` the compression (shoe head top above the spring's free tip),
+/// `F_y = -STEP(c, 0, 0, s, 1) (preload + k c)` on the shoe for `c > 0`, zero otherwise, `s` the
+/// engagement smoothing. The free tip hangs `reach_below_roof_m` below the chamber roof, so the
+/// static engagement depends on the rail's vertical clearance: it may not engage when static for
+/// a loose rail (thesis 6.3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LeafSpringSpec {
+    /// Stiffness k, N/m. Estimate.
+    pub stiffness_n_per_m: f64,
+    /// Force at first touch (c = 0+), N. Estimate.
+    pub preload_n: f64,
+    /// How far the free tip hangs below the chamber roof, m. Estimate.
+    pub reach_below_roof_m: f64,
+    /// z of the spring tip in the rail frame, m (over the rear shoe at assembly). Estimate.
+    pub z_in_rail_m: f64,
+    /// Engagement smoothing s (smooth-step width), m. Estimate.
+    pub engagement_smoothing_m: f64,
+    /// Step shape for the engagement (default cycloidal, eq. 2.4).
+    #[serde(default)]
+    pub step: StepKind,
+}
+
+/// The five solid-solid contacts of thesis 6.5 (numbered 1-5 as in Figures 6.59-6.62, 6.65-6.66).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LauncherContacts {
+    /// Contact 1: missile front (front bearing pad) - rail. Table 6.2 default.
+    pub missile_rail: ContactSpec,
+    /// Contact 2: latch - rail. Stiffer than default (thesis 6.5.2, 6.6.3; value estimate).
+    pub latch_rail: ContactSpec,
+    /// Contact 3: mid shoe - rail. Table 6.2 default.
+    pub mid_shoe_rail: ContactSpec,
+    /// Contact 4: mid shoe - latch. Stiffer than default (thesis 6.5.2, 6.6.3; value estimate).
+    pub mid_shoe_latch: ContactSpec,
+    /// Contact 5: rear shoe - rail. Table 6.2 default.
+    pub rear_shoe_rail: ContactSpec,
+}
+
+/// The Hellfire-class launcher of thesis chapter 6: kinematic rail, missile with mid and rear
+/// shoes and a front bearing pad, latch on a cylindrical joint with its coil spring, two
+/// double-barrel springs, the rear leaf spring, five contacts (Table 6.2) and friction (Table
+/// 6.1). `dimensions` sets the channel and shoe cross-sections, so the tight, design and loose
+/// variants (eq. 6.1-6.3) change the clearances.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LauncherSpec {
+    /// Rail and shoe material (anodized 7075, thesis 4.2.1).
+    #[serde(default)]
+    pub material: MaterialSpec,
+    /// Rear shoe and rail cross-section dimensions (eq. 6.1-6.2), mm.
+    pub dimensions: LauncherDimensions,
+    /// Rail layout.
+    pub rail: RailSpec,
+    /// Missile body.
+    pub missile: MissileSpec,
+    /// Mid shoe (latch side).
+    pub mid_shoe: ShoeSpec,
+    /// Rear shoe.
+    pub rear_shoe: ShoeSpec,
+    /// Missile front bearing pad (contact 1, the "front shoe (missile)" of Figure 6.59): where the
+    /// missile's forward body meets the rail's bottom face, missile frame. Estimate.
+    pub front_pad: RoundedBoxSpec,
+    /// Latch rocker.
+    pub latch: LatchSpec,
+    /// Latch coil spring.
+    pub latch_spring: CoilSpringSpec,
+    /// The two double-barrel springs on the mid shoe.
+    pub double_barrel_springs: Vec<ConstantForceSpec>,
+    /// Rear leaf spring.
+    pub rear_leaf_spring: LeafSpringSpec,
+    /// Contact parameters (Table 6.2).
+    pub contacts: LauncherContacts,
+    /// Friction for all contacts (Table 6.1).
+    pub friction: FrictionSpec,
+}
+
+impl LauncherSpec {
+    /// Rattle space of the rail, eq. 6.1-6.3.
+    pub fn rattle_space(&self) -> Result<f64, RattleSpaceError> {
+        self.dimensions.rattle_space()
+    }
+
+    /// y of the chamber roof over the centreline, rail frame, m: lip top + mean(N_rail, Q_rail).
+    pub fn chamber_roof_y_m(&self) -> f64 {
+        self.rail.lip_top_y_m + units::mm(self.dimensions.mean_chamber_height_mm())
+    }
+
+    /// Missile centre of mass in the rail frame at assembly, m: the rear shoe's head rests on the
+    /// lips (zero penetration), x = 0.
+    pub fn missile_com_in_rail_m(&self) -> [f64; 3] {
+        [
+            -self.rear_shoe.head_base_in_missile_m[0],
+            self.rail.lip_top_y_m - self.rear_shoe.head_base_in_missile_m[1],
+            self.missile.com_z_in_rail_m,
+        ]
+    }
+
+    /// Missile-frame point expressed in the rail frame at assembly, m.
+    pub fn missile_to_rail_m(&self, p: [f64; 3]) -> [f64; 3] {
+        add3(self.missile_com_in_rail_m(), p)
+    }
+
+    /// Leaf spring free tip, rail frame, m.
+    pub fn leaf_spring_tip_in_rail_m(&self) -> [f64; 3] {
+        [
+            0.0,
+            self.chamber_roof_y_m() - self.rear_leaf_spring.reach_below_roof_m,
+            self.rear_leaf_spring.z_in_rail_m,
+        ]
+    }
+
+    /// Leaf spring compression at assembly, m (> 0 engaged, < 0 a gap: not engaged when static).
+    pub fn leaf_spring_static_compression_m(&self) -> f64 {
+        let top = self.missile_to_rail_m(self.rear_shoe.head_top_in_missile_m(&self.dimensions));
+        top[1] - self.leaf_spring_tip_in_rail_m()[1]
+    }
+
+    /// Latch spring length at assembly, m.
+    pub fn latch_spring_installed_length_m(&self) -> f64 {
+        dist3(
+            self.latch_spring.point_on_rail_m,
+            add3(self.latch.com_in_rail_m, self.latch_spring.point_on_latch_m),
+        )
+    }
+
+    /// The channel faces the shoes, latch tooth and front pad can touch, rail frame (from
+    /// `dimensions` and `rail`): lip tops (floor, +y), roof halves (-y, heights N_rail left and
+    /// Q_rail right), chamber walls (width `B + A - mean(N, O)`, eq. 6.1), slot walls (width B)
+    /// and the rail's bottom face (-y). Left is -x.
+    pub fn rail_faces(&self) -> Vec<PlanarFace> {
+        let d = &self.dimensions;
+        let r = &self.rail;
+        let half_b = 0.5 * units::mm(d.b_rail_mm);
+        let half_w = 0.5 * units::mm(d.chamber_width_mm());
+        let y0 = r.lip_top_y_m;
+        let (hl, hr) = (units::mm(d.n_rail_mm), units::mm(d.q_rail_mm));
+        let yb = y0 - r.lip_thickness_m;
+        let zc = r.channel_centre_z_m;
+        let hz = 0.5 * r.channel_length_m;
+        let ez = [0.0, 0.0, 1.0];
+        // Each face: tangent along z (half length = half the channel), width across.
+        let face = |name: &str, centre: [f64; 3], normal: [f64; 3], half_width: f64| PlanarFace {
+            name: name.to_string(),
+            centre_m: centre,
+            normal,
+            tangent: ez,
+            half_length_m: hz,
+            half_width_m: half_width,
+        };
+        let lip_half = 0.5 * (half_w - half_b);
+        let bottom_half = 0.5 * (r.bottom_half_width_m - half_b);
+        vec![
+            face(
+                "lip_top_left",
+                [-(half_b + lip_half), y0, zc],
+                [0.0, 1.0, 0.0],
+                lip_half,
+            ),
+            face(
+                "lip_top_right",
+                [half_b + lip_half, y0, zc],
+                [0.0, 1.0, 0.0],
+                lip_half,
+            ),
+            face(
+                "roof_left",
+                [-0.5 * half_w, y0 + hl, zc],
+                [0.0, -1.0, 0.0],
+                0.5 * half_w,
+            ),
+            face(
+                "roof_right",
+                [0.5 * half_w, y0 + hr, zc],
+                [0.0, -1.0, 0.0],
+                0.5 * half_w,
+            ),
+            face(
+                "chamber_wall_left",
+                [-half_w, y0 + 0.5 * hl, zc],
+                [1.0, 0.0, 0.0],
+                0.5 * hl,
+            ),
+            face(
+                "chamber_wall_right",
+                [half_w, y0 + 0.5 * hr, zc],
+                [-1.0, 0.0, 0.0],
+                0.5 * hr,
+            ),
+            face(
+                "slot_wall_left",
+                [-half_b, y0 - 0.5 * r.lip_thickness_m, zc],
+                [1.0, 0.0, 0.0],
+                0.5 * r.lip_thickness_m,
+            ),
+            face(
+                "slot_wall_right",
+                [half_b, y0 - 0.5 * r.lip_thickness_m, zc],
+                [-1.0, 0.0, 0.0],
+                0.5 * r.lip_thickness_m,
+            ),
+            face(
+                "bottom_left",
+                [-(half_b + bottom_half), yb, zc],
+                [0.0, -1.0, 0.0],
+                bottom_half,
+            ),
+            face(
+                "bottom_right",
+                [half_b + bottom_half, yb, zc],
+                [0.0, -1.0, 0.0],
+                bottom_half,
+            ),
+        ]
+    }
+
+    /// Field rules and assembly checks: dimensions (eq. 6.1-6.2 rules), positive masses and
+    /// stiffnesses, real inertias, unit axes, exactly two double-barrel springs pushing +z, both
+    /// shoes seated at the same height, shoes and pad inside the channel length, lips thinner
+    /// than the neck, front pad clear of the rail bottom, latch tooth not below the lip tops.
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        let p = |name: &str| path(prefix, name);
+        self.material.validate(&p("material"))?;
+        self.dimensions.validate().map_err(
+            |RattleSpaceError::InvalidDimension { field, rule }| {
+                err(path(&p("dimensions"), field), rule)
+            },
+        )?;
+        // Rail
+        let rp = p("rail");
+        positive(&rp, "channel_length_m", self.rail.channel_length_m)?;
+        finite(&rp, "channel_centre_z_m", self.rail.channel_centre_z_m)?;
+        finite(&rp, "lip_top_y_m", self.rail.lip_top_y_m)?;
+        positive(&rp, "lip_thickness_m", self.rail.lip_thickness_m)?;
+        let neck_h = units::mm(self.dimensions.mean_neck_height_mm());
+        if self.rail.lip_thickness_m >= neck_h {
+            return Err(err(
+                path(&rp, "lip_thickness_m"),
+                format!("must be smaller than the shoes' mean neck height {neck_h} m"),
+            ));
+        }
+        let half_w = 0.5 * units::mm(self.dimensions.chamber_width_mm());
+        if !(self.rail.bottom_half_width_m.is_finite() && self.rail.bottom_half_width_m > half_w) {
+            return Err(err(
+                path(&rp, "bottom_half_width_m"),
+                format!("must exceed the chamber half width {half_w} m"),
+            ));
+        }
+        // Missile
+        let mp = p("missile");
+        positive(&mp, "mass_kg", self.missile.mass_kg)?;
+        positive(&mp, "length_m", self.missile.length_m)?;
+        positive(&mp, "diameter_m", self.missile.diameter_m)?;
+        inertia3(&mp, "inertia_kg_m2", self.missile.inertia_kg_m2())?;
+        finite(&mp, "com_z_in_rail_m", self.missile.com_z_in_rail_m)?;
+        // Shoes and pad
+        let (z_lo, z_hi) = (
+            self.rail.channel_centre_z_m - 0.5 * self.rail.channel_length_m,
+            self.rail.channel_centre_z_m + 0.5 * self.rail.channel_length_m,
+        );
+        for (name, shoe) in [("mid_shoe", &self.mid_shoe), ("rear_shoe", &self.rear_shoe)] {
+            let sp = p(name);
+            finite3(&sp, "head_base_in_missile_m", shoe.head_base_in_missile_m)?;
+            positive(&sp, "length_m", shoe.length_m)?;
+            non_negative(&sp, "edge_radius_m", shoe.edge_radius_m)?;
+            let head = shoe.head_box(&self.dimensions);
+            let neck = shoe.neck_box(&self.dimensions);
+            if head
+                .half_extents_m
+                .iter()
+                .chain(neck.half_extents_m.iter())
+                .any(|h| *h <= shoe.edge_radius_m)
+            {
+                return Err(err(
+                    path(&sp, "edge_radius_m"),
+                    "must be smaller than every half size of the head and neck",
+                ));
+            }
+            if let Some(pr) = &shoe.protrusion {
+                pr.validate(&path(&sp, "protrusion"))?;
+                if pr.min_y_m() < shoe.head_base_in_missile_m[1] {
+                    return Err(err(
+                        path(&sp, "protrusion"),
+                        "reaches below the head base: it would intersect the rail lips at assembly",
+                    ));
+                }
+            }
+            let zc = self.missile_to_rail_m(shoe.head_base_in_missile_m)[2];
+            if zc - 0.5 * shoe.length_m < z_lo || zc + 0.5 * shoe.length_m > z_hi {
+                return Err(err(
+                    path(&sp, "head_base_in_missile_m"),
+                    "the shoe lies outside the rail channel's length",
+                ));
+            }
+        }
+        if (self.mid_shoe.head_base_in_missile_m[1] - self.rear_shoe.head_base_in_missile_m[1])
+            .abs()
+            > 1e-6
+            || (self.mid_shoe.head_base_in_missile_m[0] - self.rear_shoe.head_base_in_missile_m[0])
+                .abs()
+                > 1e-6
+        {
+            return Err(err(
+                p("mid_shoe.head_base_in_missile_m"),
+                "x and y must equal the rear shoe's: both heads ride on the same lips",
+            ));
+        }
+        let fp = p("front_pad");
+        self.front_pad.validate(&fp)?;
+        let pad_top =
+            self.missile_to_rail_m(self.front_pad.centre_m)[1] + self.front_pad.half_extents_m[1];
+        let bottom = self.rail.lip_top_y_m - self.rail.lip_thickness_m;
+        if pad_top > bottom {
+            return Err(err(
+                path(&fp, "centre_m"),
+                format!("the pad top ({pad_top} m) is above the rail bottom face ({bottom} m): interference at assembly"),
+            ));
+        }
+        let pz = self.missile_to_rail_m(self.front_pad.centre_m)[2];
+        if pz - self.front_pad.half_extents_m[2] < z_lo
+            || pz + self.front_pad.half_extents_m[2] > z_hi
+        {
+            return Err(err(
+                path(&fp, "centre_m"),
+                "the pad lies outside the rail channel's length",
+            ));
+        }
+        // Latch
+        let lp = p("latch");
+        positive(&lp, "mass_kg", self.latch.mass_kg)?;
+        inertia3(&lp, "inertia_kg_m2", self.latch.inertia_kg_m2)?;
+        finite3(&lp, "com_in_rail_m", self.latch.com_in_rail_m)?;
+        finite3(
+            &lp,
+            "hinge_point_in_rail_m",
+            self.latch.hinge_point_in_rail_m,
+        )?;
+        unit3(&lp, "hinge_axis", self.latch.hinge_axis)?;
+        self.latch.tooth.validate(&path(&lp, "tooth"))?;
+        let tooth_bottom =
+            self.latch.tooth_centre_in_rail_m()[1] - self.latch.tooth.half_extents_m[1];
+        if tooth_bottom < self.rail.lip_top_y_m - 1e-9 {
+            return Err(err(
+                path(&lp, "tooth"),
+                format!("the tooth bottom ({tooth_bottom} m) is below the lip tops: interference at assembly"),
+            ));
+        }
+        // Springs
+        let sp = p("latch_spring");
+        positive(
+            &sp,
+            "stiffness_n_per_m",
+            self.latch_spring.stiffness_n_per_m,
+        )?;
+        non_negative(&sp, "damping_ns_per_m", self.latch_spring.damping_ns_per_m)?;
+        non_negative(&sp, "preload_n", self.latch_spring.preload_n)?;
+        finite3(&sp, "point_on_rail_m", self.latch_spring.point_on_rail_m)?;
+        finite3(&sp, "point_on_latch_m", self.latch_spring.point_on_latch_m)?;
+        if self.latch_spring_installed_length_m() <= 0.0 {
+            return Err(err(
+                path(&sp, "point_on_rail_m"),
+                "the two attachment points coincide at assembly",
+            ));
+        }
+        if self.double_barrel_springs.len() != 2 {
+            return Err(err(
+                p("double_barrel_springs"),
+                format!(
+                    "there are two double-barrel springs (thesis 6.5), got {}",
+                    self.double_barrel_springs.len()
+                ),
+            ));
+        }
+        for (i, f) in self.double_barrel_springs.iter().enumerate() {
+            let fp = p(&format!("double_barrel_springs[{i}]"));
+            positive(&fp, "force_n", f.force_n)?;
+            finite3(&fp, "point_in_missile_m", f.point_in_missile_m)?;
+            unit3(&fp, "direction_in_rail", f.direction_in_rail)?;
+            if f.direction_in_rail[2] <= 0.0 {
+                return Err(err(
+                    path(&fp, "direction_in_rail"),
+                    "must push forward (+z), opposite the latch (thesis 6.2.3)",
+                ));
+            }
+        }
+        let lf = p("rear_leaf_spring");
+        positive(
+            &lf,
+            "stiffness_n_per_m",
+            self.rear_leaf_spring.stiffness_n_per_m,
+        )?;
+        non_negative(&lf, "preload_n", self.rear_leaf_spring.preload_n)?;
+        non_negative(
+            &lf,
+            "reach_below_roof_m",
+            self.rear_leaf_spring.reach_below_roof_m,
+        )?;
+        finite(&lf, "z_in_rail_m", self.rear_leaf_spring.z_in_rail_m)?;
+        positive(
+            &lf,
+            "engagement_smoothing_m",
+            self.rear_leaf_spring.engagement_smoothing_m,
+        )?;
+        // Contacts and friction
+        let cp = p("contacts");
+        let c = &self.contacts;
+        c.missile_rail.validate(&path(&cp, "missile_rail"))?;
+        c.latch_rail.validate(&path(&cp, "latch_rail"))?;
+        c.mid_shoe_rail.validate(&path(&cp, "mid_shoe_rail"))?;
+        c.mid_shoe_latch.validate(&path(&cp, "mid_shoe_latch"))?;
+        c.rear_shoe_rail.validate(&path(&cp, "rear_shoe_rail"))?;
+        self.friction.validate(&p("friction"))?;
+        Ok(())
+    }
+}

@@ -1,0 +1,278 @@
+//! What the three models ARE: typed, documented, validated specifications read from the case
+//! files in `configs/` (thesis chapters 4, 5 and 6). How they move is built elsewhere from these.
+//!
+//! Conventions (SPEC 1, thesis 6.2.2): SI unless a field name says otherwise (`_mm`, `_deg`,
+//! `_n_per_mm_e`); y is vertical (up, towards the vehicle), gravity is standard gravity along -y;
+//! for the launcher the rail frame has its origin at the rail's centre of mass, z longitudinal
+//! (firing direction), x transverse. Contact and friction parameters are written in the thesis'
+//! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`] and
+//! [`FrictionSpec::to_friction_params`]. Values the thesis does not give are engineering
+//! estimates, flagged `estimate` in `docs/models.md`.
+
+use crate::analysis::rattle_space::{self, LauncherDimensions, RattleSpaceError};
+use crate::physics::friction::FrictionParams;
+use crate::physics::impact::ImpactParams;
+use crate::physics::step::StepKind;
+use crate::units;
+use serde::{Deserialize, Serialize};
+
+/// A specification that breaks a rule. `field` is the dotted path of the offending field as it
+/// appears in the case file (e.g. `launcher.rail.lip_thickness_m`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("invalid `{field}`: {rule}")]
+pub struct SpecError {
+    /// Dotted path of the field in the case file.
+    pub field: String,
+    /// The rule broken, in words, with the value where useful.
+    pub rule: String,
+}
+
+fn err(field: impl Into<String>, rule: impl Into<String>) -> SpecError {
+    SpecError {
+        field: field.into(),
+        rule: rule.into(),
+    }
+}
+
+fn path(prefix: &str, name: &str) -> String {
+    if prefix.is_empty() {
+        name.to_string()
+    } else {
+        format!("{prefix}.{name}")
+    }
+}
+
+fn finite(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(err(
+            path(prefix, name),
+            format!("must be a finite number, got {v}"),
+        ))
+    }
+}
+
+fn positive(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(err(
+            path(prefix, name),
+            format!("must be a finite number > 0, got {v}"),
+        ))
+    }
+}
+
+fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(err(
+            path(prefix, name),
+            format!("must be a finite number >= 0, got {v}"),
+        ))
+    }
+}
+
+fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), SpecError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(err(
+            path(prefix, name),
+            format!("all components must be finite, got {v:?}"),
+        ))
+    }
+}
+
+fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), SpecError> {
+    finite3(prefix, name, v)?;
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if (n - 1.0).abs() > 1e-6 {
+        return Err(err(
+            path(prefix, name),
+            format!("must be a unit vector, |v| = {n}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Principal moments must be > 0 and satisfy the triangle inequality (a real rigid body).
+fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), SpecError> {
+    if !i.iter().all(|x| x.is_finite() && *x > 0.0) {
+        return Err(err(
+            path(prefix, name),
+            format!("all moments must be finite and > 0, got {i:?}"),
+        ));
+    }
+    let tol = 1e-12 * (i[0] + i[1] + i[2]);
+    if i[0] + i[1] < i[2] - tol || i[1] + i[2] < i[0] - tol || i[0] + i[2] < i[1] - tol {
+        return Err(err(
+            path(prefix, name),
+            format!(
+                "principal moments {i:?} break the triangle inequality (no real body has them)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+mod launcher;
+mod persistent_contact;
+mod rattle_box;
+mod shared;
+#[cfg(test)]
+mod tests;
+
+pub use launcher::*;
+pub use persistent_contact::*;
+pub use rattle_box::*;
+pub use shared::*;
+
+/// Which model a case file describes (its top-level `model` key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// Thesis chapter 4; model table `[persistent_contact]`.
+    PersistentContact,
+    /// Thesis chapter 5; model table `[rattle_box]`.
+    RattleBox,
+    /// Thesis chapter 6; model table `[launcher]`.
+    Launcher,
+}
+
+/// The model table of a case, by kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModelSpecRef<'a> {
+    /// Chapter 4.
+    PersistentContact(&'a PersistentContactSpec),
+    /// Chapter 5.
+    RattleBox(&'a RattleBoxSpec),
+    /// Chapter 6.
+    Launcher(&'a LauncherSpec),
+}
+
+/// One case file (`configs/*.toml`): model kind, name, description, run control, the model's own
+/// table and the excitation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseSpec {
+    /// Model kind; the table of the same name must be present and no other model table.
+    pub model: ModelKind,
+    /// Short identifier, e.g. `rattle-box-c`.
+    pub name: String,
+    /// One-line description with the thesis source.
+    pub description: String,
+    /// Run control.
+    pub simulation: SimulationSpec,
+    /// Chapter 4 model table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub persistent_contact: Option<PersistentContactSpec>,
+    /// Chapter 5 model table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rattle_box: Option<RattleBoxSpec>,
+    /// Chapter 6 model table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub launcher: Option<LauncherSpec>,
+    /// Base excitation, kept untyped here (its schema belongs to `crate::excitation`).
+    pub excitation: serde_json::Value,
+    /// Wear law and the split of wear volume between the bodies of a contact.
+    #[serde(default)]
+    pub wear: WearSpec,
+}
+
+/// The `[wear]` table: wear law (default thesis Table 4.3 with the eq. 3.11 cutoff 2 S_y) and
+/// how each contact's volume is split between its two bodies (default inverse hardness).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WearSpec {
+    /// Wear law (tagged by `kind`: `archard`, `modified`, `legacy_appendix`).
+    #[serde(default = "crate::wear::law::WearLaw::table_4_3")]
+    pub law: crate::wear::law::WearLaw,
+    /// Volume split between the two bodies of each contact.
+    #[serde(default)]
+    pub volume_split: crate::wear::allocation::VolumeSplit,
+}
+
+impl Default for WearSpec {
+    fn default() -> Self {
+        Self {
+            law: crate::wear::law::WearLaw::table_4_3(),
+            volume_split: crate::wear::allocation::VolumeSplit::default(),
+        }
+    }
+}
+
+impl CaseSpec {
+    /// Parses a TOML case file (unknown keys are errors) and validates it.
+    pub fn from_toml_str(text: &str) -> Result<Self, SpecError> {
+        let case: Self = toml::from_str(text).map_err(|e| err("toml", e.to_string()))?;
+        case.validate()?;
+        Ok(case)
+    }
+
+    /// The model table matching `model`.
+    pub fn model_spec(&self) -> Result<ModelSpecRef<'_>, SpecError> {
+        let missing = |t: &str| err(t, format!("model = {:?} needs a [{t}] table", self.model));
+        match self.model {
+            ModelKind::PersistentContact => self
+                .persistent_contact
+                .as_ref()
+                .map(ModelSpecRef::PersistentContact)
+                .ok_or_else(|| missing("persistent_contact")),
+            ModelKind::RattleBox => self
+                .rattle_box
+                .as_ref()
+                .map(ModelSpecRef::RattleBox)
+                .ok_or_else(|| missing("rattle_box")),
+            ModelKind::Launcher => self
+                .launcher
+                .as_ref()
+                .map(ModelSpecRef::Launcher)
+                .ok_or_else(|| missing("launcher")),
+        }
+    }
+
+    /// Validates the whole case: name, the one matching model table, run control, and that the
+    /// excitation is a table with a `kind`.
+    pub fn validate(&self) -> Result<(), SpecError> {
+        if self.name.trim().is_empty() {
+            return Err(err("name", "must not be empty"));
+        }
+        let extra = [
+            (
+                "persistent_contact",
+                self.persistent_contact.is_some(),
+                ModelKind::PersistentContact,
+            ),
+            (
+                "rattle_box",
+                self.rattle_box.is_some(),
+                ModelKind::RattleBox,
+            ),
+            ("launcher", self.launcher.is_some(), ModelKind::Launcher),
+        ]
+        .into_iter()
+        .find(|(_, present, kind)| *present && *kind != self.model);
+        if let Some((table, _, _)) = extra {
+            return Err(err(
+                table,
+                format!("table present but model = {:?}", self.model),
+            ));
+        }
+        self.simulation.validate("simulation")?;
+        match self.model_spec()? {
+            ModelSpecRef::PersistentContact(s) => s.validate("persistent_contact")?,
+            ModelSpecRef::RattleBox(s) => s.validate("rattle_box")?,
+            ModelSpecRef::Launcher(s) => s.validate("launcher")?,
+        }
+        match self.excitation.get("kind").and_then(|k| k.as_str()) {
+            Some(k) if !k.is_empty() => Ok(()),
+            _ => Err(err(
+                "excitation.kind",
+                "the excitation table needs a `kind` string",
+            )),
+        }
+    }
+}

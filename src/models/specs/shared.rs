@@ -1,0 +1,362 @@
+//! Specs shared by every model: material, contact and friction (ADAMS units), rounded boxes, the simulation settings.
+
+use super::*;
+
+/// ADAMS IMPACT contact parameters in ADAMS units (N, mm, s), eq. 2.1-2.3.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Stiffness k, N/mm^e. Tables 4.1, 5.2, 6.2: 1000.
+    pub stiffness_n_per_mm_e: f64,
+    /// Force exponent e, dimensionless (>= 1). Tables 4.1, 5.2, 6.2: 2.0.
+    pub exponent: f64,
+    /// Maximum damping c_max, N·s/mm. Tables 4.1, 5.2, 6.2: 500.
+    pub damping_ns_per_mm: f64,
+    /// Penetration d at which full damping is reached, mm. Tables 4.1, 5.2, 6.2: 0.01.
+    pub penetration_depth_mm: f64,
+    /// Damping ramp shape: `cycloidal` (eq. 2.4, default) or `cubic` (ADAMS STEP).
+    #[serde(default)]
+    pub step: StepKind,
+}
+
+impl ContactSpec {
+    /// Thesis Table 4.1 / 5.2 / 6.2 default contact: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
+    pub const fn thesis_default() -> Self {
+        Self {
+            stiffness_n_per_mm_e: 1000.0,
+            exponent: 2.0,
+            damping_ns_per_mm: 500.0,
+            penetration_depth_mm: 0.01,
+            step: StepKind::Cycloidal,
+        }
+    }
+
+    /// Converts to SI [`ImpactParams`] (N/m^e, N·s/m, m).
+    pub fn to_impact_params(&self) -> ImpactParams {
+        let mut p = ImpactParams::from_adams_units(
+            self.stiffness_n_per_mm_e,
+            self.exponent,
+            self.damping_ns_per_mm,
+            self.penetration_depth_mm,
+        );
+        p.step = self.step;
+        p
+    }
+
+    /// Field rules (k > 0, e >= 1, c >= 0, d > 0), reported under `prefix`.
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        positive(prefix, "stiffness_n_per_mm_e", self.stiffness_n_per_mm_e)?;
+        if !(self.exponent.is_finite() && self.exponent >= 1.0) {
+            return Err(err(
+                path(prefix, "exponent"),
+                format!("must be a finite number >= 1, got {}", self.exponent),
+            ));
+        }
+        non_negative(prefix, "damping_ns_per_mm", self.damping_ns_per_mm)?;
+        positive(prefix, "penetration_depth_mm", self.penetration_depth_mm)?;
+        Ok(())
+    }
+}
+
+/// ADAMS Coulomb friction (eq. 4.5) with speeds in mm/s, as the thesis tables print them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionSpec {
+    /// Static coefficient mu_s. Tables 4.2, 5.2, 6.1: 0.1799.
+    pub mu_static: f64,
+    /// Dynamic coefficient mu_d. Tables 4.2, 5.2, 6.1: 0.1660.
+    pub mu_dynamic: f64,
+    /// Stiction transition speed v_s, mm/s. Tables 5.2, 6.1: 6.4634 (Table 4.2 rounds to 6.46).
+    pub stiction_transition_speed_mm_per_s: f64,
+    /// Friction transition speed v_d, mm/s (> v_s). Tables 4.2, 5.2, 6.1: 12.0.
+    pub friction_transition_speed_mm_per_s: f64,
+    /// Transition shape: `cycloidal` (eq. 4.6, default) or `cubic`.
+    #[serde(default)]
+    pub step: StepKind,
+}
+
+impl FrictionSpec {
+    /// Thesis Table 5.2 / 6.1 (dry anodized 7075 on 7075).
+    pub const fn thesis_default() -> Self {
+        Self {
+            mu_static: 0.1799,
+            mu_dynamic: 0.1660,
+            stiction_transition_speed_mm_per_s: 6.4634,
+            friction_transition_speed_mm_per_s: 12.0,
+            step: StepKind::Cycloidal,
+        }
+    }
+
+    /// Converts to SI [`FrictionParams`] (speeds in m/s).
+    pub fn to_friction_params(&self) -> FrictionParams {
+        FrictionParams {
+            mu_static: self.mu_static,
+            mu_dynamic: self.mu_dynamic,
+            stiction_transition_speed: units::mm(self.stiction_transition_speed_mm_per_s),
+            friction_transition_speed: units::mm(self.friction_transition_speed_mm_per_s),
+            step: self.step,
+        }
+    }
+
+    /// Field rules of [`FrictionParams::validate`], reported with this struct's field names.
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        non_negative(prefix, "mu_static", self.mu_static)?;
+        non_negative(prefix, "mu_dynamic", self.mu_dynamic)?;
+        positive(
+            prefix,
+            "stiction_transition_speed_mm_per_s",
+            self.stiction_transition_speed_mm_per_s,
+        )?;
+        finite(
+            prefix,
+            "friction_transition_speed_mm_per_s",
+            self.friction_transition_speed_mm_per_s,
+        )?;
+        if self.friction_transition_speed_mm_per_s <= self.stiction_transition_speed_mm_per_s {
+            return Err(err(
+                path(prefix, "friction_transition_speed_mm_per_s"),
+                "must be greater than stiction_transition_speed_mm_per_s",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Bulk material of the contacting parts. Default 7075-T73, anodized (thesis 4.2.1, SPEC 3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Density, kg/m³. 7075-T73: 2810.
+    pub density_kg_per_m3: f64,
+    /// Yield strength S_y, Pa. 7075-T73: 435 MPa (the wear-law cutoff is 2 S_y, eq. 3.11).
+    pub yield_strength_pa: f64,
+    /// Young's modulus E, Pa. 7075-T73: 72 GPa.
+    pub youngs_modulus_pa: f64,
+    /// Poisson's ratio. 7075-T73: 0.33.
+    pub poisson_ratio: f64,
+    /// Brinell hardness, HB. 7075-T73: 135 (used to split wear between bodies).
+    pub brinell_hardness: f64,
+}
+
+impl Default for MaterialSpec {
+    /// 7075-T73, from the one source of the thesis' material
+    /// ([`Material::aluminium_7075_t73`](crate::wear::material::Material::aluminium_7075_t73)).
+    fn default() -> Self {
+        let m = crate::wear::material::Material::aluminium_7075_t73();
+        Self {
+            density_kg_per_m3: m.density_kg_m3,
+            yield_strength_pa: m.yield_strength_pa,
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            poisson_ratio: m.poisson_ratio,
+            brinell_hardness: m.brinell_hardness_hb,
+        }
+    }
+}
+
+impl MaterialSpec {
+    /// Field rules: all > 0, Poisson's ratio in (-1, 0.5).
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        positive(prefix, "density_kg_per_m3", self.density_kg_per_m3)?;
+        positive(prefix, "yield_strength_pa", self.yield_strength_pa)?;
+        positive(prefix, "youngs_modulus_pa", self.youngs_modulus_pa)?;
+        positive(prefix, "brinell_hardness", self.brinell_hardness)?;
+        if !(self.poisson_ratio.is_finite()
+            && self.poisson_ratio > -1.0
+            && self.poisson_ratio < 0.5)
+        {
+            return Err(err(
+                path(prefix, "poisson_ratio"),
+                format!("must lie in (-1, 0.5), got {}", self.poisson_ratio),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A box with rounded edges and corners (a convex contact piece, SPEC 2), given by its centre
+/// in a stated frame, its outer half extents (including the roundover) along that frame's axes,
+/// and its edge radius.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoundedBoxSpec {
+    /// Centre, m, in the frame named where the box is used.
+    pub centre_m: [f64; 3],
+    /// Outer half extents along x, y, z, m (> edge radius).
+    pub half_extents_m: [f64; 3],
+    /// Edge and corner roundover radius, m (>= 0; thesis 5.4 and 6.5: small but not zero).
+    pub edge_radius_m: f64,
+}
+
+impl RoundedBoxSpec {
+    /// Field rules: finite centre, half extents > edge radius >= 0.
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        finite3(prefix, "centre_m", self.centre_m)?;
+        non_negative(prefix, "edge_radius_m", self.edge_radius_m)?;
+        for h in self.half_extents_m {
+            if !(h.is_finite() && h > self.edge_radius_m) {
+                return Err(err(
+                    path(prefix, "half_extents_m"),
+                    format!(
+                        "each half extent must be finite and larger than edge_radius_m = {}, got {:?}",
+                        self.edge_radius_m, self.half_extents_m
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Lowest y of the box, m (frame of the box).
+    pub fn min_y_m(&self) -> f64 {
+        self.centre_m[1] - self.half_extents_m[1]
+    }
+
+    /// Highest y of the box, m.
+    pub fn max_y_m(&self) -> f64 {
+        self.centre_m[1] + self.half_extents_m[1]
+    }
+}
+
+/// A bounded planar face (a rectangle) of a kinematic body, derived from a spec.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanarFace {
+    /// Name, e.g. `lip_top_left`.
+    pub name: String,
+    /// Centre of the rectangle, m, in the body frame.
+    pub centre_m: [f64; 3],
+    /// Unit outward normal (pointing out of the material, into the free space), body frame.
+    pub normal: [f64; 3],
+    /// Unit in-plane direction of the first half size, body frame.
+    pub tangent: [f64; 3],
+    /// Half size along `tangent`, m.
+    pub half_length_m: f64,
+    /// Half size along `normal x tangent`, m.
+    pub half_width_m: f64,
+}
+
+/// Run-control settings shared by all models.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Settle time with no excitation before the input starts, s (thesis 6.6.1: 2 s). Wear is
+    /// not counted during the settle.
+    #[serde(default = "default_settle_s")]
+    pub settle_s: f64,
+    /// Excited (recorded) duration after the settle, s.
+    pub duration_s: f64,
+    /// Integrator name (lower case; default `trbdf2`, a stiff L-stable method, SPEC 2).
+    #[serde(default = "default_integrator")]
+    pub integrator: String,
+    /// Newton matrix of the implicit integrators: `contact_aware` (default; contacts
+    /// linearised at every Newton iterate) or `finite_difference` (whole Jacobian by finite
+    /// differences, reused across steps). Both solve the same equations to the same tolerance.
+    #[serde(default)]
+    pub newton_jacobian: crate::physics::integrator::NewtonJacobian,
+    /// Contact patches (overlap centroid and area) of the contact-aware Newton: `per_step`
+    /// (default; computed at each step's start, the penetration exact at every iterate) or
+    /// `per_iterate` (computed at every Newton iterate).
+    #[serde(default)]
+    pub contact_patches: crate::physics::integrator::ContactPatches,
+    /// Relative local error tolerance, dimensionless (0 < tol < 1).
+    #[serde(default = "default_rel_tolerance")]
+    pub rel_tolerance: f64,
+    /// Absolute local error tolerance on positions, m (velocities are scaled by the integrator).
+    #[serde(default = "default_abs_tolerance_m")]
+    pub abs_tolerance_m: f64,
+    /// Seed of every random draw in the case (random excitation), for determinism.
+    #[serde(default)]
+    pub seed: u64,
+    /// Output (track sample) interval, s.
+    #[serde(default = "default_record_interval_s")]
+    pub record_interval_s: f64,
+    /// Relative tolerance on each step's dissipated and drive work, dimensionless (the energy
+    /// account's quadrature, docs/models.md "Energy account"). Default 10 × `rel_tolerance`
+    /// (1e-3): the account closes within 0.5 % of the dissipated work; on the rattle box it
+    /// costs 2.2x the steps of no work control (docs/performance.md). 0 switches the check
+    /// off (the account is still kept, by the same quadrature, and may not close).
+    #[serde(default)]
+    pub energy_rel_tolerance: Option<f64>,
+    /// Contact points per box edge (docs/models.md "Contact formulation"): each face of a
+    /// rounded box is resolved by `n × n` points whose stiffness shares sum to the thesis' face
+    /// law. Default 5 (25 per face); more points resolve rocking and edge contacts more finely
+    /// at a proportional cost in contact evaluation; range 2 (corners only) to 33.
+    #[serde(default = "default_contact_points_per_edge")]
+    pub contact_points_per_edge: usize,
+}
+
+pub(super) fn default_contact_points_per_edge() -> usize {
+    crate::geometry::DEFAULT_POINTS_PER_EDGE
+}
+
+pub(super) fn default_settle_s() -> f64 {
+    2.0
+}
+pub(super) fn default_integrator() -> String {
+    "trbdf2".to_string()
+}
+pub(super) fn default_rel_tolerance() -> f64 {
+    1.0e-4
+}
+pub(super) fn default_abs_tolerance_m() -> f64 {
+    1.0e-9
+}
+pub(super) fn default_record_interval_s() -> f64 {
+    1.0e-4
+}
+
+impl SimulationSpec {
+    /// Field rules: settle >= 0, duration > 0, tolerances in range, record interval in
+    /// (0, duration], integrator a non-empty lower-case identifier.
+    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+        non_negative(prefix, "settle_s", self.settle_s)?;
+        positive(prefix, "duration_s", self.duration_s)?;
+        if !(self.rel_tolerance.is_finite() && self.rel_tolerance > 0.0 && self.rel_tolerance < 1.0)
+        {
+            return Err(err(
+                path(prefix, "rel_tolerance"),
+                format!("must lie in (0, 1), got {}", self.rel_tolerance),
+            ));
+        }
+        positive(prefix, "abs_tolerance_m", self.abs_tolerance_m)?;
+        positive(prefix, "record_interval_s", self.record_interval_s)?;
+        if let Some(e) = self.energy_rel_tolerance {
+            if !(e.is_finite() && (0.0..1.0).contains(&e)) {
+                return Err(err(
+                    path(prefix, "energy_rel_tolerance"),
+                    format!("must lie in [0, 1), got {e}"),
+                ));
+            }
+        }
+        let (lo, hi) = crate::geometry::lattice::POINTS_PER_EDGE_RANGE;
+        if !(lo..=hi).contains(&self.contact_points_per_edge) {
+            return Err(err(
+                path(prefix, "contact_points_per_edge"),
+                format!(
+                    "must lie in [{lo}, {hi}], got {}",
+                    self.contact_points_per_edge
+                ),
+            ));
+        }
+        if self.record_interval_s > self.duration_s {
+            return Err(err(
+                path(prefix, "record_interval_s"),
+                "must not exceed duration_s",
+            ));
+        }
+        let ok = !self.integrator.is_empty()
+            && self
+                .integrator
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-');
+        if !ok {
+            return Err(err(
+                path(prefix, "integrator"),
+                format!(
+                    "must be a lower-case name such as \"trbdf2\", got {:?}",
+                    self.integrator
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
