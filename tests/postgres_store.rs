@@ -513,111 +513,6 @@ async fn script(store: &dyn Store) -> Vec<String> {
         store.published_curve(sweep_key).await.unwrap(),
         Some(p1.clone())
     );
-    // Versions 2 (fewer points, shorter) and 3 (more of everything) of the same key.
-    let c9 = store
-        .submit_job(new_job(9, JobKind::Sweep, None))
-        .await
-        .unwrap();
-    log("sweep 9", format!("{c9:?}"));
-    let c9 = store.claim_job("w", 6_700, 5_000).await.unwrap().unwrap();
-    let mut low = curve(2, 0.3, 1, 6_800);
-    low.job_id = c9.id;
-    assert!(store
-        .finish_job(c9.id, 1, finish_with(low), 6_800)
-        .await
-        .unwrap());
-    let v2 = store::latest_curve(store, sweep_key)
-        .await
-        .unwrap()
-        .unwrap();
-    assert_eq!(v2.version, 2);
-    // Publishing the lower-fidelity v2 over v1 is refused without force; nothing changes.
-    let refused = store
-        .publish_curve(v2.id, "eng", false, 6_900)
-        .await
-        .unwrap();
-    match &refused {
-        PublishOutcome::LowerFidelity { published, reason } => {
-            assert_eq!(published.id, v1.id);
-            assert!(reason.contains("2 points < 5"), "{reason}");
-            assert!(reason.contains("0.3 s per point < 10 s"), "{reason}");
-            assert!(reason.contains("1 seeds per point < 3"), "{reason}");
-        }
-        other => panic!("{other:?}"),
-    }
-    assert_eq!(
-        store.published_curve(sweep_key).await.unwrap(),
-        Some(p1.clone())
-    );
-    // With force it is published, and v1 no longer is.
-    let forced = store
-        .publish_curve(v2.id, "boss", true, 7_000)
-        .await
-        .unwrap();
-    assert!(matches!(&forced, PublishOutcome::Published(c) if c.id == v2.id));
-    assert_eq!(
-        store
-            .published_curve(sweep_key)
-            .await
-            .unwrap()
-            .map(|c| c.id),
-        Some(v2.id)
-    );
-    assert_eq!(
-        store.get_curve(v1.id).await.unwrap().unwrap().published,
-        None
-    );
-    // Back to the higher-fidelity v1: no force needed; publishing it again is a no-op success.
-    assert!(matches!(
-        store
-            .publish_curve(v1.id, "eng", false, 7_100)
-            .await
-            .unwrap(),
-        PublishOutcome::Published(_)
-    ));
-    let again = store
-        .publish_curve(v1.id, "eng", false, 7_200)
-        .await
-        .unwrap();
-    let PublishOutcome::Published(again) = again else {
-        panic!("{again:?}")
-    };
-    assert_eq!(again.published.map(|p| p.published_ms), Some(7_100));
-    assert_eq!(
-        store
-            .publish_curve(999_999, "eng", true, 7_300)
-            .await
-            .unwrap(),
-        PublishOutcome::NotFound
-    );
-    assert_eq!(store.published_curve("none").await.unwrap(), None);
-    let all = store
-        .list_curves(
-            PageRequest {
-                limit: 1,
-                after_seq: None,
-            },
-            CurveFilter {
-                key: Some(sweep_key.into()),
-            },
-        )
-        .await
-        .unwrap();
-    assert_eq!(all.items.len(), 1);
-    assert_eq!(all.items[0].version, 2);
-    let rest = store
-        .list_curves(
-            PageRequest {
-                limit: 10,
-                after_seq: all.next_cursor.as_deref().and_then(|c| c.parse().ok()),
-            },
-            CurveFilter::default(),
-        )
-        .await
-        .unwrap();
-    let versions: Vec<_> = rest.items.iter().map(CurveNoId::from).collect();
-    log("curves page 2", format!("{versions:?}"));
-    assert_eq!(rest.items.len(), 1);
     assert!(store.claim_job("w", 7_000, 5_000).await.unwrap().is_none());
 
     // Listing: newest first, cursor pages, status filter; counts.
@@ -726,6 +621,112 @@ async fn script(store: &dyn Store) -> Vec<String> {
     let latest = store.latest_measurement("R-1").await.unwrap().unwrap();
     assert_eq!(latest.id, Uuid::from_u128(0xabc0));
     assert_eq!(latest.measured_at, "2024-01-02");
+
+    // Version 2 of the same key: fewer points, shorter runs, one seed.
+    let c9 = store
+        .submit_job(new_job(9, JobKind::Sweep, None))
+        .await
+        .unwrap();
+    log("sweep 9", format!("{c9:?}"));
+    let c9 = store.claim_job("w", 6_700, 5_000).await.unwrap().unwrap();
+    let mut low = curve(2, 0.3, 1, 6_800);
+    low.job_id = c9.id;
+    assert!(store
+        .finish_job(c9.id, 1, finish_with(low), 6_800)
+        .await
+        .unwrap());
+    let v2 = store::latest_curve(store, sweep_key)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(v2.version, 2);
+    // Publishing the lower-fidelity v2 over v1 is refused without force; nothing changes.
+    let refused = store
+        .publish_curve(v2.id, "eng", false, 6_900)
+        .await
+        .unwrap();
+    match &refused {
+        PublishOutcome::LowerFidelity { published, reason } => {
+            assert_eq!(published.id, v1.id);
+            assert!(reason.contains("2 points < 5"), "{reason}");
+            assert!(reason.contains("0.3 s per point < 10 s"), "{reason}");
+            assert!(reason.contains("1 seeds per point < 3"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        store.published_curve(sweep_key).await.unwrap(),
+        Some(p1.clone())
+    );
+    // With force it is published, and v1 no longer is.
+    let forced = store
+        .publish_curve(v2.id, "boss", true, 7_000)
+        .await
+        .unwrap();
+    assert!(matches!(&forced, PublishOutcome::Published(c) if c.id == v2.id));
+    assert_eq!(
+        store
+            .published_curve(sweep_key)
+            .await
+            .unwrap()
+            .map(|c| c.id),
+        Some(v2.id)
+    );
+    assert_eq!(
+        store.get_curve(v1.id).await.unwrap().unwrap().published,
+        None
+    );
+    // Back to the higher-fidelity v1: no force needed; publishing it again is a no-op success.
+    assert!(matches!(
+        store
+            .publish_curve(v1.id, "eng", false, 7_100)
+            .await
+            .unwrap(),
+        PublishOutcome::Published(_)
+    ));
+    let again = store
+        .publish_curve(v1.id, "eng", false, 7_200)
+        .await
+        .unwrap();
+    let PublishOutcome::Published(again) = again else {
+        panic!("{again:?}")
+    };
+    assert_eq!(again.published.map(|p| p.published_ms), Some(7_100));
+    assert_eq!(
+        store
+            .publish_curve(999_999, "eng", true, 7_300)
+            .await
+            .unwrap(),
+        PublishOutcome::NotFound
+    );
+    assert_eq!(store.published_curve("none").await.unwrap(), None);
+    let all = store
+        .list_curves(
+            PageRequest {
+                limit: 1,
+                after_seq: None,
+            },
+            CurveFilter {
+                key: Some(sweep_key.into()),
+            },
+        )
+        .await
+        .unwrap();
+    assert_eq!(all.items.len(), 1);
+    assert_eq!(all.items[0].version, 2);
+    let rest = store
+        .list_curves(
+            PageRequest {
+                limit: 10,
+                after_seq: all.next_cursor.as_deref().and_then(|c| c.parse().ok()),
+            },
+            CurveFilter::default(),
+        )
+        .await
+        .unwrap();
+    let versions: Vec<_> = rest.items.iter().map(CurveNoId::from).collect();
+    log("curves page 2", format!("{versions:?}"));
+    assert_eq!(rest.items.len(), 1);
 
     // Tokens (their ids are random: compare the rest).
     let t = store
