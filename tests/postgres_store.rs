@@ -484,7 +484,7 @@ async fn script(store: &dyn Store) -> Vec<String> {
             summary,
             blocks,
             plots,
-            curve: Some(c),
+            curve: Some(Box::new(c)),
         }
     };
     assert!(store

@@ -68,7 +68,7 @@ fn assembled(job_id: Uuid, created_ms: i64) -> Finish {
         summary: serde_json::json!({ "points": 3 }),
         blocks: Vec::new(),
         plots: vec![("penalization.svg".into(), "<svg/>".into())],
-        curve: Some(NewCurve {
+        curve: Some(Box::new(NewCurve {
             key: CURVE_KEY.into(),
             job_id,
             curve: serde_json::json!({ "k_sl": [1.0, 0.75] }),
@@ -81,7 +81,7 @@ fn assembled(job_id: Uuid, created_ms: i64) -> Finish {
             created_by: "eng".into(),
             code_version: "test".into(),
             created_ms,
-        }),
+        })),
     }
 }
 

@@ -176,7 +176,9 @@ impl Jobs {
                 .await
                 .unwrap_or_default();
                 let curve = match (output.penalization, &job.curve_key) {
-                    (Some(data), Some(key)) => Some(new_curve(&job, key, &data, output.curve_info)),
+                    (Some(data), Some(key)) => {
+                        Some(Box::new(new_curve(&job, key, &data, output.curve_info)))
+                    }
                     _ => None,
                 };
                 Finish::Succeeded {
@@ -321,28 +323,6 @@ fn job_progress(p: Progress, elapsed: Duration) -> JobProgress {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn eta_is_linear_extrapolation() {
-        let p = Progress {
-            simulated_time_s: 1.0,
-            end_time_s: 4.0,
-            fraction: 0.25,
-        };
-        let jp = job_progress(p, Duration::from_secs(10));
-        // 25 % took 10 s, so 75 % takes 30 s more.
-        assert!((jp.eta_s.unwrap() - 30.0).abs() < 1e-9);
-        let nan = Progress {
-            fraction: f64::NAN,
-            ..p
-        };
-        assert_eq!(job_progress(nan, Duration::from_secs(1)).eta_s, None);
-    }
-}
-
 /// The curve version a sweep stores: the runner's fidelity and provenance (or, from a runner
 /// that gives none, the curve's own point and seed counts with the duration unknown), plus who
 /// submitted the sweep, the code version and the job.
@@ -378,5 +358,27 @@ fn new_curve(
         created_by: job.submitted_by.clone(),
         code_version: job.code_version.clone(),
         created_ms: clock::now_ms(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eta_is_linear_extrapolation() {
+        let p = Progress {
+            simulated_time_s: 1.0,
+            end_time_s: 4.0,
+            fraction: 0.25,
+        };
+        let jp = job_progress(p, Duration::from_secs(10));
+        // 25 % took 10 s, so 75 % takes 30 s more.
+        assert!((jp.eta_s.unwrap() - 30.0).abs() < 1e-9);
+        let nan = Progress {
+            fraction: f64::NAN,
+            ..p
+        };
+        assert_eq!(job_progress(nan, Duration::from_secs(1)).eta_s, None);
     }
 }

@@ -80,7 +80,7 @@ pub enum Finish {
         summary: serde_json::Value,
         blocks: Vec<TrackBlock>,
         plots: Vec<(String, String)>,
-        curve: Option<NewCurve>,
+        curve: Option<Box<NewCurve>>,
     },
     Failed(String),
     Cancelled,
@@ -549,23 +549,22 @@ pub async fn latest_curve(store: &dyn Store, key: &str) -> Result<Option<CurveRe
     Ok(page.items.into_iter().next())
 }
 
-/// The decision of [`Store::publish_curve`] given the candidate and the published version.
-pub fn publish_decision(
+/// The refusal of [`Store::publish_curve`] given the candidate and the published version, or
+/// `None` when it may be published.
+pub fn publish_refusal(
     candidate: &CurveRecord,
     published: Option<&CurveRecord>,
     force: bool,
-) -> Result<(), PublishOutcome> {
+) -> Option<PublishOutcome> {
     match published {
-        Some(current) if current.id != candidate.id && !force => {
-            match candidate.fidelity.shortfall(&current.fidelity) {
-                Some(reason) => Err(PublishOutcome::LowerFidelity {
-                    published: current.clone(),
-                    reason,
-                }),
-                None => Ok(()),
-            }
-        }
-        _ => Ok(()),
+        Some(current) if current.id != candidate.id && !force => candidate
+            .fidelity
+            .shortfall(&current.fidelity)
+            .map(|reason| PublishOutcome::LowerFidelity {
+                published: current.clone(),
+                reason,
+            }),
+        _ => None,
     }
 }
 

@@ -3,7 +3,7 @@
 //! writers queue instead of deadlocking on a lock upgrade), single-statement job claims.
 
 use super::{
-    publish_decision, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
+    publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
     CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
     MeasurementRecord, NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication,
     PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
@@ -639,7 +639,7 @@ impl Store for SqliteStore {
                     .await?;
                 }
                 if let Some(curve) = curve {
-                    insert_curve_version(&mut tx, curve).await?;
+                    insert_curve_version(&mut tx, *curve).await?;
                 }
             }
             tx.commit().await?;
@@ -1147,7 +1147,7 @@ impl Store for SqliteStore {
             .as_ref()
             .map(curve_from_row)
             .transpose()?;
-            if let Err(refused) = publish_decision(&candidate, current.as_ref(), force) {
+            if let Some(refused) = publish_refusal(&candidate, current.as_ref(), force) {
                 tx.rollback().await?;
                 return Ok(refused);
             }
