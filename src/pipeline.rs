@@ -84,6 +84,14 @@ pub mod limits {
     /// Points of a tolerance sweep: at least 2 (a curve needs two ends), at most 50 (each
     /// point is a full launcher simulation).
     pub const SWEEP_POINTS: std::ops::RangeInclusive<u64> = 2..=50;
+    /// Seeds (independent excitation draws) per sweep point: 1 to 10. One seed gives no
+    /// confidence interval; 3 (the default, [`super::DEFAULT_SWEEP_SEEDS`]) is the fewest whose
+    /// t-interval is not dominated by the t quantile (df 1 needs 6.31 standard errors, df 2
+    /// 2.92); beyond 10 the interval narrows by less than 5 % a seed.
+    pub const SWEEP_SEEDS: std::ops::RangeInclusive<u64> = 1..=10;
+    /// Most simulations of one sweep (`points * seeds`): each is a full launcher run and one
+    /// child job; 200 keeps a sweep's fan-out and its assembly in one short transaction.
+    pub const MAX_SWEEP_RUNS: u64 = 200;
     /// Largest seed, 2^53 - 1: every seed a JSON reader parses into a double (JavaScript, jq)
     /// is then exact, so a run can be reproduced from what a dashboard shows.
     pub const MAX_SEED: u64 = (1 << 53) - 1;
@@ -108,7 +116,13 @@ pub const SWEEP_KEYS: &[&str] = &[
     "vehicle_profile",
     "environment",
     "wear_law",
+    "rattle_space_range",
+    "offset_mm_range",
+    "base_dimensions_mm",
+    "seeds",
 ];
+/// Seeds per sweep point when a sweep names none (see [`limits::SWEEP_SEEDS`]).
+pub const DEFAULT_SWEEP_SEEDS: u64 = 3;
 /// Parameters of a calibrate job.
 pub const CALIBRATE_KEYS: &[&str] = &["friction", "wear_law", "seed"];
 
@@ -335,6 +349,393 @@ pub fn simulate_job(
     Ok(outcome)
 }
 
+/// The rattle-space range, points and seeds of a tolerance sweep, read from its params alone
+/// (no config is loaded: the report reads it from a queued sweep's params to tell whether that
+/// sweep will cover a rail).
+///
+/// Every point is `base.with_material_condition(offset)`: rail dimensions grow by the offset,
+/// shoe dimensions shrink by it (docs/launcher-dimensions.md). The range is given as one of
+/// - `rattle_space_range: {"min": k1, "max": k2}`: points evenly spaced in k_rs, or
+/// - `offset_mm_range: {"min": d1, "max": d2}`: points evenly spaced in the offset, mm,
+/// - neither: the thesis' tolerance band, offsets -0.201 to +0.1955 mm (k_rs 0.8317 to 0.7684).
+///
+/// Bounds, with their reasons: every point's dimensions must pass the checks a measured rail
+/// passes ([`LauncherDimensions::validate`]: assembly, +-50 % of design), so a sweep reaches
+/// exactly the rails a planner can record; for the design base that is offsets in
+/// (-0.30, +4.765] mm, k_rs about 0.28 to 0.848. The range must contain the design rattle
+/// space, because K_SL is the ratio to the wear rate there (eq. 6.4). A rail tighter than the
+/// design family reaches (a measured k_rs of 0.861) is covered by a sweep around its own
+/// dimensions: `base_dimensions_mm` (default: the design rail).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRange {
+    /// Dimensions the offsets apply to, mm.
+    pub base: LauncherDimensions,
+    /// True when `base` is the design rail.
+    pub design_base: bool,
+    /// Offsets of the points, mm, tight to loose (increasing).
+    pub offsets_mm: Vec<f64>,
+    /// Rattle space of each point (eq. 6.1-6.3), decreasing.
+    pub rattle_spaces: Vec<f64>,
+    /// Seeds per point.
+    pub seeds: usize,
+}
+
+use crate::analysis::rattle_space::LauncherDimensions;
+
+/// Rattle space of `base` moved by `offset_mm`, if those dimensions are a valid rail.
+fn offset_rattle_space(base: &LauncherDimensions, offset_mm: f64) -> Option<f64> {
+    base.with_material_condition(offset_mm).rattle_space().ok()
+}
+
+/// The offsets (mm) over which `base` stays a valid rail ([`LauncherDimensions::validate`]):
+/// each rule is linear in the offset, so they form an interval around 0; its ends are found by
+/// bisection to 1e-9 mm and returned on the valid side.
+pub fn offset_limits_mm(base: &LauncherDimensions) -> (f64, f64) {
+    let valid = |o: f64| offset_rattle_space(base, o).is_some();
+    let edge = |far: f64| {
+        let (mut good, mut bad) = (0.0, far);
+        if valid(far) {
+            return far;
+        }
+        while (bad - good).abs() > 1e-9 {
+            let mid = 0.5 * (good + bad);
+            if valid(mid) {
+                good = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        good
+    };
+    (edge(-100.0), edge(100.0))
+}
+
+/// The offset (mm) at which `base` has rattle space `target`, within `limits`; k_rs falls as the
+/// offset grows (looser). `None` if no offset in the limits reaches it to 1e-9.
+fn offset_for_rattle_space(
+    base: &LauncherDimensions,
+    target: f64,
+    limits: (f64, f64),
+) -> Option<f64> {
+    let k = |o: f64| offset_rattle_space(base, o).unwrap_or(f64::NAN);
+    let (mut lo, mut hi) = limits;
+    if !(k(lo) >= target && k(hi) <= target) {
+        return None;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if k(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo < 1e-13 {
+            break;
+        }
+    }
+    let o = 0.5 * (lo + hi);
+    ((k(o) - target).abs() < 1e-9).then_some(o)
+}
+
+/// `{"min": a, "max": b}` at `field`, with `a < b`, both finite.
+fn parse_min_max(value: &serde_json::Value, field: &str) -> Result<(f64, f64), RunError> {
+    let map = check_keys(value, field, &["min", "max"])?;
+    let num = |name: &str| {
+        map.get(name)
+            .and_then(serde_json::Value::as_f64)
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| invalid(&format!("{field}.{name}"), "is required (a finite number)"))
+    };
+    let (min, max) = (num("min")?, num("max")?);
+    if min >= max {
+        return Err(invalid(
+            field,
+            format!("needs min < max, got min {min} and max {max}"),
+        ));
+    }
+    Ok((min, max))
+}
+
+impl SweepRange {
+    /// Reads `points`, `seeds`, `base_dimensions_mm` and `rattle_space_range` or
+    /// `offset_mm_range` (see the type's documentation); errors name the params field.
+    pub fn from_params(params: &serde_json::Value) -> Result<Self, RunError> {
+        let n = match params.get("points") {
+            None => 5,
+            Some(v) => v
+                .as_u64()
+                .filter(|n| limits::SWEEP_POINTS.contains(n))
+                .ok_or_else(|| {
+                    invalid(
+                        "points",
+                        format!(
+                            "must be an integer in {}..={}",
+                            limits::SWEEP_POINTS.start(),
+                            limits::SWEEP_POINTS.end()
+                        ),
+                    )
+                })? as usize,
+        };
+        let seeds = match params.get("seeds") {
+            None => DEFAULT_SWEEP_SEEDS,
+            Some(v) => v
+                .as_u64()
+                .filter(|n| limits::SWEEP_SEEDS.contains(n))
+                .ok_or_else(|| {
+                    invalid(
+                        "seeds",
+                        format!(
+                            "must be an integer in {}..={} (seeds per point; 1 gives no \
+                             confidence interval)",
+                            limits::SWEEP_SEEDS.start(),
+                            limits::SWEEP_SEEDS.end()
+                        ),
+                    )
+                })?,
+        };
+        if n as u64 * seeds > limits::MAX_SWEEP_RUNS {
+            return Err(invalid(
+                "seeds",
+                format!(
+                    "points x seeds = {} simulations; at most {} per sweep",
+                    n as u64 * seeds,
+                    limits::MAX_SWEEP_RUNS
+                ),
+            ));
+        }
+        let (base, design_base) = match params.get("base_dimensions_mm") {
+            None => (LauncherDimensions::design(), true),
+            Some(v) => {
+                if !v.is_object() {
+                    return Err(invalid(
+                        "base_dimensions_mm",
+                        "must be an object of named dimensions in mm (as a measurement's \
+                         dimensions_mm)",
+                    ));
+                }
+                let dims: LauncherDimensions = serde_path_to_error::deserialize(v.clone())
+                    .map_err(|e| {
+                        let path = e.path().to_string();
+                        let field = if path == "." || path.is_empty() {
+                            "base_dimensions_mm".to_string()
+                        } else {
+                            format!("base_dimensions_mm.{path}")
+                        };
+                        invalid(&field, e.into_inner().to_string())
+                    })?;
+                dims.rattle_space().map_err(
+                    |crate::analysis::rattle_space::RattleSpaceError::InvalidDimension {
+                         field,
+                         rule,
+                     }| invalid(&format!("base_dimensions_mm.{field}"), rule),
+                )?;
+                (dims, dims == LauncherDimensions::design())
+            }
+        };
+        let limits_mm = offset_limits_mm(&base);
+        let k_of = |o: f64| offset_rattle_space(&base, o).unwrap_or(f64::NAN);
+        let (k_hi, k_lo) = (k_of(limits_mm.0), k_of(limits_mm.1));
+        let spaced = |a: f64, b: f64| -> Vec<f64> {
+            (0..n)
+                .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+                .collect()
+        };
+        let (offsets_mm, field) = match (
+            params.get("rattle_space_range"),
+            params.get("offset_mm_range"),
+        ) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "offset_mm_range",
+                    "give either rattle_space_range or offset_mm_range, not both",
+                ))
+            }
+            (Some(range), None) => {
+                let (min, max) = parse_min_max(range, "rattle_space_range")?;
+                if min < k_lo || max > k_hi {
+                    return Err(invalid(
+                        "rattle_space_range",
+                        format!(
+                            "[{min}, {max}] leaves the rattle spaces the base dimensions reach \
+                             as a valid rail, [{k_lo:.4}, {k_hi:.4}] (offsets {:.3} to {:.3} \
+                             mm); for a tighter or looser rail give its own dimensions as \
+                             base_dimensions_mm",
+                            limits_mm.0, limits_mm.1
+                        ),
+                    ));
+                }
+                let offsets = spaced(max, min)
+                    .into_iter()
+                    .map(|k| {
+                        offset_for_rattle_space(&base, k, limits_mm).ok_or_else(|| {
+                            invalid(
+                                "rattle_space_range",
+                                format!("rattle space {k} is not reached by the base dimensions"),
+                            )
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                (offsets, "rattle_space_range")
+            }
+            (None, Some(range)) => {
+                let (min, max) = parse_min_max(range, "offset_mm_range")?;
+                if min < limits_mm.0 || max > limits_mm.1 {
+                    return Err(invalid(
+                        "offset_mm_range",
+                        format!(
+                            "[{min}, {max}] mm leaves the offsets at which the base dimensions \
+                             stay a valid rail, [{:.4}, {:.4}] mm (assembly and +-50 % of \
+                             design, docs/launcher-dimensions.md)",
+                            limits_mm.0, limits_mm.1
+                        ),
+                    ));
+                }
+                (spaced(min, max), "offset_mm_range")
+            }
+            (None, None) => (sweep_offsets_mm(n), "base_dimensions_mm"),
+        };
+        let rattle_spaces = offsets_mm
+            .iter()
+            .map(|&o| {
+                offset_rattle_space(&base, o).ok_or_else(|| {
+                    invalid(
+                        field,
+                        format!(
+                            "offset {o} mm does not give a valid rail from the base dimensions"
+                        ),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let design = design_rattle_space();
+        let (k_min, k_max) = rattle_spaces
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &k| {
+                (a.min(k), b.max(k))
+            });
+        if !(k_min <= design && design <= k_max) {
+            return Err(invalid(
+                field,
+                format!(
+                    "gives rattle spaces [{k_min:.4}, {k_max:.4}], which must contain the design \
+                     rattle space {design:.4}: K_SL is the ratio to the wear rate there (eq. 6.4)"
+                ),
+            ));
+        }
+        Ok(Self {
+            base,
+            design_base,
+            offsets_mm,
+            rattle_spaces,
+            seeds: seeds as usize,
+        })
+    }
+
+    /// Swept rattle-space range `(min, max)`.
+    pub fn rattle_space_bounds(&self) -> (f64, f64) {
+        self.rattle_spaces
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &k| {
+                (a.min(k), b.max(k))
+            })
+    }
+}
+
+/// Rattle space of the design rail (eq. 6.1-6.3), 0.7990.
+pub fn design_rattle_space() -> f64 {
+    LauncherDimensions::design()
+        .rattle_space()
+        .unwrap_or(f64::NAN)
+}
+
+/// Params of a sweep whose range covers rattle space `k_rs` (and the design point), built on
+/// `template` (the published curve's sweep params, or a bare sweep): its range is replaced by
+/// `rattle_space_range` from `min(k_rs, design) - 0.005` to `max(k_rs, design) + 0.005`
+/// (clipped to what a valid rail reaches), with no fewer points than the template nor a coarser
+/// spacing than the thesis' band in 5 points. A k_rs the design family cannot reach (tighter
+/// than its zero vertical clearance) gets `base_dimensions_mm` = the rail's own dimensions.
+/// `None` when even the rail's own dimensions cannot span it.
+pub fn covering_sweep_params(
+    template: &serde_json::Value,
+    k_rs: f64,
+    rail: Option<&LauncherDimensions>,
+) -> Option<serde_json::Value> {
+    let design = design_rattle_space();
+    let mut params = template.as_object().cloned().unwrap_or_default();
+    for key in [
+        "rattle_space_range",
+        "offset_mm_range",
+        "base_dimensions_mm",
+        "seed",
+    ] {
+        params.remove(key);
+    }
+    let margin = 0.005;
+    let candidates: Vec<(LauncherDimensions, bool)> =
+        std::iter::once((LauncherDimensions::design(), true))
+            .chain(rail.map(|r| (*r, false)))
+            .collect();
+    for (base, is_design) in candidates {
+        let limits_mm = offset_limits_mm(&base);
+        let k_of = |o: f64| offset_rattle_space(&base, o).unwrap_or(f64::NAN);
+        // Keep a hair inside the valid interval so the ends are reachable by bisection.
+        let (k_lo, k_hi) = (k_of(limits_mm.1), k_of(limits_mm.0));
+        let lo = (k_rs.min(design) - margin).max(k_lo + 1e-6);
+        let hi = (k_rs.max(design) + margin).min(k_hi - 1e-6);
+        if !(lo <= k_rs.min(design) && hi >= k_rs.max(design) && lo < hi) {
+            continue;
+        }
+        let thesis_spacing = (0.8317 - 0.7684) / 4.0;
+        let template_points = template
+            .get("points")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(5);
+        let needed = ((hi - lo) / thesis_spacing).ceil() as u64 + 1;
+        let seeds = template
+            .get("seeds")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(DEFAULT_SWEEP_SEEDS)
+            .max(1);
+        let max_points = (limits::MAX_SWEEP_RUNS / seeds).min(*limits::SWEEP_POINTS.end());
+        let points = needed.max(template_points).clamp(2, max_points);
+        params.insert("points".into(), points.into());
+        let (rlo, rhi) = (round_to(lo, 4, false), round_to(hi, 4, true));
+        let rlo = if rlo > k_lo + 1e-6 { rlo } else { lo };
+        let rhi = if rhi < k_hi - 1e-6 { rhi } else { hi };
+        params.insert(
+            "rattle_space_range".into(),
+            serde_json::json!({"min": rlo, "max": rhi}),
+        );
+        if !is_design {
+            params.insert(
+                "base_dimensions_mm".into(),
+                serde_json::to_value(base).unwrap_or_default(),
+            );
+        }
+        let candidate = serde_json::Value::Object(params.clone());
+        // The suggestion must itself be a valid range (rounding stays inside the limits).
+        if SweepRange::from_params(&candidate).is_ok() {
+            return Some(candidate);
+        }
+        params.remove("base_dimensions_mm");
+    }
+    None
+}
+
+/// `x` rounded to `digits` decimals, up or down.
+fn round_to(x: f64, digits: i32, up: bool) -> f64 {
+    let f = 10f64.powi(digits);
+    let y = if up { (x * f).ceil() } else { (x * f).floor() };
+    y / f
+}
+
+/// The seed of replica `replica` of a sweep seeded `seed`: `seed + replica` modulo 2^53, so
+/// replica 0 runs the sweep's own seed (a one-seed sweep is the sweep of before) and every seed
+/// stays below 2^53 ([`limits::MAX_SEED`]).
+pub fn replica_seed(seed: u64, replica: usize) -> u64 {
+    (seed.wrapping_add(replica as u64)) & limits::MAX_SEED
+}
+
 /// One point of a tolerance sweep.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SweepPoint {
@@ -351,8 +752,15 @@ pub struct SweepPoint {
 pub struct SweepOutcome {
     /// Rattle space of the design dimensions.
     pub design_rattle_space: f64,
-    /// Points, tight to loose.
+    /// Points, tight to loose; each rate is the geometric mean over the seeds (the mean of
+    /// ln(rate), the quantity the curve interpolates).
     pub points: Vec<SweepPoint>,
+    /// Seeds of the replicas, in replica order ([`replica_seed`]).
+    #[serde(default)]
+    pub seeds: Vec<u64>,
+    /// Per point (same order), the rail wear rate of each seed, mg/h.
+    #[serde(default)]
+    pub rate_by_seed_mg_per_h: Vec<Vec<f64>>,
 }
 
 /// Material-condition offsets (mm) of an n-point sweep from tight to loose.
@@ -478,8 +886,12 @@ pub struct SweepPlan {
     /// `seed` applied, its excitation the vehicle profile's and its wear law the one named;
     /// each point replaces its launcher dimensions.
     pub base: CaseSpec,
-    /// Material-condition offsets of the points, mm, tight to loose ([`sweep_offsets_mm`]).
+    /// Material-condition offsets of the points, mm, tight to loose (`range.offsets_mm`).
     pub offsets_mm: Vec<f64>,
+    /// Range, points, seeds and base dimensions ([`SweepRange`]).
+    pub range: SweepRange,
+    /// Seed of each replica ([`replica_seed`] of the sweep's seed).
+    pub seeds: Vec<u64>,
     /// Rattle space of the design dimensions (eq. 6.1-6.3), dimensionless.
     pub design_rattle_space: f64,
     /// Vehicle profile (excitation) name, e.g. `ah64`.
@@ -490,6 +902,8 @@ pub struct SweepPlan {
     pub wear_law: String,
     /// `sweep_point` children: the point this child runs.
     pub point: Option<usize>,
+    /// `sweep_point` children: the replica (seed index) this child runs.
+    pub replica: Option<usize>,
 }
 
 impl SweepPlan {
@@ -501,7 +915,7 @@ impl SweepPlan {
     /// applies to the base case.
     pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
         let mut keys = SWEEP_KEYS.to_vec();
-        keys.push("point");
+        keys.extend(["point", "replica"]);
         check_keys(params, "params", &keys)?;
         let text = |name: &str, default: &str| -> Result<String, RunError> {
             match params.get(name) {
@@ -533,22 +947,8 @@ impl SweepPlan {
                 "a sweep's excitation is its vehicle_profile; remove it (or run simulate jobs)",
             ));
         }
-        let n = match params.get("points") {
-            None => 5,
-            Some(v) => v
-                .as_u64()
-                .filter(|n| limits::SWEEP_POINTS.contains(n))
-                .ok_or_else(|| {
-                    invalid(
-                        "points",
-                        format!(
-                            "must be an integer in {}..={}",
-                            limits::SWEEP_POINTS.start(),
-                            limits::SWEEP_POINTS.end()
-                        ),
-                    )
-                })? as usize,
-        };
+        let range = SweepRange::from_params(params)?;
+        let n = range.offsets_mm.len();
         let point = match params.get("point") {
             None => None,
             Some(v) => Some(
@@ -556,6 +956,19 @@ impl SweepPlan {
                     .filter(|i| *i < n as u64)
                     .ok_or_else(|| invalid("point", format!("must be an integer below {n}")))?
                     as usize,
+            ),
+        };
+        let replica = match params.get("replica") {
+            None => None,
+            Some(v) => Some(
+                v.as_u64()
+                    .filter(|i| *i < range.seeds as u64)
+                    .ok_or_else(|| {
+                        invalid(
+                            "replica",
+                            format!("must be an integer below {}", range.seeds),
+                        )
+                    })? as usize,
             ),
         };
         let mut p = params.clone();
@@ -573,18 +986,37 @@ impl SweepPlan {
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
             select_wear_law(case, &wear_law)
         })?;
-        let design_rattle_space = crate::analysis::rattle_space::LauncherDimensions::design()
-            .rattle_space()
-            .map_err(|e| invalid("launcher.dimensions", e.to_string()))?;
+        let design_rattle_space = design_rattle_space();
+        let seeds = (0..range.seeds)
+            .map(|j| replica_seed(base.simulation.seed, j))
+            .collect();
         Ok(Self {
             base,
-            offsets_mm: sweep_offsets_mm(n),
+            offsets_mm: range.offsets_mm.clone(),
+            range,
+            seeds,
             design_rattle_space,
             vehicle_profile,
             environment,
             wear_law,
             point,
+            replica,
         })
+    }
+
+    /// Simulations of the sweep: points x seeds (one child job each).
+    pub fn runs(&self) -> usize {
+        self.len() * self.seeds.len()
+    }
+
+    /// Child index of point `point`, replica `replica` (point-major).
+    pub fn run_index(&self, point: usize, replica: usize) -> usize {
+        point * self.seeds.len() + replica
+    }
+
+    /// Excited duration of each simulation, s (the curve's fidelity).
+    pub fn duration_per_point_s(&self) -> f64 {
+        self.base.simulation.duration_s
     }
 
     /// Number of points.
@@ -602,12 +1034,43 @@ impl SweepPlan {
         self.base.simulation.settle_s + self.base.simulation.duration_s
     }
 
-    /// The outcome of the sweep from its points, tight to loose.
-    pub fn outcome(&self, points: Vec<SweepPoint>) -> SweepOutcome {
-        SweepOutcome {
+    /// The outcome of the sweep from its runs in child order ([`SweepPlan::run_index`]): per
+    /// point, the geometric mean of its seeds' rates and the rates themselves.
+    pub fn outcome(&self, runs: Vec<SweepPoint>) -> Result<SweepOutcome, RunError> {
+        let per = self.seeds.len().max(1);
+        if runs.len() != self.runs() {
+            return Err(invalid(
+                "points",
+                format!(
+                    "the sweep has {} runs but {} results",
+                    self.runs(),
+                    runs.len()
+                ),
+            ));
+        }
+        let mut points = Vec::with_capacity(self.len());
+        let mut rates = Vec::with_capacity(self.len());
+        for chunk in runs.chunks(per) {
+            let by_seed: Vec<f64> = chunk.iter().map(|r| r.rail_wear_rate_mg_per_h).collect();
+            let mean_ln = by_seed.iter().map(|r| r.ln()).sum::<f64>() / by_seed.len() as f64;
+            let rate = if by_seed.len() == 1 {
+                by_seed[0]
+            } else {
+                mean_ln.exp()
+            };
+            points.push(SweepPoint {
+                offset_mm: chunk[0].offset_mm,
+                rattle_space: chunk[0].rattle_space,
+                rail_wear_rate_mg_per_h: rate,
+            });
+            rates.push(by_seed);
+        }
+        Ok(SweepOutcome {
             design_rattle_space: self.design_rattle_space,
             points,
-        }
+            seeds: self.seeds.clone(),
+            rate_by_seed_mg_per_h: rates,
+        })
     }
 }
 
@@ -618,6 +1081,7 @@ impl SweepPlan {
 pub fn sweep_point(
     plan: &SweepPlan,
     index: usize,
+    replica: usize,
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<SweepPoint, RunError> {
@@ -625,10 +1089,14 @@ pub fn sweep_point(
         .offsets_mm
         .get(index)
         .ok_or_else(|| invalid("point", format!("must be below {}", plan.len())))?;
+    let seed = *plan
+        .seeds
+        .get(replica)
+        .ok_or_else(|| invalid("replica", format!("must be below {}", plan.seeds.len())))?;
     let mut case = plan.base.clone();
+    case.simulation.seed = seed;
     if let Some(l) = case.launcher.as_mut() {
-        l.dimensions = crate::analysis::rattle_space::LauncherDimensions::design()
-            .with_material_condition(offset_mm);
+        l.dimensions = plan.range.base.with_material_condition(offset_mm);
     }
     let rattle_space = case
         .launcher
@@ -649,12 +1117,31 @@ pub fn sweep_point(
     })
 }
 
-/// Params of the child job that runs point `index` of the sweep with `params`: the sweep's
-/// params (which carry its seed) plus `"point": index`.
-pub fn sweep_point_params(params: &serde_json::Value, index: usize) -> serde_json::Value {
+/// Params of the child job that runs point `index`, replica `replica` of the sweep with
+/// `params`: the sweep's params (which carry its seed) plus `"point"` and `"replica"`.
+pub fn sweep_point_params(
+    params: &serde_json::Value,
+    index: usize,
+    replica: usize,
+) -> serde_json::Value {
     let mut p = params.clone();
-    merge_json(&mut p, &serde_json::json!({ "point": index }));
+    merge_json(
+        &mut p,
+        &serde_json::json!({ "point": index, "replica": replica }),
+    );
     p
+}
+
+/// The replica index of a `sweep_point` child job's params (0 when absent: children of
+/// sweeps from before seeds were replicated).
+pub fn sweep_replica_index(params: &serde_json::Value) -> Result<usize, RunError> {
+    match params.get("replica") {
+        None => Ok(0),
+        Some(v) => v
+            .as_u64()
+            .map(|i| i as usize)
+            .ok_or_else(|| invalid("replica", "must be a non-negative integer")),
+    }
 }
 
 /// The point index of a `sweep_point` child job's params.
@@ -667,8 +1154,8 @@ pub fn sweep_point_index(params: &serde_json::Value) -> Result<usize, RunError> 
 }
 
 /// A sweep job run in one process: the launcher case of `params` (default `launcher-design`) at
-/// `points` (default 5, at least 2) dimension sets from tight to loose, same seed, one after the
-/// other; returns the rail wear rate versus rattle space for the penalization curve (eq. 6.4).
+/// `points` (default 5, at least 2) dimension sets from tight to loose ([`SweepRange`]), each
+/// with `seeds` seeds (default 3), one after the other; returns the rail wear rate versus rattle space for the penalization curve (eq. 6.4).
 /// The service fans the same points out to child jobs instead (see ARCHITECTURE.md).
 pub fn sweep_job(
     params: &serde_json::Value,
@@ -685,26 +1172,29 @@ pub fn run_sweep(
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<(serde_json::Value, SweepOutcome), RunError> {
-    let total = plan.len() as f64;
-    let mut points = Vec::with_capacity(plan.len());
+    let total = plan.runs() as f64;
+    let mut runs = Vec::with_capacity(plan.runs());
     for i in 0..plan.len() {
-        if control.is_cancelled() {
-            return Err(RunError::Cancelled);
+        for j in 0..plan.seeds.len() {
+            if control.is_cancelled() {
+                return Err(RunError::Cancelled);
+            }
+            let done = plan.run_index(i, j) as f64;
+            let outer = control.progress.clone();
+            let sub = RunControl {
+                cancel: control.cancel.clone(),
+                progress: Arc::new(move |pr: Progress| {
+                    outer(Progress {
+                        simulated_time_s: pr.simulated_time_s,
+                        end_time_s: pr.end_time_s,
+                        fraction: (done + pr.fraction) / total,
+                    })
+                }),
+            };
+            runs.push(sweep_point(plan, i, j, configs_dir, &sub)?);
         }
-        let outer = control.progress.clone();
-        let sub = RunControl {
-            cancel: control.cancel.clone(),
-            progress: Arc::new(move |pr: Progress| {
-                outer(Progress {
-                    simulated_time_s: pr.simulated_time_s,
-                    end_time_s: pr.end_time_s,
-                    fraction: (i as f64 + pr.fraction) / total,
-                })
-            }),
-        };
-        points.push(sweep_point(plan, i, configs_dir, &sub)?);
     }
-    let outcome = plan.outcome(points);
+    let outcome = plan.outcome(runs)?;
     let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }
@@ -923,7 +1413,7 @@ mod tests {
     #[test]
     fn a_point_child_plans_the_same_sweep_as_its_parent() {
         let parent = serde_json::json!({"points": 4, "seed": 9, "vehicle_profile": "ah64"});
-        let child = sweep_point_params(&parent, 3);
+        let child = sweep_point_params(&parent, 3, 1);
         assert_eq!(sweep_point_index(&child).unwrap(), 3);
         let a = SweepPlan::from_params(&parent, &configs()).unwrap();
         let b = SweepPlan::from_params(&child, &configs()).unwrap();
@@ -942,8 +1432,126 @@ mod tests {
             Err(RunError::InvalidConfig { field, .. }) if field == "point"
         ));
         assert!(matches!(
-            sweep_point(&a, 4, &configs(), &RunControl::silent()),
+            sweep_point(&a, 4, 0, &configs(), &RunControl::silent()),
             Err(RunError::InvalidConfig { field, .. }) if field == "point"
         ));
+    }
+
+    fn field_of(e: RunError) -> String {
+        match e {
+            RunError::InvalidConfig { field, .. } => field,
+            other => panic!("{other}"),
+        }
+    }
+
+    #[test]
+    fn a_sweep_takes_its_rattle_space_range_points_and_seeds() {
+        use serde_json::json;
+        // Default: the thesis' band, 5 points, 3 seeds.
+        let r = SweepRange::from_params(&json!({})).unwrap();
+        assert_eq!(r.offsets_mm, sweep_offsets_mm(5));
+        assert_eq!(r.seeds, DEFAULT_SWEEP_SEEDS as usize);
+        let (lo, hi) = r.rattle_space_bounds();
+        assert!((lo - 0.7684).abs() < 1e-4 && (hi - 0.8317).abs() < 1e-4);
+        // A rattle-space range: evenly spaced k_rs, tight to loose, ends exact.
+        let r = SweepRange::from_params(
+            &json!({"rattle_space_range": {"min": 0.64, "max": 0.82}, "points": 7, "seeds": 1}),
+        )
+        .unwrap();
+        assert_eq!(r.rattle_spaces.len(), 7);
+        assert!((r.rattle_spaces[0] - 0.82).abs() < 1e-9);
+        assert!((r.rattle_spaces[6] - 0.64).abs() < 1e-9);
+        assert!((r.rattle_spaces[3] - 0.73).abs() < 1e-9);
+        assert!(r.offsets_mm.windows(2).all(|w| w[0] < w[1]));
+        // An offset range.
+        let r = SweepRange::from_params(&json!({"offset_mm_range": {"min": -0.25, "max": 1.0}}))
+            .unwrap();
+        assert_eq!(r.offsets_mm.first(), Some(&-0.25));
+        assert_eq!(r.offsets_mm.last(), Some(&1.0));
+        // Bounds, each naming the field.
+        let bad = |p: serde_json::Value| field_of(SweepRange::from_params(&p).unwrap_err());
+        // Beyond zero vertical clearance (offset -0.30 mm, k_rs 0.848) no rail assembles.
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.78, "max": 0.86}})),
+            "rattle_space_range"
+        );
+        assert_eq!(
+            bad(json!({"offset_mm_range": {"min": -0.35, "max": 0.1}})),
+            "offset_mm_range"
+        );
+        // The design point must be inside (K_SL is relative to it).
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.60, "max": 0.70}})),
+            "rattle_space_range"
+        );
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.8, "max": 0.7}})),
+            "rattle_space_range"
+        );
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.7}})),
+            "rattle_space_range.max"
+        );
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.7, "max": 0.8, "mid": 1}})),
+            "rattle_space_range.mid"
+        );
+        assert_eq!(
+            bad(json!({"rattle_space_range": {"min": 0.7, "max": 0.8},
+                       "offset_mm_range": {"min": 0, "max": 1}})),
+            "offset_mm_range"
+        );
+        assert_eq!(bad(json!({"seeds": 0})), "seeds");
+        assert_eq!(bad(json!({"seeds": 11})), "seeds");
+        assert_eq!(bad(json!({"points": 50, "seeds": 5})), "seeds");
+        assert_eq!(
+            bad(json!({"base_dimensions_mm": {"a_shoe_mm": 38.1}})),
+            "base_dimensions_mm"
+        );
+        let mut dims = serde_json::to_value(LauncherDimensions::design()).unwrap();
+        dims["a_shoe_mm"] = json!(9.0);
+        assert!(bad(json!({"base_dimensions_mm": dims})).starts_with("base_dimensions_mm."));
+    }
+
+    #[test]
+    fn the_suggested_sweep_covers_the_rail() {
+        use serde_json::json;
+        let template = json!({"config": "launcher-design", "points": 5, "seed": 3});
+        // Looser than the thesis' band: the design family reaches it.
+        let loose = LauncherDimensions::design().with_material_condition(1.075);
+        let k = loose.rattle_space().unwrap();
+        let p = covering_sweep_params(&template, k, Some(&loose)).unwrap();
+        assert!(p.get("base_dimensions_mm").is_none(), "{p}");
+        assert!(p.get("seed").is_none());
+        let r = SweepRange::from_params(&p).unwrap();
+        let (lo, hi) = r.rattle_space_bounds();
+        assert!(lo <= k && k <= hi && hi >= design_rattle_space(), "{p}");
+        // No coarser than the thesis' band in 5 points.
+        assert!(r.offsets_mm.len() as f64 >= (hi - lo) / ((0.8317 - 0.7684) / 4.0));
+        // Tighter than the design family reaches: around the rail's own dimensions.
+        let mut tight = LauncherDimensions::design().with_material_condition(-0.28);
+        tight.f_shoe_mm -= 1.0;
+        tight.h_shoe_mm -= 1.0;
+        tight.j_shoe_mm -= 1.0;
+        tight.l_shoe_mm -= 1.0;
+        let k = tight.rattle_space().unwrap();
+        assert!(k > 0.86);
+        assert!(covering_sweep_params(&template, k, None).is_none());
+        let p = covering_sweep_params(&template, k, Some(&tight)).unwrap();
+        assert!(p["base_dimensions_mm"].is_object());
+        let (lo, hi) = SweepRange::from_params(&p).unwrap().rattle_space_bounds();
+        assert!(lo <= design_rattle_space() && k <= hi, "{p}");
+    }
+
+    #[test]
+    fn replicas_run_their_own_seeds_below_2_pow_53() {
+        assert_eq!(replica_seed(7, 0), 7);
+        assert_eq!(replica_seed(7, 2), 9);
+        assert_eq!(replica_seed(limits::MAX_SEED, 1), 0);
+        let plan = SweepPlan::from_params(&serde_json::json!({"points": 2, "seed": 5}), &configs())
+            .unwrap();
+        assert_eq!(plan.seeds, vec![5, 6, 7]);
+        assert_eq!(plan.runs(), 6);
+        assert_eq!(plan.run_index(1, 2), 5);
     }
 }

@@ -202,6 +202,7 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     let params = serde_json::json!({
         "config": "launcher-design",
         "points": 12,
+        "seeds": 1,
         "seed": 2024,
         "overrides": {"simulation": {"settle_s": 0.2, "duration_s": 0.3, "record_interval_s": 0.01}},
     });
@@ -343,11 +344,19 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     }
     assert_eq!(job.result, Some(summary));
     let curve = rt
-        .block_on(store.get_curve(job.curve_key.as_deref().expect("curve key")))
+        .block_on(railwear::store::latest_curve(
+            store.as_ref(),
+            job.curve_key.as_deref().expect("curve key"),
+        ))
         .expect("curve")
         .expect("curve stored");
     assert_eq!(curve.job_id, id);
-    let expected = railwear::jobs::runner::sweep_output(&outcome).expect("curve");
+    let plan = railwear::pipeline::SweepPlan::from_params(
+        &params,
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
+    )
+    .expect("plan");
+    let expected = railwear::jobs::runner::sweep_output(&plan, &params, &outcome).expect("curve");
     assert_eq!(
         Some(curve.curve),
         expected

@@ -9,8 +9,8 @@ mod service_support;
 use railwear::config::Role;
 use railwear::jobs::{JobKind, JobProgress, JobStatus};
 use railwear::store::{
-    self, CurveRecord, Finish, Heartbeat, JobFilter, NewJob, NewMeasurement, PageRequest, Store,
-    Submitted, TrackBlock,
+    self, CurveFidelity, CurveFilter, Finish, Heartbeat, JobFilter, NewCurve, NewJob,
+    NewMeasurement, PageRequest, PublishOutcome, Store, Submitted, TrackBlock,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -50,6 +50,41 @@ fn succeeded(samples: i64) -> Finish {
             ("Force".into(), "<svg>f</svg>".into()),
         ],
         curve: None,
+    }
+}
+
+/// A curve record without its store-assigned id (identity columns may differ between
+/// engines after a failed insert), for comparing traces.
+#[derive(Debug)]
+#[allow(dead_code)]
+struct CurveNoId {
+    key: String,
+    version: i64,
+    job_id: Uuid,
+    curve: serde_json::Value,
+    fidelity: CurveFidelity,
+    provenance: serde_json::Value,
+    created_by: String,
+    created_ms: i64,
+    published: Option<(String, i64)>,
+}
+
+impl From<&store::CurveRecord> for CurveNoId {
+    fn from(c: &store::CurveRecord) -> Self {
+        CurveNoId {
+            key: c.key.clone(),
+            version: c.version,
+            job_id: c.job_id,
+            curve: c.curve.clone(),
+            fidelity: c.fidelity,
+            provenance: c.provenance.clone(),
+            created_by: c.created_by.clone(),
+            created_ms: c.created_ms,
+            published: c
+                .published
+                .as_ref()
+                .map(|p| (p.published_by.clone(), p.published_ms)),
+        }
     }
 }
 
@@ -421,37 +456,63 @@ async fn script(store: &dyn Store) -> Vec<String> {
         format!("{:?}", store.active_sweep(sweep_key).await.unwrap()),
     );
     let c8 = store.claim_job("w", 6_000, 5_000).await.unwrap().unwrap();
-    let curve = CurveRecord {
+    let curve = |points: i64, duration: f64, seeds: i64, at: i64| NewCurve {
         key: sweep_key.into(),
         job_id: c8.id,
-        curve: serde_json::json!({"k_sl": [1.0, 0.8125]}),
-        created_ms: 6_500,
+        curve: serde_json::json!({"k_sl": [1.0, 0.8125], "points": points}),
+        fidelity: CurveFidelity {
+            points,
+            duration_per_point_s: Some(duration),
+            seeds,
+        },
+        provenance: serde_json::json!({"config": "launcher-design", "seeds": [1, 2, 3]}),
+        created_by: "tester".into(),
+        code_version: "test".into(),
+        created_ms: at,
     };
-    let Finish::Succeeded {
-        summary,
-        blocks,
-        plots,
-        ..
-    } = succeeded(0)
-    else {
-        unreachable!()
+    let finish_with = |c: NewCurve| {
+        let Finish::Succeeded {
+            summary,
+            blocks,
+            plots,
+            ..
+        } = succeeded(0)
+        else {
+            unreachable!()
+        };
+        Finish::Succeeded {
+            summary,
+            blocks,
+            plots,
+            curve: Some(Box::new(c)),
+        }
     };
     assert!(store
-        .finish_job(
-            c8.id,
-            1,
-            Finish::Succeeded {
-                summary,
-                blocks,
-                plots,
-                curve: Some(curve.clone())
-            },
-            6_500
-        )
+        .finish_job(c8.id, 1, finish_with(curve(5, 10.0, 3, 6_500)), 6_500)
         .await
         .unwrap());
-    assert_eq!(store.get_curve(sweep_key).await.unwrap(), Some(curve));
-    assert_eq!(store.get_curve("none").await.unwrap(), None);
+    // A sweep stores version 1, not published: reports do not use it yet.
+    let v1 = store::latest_curve(store, sweep_key)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!((v1.version, v1.published.clone()), (1, None));
+    assert_eq!(v1.fidelity, curve(5, 10.0, 3, 0).fidelity);
+    assert_eq!(store.published_curve(sweep_key).await.unwrap(), None);
+    assert_eq!(store.get_curve(v1.id).await.unwrap(), Some(v1.clone()));
+    log("curve v1", format!("{:?}", CurveNoId::from(&v1)));
+    let published = store
+        .publish_curve(v1.id, "eng", false, 6_600)
+        .await
+        .unwrap();
+    let PublishOutcome::Published(p1) = published else {
+        panic!("{published:?}")
+    };
+    assert_eq!(p1.published.as_ref().map(|p| p.published_ms), Some(6_600));
+    assert_eq!(
+        store.published_curve(sweep_key).await.unwrap(),
+        Some(p1.clone())
+    );
     assert!(store.claim_job("w", 7_000, 5_000).await.unwrap().is_none());
 
     // Listing: newest first, cursor pages, status filter; counts.
@@ -560,6 +621,112 @@ async fn script(store: &dyn Store) -> Vec<String> {
     let latest = store.latest_measurement("R-1").await.unwrap().unwrap();
     assert_eq!(latest.id, Uuid::from_u128(0xabc0));
     assert_eq!(latest.measured_at, "2024-01-02");
+
+    // Version 2 of the same key: fewer points, shorter runs, one seed.
+    let c9 = store
+        .submit_job(new_job(9, JobKind::Sweep, None))
+        .await
+        .unwrap();
+    log("sweep 9", format!("{c9:?}"));
+    let c9 = store.claim_job("w", 6_700, 5_000).await.unwrap().unwrap();
+    let mut low = curve(2, 0.3, 1, 6_800);
+    low.job_id = c9.id;
+    assert!(store
+        .finish_job(c9.id, 1, finish_with(low), 6_800)
+        .await
+        .unwrap());
+    let v2 = store::latest_curve(store, sweep_key)
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(v2.version, 2);
+    // Publishing the lower-fidelity v2 over v1 is refused without force; nothing changes.
+    let refused = store
+        .publish_curve(v2.id, "eng", false, 6_900)
+        .await
+        .unwrap();
+    match &refused {
+        PublishOutcome::LowerFidelity { published, reason } => {
+            assert_eq!(published.id, v1.id);
+            assert!(reason.contains("2 points < 5"), "{reason}");
+            assert!(reason.contains("0.3 s per point < 10 s"), "{reason}");
+            assert!(reason.contains("1 seeds per point < 3"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        store.published_curve(sweep_key).await.unwrap(),
+        Some(p1.clone())
+    );
+    // With force it is published, and v1 no longer is.
+    let forced = store
+        .publish_curve(v2.id, "boss", true, 7_000)
+        .await
+        .unwrap();
+    assert!(matches!(&forced, PublishOutcome::Published(c) if c.id == v2.id));
+    assert_eq!(
+        store
+            .published_curve(sweep_key)
+            .await
+            .unwrap()
+            .map(|c| c.id),
+        Some(v2.id)
+    );
+    assert_eq!(
+        store.get_curve(v1.id).await.unwrap().unwrap().published,
+        None
+    );
+    // Back to the higher-fidelity v1: no force needed; publishing it again is a no-op success.
+    assert!(matches!(
+        store
+            .publish_curve(v1.id, "eng", false, 7_100)
+            .await
+            .unwrap(),
+        PublishOutcome::Published(_)
+    ));
+    let again = store
+        .publish_curve(v1.id, "eng", false, 7_200)
+        .await
+        .unwrap();
+    let PublishOutcome::Published(again) = again else {
+        panic!("{again:?}")
+    };
+    assert_eq!(again.published.map(|p| p.published_ms), Some(7_100));
+    assert_eq!(
+        store
+            .publish_curve(999_999, "eng", true, 7_300)
+            .await
+            .unwrap(),
+        PublishOutcome::NotFound
+    );
+    assert_eq!(store.published_curve("none").await.unwrap(), None);
+    let all = store
+        .list_curves(
+            PageRequest {
+                limit: 1,
+                after_seq: None,
+            },
+            CurveFilter {
+                key: Some(sweep_key.into()),
+            },
+        )
+        .await
+        .unwrap();
+    assert_eq!(all.items.len(), 1);
+    assert_eq!(all.items[0].version, 2);
+    let rest = store
+        .list_curves(
+            PageRequest {
+                limit: 10,
+                after_seq: all.next_cursor.as_deref().and_then(|c| c.parse().ok()),
+            },
+            CurveFilter::default(),
+        )
+        .await
+        .unwrap();
+    let versions: Vec<_> = rest.items.iter().map(CurveNoId::from).collect();
+    log("curves page 2", format!("{versions:?}"));
+    assert_eq!(rest.items.len(), 1);
 
     // Tokens (their ids are random: compare the rest).
     let t = store

@@ -137,8 +137,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         );
     }
     let job = store.get_job(id).await.unwrap().unwrap();
-    let curve = store
-        .get_curve(job.curve_key.as_deref().unwrap())
+    let curve = railwear::store::latest_curve(store.as_ref(), job.curve_key.as_deref().unwrap())
         .await
         .unwrap()
         .unwrap();

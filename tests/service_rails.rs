@@ -91,12 +91,39 @@ async fn measurement_report_and_penalized_life() {
             (j["status"] == "succeeded").then_some(())
         });
 
+        // The sweep stored a curve version, but reports use it only once an engineer publishes
+        // it: until then the report names the version to publish.
+        let rep = report("R-100");
+        assert!(rep["service_life"].is_null(), "{rep}");
+        let curve_id = rep["missing_curve"]["unpublished_curve_id"]
+            .as_i64()
+            .expect("the unpublished version is named");
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/curves/{curve_id}/publish"),
+            Some(PLANNER),
+            &[],
+            None,
+        );
+        r.problem(403);
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/curves/{curve_id}/publish"),
+            Some(ENGINEER),
+            &[],
+            None,
+        );
+        assert_eq!(r.status, 200, "{}", r.body);
+
         // At the design point K_SL = 1 (eq. 6.4), so the penalized life is the design life.
         let rep = report("R-100");
         let life = &rep["service_life"];
         assert_eq!(life["k_sl"], 1.0, "{rep}");
         assert_eq!(life["penalized_life_h"], 1000.0);
         assert_eq!(rep["curve_job_id"], sweep_id.as_str());
+        assert_eq!(rep["curve"]["id"], curve_id);
+        assert_eq!(rep["curve"]["version"], 1);
+        assert_eq!(rep["curve"]["fidelity"]["points"], 3);
         assert_eq!(rep["k_sl_curve"].as_array().unwrap().len(), 3);
 
         // A loose rail (k_rs 0.7684) wears 2.0 instead of 1.5 mg/h: K_SL = 1.5 / 2.0 = 0.75,
@@ -340,6 +367,262 @@ async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
             assert!(item["measured_at"].is_string() && item["recorded_at"].is_string());
         }
         assert!(items.iter().any(|i| i["id"] == old["id"]));
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+fn report_of(base: &str, serial: &str) -> serde_json::Value {
+    let r = curl(
+        "GET",
+        &format!("{base}/v1/rails/{serial}/report"),
+        Some(PLANNER),
+        &[],
+        None,
+    );
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()
+}
+
+fn run_sweep(base: &str, body: &str) -> String {
+    let r = curl(
+        "POST",
+        &format!("{base}/v1/jobs"),
+        Some(ENGINEER),
+        &[],
+        Some(body),
+    );
+    assert_eq!(r.status, 201, "{}", r.body);
+    let id = r.json()["id"].as_str().unwrap().to_string();
+    wait_for(Duration::from_secs(30), "sweep success", || {
+        let j = curl(
+            "GET",
+            &format!("{base}/v1/jobs/{id}"),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .json();
+        assert_ne!(j["status"], "failed", "{j}");
+        (j["status"] == "succeeded").then_some(())
+    });
+    id
+}
+
+fn publish(base: &str, id: i64, body: Option<&str>) -> service_support::Reply {
+    curl(
+        "POST",
+        &format!("{base}/v1/curves/{id}/publish"),
+        Some(ENGINEER),
+        &[],
+        body,
+    )
+}
+
+/// Issue 17 item 2: rails outside the swept range (k_rs 0.643, looser; 0.861, tighter than
+/// the design family reaches) get a suggested sweep whose range covers them (before: the same
+/// default sweep forever); running and publishing it gives them a service life.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
+    let dir = TempDir::new("rails-range");
+    let service = start(test_config(&dir.db_url()), true).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let post = |serial: &str, dims: LauncherDimensions| {
+            let r = curl(
+                "POST",
+                &format!("{base}/v1/rails/{serial}/measurements"),
+                Some(PLANNER),
+                &[],
+                Some(&measurement(dims)),
+            );
+            assert_eq!(r.status, 201, "{}", r.body);
+            r.json()["rattle_space"].as_f64().unwrap()
+        };
+        // A loose rail (material condition +1.075 mm) and a tight one whose head nearly fills the
+        // chamber (not a uniform offset of the design rail).
+        let loose = post(
+            "R-LOOSE",
+            LauncherDimensions::design().with_material_condition(1.075),
+        );
+        assert!((loose - 0.643).abs() < 0.003, "{loose}");
+        let mut tight_dims = LauncherDimensions::design().with_material_condition(-0.28);
+        tight_dims.f_shoe_mm -= 1.0;
+        tight_dims.h_shoe_mm -= 1.0;
+        tight_dims.j_shoe_mm -= 1.0;
+        tight_dims.l_shoe_mm -= 1.0;
+        let tight = post("R-TIGHT", tight_dims);
+        assert!(tight > 0.855, "{tight}");
+        let design_k = LauncherDimensions::design().rattle_space().unwrap();
+
+        // The default sweep's curve, published, covers neither.
+        let id = run_sweep(
+            &base,
+            r#"{"kind":"sweep","params":{"steps":1,"step_ms":1}}"#,
+        );
+        let rep = report_of(&base, "R-LOOSE");
+        // Stored but not published, and it would not cover the rail anyway.
+        assert!(
+            rep["missing_curve"]["unpublished_curve_id"].is_null(),
+            "{rep}"
+        );
+        let list = curl(
+            "GET",
+            &format!("{base}/v1/curves"),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .json();
+        let v1 = list["items"][0]["id"].as_i64().unwrap();
+        assert_eq!(publish(&base, v1, None).status, 200);
+        for (serial, k) in [("R-LOOSE", loose), ("R-TIGHT", tight)] {
+            let rep = report_of(&base, serial);
+            assert!(rep["service_life"].is_null(), "{rep}");
+            // The published curve (the default sweep's, then the loose rail's) is named.
+            assert!(rep["curve"]["id"].is_i64(), "{rep}");
+            if serial == "R-LOOSE" {
+                assert_eq!(rep["curve"]["job_id"], id.as_str());
+            }
+            let job = &rep["missing_curve"]["suggested_job"];
+            assert_eq!(job["kind"], "sweep", "{rep}");
+            let params = &job["params"];
+            // The suggestion covers the rail and the design point, and is a sweep the service
+            // plans as such.
+            let range = railwear::pipeline::SweepRange::from_params(params)
+                .unwrap_or_else(|e| panic!("{e}: {params}"));
+            let (lo, hi) = range.rattle_space_bounds();
+            assert!(lo <= k && k <= hi, "{serial}: {k} not in [{lo}, {hi}]");
+            assert!(lo <= design_k && design_k <= hi);
+            if serial == "R-TIGHT" {
+                // The design family stops at zero vertical clearance (k_rs 0.848): the sweep
+                // runs around the rail's own dimensions.
+                assert!(params["base_dimensions_mm"].is_object(), "{params}");
+            }
+            // Run it (the counting runner's closed-form curve over the planned points), then
+            // the report names it as the version to publish.
+            let sweep = run_sweep(&base, &job.to_string());
+            let rep = report_of(&base, serial);
+            let v = rep["missing_curve"]["unpublished_curve_id"]
+                .as_i64()
+                .unwrap_or_else(|| panic!("{rep}"));
+            let r = publish(&base, v, None);
+            assert_eq!(r.status, 200, "{}", r.body);
+            let rep = report_of(&base, serial);
+            let life = &rep["service_life"];
+            assert!(life["k_sl"].as_f64().is_some(), "{rep}");
+            assert_eq!(rep["curve"]["id"], v);
+            assert_eq!(rep["curve"]["job_id"], sweep.as_str());
+        }
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+/// Issue 17 item 4: a new sweep does not replace the curve planners read; publishing a
+/// lower-fidelity version over a higher one needs `force` (409 naming the field otherwise);
+/// the report names the curve, its fidelity, and carries K_SL's interval over seeds.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
+    let dir = TempDir::new("rails-publish");
+    let service = start(test_config(&dir.db_url()), true).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let dims = LauncherDimensions::design().with_material_condition(0.1);
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/rails/R-7/measurements"),
+            Some(PLANNER),
+            &[],
+            Some(&measurement(dims)),
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let k = r.json()["rattle_space"].as_f64().unwrap();
+        let kd = LauncherDimensions::design().rattle_space().unwrap();
+
+        // Production curve: 5 points, 3 seeds, 10 s per point; published.
+        run_sweep(
+            &base,
+            r#"{"kind":"sweep","params":{"steps":1,"step_ms":1,"rattle_space_range":{"min":0.76,"max":0.84},"points":5,"seeds":3,"duration_s":10}}"#,
+        );
+        let list = curl("GET", &format!("{base}/v1/curves"), Some(PLANNER), &[], None).json();
+        let v1 = &list["items"][0];
+        assert_eq!(v1["version"], 1);
+        assert_eq!(v1["published"], false);
+        assert_eq!(v1["created_by"], "eng");
+        assert!(v1["code_version"].as_str().is_some_and(|v| !v.is_empty()));
+        assert_eq!(v1["fidelity"]["seeds"], 3);
+        let v1 = v1["id"].as_i64().unwrap();
+        assert_eq!(publish(&base, v1, Some(r#"{"force":false}"#)).status, 200);
+        let rep = report_of(&base, "R-7");
+        let life = rep["service_life"].clone();
+        assert_eq!(rep["curve"]["id"], v1);
+        assert_eq!(rep["curve"]["fidelity"]["points"], 5);
+        assert_eq!(rep["curve"]["fidelity"]["seeds"], 3);
+        assert_eq!(rep["curve"]["fidelity"]["duration_per_point_s"], 10.0);
+        assert_eq!(rep["curve"]["published_by"], "eng");
+
+        // K_SL's 90 % interval against the closed form: seed j's log ratio is
+        // -(8 + 0.5 j)(kd - k), so over 3 seeds the mean is -8.5 (kd - k), the standard
+        // deviation 0.5 (kd - k), and the half width t(0.95; 2) 0.5 (kd - k) / sqrt(3).
+        let d = kd - k;
+        let half = 2.919986 * 0.5 * d / 3f64.sqrt();
+        let close = |v: &serde_json::Value, x: f64| (v.as_f64().unwrap() - x).abs() < 1e-6;
+        assert!(close(&life["k_sl"], (-8.5 * d).exp()), "{life}");
+        let i = &life["interval"];
+        assert_eq!(i["confidence"], 0.9);
+        assert_eq!(i["seeds"], 3);
+        assert!(close(&i["k_sl_low"], (-8.5 * d - half).exp()), "{i}");
+        assert!(close(&i["k_sl_high"], (-8.5 * d + half).exp()), "{i}");
+        assert!(close(&i["penalized_life_low_h"], 1000.0 * (-8.5 * d - half).exp()));
+        assert!(close(&i["penalized_life_high_h"], 1000.0 * (-8.5 * d + half).exp()));
+
+        // A 2-point, 1-seed, 0.3 s trial sweep stores version 2 and changes nothing planners
+        // read.
+        run_sweep(
+            &base,
+            r#"{"kind":"sweep","params":{"steps":1,"step_ms":1,"rattle_space_range":{"min":0.78,"max":0.82},"points":2,"seeds":1,"duration_s":0.3}}"#,
+        );
+        let rep = report_of(&base, "R-7");
+        assert_eq!(rep["curve"]["id"], v1);
+        assert_eq!(rep["service_life"], life);
+        let list = curl(
+            "GET",
+            &format!("{base}/v1/curves?curve_key=ah64/clean/modified-archard"),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .json();
+        let v2 = &list["items"][0];
+        assert_eq!((v2["version"].as_i64(), v2["published"].as_bool()), (Some(2), Some(false)));
+        let v2 = v2["id"].as_i64().unwrap();
+        // Publishing it over the 5-point curve is refused without force.
+        let p = publish(&base, v2, None).problem(409);
+        assert_eq!(p["field"], "force");
+        assert!(p["detail"].as_str().unwrap().contains("2 points < 5"), "{p}");
+        assert_eq!(report_of(&base, "R-7")["curve"]["id"], v1);
+        // Unknown keys and bad ids are refused naming the field.
+        let p = publish(&base, v2, Some(r#"{"forse":true}"#)).problem(422);
+        assert!(p["detail"].as_str().unwrap().contains("forse"), "{p}");
+        publish(&base, 0, None).problem(400);
+        publish(&base, 999_999, None).problem(404);
+        // With force it is published; the report says so and has no interval (one seed).
+        let r = publish(&base, v2, Some(r#"{"force":true}"#));
+        assert_eq!(r.status, 200, "{}", r.body);
+        let rep = report_of(&base, "R-7");
+        assert_eq!(rep["curve"]["id"], v2);
+        assert_eq!(rep["curve"]["fidelity"]["seeds"], 1);
+        assert!(rep["service_life"]["interval"].is_null(), "{rep}");
+        assert!(rep["service_life"]["uncertainty"]
+            .as_str()
+            .unwrap()
+            .contains("one seed"));
+        let one = curl("GET", &format!("{base}/v1/curves/{v1}"), Some(PLANNER), &[], None).json();
+        assert_eq!(one["published"], false);
+        assert_eq!(one["provenance"]["created_by"], "eng");
     })
     .await
     .unwrap();

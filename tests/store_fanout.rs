@@ -5,15 +5,16 @@
 //! one assembler can claim and finish the parent; a failed, cancelled or lost child fails the
 //! parent naming the child and cancels its siblings; cancelling the parent cancels the children.
 //! One scripted lifecycle gives the same records on both engines. A database written before
-//! fan-out keeps its data through the fan-out migration.
+//! fan-out keeps its data through the fan-out migration, and its curve through the curve
+//! versions migration (published version 1).
 
 mod postgres_support;
 mod service_support;
 
 use railwear::jobs::{ChildCounts, ChildOf, JobKind, JobProgress, JobStatus};
 use railwear::store::{
-    self, AttemptOutcome, CurveRecord, FanOut, FanOutResult, Finish, JobFilter, NewChild, NewJob,
-    PageRequest, Store, Submitted,
+    self, AttemptOutcome, CurveFidelity, FanOut, FanOutResult, Finish, JobFilter, NewChild,
+    NewCurve, NewJob, PageRequest, Store, Submitted,
 };
 use std::sync::Arc;
 use uuid::Uuid;
@@ -67,12 +68,20 @@ fn assembled(job_id: Uuid, created_ms: i64) -> Finish {
         summary: serde_json::json!({ "points": 3 }),
         blocks: Vec::new(),
         plots: vec![("penalization.svg".into(), "<svg/>".into())],
-        curve: Some(CurveRecord {
+        curve: Some(Box::new(NewCurve {
             key: CURVE_KEY.into(),
             job_id,
             curve: serde_json::json!({ "k_sl": [1.0, 0.75] }),
+            fidelity: CurveFidelity {
+                points: 3,
+                duration_per_point_s: Some(1.0),
+                seeds: 3,
+            },
+            provenance: serde_json::json!({}),
+            created_by: "eng".into(),
+            code_version: "test".into(),
             created_ms,
-        }),
+        })),
     }
 }
 
@@ -255,7 +264,10 @@ async fn script(store: &dyn Store) -> Vec<String> {
         [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
     );
     assert_eq!(
-        store.get_curve(CURVE_KEY).await.unwrap().map(|c| c.job_id),
+        store::latest_curve(store, CURVE_KEY)
+            .await
+            .unwrap()
+            .map(|c| c.job_id),
         Some(p)
     );
     log(
@@ -580,10 +592,31 @@ async fn check_migrated(store: &dyn Store) {
         store.plot(OLD_DONE, "penalization.svg").await.unwrap(),
         Some("<svg/>".to_string())
     );
+    // The curve stored before curve versions is version 1 of its key, published (reports keep
+    // using it), with the sweep's provenance and its fidelity as far as it was recorded.
+    let curve = store
+        .published_curve(CURVE_KEY)
+        .await
+        .unwrap()
+        .expect("migrated curve");
+    assert_eq!((curve.job_id, curve.version), (OLD_DONE, 1));
     assert_eq!(
-        store.get_curve(CURVE_KEY).await.unwrap().map(|c| c.job_id),
-        Some(OLD_DONE)
+        curve.published.as_ref().map(|p| p.published_by.as_str()),
+        Some("migration")
     );
+    assert_eq!(
+        curve.fidelity,
+        CurveFidelity {
+            points: 2,
+            duration_per_point_s: None,
+            seeds: 1
+        }
+    );
+    assert_eq!(curve.created_by, "eng");
+    assert_eq!(curve.provenance["params"], serde_json::json!({}));
+    let data: railwear::analysis::penalization::PenalizationCurve =
+        serde_json::from_value(curve.curve.clone()).expect("the migrated curve still reads");
+    assert!((data.k_sl(0.7684).unwrap() - 0.5).abs() < 1e-12);
     let claimed = store.claim_job("w", 10, 1_000).await.unwrap().unwrap();
     assert_eq!((claimed.id, claimed.attempt), (OLD_QUEUED, 1));
     assert!(store
@@ -623,7 +656,7 @@ async fn the_fan_out_migration_keeps_sqlite_data() {
     for sql in [
         "INSERT INTO job_track_blocks VALUES (?1, 0, 7, 0.0, 1.0, x'010203')",
         "INSERT INTO job_plots VALUES (?1, 'penalization.svg', '<svg/>')",
-        "INSERT INTO penalization_curves VALUES ('ah64/clean/modified-archard', ?1, '{}', 2)",
+        "INSERT INTO penalization_curves VALUES ('ah64/clean/modified-archard', ?1, '{\"design_rattle_space\":0.8317,\"points\":[{\"rattle_space\":0.7684,\"rail_wear_rate_mg_per_h\":2.0},{\"rattle_space\":0.8317,\"rail_wear_rate_mg_per_h\":1.0}]}', 2)",
     ] {
         sqlx::query(sql)
             .bind(OLD_DONE.to_string())
@@ -667,7 +700,7 @@ async fn the_fan_out_migration_keeps_postgres_data() {
     for sql in [
         "INSERT INTO job_track_blocks VALUES ($1, 0, 7, 0.0, 1.0, '\\x010203')",
         "INSERT INTO job_plots VALUES ($1, 'penalization.svg', '<svg/>')",
-        "INSERT INTO penalization_curves VALUES ('ah64/clean/modified-archard', $1, '{}', 2)",
+        "INSERT INTO penalization_curves VALUES ('ah64/clean/modified-archard', $1, '{\"design_rattle_space\":0.8317,\"points\":[{\"rattle_space\":0.7684,\"rail_wear_rate_mg_per_h\":2.0},{\"rattle_space\":0.8317,\"rail_wear_rate_mg_per_h\":1.0}]}', 2)",
     ] {
         sqlx::query(sql)
             .bind(OLD_DONE)

@@ -8,6 +8,18 @@
 //! their logarithm keeps the rate positive and, like any piecewise-linear interpolant, monotone
 //! between neighbouring points. Outside the swept range there is no data, so asking there is an
 //! error, not an extrapolation.
+//!
+//! Uncertainty (issue 17): a sweep runs every point with the same n seeds (common random
+//! numbers: seed j drives the same excitation at every k_rs). Each seed j gives its own curve
+//! `L_j(k) = ln rate_j(k)` (interpolated as above) and its own log ratio
+//! `D_j(k) = L_j(k_design) - L_j(k)`. The curve's rates are the geometric means over the seeds,
+//! so `K_SL = min(1, exp(mean_j D_j))`. Pairing by seed keeps the correlation the common seeds
+//! induce between the design point and k (it mostly cancels): the n values `D_j` are treated as
+//! independent draws of the log ratio and the two-sided t-interval at [`CONFIDENCE`] (90 %) is
+//! `mean D ± t(0.95; n-1) s_D / sqrt(n)`; K_SL's interval is `min(1, exp(.))` of its ends and the
+//! life interval that times the design life. It covers the seed-to-seed scatter of the simulated
+//! wear (excitation draws) only, not model error, and assumes `D_j` roughly normal (log rates
+//! are); with one seed there is no interval.
 
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +27,26 @@ use serde::{Deserialize, Serialize};
 pub const CONSERVATIVE_BAND_90: f64 = 0.9;
 /// Factor of the second conservative band of Figure 6.68 (20 % below K_SL).
 pub const CONSERVATIVE_BAND_80: f64 = 0.8;
+/// Two-sided confidence level of K_SL's interval over seeds.
+pub const CONFIDENCE: f64 = 0.9;
+
+/// Upper 5 % quantiles of Student's t, `t(0.95; df)` for df = 1..=30 (the 90 % two-sided
+/// interval), to six significant digits.
+const T_95: [f64; 30] = [
+    6.313752, 2.919986, 2.353363, 2.131847, 2.015048, 1.943180, 1.894579, 1.859548, 1.833113,
+    1.812461, 1.795885, 1.782288, 1.770933, 1.761310, 1.753050, 1.745884, 1.739607, 1.734064,
+    1.729133, 1.724718, 1.720743, 1.717144, 1.713872, 1.710882, 1.708141, 1.705618, 1.703288,
+    1.701131, 1.699127, 1.697261,
+];
+
+/// `t(0.95; df)`: the table for df <= 30, the normal quantile 1.644854 beyond (within 1.2 %).
+pub fn t_quantile_95(df: usize) -> f64 {
+    match df {
+        0 => f64::INFINITY,
+        d if d <= T_95.len() => T_95[d - 1],
+        _ => 1.644_854,
+    }
+}
 
 /// Why a penalization curve could not be built or evaluated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -75,6 +107,9 @@ pub struct SweepPoint {
 struct PenalizationCurveData {
     design_rattle_space: f64,
     points: Vec<SweepPoint>,
+    /// Per point (same order), the rate of each seed, mg/h; absent for one seed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    rate_by_seed_mg_per_h: Vec<Vec<f64>>,
 }
 
 /// The penalization curve of one tolerance sweep (thesis Figure 6.68).
@@ -90,6 +125,27 @@ pub struct PenalizationCurve {
     points: Vec<SweepPoint>,
     /// Interpolated wear rate at the design point, mg/h.
     design_rate_mg_per_h: f64,
+    /// Per point, the rate of each seed (all points the same seeds, in the same order), mg/h;
+    /// empty when the curve has one seed.
+    rate_by_seed: Vec<Vec<f64>>,
+}
+
+/// K_SL's confidence interval over seeds at one rattle space (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KslInterval {
+    /// Two-sided confidence level, 0.9.
+    pub confidence: f64,
+    /// Seeds behind each point (n).
+    pub seeds: usize,
+    /// Mean over seeds of the log ratio `D_j = ln rate_j(design) - ln rate_j(k)`.
+    pub mean_log_ratio: f64,
+    /// Sample standard deviation of `D_j` (n - 1 denominator).
+    pub std_log_ratio: f64,
+    /// `t(0.95; n - 1)`.
+    pub t_quantile: f64,
+    /// Lower and upper end of K_SL, each `min(1, exp(mean ∓ t s / sqrt(n)))`.
+    pub k_sl_low: f64,
+    pub k_sl_high: f64,
 }
 
 /// K_SL and its conservative bands at one rattle space (Figure 6.68).
@@ -123,7 +179,12 @@ pub struct PenalizedLife {
 impl TryFrom<PenalizationCurveData> for PenalizationCurve {
     type Error = PenalizationError;
     fn try_from(data: PenalizationCurveData) -> Result<Self, Self::Error> {
-        Self::new(&data.points, data.design_rattle_space)
+        if data.rate_by_seed_mg_per_h.is_empty() {
+            Self::new(&data.points, data.design_rattle_space)
+        } else {
+            let ks: Vec<f64> = data.points.iter().map(|p| p.rattle_space).collect();
+            Self::from_seeds(&ks, &data.rate_by_seed_mg_per_h, data.design_rattle_space)
+        }
     }
 }
 
@@ -132,6 +193,7 @@ impl From<PenalizationCurve> for PenalizationCurveData {
         Self {
             design_rattle_space: curve.design_rattle_space,
             points: curve.points,
+            rate_by_seed_mg_per_h: curve.rate_by_seed,
         }
     }
 }
@@ -195,6 +257,7 @@ impl PenalizationCurve {
             design_rattle_space,
             points: merged,
             design_rate_mg_per_h: 0.0,
+            rate_by_seed: Vec::new(),
         };
         curve.design_rate_mg_per_h =
             curve
@@ -211,6 +274,124 @@ impl PenalizationCurve {
                     other => other,
                 })?;
         Ok(curve)
+    }
+
+    /// Builds the curve from the rates of each seed at each rattle space: `rates_by_seed[i]`
+    /// holds point `i`'s rate for every seed, the same seeds in the same order at every point
+    /// (a sweep's replicas). The curve's rate at a point is the geometric mean over its seeds;
+    /// [`PenalizationCurve::k_sl_interval`] gives K_SL's confidence interval. The rattle spaces
+    /// must be distinct; other rules as [`PenalizationCurve::new`]. One seed is a curve without
+    /// an interval.
+    pub fn from_seeds(
+        rattle_spaces: &[f64],
+        rates_by_seed: &[Vec<f64>],
+        design_rattle_space: f64,
+    ) -> Result<Self, PenalizationError> {
+        let n = rates_by_seed.first().map_or(0, Vec::len);
+        if rates_by_seed.len() != rattle_spaces.len() {
+            return Err(PenalizationError::InvalidInput {
+                field: "rate_by_seed_mg_per_h",
+                rule: format!(
+                    "needs one list of rates per point ({}), got {}",
+                    rattle_spaces.len(),
+                    rates_by_seed.len()
+                ),
+            });
+        }
+        let mut points = Vec::with_capacity(rattle_spaces.len());
+        for (index, (k, rates)) in rattle_spaces.iter().zip(rates_by_seed).enumerate() {
+            if rates.len() != n || n == 0 {
+                return Err(PenalizationError::InvalidSweepPoint {
+                    index,
+                    field: "rail_wear_rate_mg_per_h",
+                    rule: format!(
+                        "every point needs the same seeds ({n} at the first point), got {}",
+                        rates.len()
+                    ),
+                });
+            }
+            if let Some(bad) = rates.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+                return Err(PenalizationError::InvalidSweepPoint {
+                    index,
+                    field: "rail_wear_rate_mg_per_h",
+                    rule: format!("must be a finite number > 0 mg/h, got {bad}"),
+                });
+            }
+            let rate = if n == 1 {
+                rates[0]
+            } else {
+                (rates.iter().map(|r| r.ln()).sum::<f64>() / n as f64).exp()
+            };
+            points.push(SweepPoint {
+                rattle_space: *k,
+                rail_wear_rate_mg_per_h: rate,
+            });
+        }
+        let mut curve = Self::new(&points, design_rattle_space)?;
+        if curve.points.len() != points.len() {
+            return Err(PenalizationError::InvalidInput {
+                field: "rattle_space",
+                rule: "points with seeds need distinct rattle spaces".into(),
+            });
+        }
+        if n > 1 {
+            // Align the seeds' rates with the sorted points.
+            let mut order: Vec<usize> = (0..points.len()).collect();
+            order.sort_by(|&a, &b| rattle_spaces[a].total_cmp(&rattle_spaces[b]));
+            curve.rate_by_seed = order.iter().map(|&i| rates_by_seed[i].clone()).collect();
+        }
+        Ok(curve)
+    }
+
+    /// Seeds behind each point (1 for a curve without per-seed rates).
+    pub fn seeds(&self) -> usize {
+        self.rate_by_seed.first().map_or(1, Vec::len)
+    }
+
+    /// ln(rate) of seed `j` at `k` (in range), interpolated as the curve.
+    fn seed_log_rate(&self, j: usize, k: f64) -> f64 {
+        let right = self
+            .points
+            .iter()
+            .position(|p| p.rattle_space >= k)
+            .unwrap_or(self.points.len() - 1)
+            .max(1);
+        let (a, b) = (self.points[right - 1], self.points[right]);
+        let t = (k - a.rattle_space) / (b.rattle_space - a.rattle_space);
+        (1.0 - t) * self.rate_by_seed[right - 1][j].ln() + t * self.rate_by_seed[right][j].ln()
+    }
+
+    /// K_SL's 90 % confidence interval over seeds at `rattle_space` (module documentation);
+    /// `Ok(None)` for a curve with one seed.
+    pub fn k_sl_interval(
+        &self,
+        rattle_space: f64,
+    ) -> Result<Option<KslInterval>, PenalizationError> {
+        self.rail_wear_rate_mg_per_h(rattle_space)?;
+        let n = self.seeds();
+        if n < 2 || self.rate_by_seed.is_empty() {
+            return Ok(None);
+        }
+        let d: Vec<f64> = (0..n)
+            .map(|j| {
+                self.seed_log_rate(j, self.design_rattle_space)
+                    - self.seed_log_rate(j, rattle_space)
+            })
+            .collect();
+        let mean = d.iter().sum::<f64>() / n as f64;
+        let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        let std = var.sqrt();
+        let t = t_quantile_95(n - 1);
+        let half = t * std / (n as f64).sqrt();
+        Ok(Some(KslInterval {
+            confidence: CONFIDENCE,
+            seeds: n,
+            mean_log_ratio: mean,
+            std_log_ratio: std,
+            t_quantile: t,
+            k_sl_low: (mean - half).exp().min(1.0),
+            k_sl_high: (mean + half).exp().min(1.0),
+        }))
     }
 
     /// Design rattle space.
@@ -437,6 +618,61 @@ mod tests {
         let c = PenalizationCurve::new(&[pt(0.7, 1.0), pt(0.7, 4.0), pt(0.8, 1.0)], 0.8).unwrap();
         assert_eq!(c.points().len(), 2);
         assert!((c.rail_wear_rate_mg_per_h(0.7).unwrap() - 2.0).abs() < 1e-12);
+    }
+
+    /// Closed form: design rate 1 mg/h for every seed, rates e^0.1, e^0.2, e^0.3 at k = 0.75,
+    /// so D_j = -0.1, -0.2, -0.3: mean -0.2, s = 0.1, t(0.95; 2) = 2.919986.
+    #[test]
+    fn k_sl_interval_is_the_t_interval_over_seeds() {
+        let e = f64::exp;
+        let c = PenalizationCurve::from_seeds(
+            &[0.75, 0.80, 0.85],
+            &[
+                vec![e(0.1), e(0.2), e(0.3)],
+                vec![1.0, 1.0, 1.0],
+                vec![0.5, 0.6, 0.7],
+            ],
+            0.80,
+        )
+        .unwrap();
+        assert_eq!(c.seeds(), 3);
+        // The curve's rate is the geometric mean: e^0.2 at 0.75.
+        assert!((c.rail_wear_rate_mg_per_h(0.75).unwrap() - e(0.2)).abs() < 1e-12);
+        let i = c.k_sl_interval(0.75).unwrap().unwrap();
+        let half = 2.919986 * 0.1 / 3f64.sqrt();
+        assert!((i.mean_log_ratio + 0.2).abs() < 1e-12);
+        assert!((i.std_log_ratio - 0.1).abs() < 1e-12);
+        assert!((i.k_sl_low - e(-0.2 - half)).abs() < 1e-9, "{i:?}");
+        assert!((i.k_sl_high - e(-0.2 + half)).abs() < 1e-9, "{i:?}");
+        let k = c.k_sl(0.75).unwrap();
+        assert!(i.k_sl_low < k && k < i.k_sl_high);
+        assert!((k - e(-0.2)).abs() < 1e-12);
+        // At the design point every seed's ratio is 1: a zero-width interval at 1.
+        let at_design = c.k_sl_interval(0.80).unwrap().unwrap();
+        assert_eq!((at_design.k_sl_low, at_design.k_sl_high), (1.0, 1.0));
+        // Tighter rails: capped at 1 like K_SL.
+        assert!(c.k_sl_interval(0.85).unwrap().unwrap().k_sl_high <= 1.0);
+        // Outside the range: the same error as K_SL.
+        assert!(c.k_sl_interval(0.9).is_err());
+        // Stored and read back with its seeds.
+        let back: PenalizationCurve =
+            serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        assert_eq!(back, c);
+        assert_eq!(back.k_sl_interval(0.75).unwrap(), Some(i));
+        // One seed: no interval.
+        assert_eq!(thesis_like().k_sl_interval(0.78).unwrap(), None);
+        // Seeds must line up.
+        assert!(
+            PenalizationCurve::from_seeds(&[0.7, 0.8], &[vec![1.0, 2.0], vec![1.0]], 0.8).is_err()
+        );
+    }
+
+    #[test]
+    fn t_quantiles_match_the_table() {
+        assert!((t_quantile_95(1) - 6.313752).abs() < 1e-6);
+        assert!((t_quantile_95(2) - 2.919986).abs() < 1e-6);
+        assert!((t_quantile_95(9) - 1.833113).abs() < 1e-6);
+        assert!(t_quantile_95(1000) < t_quantile_95(30));
     }
 
     #[test]

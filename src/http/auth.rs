@@ -32,6 +32,8 @@ pub enum Area {
     Jobs,
     /// API tokens.
     Tokens,
+    /// Penalization curve versions (publishing is an engineer's decision).
+    Curves,
 }
 
 /// The authenticated caller.
@@ -49,9 +51,9 @@ impl Caller {
         match (self.role, area) {
             (Role::Admin, _) => true,
             (_, Area::Tokens) => false,
-            (_, Area::Rails | Area::Jobs) if read => true,
+            (_, Area::Rails | Area::Jobs | Area::Curves) if read => true,
             (Role::Planner, Area::Rails) => true,
-            (Role::Engineer, Area::Jobs) => true,
+            (Role::Engineer, Area::Jobs | Area::Curves) => true,
             _ => false,
         }
     }
@@ -68,6 +70,7 @@ impl Caller {
                     Area::Rails => "rails",
                     Area::Jobs => "jobs",
                     Area::Tokens => "tokens",
+                    Area::Curves => "curves",
                 }
             )))
         }

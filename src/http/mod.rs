@@ -2,6 +2,7 @@
 //! dashboard. Each module exposes its own `router()`; shared state is [`AppState`].
 
 pub mod auth;
+pub mod curves;
 pub mod jobs;
 pub mod openapi;
 pub mod ops;
@@ -51,6 +52,7 @@ pub fn app(state: AppState) -> Router {
     Router::new()
         .merge(jobs::router())
         .merge(rails::router())
+        .merge(curves::router())
         .merge(tokens::router())
         .merge(ops::router())
         .merge(openapi::router())

@@ -1,7 +1,7 @@
 //! The OpenAPI document, generated from the handlers' annotations. `api/openapi.json` is a copy
 //! kept in sync by a test (`railwear openapi > api/openapi.json` regenerates it).
 
-use super::{jobs, ops, pagination, problem, rails, tokens, AppState};
+use super::{curves, jobs, ops, pagination, problem, rails, tokens, AppState};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
@@ -33,6 +33,7 @@ impl Modify for BearerAuth {
         jobs::get_tracks, jobs::get_plot,
         rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
         rails::get_report,
+        curves::list_curves, curves::get_curve, curves::publish_curve,
         tokens::create_token, tokens::list_tokens, tokens::revoke_token,
         ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
@@ -45,7 +46,9 @@ impl Modify for BearerAuth {
         crate::jobs::JobKind, crate::jobs::JobStatus, crate::jobs::JobProgress,
         rails::CurvePointView, crate::analysis::rattle_space::LauncherDimensions,
         rails::MeasurementRequest, rails::MeasurementView, rails::RailView, rails::ReportView,
-        rails::ServiceLife, rails::MissingCurve,
+        rails::ServiceLife, rails::MissingCurve, rails::ServiceLifeInterval, rails::ReportCurve,
+        curves::CurveView, curves::FidelityView, curves::CurveLinks, curves::PublishRequest,
+        pagination::PageView<curves::CurveView>,
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
         crate::config::Role,
     )),
@@ -53,6 +56,7 @@ impl Modify for BearerAuth {
     tags(
         (name = "jobs", description = "Simulation, sweep and calibration jobs (engineer)"),
         (name = "rails", description = "Rail registry, measurements and service-life reports (planner)"),
+        (name = "curves", description = "Penalization curve versions; publishing one makes reports use it (engineer)"),
         (name = "tokens", description = "API tokens (admin)"),
         (name = "ops", description = "Health, readiness, metrics, this document"),
     )

@@ -10,7 +10,9 @@ use super::AppState;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::analysis::rattle_space::LauncherDimensions;
 use crate::jobs::{curve_key, JobStatus};
-use crate::store::{clock, MeasurementRecord, NewMeasurement, RailRecord};
+use crate::store::{
+    clock, CurveFilter, CurveRecord, MeasurementRecord, NewMeasurement, RailRecord,
+};
 use axum::extract::{Path, Query, State};
 use axum::http::{HeaderValue, Method, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -48,6 +50,14 @@ pub mod seam {
     pub fn penalize(curve: &PenalizationCurve, k_rs: f64) -> Result<(f64, f64, f64), String> {
         let f = curve.factors(k_rs).map_err(|e| e.to_string())?;
         Ok((f.k_sl, f.k_sl_conservative_90, f.k_sl_conservative_80))
+    }
+
+    /// K_SL's confidence interval over the curve's seeds at `k_rs` (None for one seed).
+    pub fn interval(
+        curve: &PenalizationCurve,
+        k_rs: f64,
+    ) -> Option<crate::analysis::penalization::KslInterval> {
+        curve.k_sl_interval(k_rs).ok().flatten()
     }
 
     /// [k_rs, K_SL] at the swept rattle spaces (for the plot).
@@ -218,6 +228,50 @@ pub struct ServiceLife {
     pub penalized_life_h: f64,
     pub penalized_life_band_90_h: f64,
     pub penalized_life_band_80_h: f64,
+    /// K_SL and penalized life 90 % confidence interval over the curve's seeds; null when
+    /// the curve has one seed per point (`uncertainty` says so).
+    pub interval: Option<ServiceLifeInterval>,
+    /// How the interval was computed, or why there is none.
+    pub uncertainty: String,
+}
+
+/// Confidence interval of K_SL and the penalized life over the sweep's seeds: a t-interval at
+/// 90 % of the per-seed log ratio `ln rate_j(design) - ln rate_j(k_rs)` (seeds paired, as each
+/// seed drives every point), mapped through `min(1, exp(.))`. It covers seed-to-seed scatter of
+/// the simulated wear only, not model error.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ServiceLifeInterval {
+    /// Two-sided confidence level, 0.9.
+    pub confidence: f64,
+    /// Seeds per point (n); the t quantile has n - 1 degrees of freedom.
+    pub seeds: usize,
+    /// t(0.95; n - 1).
+    pub t_quantile: f64,
+    pub k_sl_low: f64,
+    pub k_sl_high: f64,
+    /// k_sl_low and k_sl_high times the design life, h.
+    pub penalized_life_low_h: f64,
+    pub penalized_life_high_h: f64,
+}
+
+/// The curve version a report used: which one and how much simulation stands behind it.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct ReportCurve {
+    /// Curve id (`/v1/curves/{id}`).
+    pub id: i64,
+    /// Version of its key (1, 2, ...).
+    pub version: i64,
+    pub curve_key: String,
+    /// The sweep job that produced it.
+    pub job_id: Uuid,
+    pub fidelity: super::curves::FidelityView,
+    /// Swept rattle-space range [min, max].
+    pub rattle_space_range: [f64; 2],
+    pub created_by: String,
+    pub code_version: String,
+    pub published_by: Option<String>,
+    pub published_at: Option<String>,
+    pub url: String,
 }
 
 /// Why no service life could be given, and what to do about it.
@@ -227,10 +281,16 @@ pub struct MissingCurve {
     pub curve_key: String,
     /// In words: what is missing and what to do.
     pub detail: String,
-    /// The sweep already queued or running for this key, if any.
+    /// The sweep already queued, running or waiting for this key whose range covers this
+    /// rail, if any.
     pub sweep_job_id: Option<Uuid>,
     pub sweep_job_status: Option<JobStatus>,
-    /// The job request an engineer should submit (POST /v1/jobs) when none is under way.
+    /// A stored but unpublished curve version that covers this rail: an engineer publishes it
+    /// (`POST /v1/curves/{id}/publish`).
+    pub unpublished_curve_id: Option<i64>,
+    /// The job request an engineer should submit (POST /v1/jobs) when none is under way: a
+    /// sweep whose rattle-space range covers this rail and the design point (the published
+    /// curve's sweep, widened), then publish its curve.
     #[schema(value_type = Option<Object>)]
     pub suggested_job: Option<serde_json::Value>,
 }
@@ -246,6 +306,8 @@ pub struct ReportView {
     pub rattle_space: f64,
     /// Key of the penalization curve used.
     pub curve_key: String,
+    /// The published curve version the report used (id, version, fidelity), if any.
+    pub curve: Option<ReportCurve>,
     /// The sweep job that produced the curve.
     pub curve_job_id: Option<Uuid>,
     /// Rattle space of the design rail (K_SL = 1 there).
@@ -470,11 +532,14 @@ pub async fn get_report(
     let key = curve_key(&profile, &environment, &wear_law);
     let k_rs = measurement.rattle_space;
 
+    let rail_dims: Option<LauncherDimensions> =
+        serde_json::from_value(measurement.dimensions_mm.clone()).ok();
     let mut report = ReportView {
         serial: serial.clone(),
         measurement: measurement.into(),
         rattle_space: k_rs,
         curve_key: key.clone(),
+        curve: None,
         curve_job_id: None,
         design_rattle_space: None,
         curve_points: Vec::new(),
@@ -482,85 +547,187 @@ pub async fn get_report(
         service_life: None,
         missing_curve: None,
     };
-    let suggested = serde_json::json!({
-        "kind": "sweep",
-        "params": {
-            "config": "launcher-design",
-            "vehicle_profile": profile,
-            "environment": environment,
-            "wear_law": wear_law,
-        }
-    });
-    let stored = state.store.get_curve(&key).await?;
-    let data = stored.as_ref().and_then(|c| {
+    let read = |c: &CurveRecord| {
         serde_json::from_value::<PenalizationCurve>(c.curve.clone())
-            .map_err(|e| tracing::warn!(key = %c.key, error = %e, "unreadable stored curve"))
+            .map_err(|e| tracing::warn!(curve = c.id, error = %e, "unreadable stored curve"))
             .ok()
-    });
-    match (stored, data) {
-        (Some(stored), Some(data)) => {
-            report.curve_job_id = Some(stored.job_id);
-            report.design_rattle_space = Some(data.design_rattle_space());
-            report.k_sl_curve = seam::samples(&data);
-            report.curve_points = data
-                .points()
-                .iter()
-                .map(|p| CurvePointView {
-                    rattle_space: p.rattle_space,
-                    rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
-                })
-                .collect();
-            match seam::penalize(&data, k_rs) {
-                Ok((k_sl, band_90, band_80)) => {
-                    report.service_life = Some(ServiceLife {
-                        k_sl,
-                        k_sl_band_90: band_90,
-                        k_sl_band_80: band_80,
-                        design_life_h,
-                        penalized_life_h: k_sl * design_life_h,
-                        penalized_life_band_90_h: band_90 * design_life_h,
-                        penalized_life_band_80_h: band_80 * design_life_h,
-                    })
-                }
-                Err(reason) => {
-                    report.missing_curve = Some(MissingCurve {
-                        curve_key: key.clone(),
-                        detail: format!(
-                            "the penalization curve {key} (sweep job {}) does not cover rattle space {k_rs:.4}: {reason}; submit a sweep whose range includes it",
-                            stored.job_id
-                        ),
-                        sweep_job_id: None,
-                        sweep_job_status: None,
-                        suggested_job: Some(suggested),
-                    })
-                }
+    };
+    let published = state.store.published_curve(&key).await?;
+    let published_data = published.as_ref().and_then(read);
+    let mut why = format!("no published penalization curve for {key}");
+    if let (Some(stored), Some(data)) = (&published, &published_data) {
+        let (lo, hi) = data.range();
+        report.curve = Some(ReportCurve {
+            id: stored.id,
+            version: stored.version,
+            curve_key: stored.key.clone(),
+            job_id: stored.job_id,
+            fidelity: super::curves::FidelityView {
+                points: stored.fidelity.points,
+                duration_per_point_s: stored.fidelity.duration_per_point_s,
+                seeds: stored.fidelity.seeds,
+            },
+            rattle_space_range: [lo, hi],
+            created_by: stored.created_by.clone(),
+            code_version: stored.code_version.clone(),
+            published_by: stored.published.as_ref().map(|p| p.published_by.clone()),
+            published_at: stored
+                .published
+                .as_ref()
+                .map(|p| clock::rfc3339(p.published_ms)),
+            url: format!("/v1/curves/{}", stored.id),
+        });
+        report.curve_job_id = Some(stored.job_id);
+        report.design_rattle_space = Some(data.design_rattle_space());
+        report.k_sl_curve = seam::samples(data);
+        report.curve_points = data
+            .points()
+            .iter()
+            .map(|p| CurvePointView {
+                rattle_space: p.rattle_space,
+                rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
+            })
+            .collect();
+        match seam::penalize(data, k_rs) {
+            Ok((k_sl, band_90, band_80)) => {
+                let interval = seam::interval(data, k_rs);
+                let uncertainty = match &interval {
+                    Some(i) => format!(
+                        "90 % t-interval over {} seeds per point (t = {:.4}, {} degrees of \
+                         freedom) of the paired log ratio of wear rates; seed-to-seed scatter \
+                         of the simulation only, not model error",
+                        i.seeds,
+                        i.t_quantile,
+                        i.seeds - 1
+                    ),
+                    None => "no interval: the curve has one seed per point; publish a sweep \
+                             with seeds >= 3 for one"
+                        .to_string(),
+                };
+                report.service_life = Some(ServiceLife {
+                    k_sl,
+                    k_sl_band_90: band_90,
+                    k_sl_band_80: band_80,
+                    design_life_h,
+                    penalized_life_h: k_sl * design_life_h,
+                    penalized_life_band_90_h: band_90 * design_life_h,
+                    penalized_life_band_80_h: band_80 * design_life_h,
+                    interval: interval.map(|i| ServiceLifeInterval {
+                        confidence: i.confidence,
+                        seeds: i.seeds,
+                        t_quantile: i.t_quantile,
+                        k_sl_low: i.k_sl_low,
+                        k_sl_high: i.k_sl_high,
+                        penalized_life_low_h: i.k_sl_low * design_life_h,
+                        penalized_life_high_h: i.k_sl_high * design_life_h,
+                    }),
+                    uncertainty,
+                });
+                return Ok(Json(report));
+            }
+            Err(reason) => {
+                why = format!(
+                    "the published penalization curve {key} (curve {} version {}, sweep job {}) \
+                     does not cover rattle space {k_rs:.4}: {reason}",
+                    stored.id, stored.version, stored.job_id
+                );
             }
         }
-        _ => {
-            let active = state.store.active_sweep(&key).await?;
-            report.missing_curve = Some(match active {
-                Some(job) => MissingCurve {
-                    curve_key: key.clone(),
-                    detail: format!(
-                        "no penalization curve for {key} yet; sweep job {} is {}: the report will include K_SL once it succeeds",
-                        job.id,
-                        job.status.as_str()
-                    ),
-                    sweep_job_id: Some(job.id),
-                    sweep_job_status: Some(job.status),
-                    suggested_job: None,
-                },
-                None => MissingCurve {
-                    curve_key: key.clone(),
-                    detail: format!(
-                        "no penalization curve for {key}: an engineer must run a sweep job (POST /v1/jobs with the suggested_job body)"
-                    ),
-                    sweep_job_id: None,
-                    sweep_job_status: None,
-                    suggested_job: Some(suggested),
-                },
-            });
+    }
+    // No published curve covers the rail: a sweep under way that will, a stored version that
+    // does (publish it), or the sweep to run.
+    let covers = |bounds: (f64, f64)| bounds.0 <= k_rs && k_rs <= bounds.1;
+    let active = state.store.active_sweep(&key).await?;
+    let active_covers = active.as_ref().is_some_and(|job| {
+        crate::pipeline::SweepRange::from_params(&job.params)
+            .map(|r| covers(r.rattle_space_bounds()))
+            .unwrap_or(true)
+    });
+    let mut unpublished = None;
+    let versions = state
+        .store
+        .list_curves(
+            crate::store::PageRequest {
+                limit: 50,
+                after_seq: None,
+            },
+            CurveFilter {
+                key: Some(key.clone()),
+            },
+        )
+        .await?;
+    for c in &versions.items {
+        if c.published.is_none() && read(c).is_some_and(|d| covers(d.range())) {
+            unpublished = Some(c);
+            break;
         }
     }
+    let template = match &published {
+        Some(p) => state
+            .store
+            .get_job(p.job_id)
+            .await?
+            .map(|job| job.params)
+            .unwrap_or_default(),
+        None => serde_json::Value::Null,
+    };
+    let template = if template.is_object() {
+        template
+    } else {
+        serde_json::json!({"config": "launcher-design"})
+    };
+    let mut template = template;
+    if let Some(map) = template.as_object_mut() {
+        map.insert("vehicle_profile".into(), profile.clone().into());
+        map.insert("environment".into(), environment.clone().into());
+        map.insert("wear_law".into(), wear_law.clone().into());
+    }
+    let suggested = crate::pipeline::covering_sweep_params(&template, k_rs, rail_dims.as_ref())
+        .map(|params| serde_json::json!({"kind": "sweep", "params": params}));
+    report.missing_curve = Some(match (active, unpublished) {
+        (Some(job), _) if active_covers => MissingCurve {
+            curve_key: key.clone(),
+            detail: format!(
+                "{why}; sweep job {} covering it is {}: once it succeeds an engineer publishes \
+                 its curve and the report includes K_SL",
+                job.id,
+                job.status.as_str()
+            ),
+            sweep_job_id: Some(job.id),
+            sweep_job_status: Some(job.status),
+            unpublished_curve_id: None,
+            suggested_job: None,
+        },
+        (_, Some(c)) => MissingCurve {
+            curve_key: key.clone(),
+            detail: format!(
+                "{why}; curve {} (version {}, sweep job {}) covers it but is not published: an \
+                 engineer publishes it with POST /v1/curves/{}/publish",
+                c.id, c.version, c.job_id, c.id
+            ),
+            sweep_job_id: None,
+            sweep_job_status: None,
+            unpublished_curve_id: Some(c.id),
+            suggested_job: None,
+        },
+        _ => MissingCurve {
+            curve_key: key.clone(),
+            detail: match &suggested {
+                Some(_) => format!(
+                    "{why}: an engineer runs the suggested sweep (POST /v1/jobs with the \
+                     suggested_job body; its rattle_space_range covers {k_rs:.4} and the design \
+                     point) and publishes its curve"
+                ),
+                None => format!(
+                    "{why}, and no tolerance sweep reaches rattle space {k_rs:.4} from the \
+                     design rail or this rail's dimensions as a valid rail"
+                ),
+            },
+            sweep_job_id: None,
+            sweep_job_status: None,
+            unpublished_curve_id: None,
+            suggested_job: suggested,
+        },
+    });
     Ok(Json(report))
 }

@@ -10,7 +10,7 @@ pub mod worker;
 use crate::store::{clock, NewJob, Store, StoreError, Submitted};
 pub use metrics::Metrics;
 pub use model::{ChildCounts, ChildOf, JobKind, JobProgress, JobRecord, JobStatus};
-pub use runner::{CaseRunner, ChildJob, FanOutPlan, JobOutput, LibraryRunner};
+pub use runner::{CaseRunner, ChildJob, CurveInfo, FanOutPlan, JobOutput, LibraryRunner};
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;

@@ -19,8 +19,21 @@ pub struct JobOutput {
     pub tracks: Vec<TrackSample>,
     /// SVG plots: (file name, SVG text).
     pub plots: Vec<(String, String)>,
-    /// Sweeps: the penalization curve (eq. 6.4, Figure 6.68), stored under the job's curve key.
+    /// Sweeps: the penalization curve (eq. 6.4, Figure 6.68), stored under the job's curve key
+    /// as a new, unpublished version.
     pub penalization: Option<PenalizationCurve>,
+    /// Sweeps: the curve's fidelity and provenance (the worker adds who and which code).
+    pub curve_info: Option<CurveInfo>,
+}
+
+/// What a sweep tells about the curve it made, beyond the curve itself.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveInfo {
+    /// Points, excited duration per point and seeds per point.
+    pub fidelity: crate::store::CurveFidelity,
+    /// Provenance (JSON object): config, vehicle_profile, environment, wear_law, range,
+    /// offsets, base dimensions, settle, seeds.
+    pub provenance: serde_json::Value,
 }
 
 /// A child job of a fan-out: what to run.
@@ -100,8 +113,8 @@ pub enum JobPlan {
     Simulate(Box<CaseSpec>),
     /// The sweep to fan out (or run in one process).
     Sweep(Box<SweepPlan>),
-    /// One point of a sweep: the sweep's plan and the point's index.
-    SweepPoint(Box<SweepPlan>, usize),
+    /// One run of a sweep: the sweep's plan, the point's index and the replica (seed) index.
+    SweepPoint(Box<SweepPlan>, usize, usize),
     /// The calibration data.
     Calibrate(CalibrateParams),
 }
@@ -141,7 +154,8 @@ impl LibraryRunner {
                     field: "point".into(),
                     rule: "is required (a non-negative integer)".into(),
                 })?;
-                Ok(JobPlan::SweepPoint(Box::new(plan), index))
+                let replica = plan.replica.unwrap_or(0);
+                Ok(JobPlan::SweepPoint(Box::new(plan), index, replica))
             }
             JobKind::Calibrate => Ok(JobPlan::Calibrate(CalibrateParams::parse(params)?)),
         }
@@ -162,17 +176,23 @@ impl CaseRunner for LibraryRunner {
                     summary: out.summary,
                     tracks: out.tracks,
                     plots: out.plots,
-                    penalization: None,
+                    ..JobOutput::default()
                 })
             }
             JobPlan::Sweep(plan) => {
                 let (_, sweep) = crate::pipeline::run_sweep(&plan, &self.configs_dir, control)?;
-                sweep_output(&sweep)
+                sweep_output(&plan, params, &sweep)
             }
-            JobPlan::SweepPoint(plan, index) => {
-                let point = crate::pipeline::sweep_point(&plan, index, &self.configs_dir, control)?;
+            JobPlan::SweepPoint(plan, index, replica) => {
+                let point = crate::pipeline::sweep_point(
+                    &plan,
+                    index,
+                    replica,
+                    &self.configs_dir,
+                    control,
+                )?;
                 Ok(JobOutput {
-                    summary: sweep_point_summary(index, &point),
+                    summary: sweep_point_summary(index, replica, &point),
                     ..JobOutput::default()
                 })
             }
@@ -187,7 +207,7 @@ impl CaseRunner for LibraryRunner {
         self.plan(kind, params).map(|_| ())
     }
 
-    /// A sweep fans out into one `sweep_point` child per point.
+    /// A sweep fans out into one `sweep_point` child per point and seed (point-major).
     fn fan_out(
         &self,
         kind: &JobKind,
@@ -199,14 +219,15 @@ impl CaseRunner for LibraryRunner {
         let JobPlan::Sweep(plan) = self.plan(kind, params)? else {
             return Ok(None);
         };
+        let seeds = plan.seeds.len();
         Ok(Some(FanOutPlan {
-            children: (0..plan.len())
-                .map(|index| ChildJob {
+            children: (0..plan.runs())
+                .map(|run| ChildJob {
                     kind: JobKind::SweepPoint,
-                    params: crate::pipeline::sweep_point_params(params, index),
+                    params: crate::pipeline::sweep_point_params(params, run / seeds, run % seeds),
                 })
                 .collect(),
-            end_time_s: plan.len() as f64 * plan.point_end_time_s(),
+            end_time_s: plan.runs() as f64 * plan.point_end_time_s(),
         }))
     }
 
@@ -224,12 +245,12 @@ impl CaseRunner for LibraryRunner {
             });
         }
         let plan = SweepPlan::from_params(params, &self.configs_dir)?;
-        if children.len() != plan.len() {
+        if children.len() != plan.runs() {
             return Err(RunError::InvalidConfig {
                 field: "points".into(),
                 rule: format!(
-                    "the sweep has {} points but {} child results",
-                    plan.len(),
+                    "the sweep has {} runs but {} child results",
+                    plan.runs(),
                     children.len()
                 ),
             });
@@ -246,14 +267,15 @@ impl CaseRunner for LibraryRunner {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        sweep_output(&plan.outcome(points))
+        sweep_output(&plan, params, &plan.outcome(points)?)
     }
 }
 
-/// Result summary of a `sweep_point` child job: its index and the point.
-pub fn sweep_point_summary(index: usize, point: &SweepPoint) -> serde_json::Value {
+/// Result summary of a `sweep_point` child job: its point and replica indices and the run.
+pub fn sweep_point_summary(index: usize, replica: usize, point: &SweepPoint) -> serde_json::Value {
     serde_json::json!({
         "point": index,
+        "replica": replica,
         "offset_mm": point.offset_mm,
         "rattle_space": point.rattle_space,
         "rail_wear_rate_mg_per_h": point.rail_wear_rate_mg_per_h,
@@ -261,19 +283,55 @@ pub fn sweep_point_summary(index: usize, point: &SweepPoint) -> serde_json::Valu
 }
 
 /// A sweep job's output from its outcome (sequential or assembled): the outcome as summary, the
-/// penalization curve (eq. 6.4) and its plot.
-pub fn sweep_output(sweep: &SweepOutcome) -> Result<JobOutput, RunError> {
-    let points: Vec<crate::analysis::penalization::SweepPoint> = sweep
-        .points
-        .iter()
-        .map(|p| crate::analysis::penalization::SweepPoint {
-            rattle_space: p.rattle_space,
-            rail_wear_rate_mg_per_h: p.rail_wear_rate_mg_per_h,
-        })
-        .collect();
-    let curve = PenalizationCurve::new(&points, sweep.design_rattle_space).map_err(|e| {
-        RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
-    })?;
+/// penalization curve (eq. 6.4) with the rates of each seed, its plot, fidelity and
+/// provenance.
+pub fn sweep_output(
+    plan: &SweepPlan,
+    params: &serde_json::Value,
+    sweep: &SweepOutcome,
+) -> Result<JobOutput, RunError> {
+    let ks: Vec<f64> = sweep.points.iter().map(|p| p.rattle_space).collect();
+    let rates: Vec<Vec<f64>> = if sweep.rate_by_seed_mg_per_h.len() == ks.len() {
+        sweep.rate_by_seed_mg_per_h.clone()
+    } else {
+        sweep
+            .points
+            .iter()
+            .map(|p| vec![p.rail_wear_rate_mg_per_h])
+            .collect()
+    };
+    let curve =
+        PenalizationCurve::from_seeds(&ks, &rates, sweep.design_rattle_space).map_err(|e| {
+            RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
+        })?;
+    let (k_min, k_max) = plan.range.rattle_space_bounds();
+    let config = match params.get("config") {
+        None => serde_json::Value::from("launcher-design"),
+        Some(serde_json::Value::String(name)) => serde_json::Value::from(name.as_str()),
+        Some(_) => serde_json::Value::from("inline"),
+    };
+    let curve_info = CurveInfo {
+        fidelity: crate::store::CurveFidelity {
+            points: plan.len() as i64,
+            duration_per_point_s: Some(plan.duration_per_point_s()),
+            seeds: plan.seeds.len() as i64,
+        },
+        provenance: serde_json::json!({
+            "config": config,
+            "overrides": params.get("overrides").cloned().unwrap_or(serde_json::Value::Null),
+            "vehicle_profile": plan.vehicle_profile,
+            "environment": plan.environment,
+            "wear_law": plan.wear_law,
+            "points": plan.len(),
+            "duration_per_point_s": plan.duration_per_point_s(),
+            "settle_s": plan.base.simulation.settle_s,
+            "seeds": plan.seeds,
+            "rattle_space_range": {"min": k_min, "max": k_max},
+            "offsets_mm": plan.offsets_mm,
+            "base_dimensions_mm": plan.range.base,
+            "design_base": plan.range.design_base,
+        }),
+    };
     let plot = curve_plot(&curve);
     let summary = serde_json::to_value(sweep).map_err(|e| RunError::InvalidConfig {
         field: "sweep".into(),
@@ -284,6 +342,7 @@ pub fn sweep_output(sweep: &SweepOutcome) -> Result<JobOutput, RunError> {
         tracks: Vec::new(),
         plots: vec![("penalization.svg".to_string(), plot)],
         penalization: Some(curve),
+        curve_info: Some(curve_info),
     })
 }
 

@@ -10,7 +10,9 @@ use super::model::{JobProgress, JobRecord, JobStatus};
 use super::runner::FanOutPlan;
 use super::Jobs;
 use crate::pipeline::{Progress, RunControl, RunError};
-use crate::store::{clock, tracks, CurveRecord, FanOut, FanOutResult, Finish, NewChild};
+use crate::store::{
+    clock, tracks, CurveFidelity, FanOut, FanOutResult, Finish, NewChild, NewCurve,
+};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -174,12 +176,9 @@ impl Jobs {
                 .await
                 .unwrap_or_default();
                 let curve = match (output.penalization, &job.curve_key) {
-                    (Some(data), Some(key)) => Some(CurveRecord {
-                        key: key.clone(),
-                        job_id: id,
-                        curve: serde_json::to_value(&data).unwrap_or_default(),
-                        created_ms: clock::now_ms(),
-                    }),
+                    (Some(data), Some(key)) => {
+                        Some(Box::new(new_curve(&job, key, &data, output.curve_info)))
+                    }
                     _ => None,
                 };
                 Finish::Succeeded {
@@ -321,6 +320,44 @@ fn job_progress(p: Progress, elapsed: Duration) -> JobProgress {
         end_time_s: p.end_time_s,
         fraction,
         eta_s,
+    }
+}
+
+/// The curve version a sweep stores: the runner's fidelity and provenance (or, from a runner
+/// that gives none, the curve's own point and seed counts with the duration unknown), plus who
+/// submitted the sweep, the code version and the job.
+fn new_curve(
+    job: &crate::jobs::JobRecord,
+    key: &str,
+    curve: &crate::analysis::penalization::PenalizationCurve,
+    info: Option<super::runner::CurveInfo>,
+) -> NewCurve {
+    let (fidelity, mut provenance) = match info {
+        Some(info) => (info.fidelity, info.provenance),
+        None => (
+            CurveFidelity {
+                points: curve.points().len() as i64,
+                duration_per_point_s: None,
+                seeds: curve.seeds() as i64,
+            },
+            serde_json::json!({}),
+        ),
+    };
+    if let Some(map) = provenance.as_object_mut() {
+        map.insert("code_version".into(), job.code_version.clone().into());
+        map.insert("created_by".into(), job.submitted_by.clone().into());
+        map.insert("job_id".into(), job.id.to_string().into());
+        map.insert("seed".into(), job.seed.into());
+    }
+    NewCurve {
+        key: key.to_string(),
+        job_id: job.id,
+        curve: serde_json::to_value(curve).unwrap_or_default(),
+        fidelity,
+        provenance,
+        created_by: job.submitted_by.clone(),
+        code_version: job.code_version.clone(),
+        created_ms: clock::now_ms(),
     }
 }
 

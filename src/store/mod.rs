@@ -80,7 +80,7 @@ pub enum Finish {
         summary: serde_json::Value,
         blocks: Vec<TrackBlock>,
         plots: Vec<(String, String)>,
-        curve: Option<CurveRecord>,
+        curve: Option<Box<NewCurve>>,
     },
     Failed(String),
     Cancelled,
@@ -290,15 +290,104 @@ pub struct MeasurementRecord {
     pub recorded_ms: i64,
 }
 
-/// A penalization curve produced by a sweep job.
+/// How much simulation stands behind a curve: publishing one with less of any of these over
+/// the published one needs `force` ([`CurveFidelity::shortfall`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveFidelity {
+    /// Points of the sweep (distinct rattle spaces).
+    pub points: i64,
+    /// Excited simulated duration of each run, s; `None` for curves migrated from before
+    /// issue 17, whose duration was not recorded.
+    pub duration_per_point_s: Option<f64>,
+    /// Seeds (independent runs) per point.
+    pub seeds: i64,
+}
+
+impl CurveFidelity {
+    /// Why `self` is a lower fidelity than `other`, or `None` when it is not: fewer points,
+    /// a shorter duration per point (when both are known) or fewer seeds per point.
+    pub fn shortfall(&self, other: &CurveFidelity) -> Option<String> {
+        let mut why = Vec::new();
+        if self.points < other.points {
+            why.push(format!("{} points < {}", self.points, other.points));
+        }
+        if let (Some(a), Some(b)) = (self.duration_per_point_s, other.duration_per_point_s) {
+            if a < b {
+                why.push(format!("{a} s per point < {b} s"));
+            }
+        }
+        if self.seeds < other.seeds {
+            why.push(format!("{} seeds per point < {}", self.seeds, other.seeds));
+        }
+        (!why.is_empty()).then(|| why.join(", "))
+    }
+}
+
+/// A penalization curve a successful sweep stores: a new version under its key, not published.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CurveRecord {
+pub struct NewCurve {
     /// `vehicle_profile/environment/wear_law`.
     pub key: String,
     pub job_id: Uuid,
-    /// Curve data (JSON, see `jobs::runner::PenalizationData`).
+    /// Curve data (JSON of `analysis::penalization::PenalizationCurve`).
     pub curve: serde_json::Value,
+    pub fidelity: CurveFidelity,
+    /// Provenance (JSON object): config, vehicle_profile, environment, wear_law, range, seeds,
+    /// duration per point, code version, created by.
+    pub provenance: serde_json::Value,
+    /// Token name of who submitted the sweep.
+    pub created_by: String,
+    pub code_version: String,
     pub created_ms: i64,
+}
+
+/// When and by whom a curve was made the one reports use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Publication {
+    pub published_by: String,
+    pub published_ms: i64,
+}
+
+/// A stored curve version.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveRecord {
+    /// Store-wide id (`/v1/curves/{id}`).
+    pub id: i64,
+    /// `vehicle_profile/environment/wear_law`.
+    pub key: String,
+    /// 1, 2, ... per key, in the order sweeps stored them.
+    pub version: i64,
+    pub job_id: Uuid,
+    pub curve: serde_json::Value,
+    pub fidelity: CurveFidelity,
+    pub provenance: serde_json::Value,
+    pub created_by: String,
+    pub code_version: String,
+    pub created_ms: i64,
+    /// Present while this version is the published one of its key.
+    pub published: Option<Publication>,
+}
+
+/// What [`Store::publish_curve`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PublishOutcome {
+    /// The version is now the one reports use (also when it already was).
+    Published(CurveRecord),
+    /// Refused without `force`: the version has a lower fidelity than the published one
+    /// (`reason` from [`CurveFidelity::shortfall`]). Nothing changed.
+    LowerFidelity {
+        published: CurveRecord,
+        reason: String,
+    },
+    /// No curve with that id.
+    NotFound,
+}
+
+/// Which curves a list shows.
+#[derive(Debug, Clone, Default)]
+pub struct CurveFilter {
+    /// Only this key.
+    pub key: Option<String>,
 }
 
 /// An API token as stored (the secret itself is only kept as its SHA-256).
@@ -396,7 +485,25 @@ pub trait Store: Send + Sync {
     /// The measurement with the latest `measured_at` (ties: the last recorded), whatever order
     /// they were recorded in (a back-filled old reading does not become the latest).
     fn latest_measurement(&self, serial: &str) -> StoreFuture<'_, Option<MeasurementRecord>>;
-    fn get_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>>;
+    /// One curve version by id.
+    fn get_curve(&self, id: i64) -> StoreFuture<'_, Option<CurveRecord>>;
+    /// The published version of a key (what reports use).
+    fn published_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>>;
+    /// Curve versions, newest first (cursor: the id).
+    fn list_curves(
+        &self,
+        page: PageRequest,
+        filter: CurveFilter,
+    ) -> StoreFuture<'_, Page<CurveRecord>>;
+    /// Make version `id` the published one of its key, in one transaction that compares it
+    /// with the version published now: a lower fidelity is refused unless `force`.
+    fn publish_curve(
+        &self,
+        id: i64,
+        published_by: &str,
+        force: bool,
+        now_ms: i64,
+    ) -> StoreFuture<'_, PublishOutcome>;
 
     fn create_token(
         &self,
@@ -423,6 +530,41 @@ pub async fn open(database_url: &str) -> Result<Arc<dyn Store>, StoreError> {
         Ok(Arc::new(store))
     } else {
         Err(StoreError::UnsupportedUrl(database_url.to_string()))
+    }
+}
+
+/// The newest stored version of `key`, published or not.
+pub async fn latest_curve(store: &dyn Store, key: &str) -> Result<Option<CurveRecord>, StoreError> {
+    let page = store
+        .list_curves(
+            PageRequest {
+                limit: 1,
+                after_seq: None,
+            },
+            CurveFilter {
+                key: Some(key.to_string()),
+            },
+        )
+        .await?;
+    Ok(page.items.into_iter().next())
+}
+
+/// The refusal of [`Store::publish_curve`] given the candidate and the published version, or
+/// `None` when it may be published.
+pub fn publish_refusal(
+    candidate: &CurveRecord,
+    published: Option<&CurveRecord>,
+    force: bool,
+) -> Option<PublishOutcome> {
+    match published {
+        Some(current) if current.id != candidate.id && !force => candidate
+            .fidelity
+            .shortfall(&current.fidelity)
+            .map(|reason| PublishOutcome::LowerFidelity {
+                published: current.clone(),
+                reason,
+            }),
+        _ => None,
     }
 }
 

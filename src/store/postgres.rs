@@ -6,9 +6,10 @@
 //! expired leases go back to the queue until `max_attempts`.
 
 use super::{
-    AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord, CurveRecord, FanOut,
-    FanOutResult, Finish, Heartbeat, JobFilter, MeasurementRecord, NewJob, NewMeasurement, Page,
-    PageRequest, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
+    CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
+    MeasurementRecord, NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication,
+    PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
 use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
@@ -226,6 +227,70 @@ async fn end_attempt(
     .bind(outcome.as_str())
     .bind(now_ms)
     .execute(&mut *conn)
+    .await?;
+    Ok(())
+}
+
+/// Curve versions with their publication (left join: `p.curve_id = v.id` only for the
+/// published one).
+const CURVE_SELECT: &str = "SELECT v.id, v.curve_key, v.version, v.job_id, v.curve, v.provenance, \
+     v.points, v.duration_per_point_s, v.seeds, v.created_by, v.code_version, v.created_ms, \
+     p.curve_id AS published_id, p.published_by, p.published_ms \
+     FROM curve_versions v LEFT JOIN published_curves p ON p.curve_key = v.curve_key";
+
+fn curve_from_row(row: &PgRow) -> Result<CurveRecord, StoreError> {
+    let id: i64 = row.try_get("id")?;
+    let job_id: Uuid = row.try_get("job_id")?;
+    let curve: String = row.try_get("curve")?;
+    let provenance: String = row.try_get("provenance")?;
+    let published_id: Option<i64> = row.try_get("published_id")?;
+    Ok(CurveRecord {
+        id,
+        key: row.try_get("curve_key")?,
+        version: row.try_get("version")?,
+        job_id,
+        curve: parse_json(&curve, "penalization curve")?,
+        fidelity: CurveFidelity {
+            points: row.try_get("points")?,
+            duration_per_point_s: row.try_get("duration_per_point_s")?,
+            seeds: row.try_get("seeds")?,
+        },
+        provenance: parse_json(&provenance, "curve provenance")?,
+        created_by: row.try_get("created_by")?,
+        code_version: row.try_get("code_version")?,
+        created_ms: row.try_get("created_ms")?,
+        published: match published_id {
+            Some(p) if p == id => Some(Publication {
+                published_by: row.try_get("published_by")?,
+                published_ms: row.try_get("published_ms")?,
+            }),
+            _ => None,
+        },
+    })
+}
+
+/// Store a sweep's curve as the next version of its key (inside the finishing transaction).
+async fn insert_curve_version(
+    tx: &mut sqlx::PgConnection,
+    curve: NewCurve,
+) -> Result<(), StoreError> {
+    sqlx::query(
+        "INSERT INTO curve_versions (curve_key, version, job_id, curve, provenance, points, \
+         duration_per_point_s, seeds, created_by, code_version, created_ms) \
+         SELECT $1, COALESCE(MAX(version), 0) + 1, $2, $3, $4, $5, $6, $7, $8, $9, $10 \
+         FROM curve_versions WHERE curve_key = $1",
+    )
+    .bind(curve.key)
+    .bind(curve.job_id)
+    .bind(curve.curve.to_string())
+    .bind(curve.provenance.to_string())
+    .bind(curve.fidelity.points)
+    .bind(curve.fidelity.duration_per_point_s)
+    .bind(curve.fidelity.seeds)
+    .bind(curve.created_by)
+    .bind(curve.code_version)
+    .bind(curve.created_ms)
+    .execute(&mut *tx)
     .await?;
     Ok(())
 }
@@ -621,17 +686,7 @@ impl Store for PgStore {
                     .await?;
                 }
                 if let Some(curve) = curve {
-                    sqlx::query(
-                        "INSERT INTO penalization_curves (curve_key, job_id, curve, created_ms) \
-                         VALUES ($1, $2, $3, $4) ON CONFLICT (curve_key) DO UPDATE SET \
-                         job_id = EXCLUDED.job_id, curve = EXCLUDED.curve, created_ms = EXCLUDED.created_ms",
-                    )
-                    .bind(curve.key)
-                    .bind(curve.job_id)
-                    .bind(curve.curve.to_string())
-                    .bind(curve.created_ms)
-                    .execute(&mut *tx)
-                    .await?;
+                    insert_curve_version(&mut tx, *curve).await?;
                 }
             }
             tx.commit().await?;
@@ -1061,25 +1116,112 @@ impl Store for PgStore {
         })
     }
 
-    fn get_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>> {
+    fn get_curve(&self, id: i64) -> StoreFuture<'_, Option<CurveRecord>> {
+        Box::pin(async move {
+            let row = sqlx::query(&format!("{CURVE_SELECT} WHERE v.id = $1"))
+                .bind(id)
+                .fetch_optional(&self.pool)
+                .await?;
+            row.as_ref().map(curve_from_row).transpose()
+        })
+    }
+
+    fn published_curve(&self, key: &str) -> StoreFuture<'_, Option<CurveRecord>> {
         let key = key.to_string();
         Box::pin(async move {
-            let row = sqlx::query(
-                "SELECT curve_key, job_id, curve, created_ms FROM penalization_curves WHERE curve_key = $1",
-            )
+            let row = sqlx::query(&format!(
+                "{CURVE_SELECT} WHERE p.curve_key = $1 AND p.curve_id = v.id"
+            ))
             .bind(key)
             .fetch_optional(&self.pool)
             .await?;
-            row.map(|row| {
-                let curve: String = row.try_get("curve")?;
-                Ok(CurveRecord {
-                    key: row.try_get("curve_key")?,
-                    job_id: row.try_get("job_id")?,
-                    curve: parse_json(&curve, "penalization curve")?,
-                    created_ms: row.try_get("created_ms")?,
-                })
-            })
-            .transpose()
+            row.as_ref().map(curve_from_row).transpose()
+        })
+    }
+
+    fn list_curves(
+        &self,
+        page: PageRequest,
+        filter: CurveFilter,
+    ) -> StoreFuture<'_, Page<CurveRecord>> {
+        Box::pin(async move {
+            let rows = sqlx::query(&format!(
+                "{CURVE_SELECT} WHERE ($1::TEXT IS NULL OR v.curve_key = $1) \
+                 AND ($2::BIGINT IS NULL OR v.id < $2) ORDER BY v.id DESC LIMIT $3"
+            ))
+            .bind(filter.key)
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(curve_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |c| c.id))
+        })
+    }
+
+    fn publish_curve(
+        &self,
+        id: i64,
+        published_by: &str,
+        force: bool,
+        now_ms: i64,
+    ) -> StoreFuture<'_, PublishOutcome> {
+        let published_by = published_by.to_string();
+        Box::pin(async move {
+            let mut tx = self.pool.begin().await?;
+            let Some(candidate) = sqlx::query(&format!("{CURVE_SELECT} WHERE v.id = $1"))
+                .bind(id)
+                .fetch_optional(&mut *tx)
+                .await?
+                .as_ref()
+                .map(curve_from_row)
+                .transpose()?
+            else {
+                tx.rollback().await?;
+                return Ok(PublishOutcome::NotFound);
+            };
+            // Publishes of one key are serialized (the comparison and the switch are one step).
+            sqlx::query("SELECT pg_advisory_xact_lock(hashtext($1))")
+                .bind(&candidate.key)
+                .execute(&mut *tx)
+                .await?;
+            let current = sqlx::query(&format!(
+                "{CURVE_SELECT} WHERE p.curve_key = $1 AND p.curve_id = v.id"
+            ))
+            .bind(&candidate.key)
+            .fetch_optional(&mut *tx)
+            .await?
+            .as_ref()
+            .map(curve_from_row)
+            .transpose()?;
+            if let Some(refused) = publish_refusal(&candidate, current.as_ref(), force) {
+                tx.rollback().await?;
+                return Ok(refused);
+            }
+            if current.as_ref().map(|c| c.id) != Some(candidate.id) {
+                sqlx::query(
+                    "INSERT INTO published_curves (curve_key, curve_id, published_by, published_ms) \
+                     VALUES ($1, $2, $3, $4) ON CONFLICT (curve_key) DO UPDATE SET \
+                     curve_id = EXCLUDED.curve_id, published_by = EXCLUDED.published_by, \
+                     published_ms = EXCLUDED.published_ms",
+                )
+                .bind(&candidate.key)
+                .bind(candidate.id)
+                .bind(&published_by)
+                .bind(now_ms)
+                .execute(&mut *tx)
+                .await?;
+            }
+            let record = sqlx::query(&format!("{CURVE_SELECT} WHERE v.id = $1"))
+                .bind(id)
+                .fetch_one(&mut *tx)
+                .await?;
+            let record = curve_from_row(&record)?;
+            tx.commit().await?;
+            Ok(PublishOutcome::Published(record))
         })
     }
 

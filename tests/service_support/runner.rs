@@ -4,6 +4,10 @@
 //!
 //! A sweep with `"children": n` fans out into n `sweep_point` children (each the same counted
 //! computation, `"fail_point": i` makes child i fail) and is assembled from their results.
+//!
+//! A sweep's curve is fixed ([`fixed_curve`]) unless its params name a `rattle_space_range`:
+//! then it is [`synthetic_curve`], a closed form over the real sweep's points and seeds
+//! (`pipeline::SweepRange`), so reports and publishing can be tested with known values.
 
 use railwear::analysis::penalization::{PenalizationCurve, SweepPoint};
 use railwear::analysis::rattle_space::LauncherDimensions;
@@ -91,10 +95,10 @@ impl CaseRunner for CountingRunner {
         }
         let tracks: Vec<TrackSample> = (0..samples).map(|i| sample(seed, i)).collect();
         let force_sum: f64 = tracks.iter().map(|t| t.normal_force_n).sum();
-        let penalization = if *kind == JobKind::Sweep {
-            Some(fixed_curve()?)
+        let (penalization, curve_info) = if *kind == JobKind::Sweep {
+            sweep_curve(params)?
         } else {
-            None
+            (None, None)
         };
         Ok(JobOutput {
             summary: serde_json::json!({ "seed": seed, "force_sum_n": force_sum, "steps": steps }),
@@ -104,6 +108,7 @@ impl CaseRunner for CountingRunner {
                 "<svg xmlns=\"http://www.w3.org/2000/svg\"/>".into(),
             )],
             penalization,
+            curve_info,
         })
     }
 
@@ -137,7 +142,7 @@ impl CaseRunner for CountingRunner {
     fn assemble(
         &self,
         _kind: &JobKind,
-        _params: &serde_json::Value,
+        params: &serde_json::Value,
         children: &[serde_json::Value],
     ) -> Result<JobOutput, RunError> {
         for (i, child) in children.iter().enumerate() {
@@ -148,13 +153,15 @@ impl CaseRunner for CountingRunner {
                 });
             }
         }
+        let (penalization, curve_info) = sweep_curve(params)?;
         Ok(JobOutput {
             summary: serde_json::json!({ "points": children }),
             plots: vec![(
                 "penalization.svg".into(),
                 "<svg xmlns=\"http://www.w3.org/2000/svg\"/>".into(),
             )],
-            penalization: Some(fixed_curve()?),
+            penalization,
+            curve_info,
             ..JobOutput::default()
         })
     }
@@ -167,6 +174,63 @@ impl CaseRunner for CountingRunner {
             }),
             _ => Ok(()),
         }
+    }
+}
+
+/// Rail wear rate of seed `j` at rattle space `k` in a synthetic sweep, mg/h:
+/// `exp((8 + 0.5 j)(0.80 - k))`. ln(rate) is linear in k, so the curve's interpolation is exact
+/// and seed j's log ratio to the design point is `-(8 + 0.5 j)(k_design - k)`.
+pub fn synthetic_rate(j: usize, k: f64) -> f64 {
+    ((8.0 + 0.5 * j as f64) * (0.80 - k)).exp()
+}
+
+/// A synthetic sweep's curve: [`synthetic_rate`] at the points and seeds the real sweep of
+/// `params` would run; fidelity `points`, `seeds` and `duration_s` (default 1 s) from params.
+pub fn synthetic_curve(
+    params: &serde_json::Value,
+) -> Result<(PenalizationCurve, railwear::jobs::CurveInfo), RunError> {
+    let range = railwear::pipeline::SweepRange::from_params(params)?;
+    let rates: Vec<Vec<f64>> = range
+        .rattle_spaces
+        .iter()
+        .map(|&k| (0..range.seeds).map(|j| synthetic_rate(j, k)).collect())
+        .collect();
+    let design = LauncherDimensions::design()
+        .rattle_space()
+        .unwrap_or(f64::NAN);
+    let curve =
+        PenalizationCurve::from_seeds(&range.rattle_spaces, &rates, design).map_err(|e| {
+            RunError::InvalidConfig {
+                field: "points".into(),
+                rule: e.to_string(),
+            }
+        })?;
+    let info = railwear::jobs::CurveInfo {
+        fidelity: railwear::store::CurveFidelity {
+            points: range.rattle_spaces.len() as i64,
+            duration_per_point_s: Some(
+                params
+                    .get("duration_s")
+                    .and_then(|v| v.as_f64())
+                    .unwrap_or(1.0),
+            ),
+            seeds: range.seeds as i64,
+        },
+        provenance: serde_json::json!({"runner": "counting", "params": params}),
+    };
+    Ok((curve, info))
+}
+
+/// The curve of a counted sweep: [`synthetic_curve`] when params name a `rattle_space_range`,
+/// else [`fixed_curve`] (no fidelity given: the worker derives it).
+pub fn sweep_curve(
+    params: &serde_json::Value,
+) -> Result<(Option<PenalizationCurve>, Option<railwear::jobs::CurveInfo>), RunError> {
+    if params.get("rattle_space_range").is_some() {
+        let (curve, info) = synthetic_curve(params)?;
+        Ok((Some(curve), Some(info)))
+    } else {
+        Ok((Some(fixed_curve()?), None))
     }
 }
 
