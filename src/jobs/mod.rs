@@ -3,7 +3,8 @@
 //! threads through the [`CaseRunner`] interface.
 
 pub mod metrics;
-pub mod model;
+/// The job records live with the store that keeps them (`store::job_records`).
+pub use crate::store::job_records as model;
 pub mod runner;
 pub mod worker;
 

@@ -8,9 +8,10 @@ pub mod sqlite;
 pub mod tracks;
 
 use crate::config::Role;
-pub use crate::jobs::model::{ChildCounts, ChildOf};
-use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
+pub mod job_records;
 use crate::physics::track::TrackSample;
+pub use job_records::{ChildCounts, ChildOf};
+use job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use std::future::Future;
 use std::pin::Pin;
 use std::sync::Arc;

@@ -5,6 +5,7 @@
 //! instead of waiting or taking it twice), every worker write is fenced by the job's attempt, and
 //! expired leases go back to the queue until `max_attempts`.
 
+use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
     CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
@@ -12,7 +13,6 @@ use super::{
     PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
-use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use sqlx::postgres::{PgConnectOptions, PgConnection, PgPool, PgPoolOptions, PgRow};
 use sqlx::Row;
 use std::str::FromStr;

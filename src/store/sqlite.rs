@@ -2,6 +2,7 @@
 //! timeout, `BEGIN IMMEDIATE` for multi-statement writes (takes the write lock up front, so two
 //! writers queue instead of deadlocking on a lock upgrade), single-statement job claims.
 
+use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
     CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
@@ -9,7 +10,6 @@ use super::{
     PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
-use crate::jobs::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteConnection, SqliteJournalMode, SqlitePool, SqlitePoolOptions,
     SqliteRow, SqliteSynchronous,

@@ -1,4 +1,5 @@
-//! What a job is: its kind, its lifecycle and its stored record.
+//! What a job is: its kind, its lifecycle and its stored record (kept here, with the store;
+//! `jobs::model` re-exports it).
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
