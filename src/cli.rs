@@ -370,3 +370,122 @@ pub fn rig(
     );
     Ok(())
 }
+
+/// `railwear diagnose`: the report (summary or JSON) and its plots.
+pub fn diagnose(
+    file: &Path,
+    json: bool,
+    out: Option<&Path>,
+    options: &crate::gap::diagnose::DiagnoseOptions,
+    configs_dir: &Path,
+) -> Result<()> {
+    use crate::gap::Campaign;
+    let campaign = Campaign::load(file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} test simulations, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message("diagnosis");
+    let cache = crate::gap::window::WindowCache::new();
+    let (report, _) = crate::gap::diagnose::diagnose(
+        &campaign,
+        configs_dir,
+        options,
+        &RunControl::silent(),
+        &cache,
+        &|done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )?;
+    bar.finish_and_clear();
+    let dir = match out {
+        Some(d) => d.to_path_buf(),
+        None => file
+            .parent()
+            .unwrap_or_else(|| Path::new("."))
+            .join("diagnosis"),
+    };
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let text = serde_json::to_string_pretty(&report)?;
+    std::fs::write(dir.join("report.json"), &text)
+        .with_context(|| format!("writing {}", dir.join("report.json").display()))?;
+    for (name, svg) in crate::gap::diagnose::plots::plots(&report) {
+        std::fs::write(dir.join(&name), svg)
+            .with_context(|| format!("writing {}", dir.join(&name).display()))?;
+    }
+    if json {
+        println!("{text}");
+        return Ok(());
+    }
+    println!("{}: {}", report.campaign, report.summary);
+    println!(
+        "nominal: chi2 {:.1} on {:.1} dof (p = {:.2e}); held-out {}",
+        report.nominal.chi2, report.nominal.dof, report.nominal.p_value, report.held_out
+    );
+    println!(
+        "\n{:<28} {:>12} {:>10} {:>10} {:>9} {:>8} explains",
+        "effect", "magnitude", "held-out", "gain", "lof p", "P(1st)"
+    );
+    for r in report.ranking.iter().chain(&report.pairs) {
+        let mags: Vec<String> = r.magnitudes.iter().map(|m| format!("{m:.3e}")).collect();
+        println!(
+            "{:<28} {:>12} {:>10.2} {:>10.2} {:>9.2e} {:>8.2} {}",
+            r.name,
+            mags.join("+"),
+            r.held_out_error,
+            r.held_out_gain,
+            r.residual_p_value,
+            r.p_first,
+            if r.explains { "yes" } else { "no" }
+        );
+    }
+    println!("\nflagged groups (Holm, 5 %):");
+    for g in report.location.groups.iter().filter(|g| g.flagged) {
+        println!(
+            "  {:<15} {:<50} mean residual {:+.2}, z {:+.1}, p_adj {:.1e}",
+            g.by, g.label, g.mean_residual, g.z, g.p_adjusted
+        );
+    }
+    println!("\nreport and plots in {}", dir.display());
+    Ok(())
+}
+
+/// `railwear diagnose-bench`: prints the scores and the confusion table.
+pub fn diagnose_bench(
+    skeleton: &Path,
+    options: &crate::gap::diagnose::bench::BenchOptions,
+    out: Option<&Path>,
+    emulator_file: Option<&Path>,
+    configs_dir: &Path,
+) -> Result<()> {
+    use crate::gap::Campaign;
+    let campaign =
+        Campaign::load(skeleton).map_err(|e| anyhow::anyhow!("{}: {e}", skeleton.display()))?;
+    let started = std::time::Instant::now();
+    let scores = crate::gap::diagnose::bench::run(
+        &campaign,
+        configs_dir,
+        options,
+        &RunControl::silent(),
+        emulator_file,
+        &|m| eprintln!("[{:>6.0} s] {m}", started.elapsed().as_secs_f64()),
+    )?;
+    println!(
+        "diagnose-bench: {} campaigns on {} (seed {}, window {} s), {:.0} s\n",
+        scores.campaigns,
+        skeleton.display(),
+        options.seed,
+        options.rig_window_s,
+        started.elapsed().as_secs_f64()
+    );
+    println!("{}", scores.table());
+    if let Some(path) = out {
+        std::fs::write(path, serde_json::to_string_pretty(&scores)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}

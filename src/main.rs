@@ -140,6 +140,68 @@ enum Command {
         #[arg(long, default_value = "configs")]
         configs_dir: PathBuf,
     },
+    /// Gap diagnosis of a campaign: where the model misses, which library effect explains it
+    /// (fitted and judged on held-out tests), how far the gap shrinks. Prints the verdict, or
+    /// the report's JSON with --json; writes report.json and SVG plots to --out.
+    Diagnose {
+        /// Campaign manifest (TOML, CSV files beside it).
+        campaign: PathBuf,
+        /// Print the report's JSON instead of the summary.
+        #[arg(long)]
+        json: bool,
+        /// Directory for report.json and the plots (residuals.svg, ranking.svg,
+        /// before_after.svg); default: <campaign's directory>/diagnosis.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Simulated excitation per increment, s.
+        #[arg(long, default_value_t = 2.0)]
+        window_s: f64,
+        /// Settle before it, s.
+        #[arg(long, default_value_t = 0.3)]
+        settle_s: f64,
+        /// Grid points of each dynamics effect (positive side).
+        #[arg(long, default_value_t = 5)]
+        grid_points: usize,
+        /// Only these library effects (comma-separated); default every applicable one.
+        #[arg(long, value_delimiter = ',')]
+        effects: Option<Vec<String>>,
+        /// Simulation threads.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
+    /// Blind check of the diagnosis: campaigns drawn from the virtual rig (controls, library
+    /// effects from barely to clearly detectable, rig-only effects), diagnosed without their
+    /// truth, scored against it. Prints the scores and the confusion table.
+    DiagnoseBench {
+        /// Campaigns to draw.
+        #[arg(long, default_value_t = 60)]
+        campaigns: usize,
+        /// Seed of the draw.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Skeleton campaign the rig fills.
+        #[arg(long, default_value = "campaigns/bench-rattle-box.toml")]
+        skeleton: PathBuf,
+        /// Simulated excitation per increment (rig and diagnosis), s.
+        #[arg(long, default_value_t = 0.5)]
+        window_s: f64,
+        /// Simulation threads.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+        /// Write every outcome as JSON here.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Keep the skeleton's emulator in this file and reuse it when the tests, options and
+        /// code version match (it depends on no measurement).
+        #[arg(long)]
+        emulator_file: Option<PathBuf>,
+        /// Directory of reference configs and profiles.
+        #[arg(long, default_value = "configs")]
+        configs_dir: PathBuf,
+    },
     /// Run the thesis anchors and print expected vs measured vs verdict.
     Validate {
         /// One JSON object per anchor (name, expected, measured, tolerance, pass).
@@ -425,6 +487,59 @@ async fn main() -> Result<()> {
                 ..Default::default()
             };
             railwear::cli::rig(base, effects, options, out, configs_dir)
+        }
+        Command::Diagnose {
+            campaign,
+            json,
+            out,
+            window_s,
+            settle_s,
+            grid_points,
+            effects,
+            threads,
+            configs_dir,
+        } => {
+            init_logging(false);
+            let mut options = railwear::gap::diagnose::DiagnoseOptions::default();
+            options.emulator.window_s = *window_s;
+            options.emulator.settle_s = *settle_s;
+            options.emulator.grid_points = *grid_points;
+            options.emulator.effects = effects.clone();
+            options.emulator.threads = *threads;
+            if let Err(e) =
+                railwear::cli::diagnose(campaign, *json, out.as_deref(), &options, configs_dir)
+            {
+                eprintln!("error: {e:#}");
+                std::process::exit(1);
+            }
+            Ok(())
+        }
+        Command::DiagnoseBench {
+            campaigns,
+            seed,
+            skeleton,
+            window_s,
+            threads,
+            out,
+            emulator_file,
+            configs_dir,
+        } => {
+            init_logging(false);
+            let mut options = railwear::gap::diagnose::bench::BenchOptions {
+                campaigns: *campaigns,
+                seed: *seed,
+                rig_window_s: *window_s,
+                ..Default::default()
+            };
+            options.diagnose.emulator.window_s = *window_s;
+            options.diagnose.emulator.threads = *threads;
+            railwear::cli::diagnose_bench(
+                skeleton,
+                &options,
+                out.as_deref(),
+                emulator_file.as_deref(),
+                configs_dir,
+            )
         }
         Command::Migrate => {
             let config = load_config(&cli)?;

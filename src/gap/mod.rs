@@ -9,13 +9,18 @@
 //!   optional wear-law terms (so wear-law effects never re-simulate).
 //! - [`effects`]: the effect library shared by the rig and the diagnosis.
 //! - [`rig`] and [`rig_effects`]: the virtual rig and the effects only the rig knows.
+//! - [`window`]: one simulated excitation window, shared (and cached) by the rig and the
+//!   diagnosis.
+//! - [`diagnose`]: the gap diagnosis (where, which effect, how far) and its blind bench.
 
 pub mod accel;
 pub mod campaign;
+pub mod diagnose;
 pub mod effects;
 pub mod rig;
 pub mod rig_effects;
 pub mod tracks;
+pub mod window;
 
 pub use campaign::Campaign;
 pub use effects::Effect;

@@ -23,19 +23,20 @@
 
 use super::accel::{AccelLocation, AccelRecord};
 use super::campaign::{Campaign, Increment, Specimen};
-use super::effects::{brinell_to_pa, Effect, SpecimenState, LIBRARY};
+use super::effects::{Effect, SpecimenState, LIBRARY};
 use super::rig_effects::{HiddenEffect, RIG_ONLY};
-use super::tracks::{SlipHistory, TrackRecord, WearTerm};
+use super::tracks::{SlipHistory, WearTerm};
+use super::window::{WindowCache, WindowOptions, WindowRun};
 use super::GapError;
-use crate::models::run::run_model_observed;
-use crate::models::specs::ModelSpecRef;
+use crate::models::specs::CaseSpec;
 use crate::pipeline::RunControl;
-use crate::units::{MG_PER_KG, S_PER_H};
+use crate::units::S_PER_H;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha20Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// How the rig runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -162,11 +163,18 @@ pub struct TruthTest {
     pub specimen_factors: BTreeMap<String, f64>,
 }
 
-/// One increment of a test as the model gives it.
-struct ModelIncrement {
-    mass_mg: BTreeMap<String, f64>,
-    input: Vec<[f64; 3]>,
-    response: Vec<[f64; 3]>,
+/// One increment of a test as the model gives it (no scatter, no noise).
+pub(crate) struct ModelIncrement {
+    /// Mass lost per body, mg.
+    pub(crate) mass_mg: BTreeMap<String, f64>,
+    /// Input acceleration of the first segment's window, m/s².
+    pub(crate) input: Vec<[f64; 3]>,
+    /// Response acceleration of the first segment's window, m/s².
+    pub(crate) response: Vec<[f64; 3]>,
+    /// Each segment's window and where it sits in the test (wear-law terms re-evaluate them).
+    pub(crate) segments: Vec<(Arc<WindowRun>, SlipHistory)>,
+    /// Slip distance accumulated by the end of the increment, m.
+    pub(crate) slip_end_m: f64,
 }
 
 fn normal(rng: &mut ChaCha20Rng) -> f64 {
@@ -232,6 +240,18 @@ pub fn run(
     options: &RigOptions,
     control: &RunControl,
 ) -> Result<(Campaign, Truth), GapError> {
+    run_cached(base, configs_dir, options, control, &WindowCache::new())
+}
+
+/// [`run`] with simulations remembered in `cache` (deterministic: a cached window is the one
+/// the rig would simulate), for callers that draw many campaigns on one skeleton.
+pub fn run_cached(
+    base: &Campaign,
+    configs_dir: &Path,
+    options: &RigOptions,
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<(Campaign, Truth), GapError> {
     check_options(options)?;
     base.validate(configs_dir)?;
     let mut rng = ChaCha20Rng::seed_from_u64(options.seed);
@@ -247,7 +267,24 @@ pub fn run(
             .map(|s| s.increments.len())
             .max()
             .unwrap_or(0);
-        let (model, slip) = simulate_test(ti, base, configs_dir, options, increments, control)?;
+        let window = WindowOptions {
+            window_s: options.window_s,
+            settle_s: options.settle_s,
+            accelerometer_rate_hz: options.accelerometer_rate_hz,
+            tolerance_scale: 1.0,
+        };
+        let model = simulate_test(
+            ti,
+            base,
+            None,
+            configs_dir,
+            options,
+            &window,
+            increments,
+            control,
+            cache,
+        )?;
+        let slip: Vec<f64> = model.iter().map(|m| m.slip_end_m).collect();
         let mut factors = BTreeMap::new();
         let out_test = &mut out.tests[ti];
         for spec in out_test.specimens.iter_mut() {
@@ -343,29 +380,40 @@ fn quantize(x: f64, resolution: f64) -> f64 {
 }
 
 /// Simulates the increments of test `ti` (shared by its specimens): model masses per
-/// increment and the slip distance at the end of each.
-fn simulate_test(
+/// increment and the slip distance at the end of each. Segments whose case is the same as an
+/// earlier one (every segment of a test without dynamics effects of time or slip) come from
+/// `cache`.
+///
+/// `case` replaces the test's own case (already resolved) when given; `window` says how each
+/// window is simulated (the rig: its window, settle and accelerometer rate at the configured
+/// tolerance).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn simulate_test(
     ti: usize,
     base: &Campaign,
+    case: Option<&CaseSpec>,
     configs_dir: &Path,
     o: &RigOptions,
+    window: &WindowOptions,
     increments: usize,
     control: &RunControl,
-) -> Result<(Vec<ModelIncrement>, Vec<f64>), GapError> {
+    cache: &WindowCache,
+) -> Result<Vec<ModelIncrement>, GapError> {
     let test = &base.tests[ti];
-    let mut case0 = test.case(ti, configs_dir)?;
-    case0.simulation.duration_s = o.window_s;
-    case0.simulation.settle_s = o.settle_s;
-    case0.simulation.record_interval_s = o.window_s;
+    let case0 = match case {
+        Some(c) => c.clone(),
+        None => test.case(ti, configs_dir)?,
+    };
     let segment_s = test.increment_duration_s / o.segments_per_increment as f64;
     let mut slip = 0.0;
     let mut out = Vec::with_capacity(increments);
-    let mut slip_out = Vec::with_capacity(increments);
     for k in 0..increments {
         let mut inc = ModelIncrement {
             mass_mg: BTreeMap::new(),
             input: Vec::new(),
             response: Vec::new(),
+            segments: Vec::new(),
+            slip_end_m: 0.0,
         };
         for j in 0..o.segments_per_increment {
             let what = format!("test {} increment {} segment {}", test.id, k + 1, j + 1);
@@ -378,35 +426,13 @@ fn simulate_test(
             for e in &o.effects {
                 e.apply(&mut case, &state, configs_dir)?;
             }
-            let sim_err = |m: String| GapError::Simulation {
-                what: what.clone(),
-                message: m,
-            };
-            let model = crate::models::case::build(&case, configs_dir)
-                .map_err(|e| sim_err(e.to_string()))?;
-            let mut run_options =
-                crate::models::case::run_options(&case).map_err(|e| sim_err(e.to_string()))?;
-            run_options.record_interval_s = -1.0;
-            if let Some(rate) = o.accelerometer_rate_hz {
-                run_options.response_rate_hz = rate;
-            }
-            let mut record = TrackRecord::new(model.system.contacts.len());
-            tracing::info!(%what, "rig: simulating");
-            let report =
-                run_model_observed(&model, &run_options, control, &mut |v| record.push_view(v))
-                    .map_err(|e| sim_err(e.to_string()))?;
-            let window = model.end_time_s - model.excitation_start_s;
-            let scale = segment_s / window;
-            let hardness = match case.model_spec() {
-                Ok(ModelSpecRef::RattleBox(s)) => s.material.brinell_hardness,
-                Ok(ModelSpecRef::Launcher(s)) => s.material.brinell_hardness,
-                _ => crate::models::specs::MaterialSpec::default().brinell_hardness,
-            };
+            let run = cache.get_or_run(&case, configs_dir, window, &what, control)?;
+            let scale = segment_s / run.window_s;
             let boxed: Vec<Box<dyn WearTerm>> = o
                 .effects
                 .iter()
                 .filter(|e| e.magnitude() != 0.0)
-                .filter_map(|e| e.wear_term(brinell_to_pa(hardness)))
+                .filter_map(|e| e.wear_term(run.hardness_pa))
                 .chain(
                     o.hidden
                         .iter()
@@ -419,27 +445,18 @@ fn simulate_test(
                 slip_start_m: slip,
                 time_scale: scale,
             };
-            let volumes = record.wear_volumes_m3(&case.wear.law, &terms, history)?;
-            for (ci, c) in model.system.contacts.iter().enumerate() {
-                let (ma, mb) = &model.contact_materials[ci];
-                let (wa, wb) = case
-                    .wear
-                    .volume_split
-                    .split(volumes[ci] * scale, ma, mb)
-                    .map_err(|e| sim_err(e.to_string()))?;
-                for (body, w) in [(c.body_a, wa), (c.body_b, wb)] {
-                    let name = model.system.bodies[body].name.clone();
-                    *inc.mass_mg.entry(name).or_insert(0.0) += w.mass_kg * MG_PER_KG;
-                }
+            for (body, mg) in run.masses_mg(&terms, history)? {
+                *inc.mass_mg.entry(body).or_insert(0.0) += mg;
             }
-            slip += record.slip_distance_m() * scale;
+            slip += run.slip_distance_m() * scale;
             if j == 0 {
-                inc.input = report.base_acceleration.clone();
-                inc.response = report.response_acceleration.clone();
+                inc.input = run.input.clone();
+                inc.response = run.response.clone();
             }
+            inc.segments.push((run, history));
         }
+        inc.slip_end_m = slip;
         out.push(inc);
-        slip_out.push(slip);
     }
-    Ok((out, slip_out))
+    Ok(out)
 }

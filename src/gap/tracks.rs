@@ -131,6 +131,39 @@ impl TrackRecord {
         self.integrate(|_, p| slip_speed_in_contact(p), &mut |_, _, _| {})
     }
 
+    /// Friction work `∫ N v_slip dt` per bin, J: each sample carries its trapezoid weight (half
+    /// the steps on either side) into the bin `bin(pressure_pa, slip_speed_m_s)` chooses (None:
+    /// not counted). For where-in-the-regime breakdowns (pressure and slip-speed bands); the
+    /// bins' sum differs from the track-wise trapezoid only where tracks appear or vanish.
+    pub fn work_by_bin(&self, bins: usize, bin: impl Fn(f64, f64) -> Option<usize>) -> Vec<f64> {
+        let mut out = vec![0.0; bins];
+        let n = self.steps.len();
+        for i in 0..n {
+            let t = self.steps[i].0;
+            let before = if i > 0 { t - self.steps[i - 1].0 } else { 0.0 };
+            let after = if i + 1 < n {
+                self.steps[i + 1].0 - t
+            } else {
+                0.0
+            };
+            let w = 0.5 * (before + after);
+            for p in self.step_points(i) {
+                if p.normal_force_n <= 0.0 {
+                    continue;
+                }
+                let pressure = if p.area_m2 > 0.0 {
+                    p.normal_force_n / p.area_m2
+                } else {
+                    f64::INFINITY
+                };
+                if let Some(b) = bin(pressure, p.slip_speed_m_s).filter(|b| *b < bins) {
+                    out[b] += p.normal_force_n * p.slip_speed_m_s * w;
+                }
+            }
+        }
+        out
+    }
+
     /// Trapezoid integral of `value(step, point)` per track over the steps, summed; a track
     /// absent from a step counts as zero there (as the run closes a vanished track). `each`
     /// sees every interval's contribution as (step at the interval's end, contact, amount).

@@ -1,0 +1,714 @@
+//! The model's predictions for a campaign's tests, nominal and under each library effect,
+//! tabulated over the effect's magnitude so that fitting never waits for a simulation.
+//!
+//! - Nominal: every test simulated through the rig's own segment path
+//!   ([`crate::gap::rig`], no scatter, no noise), once at the configured tolerance and once at
+//!   half of it (the numerical uncertainty), and once with the friction coefficients raised by
+//!   [`FRICTION_STEP`] (the parameter uncertainty of Table 5.2's fit, by sensitivity), and once
+//!   entering the excitation [`SETTLE_SHIFT_S`] later (the spread of a window's wear over
+//!   initial states).
+//! - Wear-law effects: evaluated exactly on the nominal windows' tracks at every magnitude of a
+//!   fine table (no simulation).
+//! - Dynamics effects: simulated at a grid of magnitudes (0, and the bound halved repeatedly);
+//!   between grid points the prediction is interpolated, log-linearly in each quantity. The
+//!   interpolation is an approximation of the simulator: its error is of the order of the
+//!   chaotic spread the tolerance-halving run measures, which the diagnosis already carries.
+//! - Two effects together: the product of their ratios to the nominal (exact when they act
+//!   independently, an approximation otherwise; stated in the report).
+
+use crate::gap::effects::{Acts, Effect, EffectInfo, LIBRARY};
+use crate::gap::rig::{simulate_test, ModelIncrement, RigOptions};
+use crate::gap::tracks::WearTerm;
+use crate::gap::window::{WindowCache, WindowOptions};
+use crate::gap::{Campaign, GapError};
+use crate::models::specs::CaseSpec;
+use crate::pipeline::RunControl;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Raise of mu_s and mu_d for the friction sensitivity run: Table 5.2 gives mu to three or four
+/// digits from a fit to torque records (thesis 4.4-4.5); 0.01 is taken as one standard
+/// uncertainty (estimate).
+pub const FRICTION_STEP: f64 = 0.01;
+
+/// Extra settle of the initial-state run, s: the body enters the excitation from another
+/// state. A window's wear depends on where the rattle starts (the motion may settle on one of
+/// several periodic or chaotic regimes), which a tolerance-halving run started from the same
+/// state does not show; the spread between the two runs is part of the numerical uncertainty.
+pub const SETTLE_SHIFT_S: f64 = 0.2;
+
+/// How the emulator simulates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EmulatorOptions {
+    /// Simulated excitation per increment, s.
+    pub window_s: f64,
+    /// Settle before it, s.
+    pub settle_s: f64,
+    /// Rate of the predicted acceleration records, Hz.
+    pub accelerometer_rate_hz: f64,
+    /// Grid points of each dynamics effect on the positive side of 0 (the bound, halved
+    /// `grid_points - 1` times); negative bounds get the bound and its half.
+    pub grid_points: usize,
+    /// Library effects considered (None: every effect that applies to the campaign's models).
+    pub effects: Option<Vec<String>>,
+    /// Worker threads for the simulations.
+    pub threads: usize,
+}
+
+impl Default for EmulatorOptions {
+    fn default() -> Self {
+        Self {
+            window_s: 2.0,
+            settle_s: 0.3,
+            accelerometer_rate_hz: 2000.0,
+            grid_points: 5,
+            effects: None,
+            threads: 2,
+        }
+    }
+}
+
+/// The model's prediction of one increment of one test.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Prediction {
+    /// Mass lost per body, mg.
+    pub mass_mg: BTreeMap<String, f64>,
+    /// Mean-square input acceleration per axis, m²/s⁴.
+    pub input_ms: [f64; 3],
+    /// Mean-square response acceleration per axis, m²/s⁴.
+    pub response_ms: [f64; 3],
+}
+
+impl Prediction {
+    fn from_increment(m: &ModelIncrement) -> Self {
+        Self {
+            mass_mg: m.mass_mg.clone(),
+            input_ms: mean_square(&m.input),
+            response_ms: mean_square(&m.response),
+        }
+    }
+
+    /// Every quantity in a fixed order: masses by body name, input, response.
+    pub fn flat(&self) -> Vec<f64> {
+        self.mass_mg
+            .values()
+            .copied()
+            .chain(self.input_ms)
+            .chain(self.response_ms)
+            .collect()
+    }
+
+    /// The same structure with the quantities of [`Prediction::flat`] replaced by `v`.
+    pub fn with_flat(&self, v: &[f64]) -> Self {
+        let mut out = self.clone();
+        let nm = out.mass_mg.len();
+        for (slot, x) in out.mass_mg.values_mut().zip(v) {
+            *slot = *x;
+        }
+        for i in 0..3 {
+            out.input_ms[i] = v.get(nm + i).copied().unwrap_or(f64::NAN);
+            out.response_ms[i] = v.get(nm + 3 + i).copied().unwrap_or(f64::NAN);
+        }
+        out
+    }
+
+    /// Applies `f(self, other)` to every quantity.
+    fn zip(&self, other: &Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        let mut out = self.clone();
+        for (k, v) in out.mass_mg.iter_mut() {
+            *v = f(*v, other.mass_mg.get(k).copied().unwrap_or(0.0));
+        }
+        for i in 0..3 {
+            out.input_ms[i] = f(self.input_ms[i], other.input_ms[i]);
+            out.response_ms[i] = f(self.response_ms[i], other.response_ms[i]);
+        }
+        out
+    }
+}
+
+/// Mean square per axis of an acceleration record, m²/s⁴ (mean removed).
+pub fn mean_square(a: &[[f64; 3]]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    if a.is_empty() {
+        return out;
+    }
+    let n = a.len() as f64;
+    for (axis, o) in out.iter_mut().enumerate() {
+        let mean = a.iter().map(|s| s[axis]).sum::<f64>() / n;
+        *o = a.iter().map(|s| (s[axis] - mean).powi(2)).sum::<f64>() / n;
+    }
+    out
+}
+
+/// Predictions `[test][increment]`.
+pub type TestPredictions = Vec<Vec<Prediction>>;
+
+/// One effect tabulated over its magnitude.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EffectTable {
+    /// The library entry (serialized as its name).
+    #[serde(with = "library_entry")]
+    pub info: &'static EffectInfo,
+    /// Magnitudes, ascending; contains 0.
+    pub magnitudes: Vec<f64>,
+    /// Predictions at each magnitude.
+    pub predictions: Vec<TestPredictions>,
+    /// True when the table comes from simulations (interpolated between grid points).
+    pub simulated: bool,
+}
+
+impl EffectTable {
+    /// Prediction at magnitude `m` (clamped to the table), exact at table points. Between
+    /// them each quantity's change from the nominal, `Δ(m) = q(m) - q(0)`, is interpolated as a
+    /// power law (linear in log |Δ| against log |m|) where both neighbours change it the same
+    /// way, linearly otherwise; below the first grid point on either side `Δ = Δ₁ (m/m₁)^k`,
+    /// `k` from the first two grid points (clamped to 0.5-4, 1 without a second point). Power
+    /// laws are what the effects give at small magnitude: a cross-axis share s puts s² of the
+    /// drive's mean square on the other axes; a mount of period P amplifies by 1/(1 - (fP)²).
+    pub fn at(&self, m: f64) -> TestPredictions {
+        let n = self.magnitudes.len();
+        let m = m.clamp(self.magnitudes[0], self.magnitudes[n - 1]);
+        if let Some(i) = self.magnitudes.iter().position(|g| *g == m) {
+            return self.predictions[i].clone();
+        }
+        let Some(zero) = self.magnitudes.iter().position(|g| *g == 0.0) else {
+            return self.predictions[0].clone();
+        };
+        // Grid points on m's side of 0, nearest 0 first: (|magnitude|, index).
+        let side: Vec<(f64, usize)> = if m > 0.0 {
+            (zero + 1..n).map(|i| (self.magnitudes[i], i)).collect()
+        } else {
+            (0..zero).rev().map(|i| (-self.magnitudes[i], i)).collect()
+        };
+        let x = m.abs();
+        let j = side.iter().position(|(g, _)| x < *g).unwrap_or(side.len() - 1);
+        let interp = |q: &[f64]| -> f64 {
+            // q[0]: nominal; q[1..]: the side's points in order.
+            let d = |k: usize| q[k + 1] - q[0];
+            let same = |a: f64, b: f64| a != 0.0 && b != 0.0 && a.signum() == b.signum();
+            let delta = if j == 0 {
+                let k = if side.len() > 1 && same(d(0), d(1)) {
+                    ((d(1) / d(0)).ln() / (side[1].0 / side[0].0).ln()).clamp(0.5, 4.0)
+                } else {
+                    1.0
+                };
+                d(0) * (x / side[0].0).powf(k)
+            } else {
+                let (ga, gb) = (side[j - 1].0, side[j].0);
+                let (da, db) = (d(j - 1), d(j));
+                if same(da, db) {
+                    let t = (x / ga).ln() / (gb / ga).ln();
+                    da.signum() * ((1.0 - t) * da.abs().ln() + t * db.abs().ln()).exp()
+                } else {
+                    da + (db - da) * (x - ga) / (gb - ga)
+                }
+            };
+            let v = q[0] + delta;
+            if q.iter().all(|x| *x >= 0.0) {
+                v.max(0.0)
+            } else {
+                v
+            }
+        };
+        let nominal = &self.predictions[zero];
+        nominal
+            .iter()
+            .enumerate()
+            .map(|(ti, t)| {
+                t.iter()
+                    .enumerate()
+                    .map(|(k, p0)| {
+                        let mut columns: Vec<Vec<f64>> = vec![p0.flat()];
+                        for (_, i) in &side {
+                            columns.push(self.predictions[*i][ti][k].flat());
+                        }
+                        let values: Vec<f64> = (0..columns[0].len())
+                            .map(|q| {
+                                let row: Vec<f64> = columns.iter().map(|c| c[q]).collect();
+                                interp(&row)
+                            })
+                            .collect();
+                        p0.with_flat(&values)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// The nominal model and the tabulated effects of one campaign's tests.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Emulator {
+    /// Nominal predictions.
+    pub nominal: TestPredictions,
+    /// Nominal at half the tolerances.
+    pub halving: TestPredictions,
+    /// Nominal with mu_s and mu_d raised by [`FRICTION_STEP`].
+    pub friction_step: TestPredictions,
+    /// Nominal entering the excitation [`SETTLE_SHIFT_S`] later (another initial state).
+    pub initial_state: TestPredictions,
+    /// Per test and increment: the nominal's friction work by contact-pressure band and by
+    /// slip-speed band, J (see [`PRESSURE_BANDS`], [`SLIP_BANDS`]).
+    pub bands: Vec<Vec<Bands>>,
+    /// Nominal response records per test (first increment), for spectra: (rate Hz, samples).
+    pub response_records: Vec<(f64, Vec<[f64; 3]>)>,
+    /// The same from the tolerance-halving run.
+    pub halving_response_records: Vec<(f64, Vec<[f64; 3]>)>,
+    /// Tabulated effects.
+    pub effects: Vec<EffectTable>,
+    /// Windows simulated to build it.
+    pub simulations: usize,
+    /// Options used.
+    pub options: EmulatorOptions,
+}
+
+/// Friction work of one increment's window by band, J.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Bands {
+    /// By contact pressure (see [`PRESSURE_BANDS`]).
+    pub pressure: Vec<f64>,
+    /// By slip speed (see [`SLIP_BANDS`]).
+    pub slip: Vec<f64>,
+}
+
+/// Contact-pressure bands relative to the yield strength Sy: below 0.1 Sy, 0.1-1 Sy, 1-2 Sy
+/// (plastic, below the eq. 3.11 cutoff), above 2 Sy (no wear in the thesis' law).
+pub const PRESSURE_BANDS: [&str; 4] = [
+    "< 0.1 Sy",
+    "0.1-1 Sy",
+    "1-2 Sy (below cutoff)",
+    "> 2 Sy (cutoff)",
+];
+/// Slip-speed bands: below 1 mm/s (stuck), 1-6.5 mm/s (up to Table 5.2's stiction speed),
+/// 6.5-100 mm/s, above 100 mm/s.
+pub const SLIP_BANDS: [&str; 4] = ["< 1 mm/s", "1-6.5 mm/s", "6.5-100 mm/s", "> 100 mm/s"];
+
+fn band_of(x: f64, edges: &[f64]) -> usize {
+    edges.iter().take_while(|e| x >= **e).count()
+}
+
+/// The effects of the library that apply to every test of `cases`, filtered by `only`.
+pub fn applicable(
+    cases: &[CaseSpec],
+    only: Option<&[String]>,
+) -> Result<Vec<&'static EffectInfo>, GapError> {
+    if let Some(names) = only {
+        for n in names {
+            if !LIBRARY.iter().any(|e| e.name == n) {
+                let known: Vec<&str> = LIBRARY.iter().map(|e| e.name).collect();
+                return Err(GapError::field(
+                    "effects",
+                    format!("unknown effect `{n}` (known: {})", known.join(", ")),
+                ));
+            }
+        }
+    }
+    Ok(LIBRARY
+        .iter()
+        .filter(|e| cases.iter().all(|c| e.models.contains(&c.model)))
+        .filter(|e| only.is_none_or(|o| o.iter().any(|n| n == e.name)))
+        .collect())
+}
+
+/// Magnitudes a dynamics effect is simulated at.
+pub fn dynamics_grid(info: &EffectInfo, points: usize) -> Vec<f64> {
+    let p = &info.parameters[0];
+    let mut g = vec![0.0];
+    if p.min < 0.0 {
+        g.push(p.min);
+        g.push(0.5 * p.min);
+    }
+    let mut v = p.max;
+    for _ in 0..points.max(1) {
+        g.push(v);
+        v *= 0.5;
+    }
+    g.sort_by(f64::total_cmp);
+    g.dedup();
+    g
+}
+
+/// Magnitudes a wear-law effect is evaluated at: 0 and a log-spaced table from 1e-4 of the
+/// bound to the bound (8 per decade).
+pub fn wear_grid(info: &EffectInfo) -> Vec<f64> {
+    let max = info.parameters[0].max;
+    let mut g = vec![0.0];
+    for k in 0..=32 {
+        g.push(max * 10f64.powf(-4.0 + k as f64 / 8.0));
+    }
+    g
+}
+
+fn effect_at(info: &EffectInfo, magnitude: f64) -> Effect {
+    let mut parameters: BTreeMap<String, f64> = info
+        .parameters
+        .iter()
+        .map(|p| (p.name.to_string(), p.default))
+        .collect();
+    parameters.insert(info.parameters[0].name.to_string(), magnitude);
+    Effect {
+        name: info.name.to_string(),
+        parameters,
+    }
+}
+
+/// A task's simulated increments.
+type TaskResult = Result<Vec<ModelIncrement>, GapError>;
+
+/// One simulation task: (what, effects, tolerance scale, friction step, test).
+struct Task {
+    slot: usize,
+    test: usize,
+    effects: Vec<Effect>,
+    tolerance_scale: f64,
+    friction_step: f64,
+    settle_shift_s: f64,
+}
+
+impl Emulator {
+    /// Simulates and tabulates. `progress(done, total)` is called after every test simulated.
+    pub fn build(
+        campaign: &Campaign,
+        configs_dir: &Path,
+        options: &EmulatorOptions,
+        control: &RunControl,
+        cache: &WindowCache,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Self, GapError> {
+        let cases: Vec<CaseSpec> = campaign
+            .tests
+            .iter()
+            .enumerate()
+            .map(|(ti, t)| t.case(ti, configs_dir))
+            .collect::<Result<_, _>>()?;
+        let infos = applicable(&cases, options.effects.as_deref())?;
+        let increments: Vec<usize> = campaign
+            .tests
+            .iter()
+            .map(|t| {
+                t.specimens
+                    .iter()
+                    .map(|s| s.increments.len())
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        // Slots: 0 nominal, 1 halving, 2 friction step, 3 initial state, then (dynamics
+        // effect, magnitude).
+        let mut slots: Vec<(Vec<Effect>, f64, f64, f64)> = vec![
+            (vec![], 1.0, 0.0, 0.0),
+            (vec![], 0.5, 0.0, 0.0),
+            (vec![], 1.0, FRICTION_STEP, 0.0),
+            (vec![], 1.0, 0.0, SETTLE_SHIFT_S),
+        ];
+        let mut dyn_slots: Vec<(usize, Vec<usize>)> = Vec::new();
+        for (ei, info) in infos.iter().enumerate() {
+            if info.acts != Acts::Dynamics {
+                continue;
+            }
+            let mut ids = Vec::new();
+            for m in dynamics_grid(info, options.grid_points) {
+                if m == 0.0 {
+                    ids.push(0);
+                } else {
+                    ids.push(slots.len());
+                    slots.push((vec![effect_at(info, m)], 1.0, 0.0, 0.0));
+                }
+            }
+            dyn_slots.push((ei, ids));
+        }
+        let tasks: Vec<Task> = slots
+            .iter()
+            .enumerate()
+            .flat_map(|(slot, (effects, tol, fr, settle))| {
+                (0..campaign.tests.len()).map(move |test| Task {
+                    slot,
+                    test,
+                    effects: effects.clone(),
+                    tolerance_scale: *tol,
+                    friction_step: *fr,
+                    settle_shift_s: *settle,
+                })
+            })
+            .collect();
+        let total = tasks.len();
+        let results: Mutex<Vec<Option<TaskResult>>> =
+            Mutex::new((0..total).map(|_| None).collect());
+        let next = AtomicUsize::new(0);
+        let done = AtomicUsize::new(0);
+        let before = cache.len();
+        std::thread::scope(|scope| {
+            for _ in 0..options.threads.max(1) {
+                scope.spawn(|| loop {
+                    let i = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(task) = tasks.get(i) else { break };
+                    if control.is_cancelled() {
+                        break;
+                    }
+                    let r = run_task(
+                        task,
+                        campaign,
+                        &cases,
+                        configs_dir,
+                        options,
+                        &increments,
+                        control,
+                        cache,
+                    );
+                    if let Ok(mut v) = results.lock() {
+                        v[i] = Some(r);
+                    }
+                    progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
+                });
+            }
+        });
+        if control.is_cancelled() {
+            return Err(GapError::Simulation {
+                what: "diagnosis".into(),
+                message: "cancelled".into(),
+            });
+        }
+        let mut results = results.into_inner().map_err(|_| GapError::Simulation {
+            what: "diagnosis".into(),
+            message: "a simulation thread panicked".into(),
+        })?;
+        let ntests = campaign.tests.len();
+        let mut by_slot: Vec<Vec<Vec<ModelIncrement>>> =
+            (0..slots.len()).map(|_| Vec::new()).collect();
+        for (i, task) in tasks.iter().enumerate() {
+            let r = results[i].take().ok_or_else(|| GapError::Simulation {
+                what: format!("test {}", campaign.tests[task.test].id),
+                message: "not simulated".into(),
+            })??;
+            debug_assert_eq!(by_slot[task.slot].len(), task.test);
+            by_slot[task.slot].push(r);
+        }
+        let preds = |slot: &Vec<Vec<ModelIncrement>>| -> TestPredictions {
+            slot.iter()
+                .map(|t| t.iter().map(Prediction::from_increment).collect())
+                .collect()
+        };
+        let nominal = preds(&by_slot[0]);
+        let mut effects = Vec::new();
+        let mut dyn_iter = dyn_slots.iter();
+        for info in &infos {
+            match info.acts {
+                Acts::Dynamics => {
+                    let Some((_, ids)) = dyn_iter.next() else {
+                        continue;
+                    };
+                    effects.push(EffectTable {
+                        info,
+                        magnitudes: dynamics_grid(info, options.grid_points),
+                        predictions: ids.iter().map(|&s| preds(&by_slot[s])).collect(),
+                        simulated: true,
+                    });
+                }
+                Acts::WearLaw => {
+                    let magnitudes = wear_grid(info);
+                    let mut predictions = Vec::with_capacity(magnitudes.len());
+                    for &m in &magnitudes {
+                        let e = effect_at(info, m);
+                        let mut table = nominal.clone();
+                        for (ti, t) in by_slot[0].iter().enumerate() {
+                            for (k, inc) in t.iter().enumerate() {
+                                let mut mass: BTreeMap<String, f64> = BTreeMap::new();
+                                for (run, history) in &inc.segments {
+                                    let term = e.wear_term(run.hardness_pa);
+                                    let terms: Vec<&dyn WearTerm> =
+                                        term.as_deref().filter(|_| m != 0.0).into_iter().collect();
+                                    for (b, v) in run.masses_mg(&terms, *history)? {
+                                        *mass.entry(b).or_insert(0.0) += v;
+                                    }
+                                }
+                                table[ti][k].mass_mg = mass;
+                            }
+                        }
+                        predictions.push(table);
+                    }
+                    effects.push(EffectTable {
+                        info,
+                        magnitudes,
+                        predictions,
+                        simulated: false,
+                    });
+                }
+            }
+        }
+        let bands = by_slot[0]
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|inc| {
+                        let mut b = Bands {
+                            pressure: vec![0.0; PRESSURE_BANDS.len()],
+                            slip: vec![0.0; SLIP_BANDS.len()],
+                        };
+                        for (run, h) in &inc.segments {
+                            let sy = run.yield_strength_pa;
+                            let edges = [0.1 * sy, sy, 2.0 * sy];
+                            let p = run.record.work_by_bin(4, |p, _| Some(band_of(p, &edges)));
+                            let s = run
+                                .record
+                                .work_by_bin(4, |_, v| Some(band_of(v, &[1e-3, 6.5e-3, 0.1])));
+                            for i in 0..4 {
+                                b.pressure[i] += p[i] * h.time_scale;
+                                b.slip[i] += s[i] * h.time_scale;
+                            }
+                        }
+                        b
+                    })
+                    .collect()
+            })
+            .collect();
+        let records = |slot: &Vec<Vec<ModelIncrement>>| -> Vec<(f64, Vec<[f64; 3]>)> {
+            slot.iter()
+                .map(|t| {
+                    let rate = options.accelerometer_rate_hz;
+                    (
+                        rate,
+                        t.first()
+                            .map(|inc| inc.response.clone())
+                            .unwrap_or_default(),
+                    )
+                })
+                .collect()
+        };
+        let response_records = records(&by_slot[0]);
+        let halving_response_records = records(&by_slot[1]);
+        debug_assert_eq!(nominal.len(), ntests);
+        Ok(Self {
+            halving: preds(&by_slot[1]),
+            friction_step: preds(&by_slot[2]),
+            initial_state: preds(&by_slot[3]),
+            nominal,
+            bands,
+            response_records,
+            halving_response_records,
+            effects,
+            simulations: cache.len() - before,
+            options: options.clone(),
+        })
+    }
+
+    /// Predictions with the effects `(table index, magnitude)`: one effect from its table;
+    /// two or more as the nominal times each one's ratio to the nominal.
+    pub fn predict(&self, effects: &[(usize, f64)]) -> TestPredictions {
+        match effects {
+            [] => self.nominal.clone(),
+            [(e, m)] => self.effects[*e].at(*m),
+            many => {
+                let mut out = self.nominal.clone();
+                for (e, m) in many {
+                    let p = self.effects[*e].at(*m);
+                    for (ti, t) in out.iter_mut().enumerate() {
+                        for (k, q) in t.iter_mut().enumerate() {
+                            let nom = &self.nominal[ti][k];
+                            let ratio =
+                                nom.zip(&p[ti][k], |n, x| if n > 0.0 { x / n } else { f64::NAN });
+                            let delta = nom.zip(&p[ti][k], |n, x| x - n);
+                            *q = q.zip(&ratio, |a, r| a * r);
+                            // Where the nominal is 0, add the effect's own amount.
+                            let fixed = q.zip(&delta, |a, d| if a.is_nan() { d } else { a });
+                            *q = fixed;
+                        }
+                    }
+                }
+                out
+            }
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_task(
+    task: &Task,
+    campaign: &Campaign,
+    cases: &[CaseSpec],
+    configs_dir: &Path,
+    options: &EmulatorOptions,
+    increments: &[usize],
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<Vec<ModelIncrement>, GapError> {
+    let rig = RigOptions {
+        effects: task.effects.clone(),
+        window_s: options.window_s,
+        settle_s: options.settle_s + task.settle_shift_s,
+        accelerometer_rate_hz: Some(options.accelerometer_rate_hz),
+        ..RigOptions::default()
+    };
+    let window = WindowOptions {
+        window_s: options.window_s,
+        settle_s: options.settle_s + task.settle_shift_s,
+        accelerometer_rate_hz: Some(options.accelerometer_rate_hz),
+        tolerance_scale: task.tolerance_scale,
+    };
+    let mut case = cases[task.test].clone();
+    if task.friction_step != 0.0 {
+        if let Some(rb) = case.rattle_box.as_mut() {
+            rb.friction.mu_static += task.friction_step;
+            rb.friction.mu_dynamic += task.friction_step;
+        }
+        if let Some(l) = case.launcher.as_mut() {
+            l.friction.mu_static += task.friction_step;
+            l.friction.mu_dynamic += task.friction_step;
+        }
+    }
+    simulate_test(
+        task.test,
+        campaign,
+        Some(&case),
+        configs_dir,
+        &rig,
+        &window,
+        increments[task.test],
+        control,
+        cache,
+    )
+}
+
+/// Serializes a library entry as its name.
+mod library_entry {
+    use crate::gap::effects::{info, EffectInfo};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(e: &&'static EffectInfo, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(e.name)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<&'static EffectInfo, D::Error> {
+        let name = String::deserialize(d)?;
+        info(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown effect `{name}`")))
+    }
+}
+
+impl Emulator {
+    /// A key of what the emulator depends on: the tests' configurations (never their
+    /// measurements), the options and the code version. Saved emulators are reused only
+    /// under the same key.
+    pub fn key(campaign: &Campaign, options: &EmulatorOptions) -> String {
+        use sha2::{Digest, Sha256};
+        let tests: Vec<serde_json::Value> = campaign
+            .tests
+            .iter()
+            .map(|t| {
+                serde_json::json!({
+                    "config": t.config, "overrides": t.overrides, "rattle_space": t.rattle_space,
+                    "drive": t.drive, "increment_duration_s": t.increment_duration_s,
+                    "increments": t.specimens.iter().map(|s| s.increments.len()).max(),
+                })
+            })
+            .collect();
+        let text = serde_json::json!({
+            "tests": tests,
+            "options": options,
+            "code": crate::models::case::CODE_VERSION,
+        })
+        .to_string();
+        format!("{:x}", Sha256::digest(text.as_bytes()))
+    }
+}

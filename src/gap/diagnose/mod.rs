@@ -1,0 +1,819 @@
+//! Gap diagnosis (SPEC 7, issue 15): where the sim-to-real gap of a test campaign lies, which
+//! effect of the library causes it, and how far it shrinks once that effect is added, judged on
+//! held-out tests.
+//!
+//! 1. **Observations.** Per test, increment and weighed component: the specimens' mean mass
+//!    loss; per test, increment, accelerometer location and axis: the specimens' mean square
+//!    acceleration less the sensor noise variance.
+//! 2. **Uncertainty** `u` of each observation about a prediction `μ` ([`noise`]):
+//!    measurement and specimen scatter from the repeats (pooled relative variance; an assumed
+//!    value, stated, when there are none) and the scale's quantisation; numerical, from a
+//!    tolerance-halving run; parameters, from the wear coefficient's relative uncertainty and a
+//!    friction sensitivity run. Components of one specimen share its scatter, so each of a
+//!    test's `n` components enters the likelihood with weight `1/n` (a composite likelihood,
+//!    conservative when they are fully correlated).
+//! 3. **Where** ([`location`]): standardized residuals `(y - μ)/u` of the nominal model, grouped
+//!    by test, component, increment, contact-pressure and slip-speed band (weighted by where the
+//!    model's friction work falls) and 1/3-octave band of the response spectrum; p-values
+//!    adjusted by Holm's method (family-wise error rate 5 %).
+//! 4. **Which**: each effect's magnitude is fitted by maximum likelihood on the training tests
+//!    and judged on the held-out test (leave-one-test-out with three or more tests, otherwise
+//!    leave-one-increment-out); AICc and BIC of the full-data fit; a bootstrap over the held-out
+//!    groups gives the probability that each ranks first. An effect *explains* the gap when its
+//!    held-out log-likelihood gain over the nominal exceeds [`MIN_HELD_OUT_GAIN`], it removes
+//!    at least [`MIN_EXPLAINED_SHARE`] of the nominal's excess chi-square, and the residuals
+//!    left after it pass the lack-of-fit test at `alpha`: the diagnosis never names the least
+//!    bad effect. Pairs are tried when no single effect explains.
+//! 5. **How far**: held-out RMS standardized error before and after, the shrink and its
+//!    bootstrap interval, and the fitted magnitude with its profile-likelihood interval.
+
+pub mod bench;
+pub mod emulator;
+pub mod location;
+pub mod noise;
+pub mod plots;
+pub mod stats;
+
+use crate::gap::accel::AccelLocation;
+use crate::gap::window::WindowCache;
+use crate::gap::{Campaign, GapError};
+use crate::pipeline::RunControl;
+use emulator::{Emulator, EmulatorOptions, TestPredictions};
+use noise::{NoiseModel, Observation};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Held-out log-likelihood gain over the nominal model an effect must exceed to count as an
+/// improvement beyond noise: a likelihood ratio of e² (about 7.4), the conventional "strong"
+/// evidence threshold (Kass & Raftery 1995), on data the fit did not see.
+pub const MIN_HELD_OUT_GAIN: f64 = 2.0;
+
+/// Share of the nominal model's excess chi-square an explaining effect must remove: an effect
+/// that passes the lack-of-fit test only because the gap was marginal, while accounting for
+/// little of it, does not explain it.
+pub const MIN_EXPLAINED_SHARE: f64 = 0.5;
+
+/// Profile-likelihood drop of a 95 % interval for one parameter (chi-square 1 dof: 3.84 / 2).
+pub const PROFILE_95: f64 = 1.920_729_410_347_062;
+
+/// How the diagnosis runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagnoseOptions {
+    /// Simulations.
+    pub emulator: EmulatorOptions,
+    /// Significance level of the lack-of-fit tests and flags.
+    pub alpha: f64,
+    /// Bootstrap rounds.
+    pub bootstrap_rounds: usize,
+    /// Relative specimen scatter assumed when the campaign has no repeats (1 sigma).
+    pub assumed_scatter_rel: f64,
+    /// Relative standard uncertainty of the wear coefficient K (parameter uncertainty).
+    pub k_rel_uncertainty: f64,
+    /// Relative calibration uncertainty of an accelerometer's sensitivity (a mean square
+    /// carries twice it).
+    pub accelerometer_calibration_rel: f64,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        Self {
+            emulator: EmulatorOptions::default(),
+            alpha: 0.01,
+            bootstrap_rounds: 500,
+            assumed_scatter_rel: 0.3,
+            k_rel_uncertainty: 0.1,
+            accelerometer_calibration_rel: 0.02,
+        }
+    }
+}
+
+/// The verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// The nominal model agrees with the measurements within their uncertainty.
+    NoGap,
+    /// An effect (or a pair) explains the gap on held-out tests.
+    Explained,
+    /// There is a gap and no effect of the library explains it.
+    NotExplained,
+}
+
+/// A fitted or fixed parameter of the chosen effect.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedParameter {
+    /// Effect.
+    pub effect: String,
+    /// Parameter name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Value (fitted on all tests, or the library default when not fitted).
+    pub value: f64,
+    /// 95 % profile-likelihood interval (fitted parameters), clipped to the bounds.
+    pub interval: Option<[f64; 2]>,
+    /// Physical bounds.
+    pub bounds: [f64; 2],
+    /// True when fitted; false when held at the library default.
+    pub fitted: bool,
+}
+
+/// The chosen effect and how far it closes the gap.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BestEffect {
+    /// Effect name, or `a+b` for a pair.
+    pub name: String,
+    /// Parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Held-out RMS standardized error of the nominal model.
+    pub held_out_error_before: f64,
+    /// Held-out RMS standardized error with the effect.
+    pub held_out_error_after: f64,
+    /// 1 - after / before.
+    pub shrink: f64,
+    /// 90 % bootstrap interval of the shrink (over held-out groups).
+    pub shrink_interval: [f64; 2],
+    /// Lack-of-fit p-value of the residuals left with the effect (full-data fit).
+    pub residual_p_value: f64,
+    /// Held-out RMS standardized error per held-out group, before and after.
+    pub per_group: Vec<GroupError>,
+}
+
+/// Held-out error of one held-out group.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupError {
+    /// Group (test id, or increment).
+    pub group: String,
+    /// Nominal model.
+    pub before: f64,
+    /// With the effect.
+    pub after: f64,
+}
+
+/// One candidate in the ranking.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RankEntry {
+    /// Effect name, `a+b` for a pair, `none` for the nominal model.
+    pub name: String,
+    /// Fitted magnitudes (full data), in the order of the names.
+    pub magnitudes: Vec<f64>,
+    /// Parameters fitted.
+    pub parameters: usize,
+    /// Held-out log-likelihood (sum over held-out groups).
+    pub held_out_log_likelihood: f64,
+    /// Gain over the nominal model's held-out log-likelihood.
+    pub held_out_gain: f64,
+    /// Held-out RMS standardized error.
+    pub held_out_error: f64,
+    /// AICc of the full-data fit.
+    pub aicc: f64,
+    /// BIC of the full-data fit.
+    pub bic: f64,
+    /// Lack-of-fit p-value of the full-data fit.
+    pub residual_p_value: f64,
+    /// Bootstrap probability of ranking first (among candidates and the nominal).
+    pub p_first: f64,
+    /// Share of the nominal model's excess chi-square (chi2 - dof) the full-data fit removes.
+    pub explained_share: f64,
+    /// Explains the gap: gain > MIN_HELD_OUT_GAIN, residual p-value >= alpha and at least
+    /// [`MIN_EXPLAINED_SHARE`] of the excess removed.
+    pub explains: bool,
+}
+
+/// Fit of the nominal model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NominalFit {
+    /// Weighted sum of squared standardized residuals.
+    pub chi2: f64,
+    /// Degrees of freedom (weighted observation count).
+    pub dof: f64,
+    /// Lack-of-fit p-value.
+    pub p_value: f64,
+    /// Held-out log-likelihood (no parameter: the plain log-likelihood).
+    pub held_out_log_likelihood: f64,
+    /// RMS standardized error.
+    pub held_out_error: f64,
+}
+
+/// How the predictions were made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EmulatorReport {
+    /// Simulated excitation per increment, s.
+    pub window_s: f64,
+    /// Settle, s.
+    pub settle_s: f64,
+    /// Windows simulated.
+    pub simulations: usize,
+    /// Dynamics-effect grid points (positive side).
+    pub grid_points: usize,
+    /// Approximations, in words.
+    pub approximations: Vec<String>,
+}
+
+/// The diagnosis report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Campaign name.
+    pub campaign: String,
+    /// Verdict.
+    pub verdict: Verdict,
+    /// One sentence.
+    pub summary: String,
+    /// The effect (or pair) chosen, when explained.
+    pub best_effect: Option<BestEffect>,
+    /// Other explaining candidates that cannot be told apart from the best.
+    pub indistinguishable: Vec<String>,
+    /// Single effects, best held-out log-likelihood first.
+    pub ranking: Vec<RankEntry>,
+    /// Pairs tried (when no single effect explains).
+    pub pairs: Vec<RankEntry>,
+    /// Where the nominal model misses.
+    #[serde(rename = "where")]
+    pub location: location::Where,
+    /// Nominal fit.
+    pub nominal: NominalFit,
+    /// Uncertainty model.
+    pub noise: noise::NoiseReport,
+    /// Hold-out scheme.
+    pub held_out: String,
+    /// Multiple-comparison correction.
+    pub multiple_comparisons: String,
+    /// Significance level.
+    pub alpha: f64,
+    /// Predictions.
+    pub emulator: EmulatorReport,
+    /// railwear version.
+    pub code_version: String,
+}
+
+/// Likelihood of one prediction set.
+struct Score {
+    /// Negative log-likelihood per group.
+    nll: Vec<f64>,
+    /// Weighted squared standardized residuals per group.
+    r2: Vec<f64>,
+    /// Weighted observation count per group.
+    w: Vec<f64>,
+}
+
+/// The data, noise model and folds of one diagnosis.
+pub struct Problem<'a> {
+    obs: Vec<Observation>,
+    noise: NoiseModel,
+    emulator: &'a Emulator,
+    /// Group (fold) of each observation.
+    group: Vec<usize>,
+    groups: usize,
+    group_labels: Vec<String>,
+    held_out: String,
+}
+
+impl<'a> Problem<'a> {
+    fn new(campaign: &Campaign, emulator: &'a Emulator, options: &DiagnoseOptions) -> Self {
+        let mut obs = noise::observations(campaign);
+        let noise = NoiseModel::estimate(campaign, &mut obs, emulator, options);
+        let by_test = campaign.tests.len() >= 3;
+        let (group, groups, group_labels, held_out) = if by_test {
+            (
+                obs.iter().map(|o| o.test).collect(),
+                campaign.tests.len(),
+                campaign.tests.iter().map(|t| t.id.clone()).collect(),
+                "leave-one-test-out".to_string(),
+            )
+        } else {
+            let n = obs.iter().map(|o| o.increment + 1).max().unwrap_or(1);
+            (
+                obs.iter().map(|o| o.increment).collect(),
+                n,
+                (1..=n).map(|k| format!("increment {k}")).collect(),
+                "leave-one-increment-out (fewer than 3 tests)".to_string(),
+            )
+        };
+        Self {
+            obs,
+            noise,
+            emulator,
+            group,
+            groups,
+            group_labels,
+            held_out,
+        }
+    }
+
+    fn score(&self, p: &TestPredictions) -> Score {
+        let mut s = Score {
+            nll: vec![0.0; self.groups],
+            r2: vec![0.0; self.groups],
+            w: vec![0.0; self.groups],
+        };
+        for (i, o) in self.obs.iter().enumerate() {
+            let mu = o.predicted(p);
+            let u = self.noise.u(o, mu);
+            let r = (o.value - mu) / u;
+            let g = self.group[i];
+            s.nll[g] += o.weight * (0.5 * r * r + u.ln());
+            s.r2[g] += o.weight * r * r;
+            s.w[g] += o.weight;
+        }
+        s
+    }
+
+    fn nll_of(&self, p: &TestPredictions, mask: impl Fn(usize) -> bool) -> f64 {
+        let s = self.score(p);
+        (0..self.groups)
+            .filter(|g| mask(*g))
+            .map(|g| s.nll[g])
+            .sum()
+    }
+
+    /// Magnitudes to try for table `e`: the table's points and four between each pair.
+    fn candidates(&self, e: usize) -> Vec<f64> {
+        let m = &self.emulator.effects[e].magnitudes;
+        let mut out = Vec::with_capacity(m.len() * 5);
+        for w in m.windows(2) {
+            for k in 0..5 {
+                out.push(w[0] + (w[1] - w[0]) * k as f64 / 5.0);
+            }
+        }
+        out.extend(m.last());
+        out
+    }
+
+    /// Best magnitudes of `effects` on the groups `mask` keeps: a grid search (one effect: the
+    /// table refined five-fold; two: the tables' own points).
+    fn fit(&self, effects: &[usize], mask: &dyn Fn(usize) -> bool) -> (Vec<f64>, f64) {
+        let mut best = (vec![0.0; effects.len()], f64::INFINITY);
+        let mut try_one = |mags: Vec<f64>| {
+            let spec: Vec<(usize, f64)> =
+                effects.iter().copied().zip(mags.iter().copied()).collect();
+            let nll = self.nll_of(&self.emulator.predict(&spec), mask);
+            if nll < best.1 {
+                best = (mags, nll);
+            }
+        };
+        match effects {
+            [] => try_one(Vec::new()),
+            [e] => {
+                for m in self.candidates(*e) {
+                    try_one(vec![m]);
+                }
+            }
+            [a, b] => {
+                let ma = self.emulator.effects[*a].magnitudes.clone();
+                let mb = self.emulator.effects[*b].magnitudes.clone();
+                for x in &ma {
+                    for y in &mb {
+                        try_one(vec![*x, *y]);
+                    }
+                }
+            }
+            _ => {}
+        }
+        best
+    }
+
+    /// Candidate evaluated: held-out per group, full-data fit, criteria.
+    fn evaluate(&self, effects: &[usize], alpha: f64) -> Candidate {
+        let mut held_nll = Vec::with_capacity(self.groups);
+        let mut held_r2 = Vec::with_capacity(self.groups);
+        let mut held_w = Vec::with_capacity(self.groups);
+        for g in 0..self.groups {
+            let (mags, _) = self.fit(effects, &|h| h != g);
+            let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags).collect();
+            let s = self.score(&self.emulator.predict(&spec));
+            held_nll.push(s.nll[g]);
+            held_r2.push(s.r2[g]);
+            held_w.push(s.w[g]);
+        }
+        let (mags, nll_full) = self.fit(effects, &|_| true);
+        let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags.iter().copied()).collect();
+        let full = self.score(&self.emulator.predict(&spec));
+        let k = effects.len() as f64;
+        let n: f64 = full.w.iter().sum();
+        let chi2: f64 = full.r2.iter().sum();
+        let residual_p = stats::chi2_sf(chi2, (n - k).round().max(1.0) as usize);
+        Candidate {
+            effects: effects.to_vec(),
+            magnitudes: mags,
+            held_nll,
+            held_r2,
+            held_w,
+            aicc: 2.0 * k + 2.0 * nll_full + 2.0 * k * (k + 1.0) / (n - k - 1.0).max(1.0),
+            bic: k * n.max(1.0).ln() + 2.0 * nll_full,
+            residual_p,
+            chi2,
+            dof: n,
+            alpha,
+        }
+    }
+
+    fn name_of(&self, effects: &[usize]) -> String {
+        if effects.is_empty() {
+            return "none".into();
+        }
+        effects
+            .iter()
+            .map(|e| self.emulator.effects[*e].info.name)
+            .collect::<Vec<_>>()
+            .join("+")
+    }
+}
+
+/// One candidate's numbers.
+#[derive(Debug, Clone)]
+struct Candidate {
+    effects: Vec<usize>,
+    magnitudes: Vec<f64>,
+    held_nll: Vec<f64>,
+    held_r2: Vec<f64>,
+    held_w: Vec<f64>,
+    aicc: f64,
+    bic: f64,
+    residual_p: f64,
+    chi2: f64,
+    dof: f64,
+    alpha: f64,
+}
+
+impl Candidate {
+    fn held_ll(&self) -> f64 {
+        -self.held_nll.iter().sum::<f64>()
+    }
+
+    fn held_error(&self) -> f64 {
+        (self.held_r2.iter().sum::<f64>() / self.held_w.iter().sum::<f64>().max(1e-300)).sqrt()
+    }
+
+    fn explained_share(&self, nominal: &Candidate) -> f64 {
+        let excess = nominal.chi2 - nominal.dof;
+        if excess > 0.0 {
+            (nominal.chi2 - self.chi2) / excess
+        } else {
+            0.0
+        }
+    }
+
+    fn explains(&self, nominal: &Candidate) -> bool {
+        self.held_ll() - nominal.held_ll() > MIN_HELD_OUT_GAIN
+            && self.residual_p >= self.alpha
+            && self.explained_share(nominal) >= MIN_EXPLAINED_SHARE
+    }
+}
+
+/// Runs the diagnosis: builds the emulator (simulations, reported through `progress(done,
+/// total)`), then fits, ranks and locates.
+pub fn diagnose(
+    campaign: &Campaign,
+    configs_dir: &Path,
+    options: &DiagnoseOptions,
+    control: &RunControl,
+    cache: &WindowCache,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Report, Emulator), GapError> {
+    campaign.validate(configs_dir)?;
+    check_options(options)?;
+    let emulator = Emulator::build(
+        campaign,
+        configs_dir,
+        &options.emulator,
+        control,
+        cache,
+        progress,
+    )?;
+    let report = diagnose_with(campaign, &emulator, options)?;
+    Ok((report, emulator))
+}
+
+fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
+    let rule = |field: &str, ok: bool, text: &str| {
+        if ok {
+            Ok(())
+        } else {
+            Err(GapError::field(field, text.to_string()))
+        }
+    };
+    rule(
+        "alpha",
+        o.alpha > 0.0 && o.alpha < 0.5,
+        "must lie in (0, 0.5)",
+    )?;
+    rule(
+        "bootstrap_rounds",
+        (10..=100_000).contains(&o.bootstrap_rounds),
+        "must lie in 10..=100000",
+    )?;
+    rule(
+        "window_s",
+        o.emulator.window_s.is_finite()
+            && o.emulator.window_s > 0.0
+            && o.emulator.window_s <= 600.0,
+        "must lie in (0, 600] s",
+    )?;
+    rule(
+        "settle_s",
+        o.emulator.settle_s.is_finite() && (0.0..=600.0).contains(&o.emulator.settle_s),
+        "must lie in [0, 600] s",
+    )?;
+    rule(
+        "grid_points",
+        (2..=12).contains(&o.emulator.grid_points),
+        "must lie in 2..=12",
+    )?;
+    rule(
+        "threads",
+        (1..=64).contains(&o.emulator.threads),
+        "must lie in 1..=64",
+    )?;
+    rule(
+        "accelerometer_rate_hz",
+        o.emulator.accelerometer_rate_hz.is_finite()
+            && o.emulator.accelerometer_rate_hz >= 100.0
+            && o.emulator.accelerometer_rate_hz <= 1e5,
+        "must lie in [100, 1e5] Hz",
+    )?;
+    rule(
+        "assumed_scatter_rel",
+        o.assumed_scatter_rel.is_finite()
+            && o.assumed_scatter_rel > 0.0
+            && o.assumed_scatter_rel <= 2.0,
+        "must lie in (0, 2]",
+    )?;
+    rule(
+        "accelerometer_calibration_rel",
+        o.accelerometer_calibration_rel.is_finite()
+            && (0.0..=0.5).contains(&o.accelerometer_calibration_rel),
+        "must lie in [0, 0.5]",
+    )?;
+    rule(
+        "k_rel_uncertainty",
+        o.k_rel_uncertainty.is_finite() && (0.0..=2.0).contains(&o.k_rel_uncertainty),
+        "must lie in [0, 2]",
+    )?;
+    Ok(())
+}
+
+/// The diagnosis on an emulator already built for `campaign` (the bench reuses one emulator
+/// for many campaigns drawn on the same tests).
+pub fn diagnose_with(
+    campaign: &Campaign,
+    emulator: &Emulator,
+    options: &DiagnoseOptions,
+) -> Result<Report, GapError> {
+    let problem = Problem::new(campaign, emulator, options);
+    if problem.obs.is_empty() {
+        return Err(GapError::field(
+            "tests",
+            "the campaign has no measurement to diagnose (every mass_loss_mg is empty)",
+        ));
+    }
+    let alpha = options.alpha;
+    let nominal = problem.evaluate(&[], alpha);
+    let nominal_score = problem.score(&emulator.nominal);
+    let chi2: f64 = nominal_score.r2.iter().sum();
+    let dof: f64 = nominal_score.w.iter().sum();
+    let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
+    let location = location::locate(campaign, &problem, options);
+    let any_flag = location.any_flagged();
+
+    let singles: Vec<Candidate> = (0..emulator.effects.len())
+        .map(|e| problem.evaluate(&[e], alpha))
+        .collect();
+    let mut order: Vec<usize> = (0..singles.len()).collect();
+    order.sort_by(|a, b| singles[*b].held_ll().total_cmp(&singles[*a].held_ll()));
+
+    let no_gap = nominal_p >= alpha && !any_flag;
+    let mut pairs: Vec<Candidate> = Vec::new();
+    let explaining_singles: Vec<usize> = order
+        .iter()
+        .copied()
+        .filter(|&i| singles[i].explains(&nominal))
+        .collect();
+    if !no_gap && explaining_singles.is_empty() {
+        let top: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| singles[i].held_ll() > nominal.held_ll())
+            .take(4)
+            .collect();
+        for (ai, &a) in top.iter().enumerate() {
+            for &b in &top[ai + 1..] {
+                pairs.push(problem.evaluate(&[a, b], alpha));
+            }
+        }
+        pairs.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
+    }
+
+    // Bootstrap over held-out groups: P(first) among the nominal, singles and pairs.
+    let all: Vec<&Candidate> = std::iter::once(&nominal)
+        .chain(singles.iter())
+        .chain(pairs.iter())
+        .collect();
+    let resamples = stats::bootstrap_indices(problem.groups, options.bootstrap_rounds, 0x5eed);
+    let mut firsts = vec![0usize; all.len()];
+    for idx in &resamples {
+        let best = all
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (i, -idx.iter().map(|g| c.held_nll[*g]).sum::<f64>()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(i, _)| i);
+        firsts[best] += 1;
+    }
+    let p_first = |i: usize| firsts[i] as f64 / resamples.len().max(1) as f64;
+    let entry = |c: &Candidate, i: usize| RankEntry {
+        name: problem.name_of(&c.effects),
+        magnitudes: c.magnitudes.clone(),
+        parameters: c.effects.len(),
+        held_out_log_likelihood: c.held_ll(),
+        held_out_gain: c.held_ll() - nominal.held_ll(),
+        held_out_error: c.held_error(),
+        aicc: c.aicc,
+        bic: c.bic,
+        residual_p_value: c.residual_p,
+        p_first: p_first(i),
+        explained_share: c.explained_share(&nominal),
+        explains: c.explains(&nominal),
+    };
+    let ranking: Vec<RankEntry> = order.iter().map(|&i| entry(&singles[i], 1 + i)).collect();
+    let pair_entries: Vec<RankEntry> = pairs
+        .iter()
+        .enumerate()
+        .map(|(j, c)| entry(c, 1 + singles.len() + j))
+        .collect();
+
+    let chosen: Option<(&Candidate, Vec<String>)> = if no_gap {
+        None
+    } else if let Some(&best) = explaining_singles.first() {
+        let b = &singles[best];
+        let others = explaining_singles[1..]
+            .iter()
+            .filter(|&&i| {
+                b.held_ll() - singles[i].held_ll() < MIN_HELD_OUT_GAIN || p_first(1 + i) >= 0.1
+            })
+            .map(|&i| problem.name_of(&singles[i].effects))
+            .collect();
+        Some((b, others))
+    } else {
+        let explaining: Vec<usize> = (0..pairs.len())
+            .filter(|&j| pairs[j].explains(&nominal))
+            .collect();
+        explaining.first().map(|&j| {
+            let b = &pairs[j];
+            let others = explaining[1..]
+                .iter()
+                .filter(|&&i| {
+                    b.held_ll() - pairs[i].held_ll() < MIN_HELD_OUT_GAIN
+                        || p_first(1 + singles.len() + i) >= 0.1
+                })
+                .map(|&i| problem.name_of(&pairs[i].effects))
+                .collect();
+            (b, others)
+        })
+    };
+
+    let verdict = if no_gap {
+        Verdict::NoGap
+    } else if chosen.is_some() {
+        Verdict::Explained
+    } else {
+        Verdict::NotExplained
+    };
+    let best_effect = chosen
+        .as_ref()
+        .map(|(c, _)| best_effect(&problem, c, &nominal, &resamples));
+    let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
+    let summary = match verdict {
+        Verdict::NoGap => format!(
+            "no gap: the nominal model fits within the uncertainty (chi2 {chi2:.1} on {dof:.1} dof, p = {nominal_p:.3}; no group flagged)"
+        ),
+        Verdict::Explained => {
+            let b = best_effect.as_ref();
+            format!(
+                "explained by {}: held-out error {:.2} -> {:.2} (shrink {:.0} %)",
+                b.map_or("?", |b| b.name.as_str()),
+                b.map_or(f64::NAN, |b| b.held_out_error_before),
+                b.map_or(f64::NAN, |b| b.held_out_error_after),
+                b.map_or(f64::NAN, |b| 100.0 * b.shrink),
+            )
+        }
+        Verdict::NotExplained => format!(
+            "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
+        ),
+    };
+    Ok(Report {
+        campaign: campaign.name.clone(),
+        verdict,
+        summary,
+        best_effect,
+        indistinguishable,
+        ranking,
+        pairs: pair_entries,
+        location,
+        nominal: NominalFit {
+            chi2,
+            dof,
+            p_value: nominal_p,
+            held_out_log_likelihood: nominal.held_ll(),
+            held_out_error: nominal.held_error(),
+        },
+        noise: problem.noise.report(),
+        held_out: problem.held_out.clone(),
+        multiple_comparisons: "Holm step-down over every group of `where` (family-wise error rate 0.05)".into(),
+        alpha,
+        emulator: EmulatorReport {
+            window_s: emulator.options.window_s,
+            settle_s: emulator.options.settle_s,
+            simulations: emulator.simulations,
+            grid_points: emulator.options.grid_points,
+            approximations: vec![
+                "each increment is represented by one simulated window (wear scaled by increment / window); dynamics effects of time or slip see the state at the increment's middle".into(),
+                "dynamics effects are simulated on a grid of magnitudes and interpolated log-linearly between grid points".into(),
+                "pairs combine as the nominal times each effect's ratio to the nominal".into(),
+                "parameters other than each effect's magnitude are held at the library defaults".into(),
+                "specimen scatter is common to a specimen's increments; that correlation is not modelled".into(),
+            ],
+        },
+        code_version: crate::models::case::CODE_VERSION.to_string(),
+    })
+}
+
+fn best_effect(
+    problem: &Problem,
+    c: &Candidate,
+    nominal: &Candidate,
+    resamples: &[Vec<usize>],
+) -> BestEffect {
+    let before = nominal.held_error();
+    let after = c.held_error();
+    let shrinks: Vec<f64> = resamples
+        .iter()
+        .map(|idx| {
+            let rb: f64 = idx.iter().map(|g| nominal.held_r2[*g]).sum();
+            let ra: f64 = idx.iter().map(|g| c.held_r2[*g]).sum();
+            if rb > 0.0 {
+                1.0 - (ra / rb).sqrt()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut parameters = Vec::new();
+    for (slot, (&e, &m)) in c.effects.iter().zip(&c.magnitudes).enumerate() {
+        let info = problem.emulator.effects[e].info;
+        let interval = (c.effects.len() == 1).then(|| profile_interval(problem, e, m));
+        let _ = slot;
+        for (pi, p) in info.parameters.iter().enumerate() {
+            parameters.push(FittedParameter {
+                effect: info.name.to_string(),
+                name: p.name.to_string(),
+                unit: p.unit.to_string(),
+                value: if pi == 0 { m } else { p.default },
+                interval: if pi == 0 { interval } else { None },
+                bounds: [p.min, p.max],
+                fitted: pi == 0,
+            });
+        }
+    }
+    BestEffect {
+        name: problem.name_of(&c.effects),
+        parameters,
+        held_out_error_before: before,
+        held_out_error_after: after,
+        shrink: if before > 0.0 {
+            1.0 - after / before
+        } else {
+            0.0
+        },
+        shrink_interval: [
+            stats::quantile(&shrinks, 0.05),
+            stats::quantile(&shrinks, 0.95),
+        ],
+        residual_p_value: c.residual_p,
+        per_group: (0..problem.groups)
+            .map(|g| GroupError {
+                group: problem.group_labels[g].clone(),
+                before: (nominal.held_r2[g] / nominal.held_w[g].max(1e-300)).sqrt(),
+                after: (c.held_r2[g] / c.held_w[g].max(1e-300)).sqrt(),
+            })
+            .collect(),
+    }
+}
+
+/// 95 % profile-likelihood interval of one effect's magnitude around its full-data optimum.
+fn profile_interval(problem: &Problem, e: usize, best: f64) -> [f64; 2] {
+    let nll = |m: f64| problem.nll_of(&problem.emulator.predict(&[(e, m)]), |_| true);
+    let floor = nll(best);
+    let cands = problem.candidates(e);
+    let inside: Vec<f64> = cands
+        .into_iter()
+        .filter(|m| nll(*m) <= floor + PROFILE_95)
+        .collect();
+    let lo = inside.iter().copied().fold(best, f64::min);
+    let hi = inside.iter().copied().fold(best, f64::max);
+    [lo, hi]
+}
+
+/// Location of an accelerometer quantity, for labels.
+pub fn location_label(l: AccelLocation) -> &'static str {
+    l.as_str()
+}

@@ -1,0 +1,236 @@
+//! SVG plots of a diagnosis report: residuals by group with the flag threshold, the effect
+//! ranking, and the held-out error before and after the chosen effect per held-out group.
+//! Horizontal labelled bars, drawn without dependencies (the report's numbers are in its JSON).
+
+use super::Report;
+use crate::analysis::svg::escape;
+use std::fmt::Write;
+
+/// One bar.
+struct Bar {
+    label: String,
+    value: f64,
+    /// Second value drawn as a thinner bar below (before/after plots).
+    second: Option<f64>,
+    note: String,
+    highlight: bool,
+}
+
+fn bar_chart(
+    title: &str,
+    axis: &str,
+    bars: &[Bar],
+    guides: &[f64],
+    legend: Option<(&str, &str)>,
+) -> String {
+    let row = 22.0;
+    let left = 330.0;
+    let width = 900.0;
+    let plot_w = width - left - 140.0;
+    let top = 50.0;
+    let height = top + row * bars.len().max(1) as f64 + 60.0;
+    let values = bars
+        .iter()
+        .flat_map(|b| std::iter::once(b.value).chain(b.second))
+        .chain(guides.iter().copied())
+        .chain([0.0])
+        .filter(|v| v.is_finite());
+    let (mut lo, mut hi) = values.fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    if hi - lo <= 0.0 {
+        hi = lo + 1.0;
+    }
+    let pad = 0.05 * (hi - lo);
+    lo -= pad;
+    hi += pad;
+    let x = |v: f64| left + (v.clamp(lo, hi) - lo) / (hi - lo) * plot_w;
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = write!(
+        s,
+        r#"<rect width="100%" height="100%" fill="white"/><text x="{}" y="24" font-size="15" text-anchor="middle">{}</text>"#,
+        width / 2.0,
+        escape(title)
+    );
+    let bottom = top + row * bars.len() as f64;
+    for g in guides.iter().chain([&0.0]) {
+        let dash = if *g == 0.0 {
+            ""
+        } else {
+            r#" stroke-dasharray="4 3""#
+        };
+        let _ = write!(
+            s,
+            r##"<line x1="{0:.1}" y1="{1}" x2="{0:.1}" y2="{2}" stroke="#888"{dash}/>"##,
+            x(*g),
+            top - 6.0,
+            bottom + 4.0
+        );
+    }
+    for (i, b) in bars.iter().enumerate() {
+        let y = top + row * i as f64;
+        let colour = if b.highlight { "#c0392b" } else { "#2c7fb8" };
+        let _ = write!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="end">{}</text>"#,
+            left - 8.0,
+            y + 14.0,
+            escape(&b.label)
+        );
+        let (x0, x1) = (x(0.0).min(x(b.value)), x(0.0).max(x(b.value)));
+        let h = if b.second.is_some() { 8.0 } else { 14.0 };
+        if b.value.is_finite() {
+            let _ = write!(
+                s,
+                r#"<rect x="{x0:.1}" y="{:.1}" width="{:.1}" height="{h}" fill="{colour}"/>"#,
+                y + 3.0,
+                (x1 - x0).max(0.5)
+            );
+        }
+        if let Some(v) = b.second.filter(|v| v.is_finite()) {
+            let (a0, a1) = (x(0.0).min(x(v)), x(0.0).max(x(v)));
+            let _ = write!(
+                s,
+                r##"<rect x="{a0:.1}" y="{:.1}" width="{:.1}" height="8" fill="#27ae60"/>"##,
+                y + 12.0,
+                (a1 - a0).max(0.5)
+            );
+        }
+        let _ = write!(
+            s,
+            r#"<text x="{}" y="{}">{}</text>"#,
+            left + plot_w + 8.0,
+            y + 14.0,
+            escape(&b.note)
+        );
+    }
+    // Axis ticks.
+    for k in 0..=4 {
+        let v = lo + (hi - lo) * k as f64 / 4.0;
+        let _ = write!(
+            s,
+            r#"<text x="{:.1}" y="{}" text-anchor="middle">{:.3}</text>"#,
+            x(v),
+            bottom + 20.0,
+            v
+        );
+    }
+    let _ = write!(
+        s,
+        r#"<text x="{:.1}" y="{}" text-anchor="middle">{}</text>"#,
+        left + plot_w / 2.0,
+        bottom + 40.0,
+        escape(axis)
+    );
+    if let Some((a, b)) = legend {
+        let _ = write!(
+            s,
+            r##"<rect x="{0}" y="32" width="10" height="8" fill="#2c7fb8"/><text x="{1}" y="40">{2}</text><rect x="{3}" y="32" width="10" height="8" fill="#27ae60"/><text x="{4}" y="40">{5}</text>"##,
+            left,
+            left + 14.0,
+            escape(a),
+            left + 200.0,
+            left + 214.0,
+            escape(b)
+        );
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// The report's plots: (file name, SVG text).
+pub fn plots(report: &Report) -> Vec<(String, String)> {
+    let residual_bars: Vec<Bar> = report
+        .location
+        .groups
+        .iter()
+        .map(|g| Bar {
+            label: format!("{}: {}", g.by, g.label),
+            value: g.z,
+            second: None,
+            note: format!("p_adj {:.2}", g.p_adjusted),
+            highlight: g.flagged,
+        })
+        .collect();
+    let residuals = bar_chart(
+        &format!(
+            "{}: where the nominal model misses (red: flagged, Holm 5 %)",
+            report.campaign
+        ),
+        "bias score z (measured above the model: > 0); dashed: |z| = 2",
+        &residual_bars,
+        &[-2.0, 2.0],
+        None,
+    );
+    let rank_bars: Vec<Bar> = report
+        .ranking
+        .iter()
+        .chain(&report.pairs)
+        .map(|r| Bar {
+            label: r.name.clone(),
+            value: r.held_out_gain,
+            second: None,
+            note: format!(
+                "P(first) {:.2}, lack-of-fit p {:.2}",
+                r.p_first, r.residual_p_value
+            ),
+            highlight: r.explains,
+        })
+        .collect();
+    let ranking = bar_chart(
+        &format!(
+            "{}: effects ranked by held-out log-likelihood gain (red: explains)",
+            report.campaign
+        ),
+        "held-out log-likelihood gain over the nominal model; dashed: the explaining threshold",
+        &rank_bars,
+        &[super::MIN_HELD_OUT_GAIN],
+        None,
+    );
+    let before_after = match &report.best_effect {
+        Some(b) => bar_chart(
+            &format!(
+                "{}: held-out RMS standardized error, nominal vs {} (shrink {:.0} %)",
+                report.campaign,
+                b.name,
+                100.0 * b.shrink
+            ),
+            "held-out RMS standardized error per held-out group",
+            &b.per_group
+                .iter()
+                .map(|g| Bar {
+                    label: g.group.clone(),
+                    value: g.before,
+                    second: Some(g.after),
+                    note: format!("{:.2} -> {:.2}", g.before, g.after),
+                    highlight: false,
+                })
+                .collect::<Vec<_>>(),
+            &[1.0],
+            Some(("nominal", b.name.as_str())),
+        ),
+        None => bar_chart(
+            &format!(
+                "{}: no effect chosen ({:?})",
+                report.campaign, report.verdict
+            ),
+            "held-out RMS standardized error of the nominal model",
+            &[Bar {
+                label: "nominal".into(),
+                value: report.nominal.held_out_error,
+                second: None,
+                note: format!("{:.2}", report.nominal.held_out_error),
+                highlight: false,
+            }],
+            &[1.0],
+            None,
+        ),
+    };
+    vec![
+        ("residuals.svg".into(), residuals),
+        ("ranking.svg".into(), ranking),
+        ("before_after.svg".into(), before_after),
+    ]
+}
