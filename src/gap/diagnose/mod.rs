@@ -38,7 +38,7 @@ use crate::gap::accel::AccelLocation;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
-use emulator::{Emulator, EmulatorOptions, TestPredictions};
+use emulator::{Emulator, EmulatorOptions};
 use noise::{NoiseModel, Observation};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -266,6 +266,9 @@ pub struct Problem<'a> {
     groups: usize,
     group_labels: Vec<String>,
     held_out: String,
+    /// Per effect table, per observation: the table's relative roughness², added to the
+    /// model's variance wherever the effect is on.
+    roughness: Vec<Vec<f64>>,
 }
 
 impl<'a> Problem<'a> {
@@ -289,10 +292,21 @@ impl<'a> Problem<'a> {
                 "leave-one-increment-out (fewer than 3 tests)".to_string(),
             )
         };
+        let roughness = emulator
+            .effects
+            .iter()
+            .map(|t| {
+                let r = t.roughness();
+                obs.iter()
+                    .map(|o| r.get(&o.quantity.label()).copied().unwrap_or(0.0).powi(2))
+                    .collect()
+            })
+            .collect();
         Self {
             obs,
             noise,
             emulator,
+            roughness,
             group,
             groups,
             group_labels,
@@ -300,15 +314,22 @@ impl<'a> Problem<'a> {
         }
     }
 
-    fn score(&self, p: &TestPredictions) -> Score {
+    /// Scores the predictions of `spec` (effect table, magnitude).
+    fn score(&self, spec: &[(usize, f64)]) -> Score {
+        let p = self.emulator.predict(spec);
         let mut s = Score {
             nll: vec![0.0; self.groups],
             r2: vec![0.0; self.groups],
             w: vec![0.0; self.groups],
         };
         for (i, o) in self.obs.iter().enumerate() {
-            let mu = o.predicted(p);
-            let u = self.noise.u(o, mu);
+            let mu = o.predicted(&p);
+            let extra: f64 = spec
+                .iter()
+                .filter(|(_, m)| *m != 0.0)
+                .map(|(e, _)| self.roughness[*e][i])
+                .sum();
+            let u = (self.noise.u(o, mu).powi(2) + extra * mu * mu).sqrt();
             let r = (o.value - mu) / u;
             let g = self.group[i];
             s.nll[g] += o.weight * (0.5 * r * r + u.ln());
@@ -318,8 +339,8 @@ impl<'a> Problem<'a> {
         s
     }
 
-    fn nll_of(&self, p: &TestPredictions, mask: impl Fn(usize) -> bool) -> f64 {
-        let s = self.score(p);
+    fn nll_of(&self, spec: &[(usize, f64)], mask: impl Fn(usize) -> bool) -> f64 {
+        let s = self.score(spec);
         (0..self.groups)
             .filter(|g| mask(*g))
             .map(|g| s.nll[g])
@@ -346,7 +367,7 @@ impl<'a> Problem<'a> {
         let mut try_one = |mags: Vec<f64>| {
             let spec: Vec<(usize, f64)> =
                 effects.iter().copied().zip(mags.iter().copied()).collect();
-            let nll = self.nll_of(&self.emulator.predict(&spec), mask);
+            let nll = self.nll_of(&spec, mask);
             if nll < best.1 {
                 best = (mags, nll);
             }
@@ -380,14 +401,14 @@ impl<'a> Problem<'a> {
         for g in 0..self.groups {
             let (mags, _) = self.fit(effects, &|h| h != g);
             let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags).collect();
-            let s = self.score(&self.emulator.predict(&spec));
+            let s = self.score(&spec);
             held_nll.push(s.nll[g]);
             held_r2.push(s.r2[g]);
             held_w.push(s.w[g]);
         }
         let (mags, nll_full) = self.fit(effects, &|_| true);
         let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags.iter().copied()).collect();
-        let full = self.score(&self.emulator.predict(&spec));
+        let full = self.score(&spec);
         let k = effects.len() as f64;
         let n: f64 = full.w.iter().sum();
         let chi2: f64 = full.r2.iter().sum();
@@ -568,7 +589,7 @@ pub fn diagnose_with(
     }
     let alpha = options.alpha;
     let nominal = problem.evaluate(&[], alpha);
-    let nominal_score = problem.score(&emulator.nominal);
+    let nominal_score = problem.score(&[]);
     let chi2: f64 = nominal_score.r2.iter().sum();
     let dof: f64 = nominal_score.w.iter().sum();
     let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
@@ -801,7 +822,7 @@ fn best_effect(
 
 /// 95 % profile-likelihood interval of one effect's magnitude around its full-data optimum.
 fn profile_interval(problem: &Problem, e: usize, best: f64) -> [f64; 2] {
-    let nll = |m: f64| problem.nll_of(&problem.emulator.predict(&[(e, m)]), |_| true);
+    let nll = |m: f64| problem.nll_of(&[(e, m)], |_| true);
     let floor = nll(best);
     let cands = problem.candidates(e);
     let inside: Vec<f64> = cands
