@@ -174,7 +174,7 @@ enum CampaignCommand {
 enum TokenCommand {
     /// Create a token and print it (shown once).
     Create {
-        /// planner, engineer or admin.
+        /// planner, engineer, test-engineer (also spelled test_engineer) or admin.
         #[arg(long)]
         role: String,
         /// Who holds it.
@@ -337,7 +337,7 @@ async fn main() -> Result<()> {
             command: TokenCommand::Create { role, name },
         } => {
             let Some(role) = Role::parse(role) else {
-                bail!("--role must be planner, engineer or admin");
+                bail!("--role must be planner, engineer, test-engineer or admin");
             };
             let config = load_config(&cli)?;
             let store = railwear::store::open(&config.database_url).await?;

@@ -2,6 +2,7 @@
 //! dashboard. Each module exposes its own `router()`; shared state is [`AppState`].
 
 pub mod auth;
+pub mod campaigns;
 pub mod curves;
 pub mod jobs;
 pub mod openapi;
@@ -46,16 +47,27 @@ impl Deref for AppState {
     }
 }
 
-/// The complete router with body limits, problem+json fallbacks and request tracing.
+/// The complete router with body limits, problem+json fallbacks and request tracing. Every
+/// route takes bodies up to `body_limit_bytes`, except the campaign upload, which takes up to
+/// `campaign_body_limit_bytes` (accelerometer samples inline).
 pub fn app(state: AppState) -> Router {
     let limit = state.config.body_limit_bytes;
-    Router::new()
+    let campaign_limit = state.config.campaign_body_limit_bytes;
+    let general = Router::new()
         .merge(jobs::router())
         .merge(rails::router())
         .merge(curves::router())
         .merge(tokens::router())
         .merge(ops::router())
         .merge(openapi::router())
+        .layer(DefaultBodyLimit::max(limit))
+        .layer(RequestBodyLimitLayer::new(limit));
+    let campaigns = campaigns::router()
+        .layer(DefaultBodyLimit::max(campaign_limit))
+        .layer(RequestBodyLimitLayer::new(campaign_limit));
+    Router::new()
+        .merge(general)
+        .merge(campaigns)
         .fallback(|| async { Problem::not_found("no such resource") })
         .method_not_allowed_fallback(|| async {
             Problem::new(
@@ -66,8 +78,6 @@ pub fn app(state: AppState) -> Router {
             )
         })
         .layer(middleware::from_fn_with_state(state.clone(), http_metrics))
-        .layer(DefaultBodyLimit::max(limit))
-        .layer(RequestBodyLimitLayer::new(limit))
         .layer(middleware::map_response(problem::problem_for_bare_errors))
         .layer(TraceLayer::new_for_http())
         .with_state(state)

@@ -1,7 +1,7 @@
 //! The OpenAPI document, generated from the handlers' annotations. `api/openapi.json` is a copy
 //! kept in sync by a test (`railwear openapi > api/openapi.json` regenerates it).
 
-use super::{curves, jobs, ops, pagination, problem, rails, tokens, AppState};
+use super::{campaigns, curves, jobs, ops, pagination, problem, rails, tokens, AppState};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
@@ -25,7 +25,7 @@ impl Modify for BearerAuth {
 #[openapi(
     info(
         title = "railwear",
-        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs), admin (tokens)."
+        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs, curves), test_engineer (test campaigns), admin (tokens, and everything)."
     ),
     paths(
         jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::get_attempts, jobs::cancel_job,
@@ -34,6 +34,7 @@ impl Modify for BearerAuth {
         rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
         rails::get_report,
         curves::list_curves, curves::get_curve, curves::publish_curve,
+        campaigns::upload_campaign, campaigns::list_campaigns, campaigns::get_campaign,
         tokens::create_token, tokens::list_tokens, tokens::revoke_token,
         ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
@@ -49,6 +50,11 @@ impl Modify for BearerAuth {
         rails::ServiceLife, rails::MissingCurve, rails::ServiceLifeInterval, rails::ReportCurve,
         curves::CurveView, curves::FidelityView, curves::CurveLinks, curves::PublishRequest,
         pagination::PageView<curves::CurveView>,
+        campaigns::CampaignView, campaigns::CampaignCountsView, campaigns::CampaignLinks,
+        campaigns::CampaignDocument, campaigns::CampaignTestDocument, campaigns::DriveDocument,
+        campaigns::SpecimenDocument, campaigns::IncrementDocument,
+        campaigns::AccelRecordDocument, campaigns::AccelLocationDocument,
+        pagination::PageView<campaigns::CampaignView>,
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
         crate::config::Role,
     )),
@@ -57,6 +63,7 @@ impl Modify for BearerAuth {
         (name = "jobs", description = "Simulation, sweep and calibration jobs (engineer)"),
         (name = "rails", description = "Rail registry, measurements and service-life reports (planner)"),
         (name = "curves", description = "Penalization curve versions; publishing one makes reports use it (engineer)"),
+        (name = "campaigns", description = "Test campaigns: measured wear and accelerometer records of physical tests (upload: test_engineer; read: every role)"),
         (name = "tokens", description = "API tokens (admin)"),
         (name = "ops", description = "Health, readiness, metrics, this document"),
     )

@@ -4,10 +4,11 @@
 
 use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
-    publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
-    CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
-    MeasurementRecord, NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication,
-    PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    publish_refusal, AttemptOutcome, AttemptRecord, CampaignCounts, CampaignInsert, CampaignRecord,
+    CampaignSummary, ChildCounts, ChildOf, ChildRecord, CurveFidelity, CurveFilter, CurveRecord,
+    FanOut, FanOutResult, Finish, Heartbeat, JobFilter, MeasurementRecord, NewCampaign, NewCurve,
+    NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord, Store,
+    StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
 use sqlx::sqlite::{
@@ -226,6 +227,29 @@ fn token_from_row(row: &SqliteRow) -> Result<TokenRecord, StoreError> {
         role: Role::parse(&role).ok_or_else(|| corrupt(format!("token role `{role}`")))?,
         created_ms: row.try_get("created_ms")?,
         revoked: row.try_get::<Option<i64>, _>("revoked_ms")?.is_some(),
+    })
+}
+
+/// Columns of a campaign summary (everything but the content).
+const CAMPAIGN_SUMMARY: &str = "seq, id, name, created_by, created_ms, content_sha256, \
+    content_bytes, tests, specimens, increments, accelerometer_records";
+
+fn campaign_from_row(row: &SqliteRow) -> Result<CampaignSummary, StoreError> {
+    let id: String = row.try_get("id")?;
+    Ok(CampaignSummary {
+        id: parse_uuid(&id)?,
+        seq: row.try_get("seq")?,
+        name: row.try_get("name")?,
+        created_by: row.try_get("created_by")?,
+        created_ms: row.try_get("created_ms")?,
+        content_sha256: row.try_get("content_sha256")?,
+        content_bytes: row.try_get("content_bytes")?,
+        counts: CampaignCounts {
+            tests: row.try_get("tests")?,
+            specimens: row.try_get("specimens")?,
+            increments: row.try_get("increments")?,
+            accelerometer_records: row.try_get("accelerometer_records")?,
+        },
     })
 }
 
@@ -1172,6 +1196,76 @@ impl Store for SqliteStore {
             let record = curve_from_row(&record)?;
             tx.commit().await?;
             Ok(PublishOutcome::Published(record))
+        })
+    }
+
+    fn insert_campaign(&self, c: NewCampaign) -> StoreFuture<'_, CampaignInsert> {
+        Box::pin(async move {
+            let inserted = sqlx::query(&format!(
+                "INSERT INTO campaigns (id, name, created_by, created_ms, content, \
+                 content_sha256, content_bytes, tests, specimens, increments, \
+                 accelerometer_records) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11) \
+                 ON CONFLICT (content_sha256) DO NOTHING RETURNING {CAMPAIGN_SUMMARY}"
+            ))
+            .bind(c.id.to_string())
+            .bind(&c.name)
+            .bind(&c.created_by)
+            .bind(c.created_ms)
+            .bind(&c.content)
+            .bind(&c.content_sha256)
+            .bind(c.content.len() as i64)
+            .bind(c.counts.tests)
+            .bind(c.counts.specimens)
+            .bind(c.counts.increments)
+            .bind(c.counts.accelerometer_records)
+            .fetch_optional(&self.pool)
+            .await?;
+            if let Some(row) = inserted {
+                return Ok(CampaignInsert::Created(campaign_from_row(&row)?));
+            }
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns WHERE content_sha256 = ?1"
+            ))
+            .bind(&c.content_sha256)
+            .fetch_one(&self.pool)
+            .await?;
+            Ok(CampaignInsert::Existing(campaign_from_row(&row)?))
+        })
+    }
+
+    fn get_campaign(&self, id: Uuid) -> StoreFuture<'_, Option<CampaignRecord>> {
+        Box::pin(async move {
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY}, content FROM campaigns WHERE id = ?1"
+            ))
+            .bind(id.to_string())
+            .fetch_optional(&self.pool)
+            .await?;
+            row.map(|row| {
+                Ok(CampaignRecord {
+                    summary: campaign_from_row(&row)?,
+                    content: row.try_get("content")?,
+                })
+            })
+            .transpose()
+        })
+    }
+
+    fn list_campaigns(&self, page: PageRequest) -> StoreFuture<'_, Page<CampaignSummary>> {
+        Box::pin(async move {
+            let rows = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns WHERE (?1 IS NULL OR seq < ?1) \
+                 ORDER BY seq DESC LIMIT ?2"
+            ))
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(campaign_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |c| c.seq))
         })
     }
 

@@ -13,10 +13,14 @@ use std::time::{Duration, Instant};
 pub const ADMIN: &str = "admin-token-0123456789abcdef";
 pub const ENGINEER: &str = "engineer-token-0123456789abcdef";
 pub const PLANNER: &str = "planner-token-0123456789abcdef";
+pub const TEST_ENGINEER: &str = "test-engineer-token-0123456789abcdef";
 
-/// `RAILWEAR_TOKENS` value for the three test tokens.
+/// `RAILWEAR_TOKENS` value for the four test tokens.
 pub fn tokens_env() -> String {
-    format!("root:admin:{ADMIN},eng:engineer:{ENGINEER},plan:planner:{PLANNER}")
+    format!(
+        "root:admin:{ADMIN},eng:engineer:{ENGINEER},plan:planner:{PLANNER},\
+         lab:test-engineer:{TEST_ENGINEER}"
+    )
 }
 
 /// A fresh directory under the system temp dir, removed on drop.
