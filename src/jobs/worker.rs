@@ -197,12 +197,46 @@ impl Jobs {
         };
         let status = finish.status();
         self.running_flags().remove(&id);
-        self.metrics.attempt_finished(id, kind, status);
+        match job.started_ms {
+            // A fanned-out job's duration is the whole job's, from its first claim.
+            Some(first_claim) if job.children.is_some() => {
+                let whole_s = (clock::now_ms() - first_claim) as f64 / 1000.0;
+                self.metrics
+                    .fanned_out_job_finished(id, kind, status, whole_s);
+            }
+            _ => self.metrics.attempt_finished(id, kind, status),
+        }
         if lost {
             tracing::warn!(job = %id, attempt, "lease lost to a newer attempt; result discarded");
             return;
         }
         self.finish(id, attempt, finish).await;
+        if let (Some(child_of), JobStatus::Failed | JobStatus::Cancelled) = (job.parent, status) {
+            self.observe_parent_end(child_of.parent_id, id).await;
+        }
+    }
+
+    /// After child `child` ended unsuccessfully: when that failed its parent (the parent's
+    /// error names this child; the store writes it in the child's finishing transaction), the
+    /// parent ended without an attempt of its own, and its whole duration goes to the
+    /// histogram here, once.
+    async fn observe_parent_end(&self, parent: uuid::Uuid, child: uuid::Uuid) {
+        let Ok(Some(record)) = self.store.get_job(parent).await else {
+            return;
+        };
+        let named = record
+            .error
+            .as_deref()
+            .is_some_and(|e| e.contains(&format!("(job {child})")));
+        if let (JobStatus::Failed, true, Some(started), Some(finished)) =
+            (record.status, named, record.started_ms, record.finished_ms)
+        {
+            self.metrics.job_ended(
+                record.kind,
+                record.status,
+                (finished - started) as f64 / 1000.0,
+            );
+        }
     }
 
     /// End an attempt. A finish that fails on a transient database error is retried; a
