@@ -106,6 +106,9 @@ pub struct ServiceConfig {
     pub poll_interval_ms: u64,
     /// Attempts before a job whose worker keeps dying is failed.
     pub max_attempts: u32,
+    /// On SIGTERM, how long a running attempt gets to stop at a step boundary before its job
+    /// is given back to the queue anyway, s.
+    pub shutdown_grace_s: f64,
     /// Largest accepted request body, bytes.
     pub body_limit_bytes: usize,
     /// Largest accepted campaign upload (`POST /v1/campaigns`, accelerometer samples inline),
@@ -132,6 +135,7 @@ impl Default for ServiceConfig {
             heartbeat_s: 1.0,
             poll_interval_ms: 250,
             max_attempts: 3,
+            shutdown_grace_s: 5.0,
             body_limit_bytes: 8 * 1024 * 1024,
             campaign_body_limit_bytes: DEFAULT_CAMPAIGN_BODY_LIMIT_BYTES,
             log_format: "text".into(),
@@ -230,6 +234,9 @@ impl ServiceConfig {
         if let Some(v) = env("RAILWEAR_MAX_ATTEMPTS") {
             self.max_attempts = num("RAILWEAR_MAX_ATTEMPTS", &v)?;
         }
+        if let Some(v) = env("RAILWEAR_SHUTDOWN_GRACE_S") {
+            self.shutdown_grace_s = num("RAILWEAR_SHUTDOWN_GRACE_S", &v)?;
+        }
         if let Some(v) = env("RAILWEAR_BODY_LIMIT_BYTES") {
             self.body_limit_bytes = num("RAILWEAR_BODY_LIMIT_BYTES", &v)?;
         }
@@ -280,6 +287,12 @@ impl ServiceConfig {
         }
         if self.heartbeat_s * 2.0 > self.lease_s {
             return Err(invalid("heartbeat_s", "must be at most half of lease_s"));
+        }
+        if !(self.shutdown_grace_s.is_finite() && (0.0..=300.0).contains(&self.shutdown_grace_s)) {
+            return Err(invalid(
+                "shutdown_grace_s",
+                "must be a number of seconds in [0, 300]",
+            ));
         }
         if self.max_attempts == 0 {
             return Err(invalid("max_attempts", "must be at least 1"));
@@ -332,6 +345,18 @@ impl ServiceConfig {
                 .unwrap_or_else(|_| self.configs_dir.clone())
         };
         dir.canonicalize().unwrap_or(dir)
+    }
+
+    /// Worker-pool settings (lease, heartbeat, poll, attempts, track blocks, shutdown grace).
+    pub fn worker_settings(&self) -> crate::jobs::WorkerSettings {
+        crate::jobs::WorkerSettings {
+            lease: std::time::Duration::from_secs_f64(self.lease_s),
+            heartbeat: std::time::Duration::from_secs_f64(self.heartbeat_s),
+            poll: std::time::Duration::from_millis(self.poll_interval_ms.max(1)),
+            max_attempts: self.max_attempts,
+            track_block_samples: self.track_block_samples,
+            shutdown_grace: std::time::Duration::from_secs_f64(self.shutdown_grace_s),
+        }
     }
 
     /// Number of worker threads to run (`workers`, or one per core when 0).

@@ -116,7 +116,9 @@ pub struct AttemptView {
     /// RFC 3339 UTC time the attempt ended; absent while it runs.
     pub ended_at: Option<String>,
     /// `running`, `succeeded`, `failed`, `cancelled`, `fanned_out` (made the job's children
-    /// and left it waiting for them) or `lost` (lease expired).
+    /// and left it waiting for them), `lost` (lease expired, or its process was found dead by
+    /// a worker starting on the same host) or `released` (given back to the queue when its
+    /// worker shut down).
     pub outcome: String,
 }
 

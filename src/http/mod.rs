@@ -13,7 +13,7 @@ pub mod rails;
 pub mod tokens;
 
 use crate::config::{Role, ServiceConfig};
-use crate::jobs::{CaseRunner, CurveDefaults, Jobs, WorkerSettings};
+use crate::jobs::{CaseRunner, CurveDefaults, Jobs};
 use crate::store::{self, Store, StoreError};
 use axum::extract::DefaultBodyLimit;
 use axum::http::StatusCode;
@@ -23,7 +23,6 @@ use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::ops::Deref;
 use std::sync::Arc;
-use std::time::Duration;
 use tower_http::limit::RequestBodyLimitLayer;
 use tower_http::trace::TraceLayer;
 
@@ -128,14 +127,23 @@ pub struct RunningService {
 }
 
 impl RunningService {
-    /// Stop accepting requests, finish in-flight ones, stop the workers. A job running here
-    /// is left to its lease: it is re-queued when the lease expires.
+    /// Clean shutdown: stop accepting requests and finish in-flight ones, while the workers
+    /// stop taking jobs and give running ones back to the queue within `shutdown_grace_s`
+    /// ([`Jobs::shutdown`]).
     pub async fn stop(self) {
         let _ = self.shutdown.send(());
+        self.state.jobs.shutdown(self.workers).await;
         let _ = self.server.await;
+    }
+
+    /// Stop as a crash would leave things: the workers are dropped mid-attempt, their jobs
+    /// stay running until their leases expire (tests of lease recovery).
+    pub async fn abandon(self) {
         for worker in self.workers {
             worker.abort();
         }
+        let _ = self.shutdown.send(());
+        let _ = self.server.await;
     }
 }
 
@@ -146,13 +154,7 @@ pub async fn start(
     workers: bool,
 ) -> Result<RunningService, StartError> {
     let store = store::open(&config.database_url).await?;
-    let settings = WorkerSettings {
-        lease: Duration::from_secs_f64(config.lease_s),
-        heartbeat: Duration::from_secs_f64(config.heartbeat_s),
-        poll: Duration::from_millis(config.poll_interval_ms.max(1)),
-        max_attempts: config.max_attempts,
-        track_block_samples: config.track_block_samples,
-    };
+    let settings = config.worker_settings();
     let curve_defaults = CurveDefaults {
         vehicle_profile: config.report.vehicle_profile.clone(),
         environment: config.report.environment.clone(),
@@ -176,8 +178,10 @@ pub async fn start(
     })?;
     let worker_handles = if workers {
         let count = config.worker_count();
-        tracing::info!(count, "starting workers");
-        jobs.spawn_workers(count, &format!("{}-{}", std::process::id(), addr.port()))
+        // Jobs left running by dead processes of this host go back to the queue at once.
+        jobs.release_dead_leases().await?;
+        tracing::info!(count, host = %jobs.host.host, pid = jobs.host.pid, "starting workers");
+        jobs.spawn_workers(count, &jobs.worker_prefix())
     } else {
         Vec::new()
     };

@@ -106,6 +106,13 @@ impl Metrics {
         });
     }
 
+    /// An attempt was given back at shutdown: no longer running here, not a finished job.
+    pub fn attempt_released(&self, id: Uuid) {
+        self.with(|m| {
+            m.running.remove(&id);
+        });
+    }
+
     /// The attempt that ended a fanned-out job (a sweep's assembly) ended with `status`; the
     /// job took `whole_s` from its first claim (fan-out, children, assembly), which is what the
     /// duration histogram counts for it, not the assembly alone.

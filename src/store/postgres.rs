@@ -9,9 +9,9 @@ use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, CampaignCounts, CampaignInsert, CampaignRecord,
     CampaignSummary, ChildCounts, ChildOf, ChildRecord, CurveFidelity, CurveFilter, CurveRecord,
-    FanOut, FanOutResult, Finish, Heartbeat, JobFilter, MeasurementRecord, NewCampaign, NewCurve,
-    NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord, Store,
-    StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    FanOut, FanOutResult, Finish, Heartbeat, HostLease, JobFilter, MeasurementRecord, NewCampaign,
+    NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord,
+    ReleaseOutcome, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
 use crate::config::Role;
 use sqlx::postgres::{PgConnectOptions, PgConnection, PgPool, PgPoolOptions, PgRow};
@@ -524,13 +524,15 @@ impl Store for PgStore {
         })
     }
 
-    fn claim_job(
+    fn claim_job_on(
         &self,
         worker: &str,
+        host: Option<&WorkerHost>,
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
         let worker = worker.to_string();
+        let host = host.cloned();
         Box::pin(async move {
             let mut tx = self.pool.begin().await?;
             // The row lock is held to commit; a concurrent claimer skips the locked row and
@@ -550,7 +552,7 @@ impl Store for PgStore {
             let sql = format!(
                 "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $2, \
                  lease_expires_ms = $3 + $4, started_ms = COALESCE(started_ms, $3), \
-                 attempt_started_ms = $3, \
+                 attempt_started_ms = $3, lease_host = $5, lease_pid = $6, lease_instance = $7, \
                  progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
                  progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
                  progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
@@ -562,6 +564,9 @@ impl Store for PgStore {
                 .bind(&worker)
                 .bind(now_ms)
                 .bind(lease_ms)
+                .bind(host.as_ref().map(|h| h.host.clone()))
+                .bind(host.as_ref().map(|h| i64::from(h.pid)))
+                .bind(host.as_ref().map(|h| h.instance.clone()))
                 .fetch_optional(&mut *tx)
                 .await?;
             let record = row.as_ref().map(job_from_row).transpose()?;
@@ -579,6 +584,85 @@ impl Store for PgStore {
             }
             tx.commit().await?;
             Ok(record)
+        })
+    }
+
+    fn host_leases(&self, host: &str) -> StoreFuture<'_, Vec<HostLease>> {
+        let host = host.to_string();
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT id, attempt, lease_pid, lease_instance FROM jobs \
+                 WHERE status = 'running' AND lease_host = $1 AND lease_pid IS NOT NULL \
+                 AND lease_instance IS NOT NULL ORDER BY seq",
+            )
+            .bind(host)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let pid: i64 = row.try_get("lease_pid")?;
+                    Ok(HostLease {
+                        job: row.try_get("id")?,
+                        attempt: row.try_get("attempt")?,
+                        pid: u32::try_from(pid).map_err(|_| corrupt(format!("pid {pid}")))?,
+                        instance: row.try_get("lease_instance")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn expire_leases(&self, attempts: Vec<(Uuid, i64)>, now_ms: i64) -> StoreFuture<'_, u64> {
+        Box::pin(async move {
+            let mut n = 0;
+            // One statement per job (no other row touched): no lock order to keep.
+            for (id, attempt) in attempts {
+                n += sqlx::query(
+                    "UPDATE jobs SET lease_expires_ms = $3 - 1 \
+                     WHERE id = $1 AND attempt = $2 AND status = 'running'",
+                )
+                .bind(id)
+                .bind(attempt)
+                .bind(now_ms)
+                .execute(&self.pool)
+                .await?
+                .rows_affected();
+            }
+            Ok(n)
+        })
+    }
+
+    fn release_job(&self, id: Uuid, attempt: i64, now_ms: i64) -> StoreFuture<'_, ReleaseOutcome> {
+        Box::pin(async move {
+            // Only the job's own row (and its attempt) is written: no parent lock needed.
+            let mut tx = self.pool.begin().await?;
+            let row = sqlx::query(
+                "SELECT cancel_requested FROM jobs WHERE id = $1 AND attempt = $2 \
+                 AND status = 'running' FOR UPDATE",
+            )
+            .bind(id)
+            .bind(attempt)
+            .fetch_optional(&mut *tx)
+            .await?;
+            let outcome = match row {
+                None => ReleaseOutcome::Stale,
+                Some(row) if row.try_get::<bool, _>("cancel_requested")? => {
+                    ReleaseOutcome::CancelRequested
+                }
+                Some(_) => {
+                    sqlx::query(
+                        "UPDATE jobs SET status = 'queued', lease_owner = NULL, \
+                         lease_expires_ms = NULL, progress_eta_s = NULL WHERE id = $1",
+                    )
+                    .bind(id)
+                    .execute(&mut *tx)
+                    .await?;
+                    end_attempt(&mut tx, id, attempt, AttemptOutcome::Released, now_ms).await?;
+                    ReleaseOutcome::Released
+                }
+            };
+            tx.commit().await?;
+            Ok(outcome)
         })
     }
 

@@ -6,9 +6,9 @@ use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, CampaignCounts, CampaignInsert, CampaignRecord,
     CampaignSummary, ChildCounts, ChildOf, ChildRecord, CurveFidelity, CurveFilter, CurveRecord,
-    FanOut, FanOutResult, Finish, Heartbeat, JobFilter, MeasurementRecord, NewCampaign, NewCurve,
-    NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord, Store,
-    StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    FanOut, FanOutResult, Finish, Heartbeat, HostLease, JobFilter, MeasurementRecord, NewCampaign,
+    NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord,
+    ReleaseOutcome, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
 use crate::config::Role;
 use sqlx::sqlite::{
@@ -483,13 +483,15 @@ impl Store for SqliteStore {
         })
     }
 
-    fn claim_job(
+    fn claim_job_on(
         &self,
         worker: &str,
+        host: Option<&WorkerHost>,
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
         let worker = worker.to_string();
+        let host = host.cloned();
         Box::pin(async move {
             // One statement: the sub-select and the update run under the same write lock, so
             // two workers can never take the same job. A parent queued for its assembly keeps
@@ -498,7 +500,7 @@ impl Store for SqliteStore {
             let sql = format!(
                 "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = ?1, \
                  lease_expires_ms = ?2 + ?3, started_ms = COALESCE(started_ms, ?2), \
-                 attempt_started_ms = ?2, \
+                 attempt_started_ms = ?2, lease_host = ?4, lease_pid = ?5, lease_instance = ?6, \
                  progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
                  progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
                  progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
@@ -510,6 +512,9 @@ impl Store for SqliteStore {
                 .bind(&worker)
                 .bind(now_ms)
                 .bind(lease_ms)
+                .bind(host.as_ref().map(|h| h.host.clone()))
+                .bind(host.as_ref().map(|h| i64::from(h.pid)))
+                .bind(host.as_ref().map(|h| h.instance.clone()))
                 .fetch_optional(&mut *tx)
                 .await?;
             let Some(job) = row.as_ref().map(job_from_row).transpose()? else {
@@ -528,6 +533,93 @@ impl Store for SqliteStore {
             .await?;
             tx.commit().await?;
             Ok(Some(job))
+        })
+    }
+
+    fn host_leases(&self, host: &str) -> StoreFuture<'_, Vec<HostLease>> {
+        let host = host.to_string();
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT id, attempt, lease_pid, lease_instance FROM jobs \
+                 WHERE status = 'running' AND lease_host = ?1 AND lease_pid IS NOT NULL \
+                 AND lease_instance IS NOT NULL ORDER BY seq",
+            )
+            .bind(host)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let id: String = row.try_get("id")?;
+                    let pid: i64 = row.try_get("lease_pid")?;
+                    Ok(HostLease {
+                        job: parse_uuid(&id)?,
+                        attempt: row.try_get("attempt")?,
+                        pid: u32::try_from(pid).map_err(|_| corrupt(format!("pid {pid}")))?,
+                        instance: row.try_get("lease_instance")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn expire_leases(&self, attempts: Vec<(Uuid, i64)>, now_ms: i64) -> StoreFuture<'_, u64> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let mut n = 0;
+            for (id, attempt) in attempts {
+                n += sqlx::query(
+                    "UPDATE jobs SET lease_expires_ms = ?3 - 1 \
+                     WHERE id = ?1 AND attempt = ?2 AND status = 'running'",
+                )
+                .bind(id.to_string())
+                .bind(attempt)
+                .bind(now_ms)
+                .execute(&mut *tx)
+                .await?
+                .rows_affected();
+            }
+            tx.commit().await?;
+            Ok(n)
+        })
+    }
+
+    fn release_job(&self, id: Uuid, attempt: i64, now_ms: i64) -> StoreFuture<'_, ReleaseOutcome> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let row = sqlx::query(
+                "SELECT cancel_requested FROM jobs WHERE id = ?1 AND attempt = ?2 \
+                 AND status = 'running'",
+            )
+            .bind(id.to_string())
+            .bind(attempt)
+            .fetch_optional(&mut *tx)
+            .await?;
+            let outcome = match row {
+                None => ReleaseOutcome::Stale,
+                Some(row) if row.try_get::<i64, _>("cancel_requested")? != 0 => {
+                    ReleaseOutcome::CancelRequested
+                }
+                Some(_) => {
+                    sqlx::query(
+                        "UPDATE jobs SET status = 'queued', lease_owner = NULL, \
+                         lease_expires_ms = NULL, progress_eta_s = NULL WHERE id = ?1",
+                    )
+                    .bind(id.to_string())
+                    .execute(&mut *tx)
+                    .await?;
+                    end_attempt(
+                        &mut tx,
+                        &id.to_string(),
+                        attempt,
+                        AttemptOutcome::Released,
+                        now_ms,
+                    )
+                    .await?;
+                    ReleaseOutcome::Released
+                }
+            };
+            tx.commit().await?;
+            Ok(outcome)
         })
     }
 
