@@ -605,6 +605,9 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         assert!(p["detail"].as_str().unwrap().contains("2 points < 5"), "{p}");
         assert_eq!(report_of(&base, "R-7")["curve"]["id"], v1);
         // Unknown keys and bad ids are refused naming the field.
+        // JSON `null` (the document allows it: the body is optional) is no force either.
+        let p = publish(&base, v2, Some("null")).problem(409);
+        assert_eq!(p["field"], "force");
         let p = publish(&base, v2, Some(r#"{"forse":true}"#)).problem(422);
         assert!(p["detail"].as_str().unwrap().contains("forse"), "{p}");
         publish(&base, 0, None).problem(400);

@@ -106,6 +106,7 @@ impl From<CampaignSummary> for CampaignView {
 #[serde(deny_unknown_fields)]
 pub struct CampaignDocument {
     /// Format version: 1.
+    #[schema(minimum = 1, maximum = 1)]
     pub format_version: u32,
     /// Short identifier (not empty).
     pub name: String,

@@ -336,7 +336,7 @@ pub struct ReportQuery {
     /// Wear law of the curve: `modified-archard`, `archard` or `legacy-appendix`.
     pub wear_law: Option<String>,
     /// T_SL,design, h (> 0).
-    #[param(value_type = Option<f64>)]
+    #[param(value_type = Option<f64>, exclusive_minimum = 0)]
     pub design_life_h: Option<String>,
 }
 
@@ -413,7 +413,8 @@ fn check_serial(serial: &str) -> Result<(), Problem> {
         Err(Problem::bad_parameter(
             "serial",
             format!(
-                "must match {SERIAL_PATTERN}: 1-64 characters, letters, digits, '-', '_' or '.',                  starting with a letter or digit"
+                "must match {SERIAL_PATTERN}: 1-64 characters, letters, digits, '-', '_' or '.', \
+                 starting with a letter or digit"
             ),
         ))
     }
