@@ -236,7 +236,7 @@ enum CampaignCommand {
 enum TokenCommand {
     /// Create a token and print it (shown once).
     Create {
-        /// planner, engineer or admin.
+        /// planner, engineer, test-engineer (also spelled test_engineer) or admin.
         #[arg(long)]
         role: String,
         /// Who holds it.
@@ -324,9 +324,13 @@ async fn serve(
     std::io::stdout().flush()?;
     tracing::info!(addr = %service.addr, version = %railwear::jobs::code_version(), "serving");
     shutdown_signal().await;
-    tracing::info!("shutting down");
+    tracing::info!(
+        grace_s = service.state.config.shutdown_grace_s,
+        "shutting down"
+    );
     service.stop().await;
-    Ok(())
+    tracing::info!("stopped");
+    exit_now()
 }
 
 async fn worker(
@@ -345,13 +349,7 @@ async fn worker(
     let store = railwear::store::open(&config.database_url)
         .await
         .context("opening the job database")?;
-    let settings = railwear::jobs::WorkerSettings {
-        lease: std::time::Duration::from_secs_f64(config.lease_s),
-        heartbeat: std::time::Duration::from_secs_f64(config.heartbeat_s),
-        poll: std::time::Duration::from_millis(config.poll_interval_ms.max(1)),
-        max_attempts: config.max_attempts,
-        track_block_samples: config.track_block_samples,
-    };
+    let settings = config.worker_settings();
     let curve_defaults = railwear::jobs::CurveDefaults {
         vehicle_profile: config.report.vehicle_profile.clone(),
         environment: config.report.environment.clone(),
@@ -362,20 +360,29 @@ async fn worker(
     });
     let jobs = railwear::jobs::Jobs::new(store, runner, settings, curve_defaults);
     let count = config.worker_count();
+    // Jobs left running by dead processes of this host go back to the queue at once.
+    jobs.release_dead_leases()
+        .await
+        .context("releasing the leases of dead workers")?;
     // Worker names carry host and pid so a lease owner can be traced to its process.
-    let host = std::env::var("HOSTNAME").unwrap_or_else(|_| "host".into());
-    let handles = jobs.spawn_workers(count, &format!("{host}-{}", std::process::id()));
+    let handles = jobs.spawn_workers(count, &jobs.worker_prefix());
     // Tests and scripts read this line to know the workers are polling.
     println!("workers started: {count}");
     std::io::stdout().flush()?;
     tracing::info!(count, version = %railwear::jobs::code_version(), "workers started");
     shutdown_signal().await;
-    // Attempts in flight are abandoned; their leases expire and another worker re-runs them.
-    tracing::info!("shutting down");
-    for handle in handles {
-        handle.abort();
-    }
-    Ok(())
+    // Stop taking jobs; running ones stop at a step boundary and go back to the queue.
+    tracing::info!(grace_s = config.shutdown_grace_s, "shutting down");
+    jobs.shutdown(handles).await;
+    tracing::info!("workers stopped");
+    exit_now()
+}
+
+/// End the process at once: a computation that did not stop within the grace period is not
+/// waited for (its job is already back in the queue, and its late result would be fenced out).
+fn exit_now() -> ! {
+    let _ = std::io::stdout().flush();
+    std::process::exit(0)
 }
 
 #[tokio::main]
@@ -399,7 +406,7 @@ async fn main() -> Result<()> {
             command: TokenCommand::Create { role, name },
         } => {
             let Some(role) = Role::parse(role) else {
-                bail!("--role must be planner, engineer or admin");
+                bail!("--role must be planner, engineer, test-engineer or admin");
             };
             let config = load_config(&cli)?;
             let store = railwear::store::open(&config.database_url).await?;

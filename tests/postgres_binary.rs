@@ -366,3 +366,59 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     drop(store);
     drop(rt);
 }
+
+/// Issue 17 on PostgreSQL: SIGTERM to a `railwear worker` running a 600 s simulation makes it
+/// exit within its grace and give the job back at once (attempt `released`); a worker started
+/// next takes it as attempt 2 without waiting for the 60 s lease.
+#[test]
+fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
+    let rt = tokio::runtime::Runtime::new().expect("runtime");
+    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("sigterm").await }) else {
+        return;
+    };
+    let env = [
+        ("RAILWEAR_LEASE_S", "60"),
+        ("RAILWEAR_SHUTDOWN_GRACE_S", "2"),
+    ];
+    let (_api, base) = api(&db.url, &env);
+    let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
+    let id = submit_job(&base, long);
+    let mut first = worker(&db.url, &env);
+    wait_status(&base, &id, "running", Duration::from_secs(60));
+    let asked = std::time::Instant::now();
+    let status = std::process::Command::new("kill")
+        .args(["-TERM", &first.0.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let exit = loop {
+        if let Some(exit) = first.0.try_wait().expect("try_wait") {
+            break exit;
+        }
+        assert!(asked.elapsed() < Duration::from_secs(20), "no exit");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(exit.success(), "{exit}");
+    assert!(
+        asked.elapsed() < Duration::from_secs(2 + 3),
+        "{:?}",
+        asked.elapsed()
+    );
+    let j = get_job(&base, &id);
+    assert_eq!(j["status"], "queued", "{j}");
+    let log = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
+    assert_eq!(log[0]["outcome"], "released", "{log}");
+
+    let _second = worker(&db.url, &env);
+    let retaken = wait_status(&base, &id, "running", Duration::from_secs(10));
+    assert_eq!(retaken["attempt"], 2);
+    curl(
+        "POST",
+        &format!("{base}/v1/jobs/{id}/cancel"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    wait_status(&base, &id, "cancelled", Duration::from_secs(30));
+    drop(rt);
+}

@@ -9,8 +9,9 @@ mod service_support;
 use railwear::config::Role;
 use railwear::jobs::{JobKind, JobProgress, JobStatus};
 use railwear::store::{
-    self, CurveFidelity, CurveFilter, Finish, Heartbeat, JobFilter, NewCurve, NewJob,
-    NewMeasurement, PageRequest, PublishOutcome, Store, Submitted, TrackBlock,
+    self, CampaignCounts, CampaignInsert, CampaignSummary, CurveFidelity, CurveFilter, Finish,
+    Heartbeat, JobFilter, NewCampaign, NewCurve, NewJob, NewMeasurement, PageRequest,
+    PublishOutcome, Store, Submitted, TrackBlock,
 };
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -252,6 +253,71 @@ async fn expired_lease_is_requeued_and_the_stale_attempt_is_fenced_out() {
         .unwrap()
         .is_none());
     assert!(!store.finish_job(id, 3, succeeded(7), 16_000).await.unwrap());
+}
+
+/// Campaign `n` of a test with the given content (fixed id and times).
+fn new_campaign(n: u128, content: &str) -> NewCampaign {
+    NewCampaign {
+        id: Uuid::from_u128(0xca3a_0000 + n),
+        name: format!("campaign-{n}"),
+        created_by: format!("lab-{n}"),
+        created_ms: 10_000 + n as i64,
+        content: content.to_string(),
+        content_sha256: railwear::jobs::hex(&<sha2::Sha256 as sha2::Digest>::digest(
+            content.as_bytes(),
+        )),
+        counts: CampaignCounts {
+            tests: 4,
+            specimens: 6,
+            increments: 10 + n as i64,
+            accelerometer_records: 2,
+        },
+    }
+}
+
+/// A campaign summary without its store-assigned sequence number (an upload refused as a
+/// duplicate uses up a PostgreSQL identity value, not an SQLite one), for comparing traces.
+fn campaign_no_seq(c: &CampaignSummary) -> String {
+    format!(
+        "{} {} {} {} {} {} {:?}",
+        c.id, c.name, c.created_by, c.created_ms, c.content_sha256, c.content_bytes, c.counts
+    )
+}
+
+/// Eight concurrent uploads of the same campaign content store it once: one `Created`, seven
+/// `Existing` naming that record, no unique-key error.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn racing_identical_campaign_uploads_store_one() {
+    let db = fresh_db!("campaign");
+    let store = store::open(&db.url).await.expect("open postgres store");
+    let mut tasks = Vec::new();
+    for n in 0..8 {
+        let store = Arc::clone(&store);
+        tasks.push(tokio::spawn(async move {
+            store
+                .insert_campaign(new_campaign(n, r#"{"name":"same"}"#))
+                .await
+                .unwrap()
+        }));
+    }
+    let (mut created, mut existing) = (Vec::new(), Vec::new());
+    for task in tasks {
+        match task.await.unwrap() {
+            CampaignInsert::Created(c) => created.push(c.id),
+            CampaignInsert::Existing(c) => existing.push(c.id),
+        }
+    }
+    assert_eq!(created.len(), 1);
+    assert_eq!(existing.len(), 7);
+    assert!(existing.iter().all(|id| *id == created[0]));
+    let page = store
+        .list_campaigns(PageRequest {
+            limit: 100,
+            after_seq: None,
+        })
+        .await
+        .unwrap();
+    assert_eq!(page.items.len(), 1);
 }
 
 /// Eight concurrent submissions with one Idempotency-Key make one job: one `Created`, seven
@@ -728,6 +794,67 @@ async fn script(store: &dyn Store) -> Vec<String> {
     log("curves page 2", format!("{versions:?}"));
     assert_eq!(rest.items.len(), 1);
 
+    // Campaigns: the content comes back as the exact text stored (floats, non-ASCII, 2 MB);
+    // the same content is stored once; lists are newest first, without content.
+    let big = format!(
+        r#"{{"name":"c2","samples":[{}]}}"#,
+        vec!["[0.30000000000000004,-1e-300,2.5e300,0.1]"; 50_000].join(",")
+    );
+    let c1 = store
+        .insert_campaign(new_campaign(1, r#"{"name":"c1","µ":"ü","x":0.1}"#))
+        .await
+        .unwrap();
+    let CampaignInsert::Created(c1) = c1 else {
+        panic!("{c1:?}")
+    };
+    assert_eq!(
+        c1.content_bytes,
+        r#"{"name":"c1","µ":"ü","x":0.1}"#.len() as i64
+    );
+    let c2 = store.insert_campaign(new_campaign(2, &big)).await.unwrap();
+    let CampaignInsert::Created(c2) = c2 else {
+        panic!("{c2:?}")
+    };
+    assert!(c2.seq > c1.seq);
+    let again = store
+        .insert_campaign(new_campaign(3, r#"{"name":"c1","µ":"ü","x":0.1}"#))
+        .await
+        .unwrap();
+    assert_eq!(again, CampaignInsert::Existing(c1.clone()));
+    let got = store.get_campaign(c2.id).await.unwrap().unwrap();
+    assert_eq!(got.content, big);
+    assert_eq!(got.summary, c2);
+    let got = store.get_campaign(c1.id).await.unwrap().unwrap();
+    assert_eq!(got.content, r#"{"name":"c1","µ":"ü","x":0.1}"#);
+    assert_eq!(
+        store
+            .get_campaign(Uuid::from_u128(0xca3a_0003))
+            .await
+            .unwrap(),
+        None
+    );
+    let first = store
+        .list_campaigns(PageRequest {
+            limit: 1,
+            after_seq: None,
+        })
+        .await
+        .unwrap();
+    assert_eq!(first.items, vec![c2.clone()]);
+    let second = store
+        .list_campaigns(PageRequest {
+            limit: 1,
+            after_seq: first.next_cursor.as_deref().and_then(|c| c.parse().ok()),
+        })
+        .await
+        .unwrap();
+    assert_eq!(second.items, vec![c1.clone()]);
+    assert_eq!(second.next_cursor, None);
+    log(
+        "campaigns",
+        format!("{} | {}", campaign_no_seq(&c2), campaign_no_seq(&c1)),
+    );
+
     // Tokens (their ids are random: compare the rest).
     let t = store
         .create_token("ops", Role::Engineer, "sha-t", 9_000)
@@ -737,6 +864,14 @@ async fn script(store: &dyn Store) -> Vec<String> {
         .create_token("boss", Role::Admin, "sha-u", 9_001)
         .await
         .unwrap();
+    store
+        .create_token("lab", Role::TestEngineer, "sha-v", 9_002)
+        .await
+        .unwrap();
+    assert_eq!(
+        store.find_token("sha-v").await.unwrap().map(|t| t.role),
+        Some(Role::TestEngineer)
+    );
     assert_eq!(
         store.find_token("sha-t").await.unwrap().map(|t| t.role),
         Some(Role::Engineer)

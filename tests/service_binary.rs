@@ -279,3 +279,204 @@ fn cancel_a_running_simulation() {
     });
     assert!(asked.elapsed() < Duration::from_millis(1500));
 }
+
+/// SIGTERM to `server`; returns how long it took to exit (panics after 30 s).
+fn sigterm(server: &mut Binary) -> Duration {
+    let asked = std::time::Instant::now();
+    let status = Command::new("kill")
+        .args(["-TERM", &server.child.id().to_string()])
+        .status()
+        .expect("run kill");
+    assert!(status.success());
+    loop {
+        if let Some(exit) = server.child.try_wait().expect("try_wait") {
+            assert!(exit.success(), "exit status {exit}");
+            return asked.elapsed();
+        }
+        assert!(
+            asked.elapsed() < Duration::from_secs(30),
+            "no exit after SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn attempt_outcomes(server: &Binary, id: &str) -> Vec<String> {
+    let r = curl(
+        "GET",
+        &server.url(&format!("/v1/jobs/{id}/attempts")),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()
+        .as_array()
+        .expect("attempts")
+        .iter()
+        .map(|a| a["outcome"].as_str().unwrap_or("?").to_string())
+        .collect()
+}
+
+fn job(server: &Binary, id: &str) -> serde_json::Value {
+    curl(
+        "GET",
+        &server.url(&format!("/v1/jobs/{id}")),
+        Some(ENGINEER),
+        &[],
+        None,
+    )
+    .json()
+}
+
+/// Issue 17: SIGTERM with a 600 s simulation running: the process exits within the grace, the
+/// job is queued again at once (not left running on a dead worker for the lease), its attempt
+/// logged `released`.
+#[test]
+fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
+    let dir = TempDir::new("sigterm");
+    let env = [
+        ("RAILWEAR_SHUTDOWN_GRACE_S", "2"),
+        ("RAILWEAR_LEASE_S", "60"),
+        ("RAILWEAR_WORKERS", "1"),
+    ];
+    let mut server = Binary::start(&dir.db_url(), &env);
+    let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
+    let id = submit_job(&server.url(""), long);
+    wait_for(Duration::from_secs(60), "running", || {
+        (job(&server, &id)["status"] == "running").then_some(())
+    });
+    let took = sigterm(&mut server);
+    assert!(took < Duration::from_secs(2 + 3), "exit took {took:?}");
+    drop(server);
+
+    // An API-only process reads the store: queued at once, the attempt released.
+    let api = Binary::start_with_args(&dir.db_url(), &env, &["--no-workers"]);
+    let j = job(&api, &id);
+    assert_eq!(j["status"], "queued", "{j}");
+    assert_eq!(j["worker"], serde_json::Value::Null);
+    assert_eq!(attempt_outcomes(&api, &id), ["released"]);
+}
+
+/// Issue 17: SIGTERM in the middle of a real sweep (one worker, three points), then a
+/// restart: the points finished before the shutdown are kept (the sweep-level checkpoint), the
+/// point that was running is given back and re-run from its start with its seed, and the
+/// sweep's result equals bit for bit the sequential uninterrupted sweep.
+#[test]
+fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
+    let params = serde_json::json!({
+        "config": "launcher-design",
+        "points": 3,
+        "seeds": 1,
+        "seed": 31,
+        "overrides": {"simulation": {"settle_s": 0.2, "duration_s": 0.3, "record_interval_s": 0.01}},
+    });
+    let reference = {
+        let params = params.clone();
+        std::thread::spawn(move || {
+            let configs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+            railwear::pipeline::sweep_job(
+                &params,
+                &configs,
+                &railwear::pipeline::RunControl::silent(),
+            )
+            .expect("sequential sweep")
+            .0
+        })
+    };
+    let dir = TempDir::new("sigterm-sweep");
+    let env = [
+        ("RAILWEAR_SHUTDOWN_GRACE_S", "5"),
+        ("RAILWEAR_LEASE_S", "60"),
+        ("RAILWEAR_WORKERS", "1"),
+    ];
+    let mut server = Binary::start(&dir.db_url(), &env);
+    let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
+    let id = submit_job(&server.url(""), &body);
+    let children = |server: &Binary| -> Vec<serde_json::Value> {
+        curl(
+            "GET",
+            &server.url(&format!("/v1/jobs?parent={id}&limit=100")),
+            Some(ENGINEER),
+            &[],
+            None,
+        )
+        .json()["items"]
+            .as_array()
+            .cloned()
+            .unwrap_or_default()
+    };
+    // Stop while one point is done and another runs.
+    let done_before: Vec<String> = wait_for(Duration::from_secs(300), "a point done", || {
+        let kids = children(&server);
+        let done: Vec<String> = kids
+            .iter()
+            .filter(|c| c["status"] == "succeeded")
+            .filter_map(|c| c["id"].as_str().map(str::to_string))
+            .collect();
+        let running = kids.iter().any(|c| c["status"] == "running");
+        (!done.is_empty() && running).then_some(done)
+    });
+    let took = sigterm(&mut server);
+    assert!(took < Duration::from_secs(5 + 3), "exit took {took:?}");
+    drop(server);
+
+    let server = Binary::start(&dir.db_url(), &env);
+    let done = wait_succeeded(&server, &id, Duration::from_secs(300));
+    assert_eq!(done["children"]["succeeded"], 3);
+    let result = curl(
+        "GET",
+        &server.url(&format!("/v1/jobs/{id}/result")),
+        Some(ENGINEER),
+        &[],
+        None,
+    )
+    .json();
+    assert_eq!(
+        result["summary"],
+        reference.join().expect("reference"),
+        "bit for bit the uninterrupted sweep"
+    );
+    let mut released = 0;
+    for kid in children(&server) {
+        let kid_id = kid["id"].as_str().unwrap().to_string();
+        let log = attempt_outcomes(&server, &kid_id);
+        if done_before.contains(&kid_id) {
+            assert_eq!(log, ["succeeded"], "kept, not re-run");
+        }
+        released += log.iter().filter(|o| *o == "released").count();
+        assert_eq!(log.last().map(String::as_str), Some("succeeded"));
+    }
+    assert!(released >= 1, "the running point was given back");
+}
+
+/// Issue 17: after a crash (SIGKILL) the restarted service, on the same host, re-queues the
+/// dead process's running job at once instead of after the 60 s lease.
+#[test]
+fn a_restarted_service_releases_its_dead_predecessors_job_at_once() {
+    let dir = TempDir::new("restart");
+    let env = [("RAILWEAR_LEASE_S", "60"), ("RAILWEAR_WORKERS", "1")];
+    let server = Binary::start(&dir.db_url(), &env);
+    let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":4,"overrides":{"simulation":{"duration_s":600}}}}"#;
+    let id = submit_job(&server.url(""), long);
+    wait_for(Duration::from_secs(60), "running", || {
+        (job(&server, &id)["status"] == "running").then_some(())
+    });
+    server.kill9();
+
+    let restarted = std::time::Instant::now();
+    let server = Binary::start(&dir.db_url(), &env);
+    let j = wait_for(Duration::from_secs(10), "attempt 2 running", || {
+        let j = job(&server, &id);
+        (j["status"] == "running" && j["attempt"] == 2).then_some(j)
+    });
+    assert!(restarted.elapsed() < Duration::from_secs(15));
+    assert_eq!(attempt_outcomes(&server, &id), ["lost", "running"], "{j}");
+    curl(
+        "POST",
+        &server.url(&format!("/v1/jobs/{id}/cancel")),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+}

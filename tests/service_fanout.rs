@@ -279,3 +279,80 @@ async fn sweep_points_cannot_be_submitted_and_bad_filters_are_refused() {
     .unwrap();
     service.stop().await;
 }
+
+/// The value of the Prometheus sample `name{labels}` in `text`, if present.
+fn sample_value(text: &str, series: &str) -> Option<f64> {
+    text.lines()
+        .find_map(|l| l.strip_prefix(series))
+        .and_then(|rest| rest.trim().parse().ok())
+}
+
+/// Issue 17: the sweep duration histogram counts whole sweeps, from the first claim through the
+/// children to the assembly (the assembly alone takes milliseconds), also when a child's
+/// failure ends the sweep; each sweep once.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_sweep_duration_histogram_counts_whole_sweeps() {
+    let dir = TempDir::new("fanout-metrics");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 2;
+    let service = start(config, true).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        // 4 children of 5 x 60 ms on 2 workers: at least 0.6 s of wall time.
+        let body = r#"{"kind":"sweep","params":{"children":4,"steps":5,"step_ms":60,"seed":3}}"#;
+        let id = submit_job(&base, body);
+        let failing =
+            r#"{"kind":"sweep","params":{"children":3,"steps":5,"step_ms":60,"fail_point":1}}"#;
+        let failed_id = submit_job(&base, failing);
+        for (job, status) in [(&id, "succeeded"), (&failed_id, "failed")] {
+            wait_for(Duration::from_secs(30), "sweep end", || {
+                (get_job(&base, job)["status"] == status).then_some(())
+            });
+        }
+        let job = get_job(&base, &id);
+        let whole_s = (chrono_ms(&job["finished_at"]) - chrono_ms(&job["started_at"])) / 1000.0;
+        assert!(whole_s >= 0.6, "{job}");
+        let text = curl("GET", &format!("{base}/metrics"), None, &[], None).body;
+        let sum = sample_value(
+            &text,
+            "railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"succeeded\"}",
+        )
+        .unwrap_or_else(|| panic!("{text}"));
+        assert!(
+            sum >= 0.6 && (sum - whole_s).abs() < 0.1,
+            "sum {sum}, whole {whole_s}"
+        );
+        assert_eq!(
+            sample_value(
+                &text,
+                "railwear_job_duration_seconds_count{kind=\"sweep\",status=\"succeeded\"}"
+            ),
+            Some(1.0)
+        );
+        // The failed sweep ended in its child's finish: counted once, with its whole time.
+        assert_eq!(
+            sample_value(
+                &text,
+                "railwear_job_duration_seconds_count{kind=\"sweep\",status=\"failed\"}"
+            ),
+            Some(1.0),
+            "{text}"
+        );
+        let failed_sum = sample_value(
+            &text,
+            "railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"failed\"}",
+        )
+        .unwrap();
+        assert!(failed_sum >= 0.25, "{failed_sum}");
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+/// Unix ms of an RFC 3339 time as the API writes it (`2024-05-01T08:30:00.123Z`).
+fn chrono_ms(v: &Value) -> f64 {
+    let text = v.as_str().expect("a time");
+    let ms = railwear::store::clock::parse_iso8601_ms(text).expect("RFC 3339");
+    ms as f64
+}

@@ -605,6 +605,9 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         assert!(p["detail"].as_str().unwrap().contains("2 points < 5"), "{p}");
         assert_eq!(report_of(&base, "R-7")["curve"]["id"], v1);
         // Unknown keys and bad ids are refused naming the field.
+        // JSON `null` (the document allows it: the body is optional) is no force either.
+        let p = publish(&base, v2, Some("null")).problem(409);
+        assert_eq!(p["field"], "force");
         let p = publish(&base, v2, Some(r#"{"forse":true}"#)).problem(422);
         assert!(p["detail"].as_str().unwrap().contains("forse"), "{p}");
         publish(&base, 0, None).problem(400);
@@ -623,6 +626,86 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         let one = curl("GET", &format!("{base}/v1/curves/{v1}"), Some(PLANNER), &[], None).json();
         assert_eq!(one["published"], false);
         assert_eq!(one["provenance"]["created_by"], "eng");
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+/// Issue 17: a report query naming a vehicle profile, environment or wear law no sweep can run
+/// is a 422 naming the parameter (it would stay at missing_curve forever); a malformed design
+/// life or an unknown or repeated parameter is a 400 naming it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn report_labels_must_name_what_a_sweep_runs() {
+    let dir = TempDir::new("report-labels");
+    let service = start(test_config(&dir.db_url()), false).await;
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/rails/R-7/measurements"),
+            Some(PLANNER),
+            &[],
+            Some(&measurement(LauncherDimensions::design())),
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let get = |query: &str| {
+            curl(
+                "GET",
+                &format!("{base}/v1/rails/R-7/report?{query}"),
+                Some(PLANNER),
+                &[],
+                None,
+            )
+        };
+        for (query, field, words) in [
+            (
+                "vehicle_profile=uh60",
+                "vehicle_profile",
+                "`uh60` is not a vehicle profile",
+            ),
+            ("environment=sand", "environment", "`sand` is not modelled"),
+            (
+                "wear_law=totally-made-up",
+                "wear_law",
+                "`totally-made-up` is not a wear law",
+            ),
+            (
+                "environment=clean&wear_law=Archard",
+                "wear_law",
+                "(known: modified-archard",
+            ),
+        ] {
+            let p = get(query).problem(422);
+            assert_eq!(p["field"], field, "{query}: {p}");
+            assert!(
+                p["detail"].as_str().unwrap().contains(words),
+                "{query}: {p}"
+            );
+        }
+        for (query, field) in [
+            ("design_life_h=abc", "design_life_h"),
+            ("design_life_h=-5", "design_life_h"),
+            ("vehicle_profil=ah64", "vehicle_profil"),
+            ("wear_law=archard&wear_law=archard", "wear_law"),
+        ] {
+            let p = get(query).problem(400);
+            assert_eq!(p["field"], field, "{query}: {p}");
+        }
+        // Known labels, by alias or by profile file name, give a report (no curve yet).
+        for query in [
+            "vehicle_profile=ah64&environment=clean&wear_law=archard",
+            "vehicle_profile=ah64-transverse",
+            "design_life_h=400",
+        ] {
+            let r = get(query);
+            assert_eq!(r.status, 200, "{query}: {}", r.body);
+            assert!(r.json()["missing_curve"].is_object());
+        }
+        assert_eq!(
+            get("vehicle_profile=ah64-transverse").json()["curve_key"],
+            "ah64-transverse/clean/modified-archard"
+        );
     })
     .await
     .unwrap();

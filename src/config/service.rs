@@ -12,6 +12,11 @@ pub enum Role {
     Planner,
     /// Engineer: submits, watches, cancels simulation/sweep/calibration jobs.
     Engineer,
+    /// Test engineer: uploads test campaigns (measured wear and accelerometer records of
+    /// physical tests, issue 14). `test-engineer` is accepted on the command line and in
+    /// `RAILWEAR_TOKENS`.
+    #[serde(rename = "test_engineer")]
+    TestEngineer,
     /// Administrator: manages tokens; may also do what planners and engineers do.
     Admin,
 }
@@ -22,15 +27,17 @@ impl Role {
         match self {
             Role::Planner => "planner",
             Role::Engineer => "engineer",
+            Role::TestEngineer => "test_engineer",
             Role::Admin => "admin",
         }
     }
 
-    /// Parse a lower-case role name.
+    /// Parse a lower-case role name (`test-engineer` is read as `test_engineer`).
     pub fn parse(text: &str) -> Option<Role> {
         match text {
             "planner" => Some(Role::Planner),
             "engineer" => Some(Role::Engineer),
+            "test_engineer" | "test-engineer" => Some(Role::TestEngineer),
             "admin" => Some(Role::Admin),
             _ => None,
         }
@@ -74,6 +81,11 @@ impl Default for ReportSettings {
     }
 }
 
+/// Default largest campaign upload: 32 MiB. A sample `[time_s, a_x, a_y, a_z]` is about 80
+/// bytes of JSON, so this holds about 400 000 samples: e.g. 20 records of 10 s at 2 kHz, or one
+/// 200 s record at 2 kHz (the rattle box's 20 Hz tone sampled 100 times a period).
+pub const DEFAULT_CAMPAIGN_BODY_LIMIT_BYTES: usize = 32 * 1024 * 1024;
+
 /// All service settings. See `configs/service.toml` for the meaning of each key.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -94,8 +106,14 @@ pub struct ServiceConfig {
     pub poll_interval_ms: u64,
     /// Attempts before a job whose worker keeps dying is failed.
     pub max_attempts: u32,
+    /// On SIGTERM, how long a running attempt gets to stop at a step boundary before its job
+    /// is given back to the queue anyway, s.
+    pub shutdown_grace_s: f64,
     /// Largest accepted request body, bytes.
     pub body_limit_bytes: usize,
+    /// Largest accepted campaign upload (`POST /v1/campaigns`, accelerometer samples inline),
+    /// bytes.
+    pub campaign_body_limit_bytes: usize,
     /// Log format: `text` or `json`.
     pub log_format: String,
     /// Samples per stored contact-track block (each block is compressed on its own).
@@ -117,7 +135,9 @@ impl Default for ServiceConfig {
             heartbeat_s: 1.0,
             poll_interval_ms: 250,
             max_attempts: 3,
+            shutdown_grace_s: 5.0,
             body_limit_bytes: 8 * 1024 * 1024,
+            campaign_body_limit_bytes: DEFAULT_CAMPAIGN_BODY_LIMIT_BYTES,
             log_format: "text".into(),
             track_block_samples: 16_384,
             report: ReportSettings::default(),
@@ -214,8 +234,14 @@ impl ServiceConfig {
         if let Some(v) = env("RAILWEAR_MAX_ATTEMPTS") {
             self.max_attempts = num("RAILWEAR_MAX_ATTEMPTS", &v)?;
         }
+        if let Some(v) = env("RAILWEAR_SHUTDOWN_GRACE_S") {
+            self.shutdown_grace_s = num("RAILWEAR_SHUTDOWN_GRACE_S", &v)?;
+        }
         if let Some(v) = env("RAILWEAR_BODY_LIMIT_BYTES") {
             self.body_limit_bytes = num("RAILWEAR_BODY_LIMIT_BYTES", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_CAMPAIGN_BODY_LIMIT_BYTES") {
+            self.campaign_body_limit_bytes = num("RAILWEAR_CAMPAIGN_BODY_LIMIT_BYTES", &v)?;
         }
         if let Some(v) = env("RAILWEAR_LOG_FORMAT") {
             self.log_format = v;
@@ -233,7 +259,10 @@ impl ServiceConfig {
                     ));
                 };
                 let role = Role::parse(role).ok_or_else(|| {
-                    invalid("RAILWEAR_TOKENS", "role must be planner, engineer or admin")
+                    invalid(
+                        "RAILWEAR_TOKENS",
+                        "role must be planner, engineer, test_engineer or admin",
+                    )
                 })?;
                 self.tokens.push(TokenSetting {
                     name: name.to_string(),
@@ -259,11 +288,23 @@ impl ServiceConfig {
         if self.heartbeat_s * 2.0 > self.lease_s {
             return Err(invalid("heartbeat_s", "must be at most half of lease_s"));
         }
+        if !(self.shutdown_grace_s.is_finite() && (0.0..=300.0).contains(&self.shutdown_grace_s)) {
+            return Err(invalid(
+                "shutdown_grace_s",
+                "must be a number of seconds in [0, 300]",
+            ));
+        }
         if self.max_attempts == 0 {
             return Err(invalid("max_attempts", "must be at least 1"));
         }
         if self.body_limit_bytes < 1024 {
             return Err(invalid("body_limit_bytes", "must be at least 1024"));
+        }
+        if self.campaign_body_limit_bytes < 1024 {
+            return Err(invalid(
+                "campaign_body_limit_bytes",
+                "must be at least 1024",
+            ));
         }
         if self.track_block_samples == 0 {
             return Err(invalid("track_block_samples", "must be at least 1"));
@@ -304,6 +345,18 @@ impl ServiceConfig {
                 .unwrap_or_else(|_| self.configs_dir.clone())
         };
         dir.canonicalize().unwrap_or(dir)
+    }
+
+    /// Worker-pool settings (lease, heartbeat, poll, attempts, track blocks, shutdown grace).
+    pub fn worker_settings(&self) -> crate::jobs::WorkerSettings {
+        crate::jobs::WorkerSettings {
+            lease: std::time::Duration::from_secs_f64(self.lease_s),
+            heartbeat: std::time::Duration::from_secs_f64(self.heartbeat_s),
+            poll: std::time::Duration::from_millis(self.poll_interval_ms.max(1)),
+            max_attempts: self.max_attempts,
+            track_block_samples: self.track_block_samples,
+            shutdown_grace: std::time::Duration::from_secs_f64(self.shutdown_grace_s),
+        }
     }
 
     /// Number of worker threads to run (`workers`, or one per core when 0).

@@ -34,6 +34,8 @@ pub enum Area {
     Tokens,
     /// Penalization curve versions (publishing is an engineer's decision).
     Curves,
+    /// Test campaigns: measured data of physical tests (uploading is a test engineer's).
+    Campaigns,
 }
 
 /// The authenticated caller.
@@ -44,16 +46,20 @@ pub struct Caller {
 }
 
 impl Caller {
-    /// Role policy: planners write rails, engineers write jobs, admins everything; every role
-    /// may read rails and jobs (a planner sees whether the sweep a report needs is running).
+    /// Role policy: planners write rails, engineers write jobs and curves, test engineers
+    /// write campaigns, admins everything; every role may read rails, jobs, curves and
+    /// campaigns (a planner sees whether the sweep a report needs is running). Measured data
+    /// is written only by those who measure it: engineers, who tune and run the model, do not
+    /// upload campaigns, as they do not record rail measurements (docs/campaigns.md).
     pub fn allowed(&self, area: Area, method: &Method) -> bool {
         let read = method == Method::GET || method == Method::HEAD;
         match (self.role, area) {
             (Role::Admin, _) => true,
             (_, Area::Tokens) => false,
-            (_, Area::Rails | Area::Jobs | Area::Curves) if read => true,
+            (_, Area::Rails | Area::Jobs | Area::Curves | Area::Campaigns) if read => true,
             (Role::Planner, Area::Rails) => true,
             (Role::Engineer, Area::Jobs | Area::Curves) => true,
+            (Role::TestEngineer, Area::Campaigns) => true,
             _ => false,
         }
     }
@@ -71,6 +77,7 @@ impl Caller {
                     Area::Jobs => "jobs",
                     Area::Tokens => "tokens",
                     Area::Curves => "curves",
+                    Area::Campaigns => "campaigns",
                 }
             )))
         }
@@ -129,6 +136,17 @@ mod tests {
         assert!(!caller(Role::Engineer).allowed(Area::Rails, &post));
         assert!(!caller(Role::Engineer).allowed(Area::Tokens, &get));
         assert!(caller(Role::Admin).allowed(Area::Tokens, &post));
+        // Campaigns: uploaded by test engineers (and admins), read by every role.
+        assert!(caller(Role::TestEngineer).allowed(Area::Campaigns, &post));
+        assert!(caller(Role::Admin).allowed(Area::Campaigns, &post));
+        assert!(!caller(Role::Planner).allowed(Area::Campaigns, &post));
+        assert!(!caller(Role::Engineer).allowed(Area::Campaigns, &post));
+        for role in [Role::Planner, Role::Engineer, Role::TestEngineer] {
+            assert!(caller(role).allowed(Area::Campaigns, &get));
+        }
+        assert!(!caller(Role::TestEngineer).allowed(Area::Jobs, &post));
+        assert!(!caller(Role::TestEngineer).allowed(Area::Rails, &post));
+        assert!(!caller(Role::TestEngineer).allowed(Area::Tokens, &get));
     }
 
     #[test]

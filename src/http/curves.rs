@@ -172,7 +172,7 @@ pub async fn list_curves(
 /// One curve version.
 #[utoipa::path(
     get, path = "/v1/curves/{id}", tag = "curves",
-    params(("id" = i64, Path, description = "Curve id")),
+    params(("id" = i64, Path, description = "Curve id", minimum = 1)),
     responses((status = 200, body = CurveView), (status = 400, body = Problem, content_type = "application/problem+json"), (status = 404, body = Problem, content_type = "application/problem+json")),
     security(("bearer" = []))
 )]
@@ -195,7 +195,7 @@ pub async fn get_curve(
 /// `{"force": true}` to publish a lower-fidelity version over the published one.
 #[utoipa::path(
     post, path = "/v1/curves/{id}/publish", tag = "curves",
-    params(("id" = i64, Path, description = "Curve id")),
+    params(("id" = i64, Path, description = "Curve id", minimum = 1)),
     request_body(content = Option<PublishRequest>, description = "Optional; `force` defaults to false"),
     responses(
         (status = 200, description = "Published (also when it already was)", body = CurveView),
@@ -218,10 +218,13 @@ pub async fn publish_curve(
             .headers()
             .get(header::CONTENT_LENGTH)
             .is_none_or(|v| v.as_bytes() == b"0");
+    // No body, or JSON `null`, publishes without force.
     let request: PublishRequest = if empty {
         PublishRequest::default()
     } else {
-        read_json(body).await?
+        read_json::<Option<PublishRequest>>(body)
+            .await?
+            .unwrap_or_default()
     };
     match state
         .store

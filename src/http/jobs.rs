@@ -116,7 +116,9 @@ pub struct AttemptView {
     /// RFC 3339 UTC time the attempt ended; absent while it runs.
     pub ended_at: Option<String>,
     /// `running`, `succeeded`, `failed`, `cancelled`, `fanned_out` (made the job's children
-    /// and left it waiting for them) or `lost` (lease expired).
+    /// and left it waiting for them), `lost` (lease expired, or its process was found dead by
+    /// a worker starting on the same host) or `released` (given back to the queue when its
+    /// worker shut down).
     pub outcome: String,
 }
 
@@ -261,8 +263,10 @@ impl JobFilter {
 #[into_params(parameter_in = Query)]
 pub struct TrackQuery {
     /// `csv` (default) or `json`.
+    #[param(pattern = "^(csv|json)$")]
     pub format: Option<String>,
     /// Keep every N-th sample (downsampling), N >= 1; default 1.
+    #[param(minimum = 1)]
     pub every: Option<u64>,
 }
 
@@ -307,7 +311,7 @@ fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, Problem> {
 #[utoipa::path(
     post, path = "/v1/jobs", tag = "jobs",
     request_body = JobRequest,
-    params(("Idempotency-Key" = Option<String>, Header, description = "Makes retries safe: same key + same body = same job")),
+    params(("Idempotency-Key" = Option<String>, Header, description = "Makes retries safe: same key + same body = same job. 1 to 255 visible ASCII characters (inner spaces allowed).", pattern = "^[!-~]([ !-~]{0,253}[!-~])?$")),
     responses(
         (status = 201, description = "Job queued", body = JobView),
         (status = 200, description = "Replay of an earlier submission with the same Idempotency-Key", body = JobView),

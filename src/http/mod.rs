@@ -2,6 +2,7 @@
 //! dashboard. Each module exposes its own `router()`; shared state is [`AppState`].
 
 pub mod auth;
+pub mod campaigns;
 pub mod curves;
 pub mod jobs;
 pub mod openapi;
@@ -12,7 +13,7 @@ pub mod rails;
 pub mod tokens;
 
 use crate::config::{Role, ServiceConfig};
-use crate::jobs::{CaseRunner, CurveDefaults, Jobs, WorkerSettings};
+use crate::jobs::{CaseRunner, CurveDefaults, Jobs};
 use crate::store::{self, Store, StoreError};
 use axum::extract::DefaultBodyLimit;
 use axum::http::StatusCode;
@@ -22,7 +23,6 @@ use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::ops::Deref;
 use std::sync::Arc;
-use std::time::Duration;
 use tower_http::limit::RequestBodyLimitLayer;
 use tower_http::trace::TraceLayer;
 
@@ -46,16 +46,27 @@ impl Deref for AppState {
     }
 }
 
-/// The complete router with body limits, problem+json fallbacks and request tracing.
+/// The complete router with body limits, problem+json fallbacks and request tracing. Every
+/// route takes bodies up to `body_limit_bytes`, except the campaign upload, which takes up to
+/// `campaign_body_limit_bytes` (accelerometer samples inline).
 pub fn app(state: AppState) -> Router {
     let limit = state.config.body_limit_bytes;
-    Router::new()
+    let campaign_limit = state.config.campaign_body_limit_bytes;
+    let general = Router::new()
         .merge(jobs::router())
         .merge(rails::router())
         .merge(curves::router())
         .merge(tokens::router())
         .merge(ops::router())
         .merge(openapi::router())
+        .layer(DefaultBodyLimit::max(limit))
+        .layer(RequestBodyLimitLayer::new(limit));
+    let campaigns = campaigns::router()
+        .layer(DefaultBodyLimit::max(campaign_limit))
+        .layer(RequestBodyLimitLayer::new(campaign_limit));
+    Router::new()
+        .merge(general)
+        .merge(campaigns)
         .fallback(|| async { Problem::not_found("no such resource") })
         .method_not_allowed_fallback(|| async {
             Problem::new(
@@ -66,8 +77,6 @@ pub fn app(state: AppState) -> Router {
             )
         })
         .layer(middleware::from_fn_with_state(state.clone(), http_metrics))
-        .layer(DefaultBodyLimit::max(limit))
-        .layer(RequestBodyLimitLayer::new(limit))
         .layer(middleware::map_response(problem::problem_for_bare_errors))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
@@ -118,14 +127,23 @@ pub struct RunningService {
 }
 
 impl RunningService {
-    /// Stop accepting requests, finish in-flight ones, stop the workers. A job running here
-    /// is left to its lease: it is re-queued when the lease expires.
+    /// Clean shutdown: stop accepting requests and finish in-flight ones, while the workers
+    /// stop taking jobs and give running ones back to the queue within `shutdown_grace_s`
+    /// ([`Jobs::shutdown`]).
     pub async fn stop(self) {
         let _ = self.shutdown.send(());
+        self.state.jobs.shutdown(self.workers).await;
         let _ = self.server.await;
+    }
+
+    /// Stop as a crash would leave things: the workers are dropped mid-attempt, their jobs
+    /// stay running until their leases expire (tests of lease recovery).
+    pub async fn abandon(self) {
         for worker in self.workers {
             worker.abort();
         }
+        let _ = self.shutdown.send(());
+        let _ = self.server.await;
     }
 }
 
@@ -136,13 +154,7 @@ pub async fn start(
     workers: bool,
 ) -> Result<RunningService, StartError> {
     let store = store::open(&config.database_url).await?;
-    let settings = WorkerSettings {
-        lease: Duration::from_secs_f64(config.lease_s),
-        heartbeat: Duration::from_secs_f64(config.heartbeat_s),
-        poll: Duration::from_millis(config.poll_interval_ms.max(1)),
-        max_attempts: config.max_attempts,
-        track_block_samples: config.track_block_samples,
-    };
+    let settings = config.worker_settings();
     let curve_defaults = CurveDefaults {
         vehicle_profile: config.report.vehicle_profile.clone(),
         environment: config.report.environment.clone(),
@@ -166,8 +178,10 @@ pub async fn start(
     })?;
     let worker_handles = if workers {
         let count = config.worker_count();
-        tracing::info!(count, "starting workers");
-        jobs.spawn_workers(count, &format!("{}-{}", std::process::id(), addr.port()))
+        // Jobs left running by dead processes of this host go back to the queue at once.
+        jobs.release_dead_leases().await?;
+        tracing::info!(count, host = %jobs.host.host, pid = jobs.host.pid, "starting workers");
+        jobs.spawn_workers(count, &jobs.worker_prefix())
     } else {
         Vec::new()
     };

@@ -1,7 +1,7 @@
 //! The OpenAPI document, generated from the handlers' annotations. `api/openapi.json` is a copy
 //! kept in sync by a test (`railwear openapi > api/openapi.json` regenerates it).
 
-use super::{curves, jobs, ops, pagination, problem, rails, tokens, AppState};
+use super::{campaigns, curves, jobs, ops, pagination, problem, rails, tokens, AppState};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
@@ -21,11 +21,89 @@ impl Modify for BearerAuth {
     }
 }
 
+/// The error answers every operation can give, added where an operation does not document
+/// them itself, so the document lists every status the service sends (a property-based run
+/// checks it, `tests/api_schemathesis.rs`): 401 on every operation with a token, 403 on
+/// writes and on token listing (the role is checked before anything else), 400 on operations
+/// with path or query parameters (a malformed or unknown parameter), and on operations with a
+/// body 400 (malformed JSON), 413 (too large), 415 (not JSON) and 422 (a rule broken).
+struct CommonErrors;
+
+impl CommonErrors {
+    fn problem(description: &str) -> utoipa::openapi::RefOr<utoipa::openapi::Response> {
+        use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
+        ResponseBuilder::new()
+            .description(description)
+            .content(
+                "application/problem+json",
+                ContentBuilder::new()
+                    .schema(Some(Ref::from_schema_name("Problem")))
+                    .build(),
+            )
+            .build()
+            .into()
+    }
+
+    fn add(operation: &mut utoipa::openapi::path::Operation, path: &str, write: bool) {
+        let secured = operation.security.as_ref().is_some_and(|s| !s.is_empty());
+        let has_params =
+            operation.parameters.as_ref().is_some_and(|p| !p.is_empty()) || path.contains('{');
+        let mut wanted: Vec<(&str, &str)> = Vec::new();
+        if secured {
+            wanted.push(("401", "Missing, unknown or revoked token"));
+            if write || path.starts_with("/v1/tokens") {
+                wanted.push(("403", "The token's role may not do this"));
+            }
+        }
+        if path.contains('{') {
+            wanted.push(("404", "No such resource"));
+        }
+        if has_params {
+            wanted.push((
+                "400",
+                "Malformed, unknown or repeated path or query parameter; `field` names it",
+            ));
+        }
+        if operation.request_body.is_some() {
+            wanted.push(("400", "Malformed JSON body"));
+            wanted.push(("413", "Request body over the route's limit"));
+            wanted.push(("415", "Body not sent as application/json"));
+            wanted.push(("422", "A field breaks a rule; `field` names it"));
+        }
+        for (status, description) in wanted {
+            operation
+                .responses
+                .responses
+                .entry(status.to_string())
+                .or_insert_with(|| Self::problem(description));
+        }
+    }
+}
+
+impl Modify for CommonErrors {
+    fn modify(&self, openapi: &mut utoipa::openapi::OpenApi) {
+        for (path, item) in openapi.paths.paths.iter_mut() {
+            for (operation, write) in [
+                (&mut item.get, false),
+                (&mut item.head, false),
+                (&mut item.post, true),
+                (&mut item.put, true),
+                (&mut item.patch, true),
+                (&mut item.delete, true),
+            ] {
+                if let Some(operation) = operation.as_mut() {
+                    Self::add(operation, path, write);
+                }
+            }
+        }
+    }
+}
+
 #[derive(OpenApi)]
 #[openapi(
     info(
         title = "railwear",
-        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs), admin (tokens)."
+        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs, curves), test_engineer (test campaigns), admin (tokens, and everything)."
     ),
     paths(
         jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::get_attempts, jobs::cancel_job,
@@ -34,6 +112,7 @@ impl Modify for BearerAuth {
         rails::post_measurement, rails::list_rails, rails::get_rail, rails::list_measurements,
         rails::get_report,
         curves::list_curves, curves::get_curve, curves::publish_curve,
+        campaigns::upload_campaign, campaigns::list_campaigns, campaigns::get_campaign,
         tokens::create_token, tokens::list_tokens, tokens::revoke_token,
         ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
@@ -49,14 +128,20 @@ impl Modify for BearerAuth {
         rails::ServiceLife, rails::MissingCurve, rails::ServiceLifeInterval, rails::ReportCurve,
         curves::CurveView, curves::FidelityView, curves::CurveLinks, curves::PublishRequest,
         pagination::PageView<curves::CurveView>,
+        campaigns::CampaignView, campaigns::CampaignCountsView, campaigns::CampaignLinks,
+        campaigns::CampaignDocument, campaigns::CampaignTestDocument, campaigns::DriveDocument,
+        campaigns::SpecimenDocument, campaigns::IncrementDocument,
+        campaigns::AccelRecordDocument, campaigns::AccelLocationDocument,
+        pagination::PageView<campaigns::CampaignView>,
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
         crate::config::Role,
     )),
-    modifiers(&BearerAuth),
+    modifiers(&BearerAuth, &CommonErrors),
     tags(
         (name = "jobs", description = "Simulation, sweep and calibration jobs (engineer)"),
         (name = "rails", description = "Rail registry, measurements and service-life reports (planner)"),
         (name = "curves", description = "Penalization curve versions; publishing one makes reports use it (engineer)"),
+        (name = "campaigns", description = "Test campaigns: measured wear and accelerometer records of physical tests (upload: test_engineer; read: every role)"),
         (name = "tokens", description = "API tokens (admin)"),
         (name = "ops", description = "Health, readiness, metrics, this document"),
     )

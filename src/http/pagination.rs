@@ -15,9 +15,10 @@ pub const DEFAULT_LIMIT: i64 = 20;
 #[into_params(parameter_in = Query)]
 pub struct PageQuery {
     /// Items per page, 1..=100 (default 20).
-    #[param(value_type = Option<i64>)]
+    #[param(value_type = Option<i64>, minimum = 1, maximum = 100)]
     pub limit: Option<String>,
     /// `next_cursor` of the previous page.
+    #[param(pattern = "^[1-9][0-9]{0,17}$")]
     pub cursor: Option<String>,
 }
 

@@ -143,36 +143,7 @@ where
     type Rejection = Problem;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
-        let is_json = req
-            .headers()
-            .get(header::CONTENT_TYPE)
-            .and_then(|v| v.to_str().ok())
-            .map(|v| {
-                let mime = v.split(';').next().unwrap_or("").trim();
-                mime == "application/json" || mime.ends_with("+json")
-            })
-            .unwrap_or(false);
-        if !is_json {
-            return Err(Problem::new(
-                StatusCode::UNSUPPORTED_MEDIA_TYPE,
-                "unsupported-media-type",
-                "Unsupported media type",
-                "send the body as Content-Type: application/json",
-            ));
-        }
-        let bytes = Bytes::from_request(req, state).await.map_err(|rejection| {
-            let status = rejection.status();
-            if status == StatusCode::PAYLOAD_TOO_LARGE {
-                Problem::new(
-                    status,
-                    "body-too-large",
-                    "Request body too large",
-                    rejection.body_text(),
-                )
-            } else {
-                Problem::new(status, "bad-body", "Unreadable body", rejection.body_text())
-            }
-        })?;
+        let bytes = json_body_bytes(req, state).await?;
         let mut deserializer = serde_json::Deserializer::from_slice(&bytes);
         match serde_path_to_error::deserialize(&mut deserializer) {
             Ok(value) => {
@@ -207,6 +178,57 @@ where
             }
         }
     }
+}
+
+/// The bytes of a body sent as JSON (`application/json` or `*+json`, else 415), 413 when over
+/// the route's limit. Not parsed.
+pub async fn json_body_bytes<S: Send + Sync>(req: Request, state: &S) -> Result<Bytes, Problem> {
+    let is_json = req
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .map(|v| {
+            let mime = v.split(';').next().unwrap_or("").trim();
+            mime == "application/json" || mime.ends_with("+json")
+        })
+        .unwrap_or(false);
+    if !is_json {
+        return Err(Problem::new(
+            StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            "unsupported-media-type",
+            "Unsupported media type",
+            "send the body as Content-Type: application/json",
+        ));
+    }
+    Bytes::from_request(req, state).await.map_err(|rejection| {
+        let status = rejection.status();
+        if status == StatusCode::PAYLOAD_TOO_LARGE {
+            Problem::new(
+                status,
+                "body-too-large",
+                "Request body too large",
+                rejection.body_text(),
+            )
+        } else {
+            Problem::new(status, "bad-body", "Unreadable body", rejection.body_text())
+        }
+    })
+}
+
+/// 400 when `bytes` is not one well-formed JSON value (syntax, truncation, trailing text);
+/// checked without building the value.
+pub fn check_json_syntax(bytes: &[u8]) -> Result<(), Problem> {
+    let mut deserializer = serde_json::Deserializer::from_slice(bytes);
+    let parsed = <serde::de::IgnoredAny as serde::Deserialize>::deserialize(&mut deserializer)
+        .and_then(|_| deserializer.end());
+    parsed.map_err(|e| {
+        Problem::new(
+            StatusCode::BAD_REQUEST,
+            "malformed-json",
+            "Malformed JSON",
+            e.to_string(),
+        )
+    })
 }
 
 /// Read a JSON body with [`ApiJson`]'s rules after the handler has checked the caller's role,

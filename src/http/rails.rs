@@ -322,15 +322,75 @@ pub struct ReportView {
     pub missing_curve: Option<MissingCurve>,
 }
 
-/// Which penalization curve and design life a report uses (defaults from the settings).
+/// Which penalization curve and design life a report uses (defaults from the settings'
+/// `[report]`). The three labels must name what a sweep can run: an unknown one is a 422
+/// naming the parameter (it could never have a curve). Unknown parameters are refused (400).
 #[derive(Debug, Deserialize, IntoParams)]
 #[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
 pub struct ReportQuery {
+    /// Vehicle profile of the curve: `ah64` or a profile file name in `configs/profiles`.
     pub vehicle_profile: Option<String>,
+    /// Environment of the curve: `clean` (the only one modelled).
     pub environment: Option<String>,
+    /// Wear law of the curve: `modified-archard`, `archard` or `legacy-appendix`.
     pub wear_law: Option<String>,
-    /// T_SL,design, h.
-    pub design_life_h: Option<f64>,
+    /// T_SL,design, h (> 0).
+    #[param(value_type = Option<f64>, exclusive_minimum = 0)]
+    pub design_life_h: Option<String>,
+}
+
+/// The curve labels of a report query, defaults filled in; a label given but unknown is a 422
+/// naming its parameter (the same names a sweep accepts, `pipeline::SweepPlan`).
+fn report_labels(
+    query: &ReportQuery,
+    defaults: &crate::config::service::ReportSettings,
+    configs_dir: &std::path::Path,
+) -> Result<(String, String, String), Problem> {
+    if let Some(profile) = &query.vehicle_profile {
+        crate::pipeline::vehicle_profile_file(configs_dir, profile).map_err(|e| match e {
+            crate::pipeline::RunError::InvalidConfig { rule, .. } => {
+                Problem::invalid_field("vehicle_profile", rule)
+            }
+            other => Problem::invalid_field("vehicle_profile", other),
+        })?;
+    }
+    if let Some(environment) = &query.environment {
+        if !crate::pipeline::ENVIRONMENTS.contains(&environment.as_str()) {
+            return Err(Problem::invalid_field(
+                "environment",
+                format!(
+                    "`{environment}` is not modelled (known: {})",
+                    crate::pipeline::ENVIRONMENTS.join(", ")
+                ),
+            ));
+        }
+    }
+    if let Some(law) = &query.wear_law {
+        if !crate::pipeline::WEAR_LAWS.contains(&law.as_str()) {
+            return Err(Problem::invalid_field(
+                "wear_law",
+                format!(
+                    "`{law}` is not a wear law (known: {})",
+                    crate::pipeline::WEAR_LAWS.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok((
+        query
+            .vehicle_profile
+            .clone()
+            .unwrap_or_else(|| defaults.vehicle_profile.clone()),
+        query
+            .environment
+            .clone()
+            .unwrap_or_else(|| defaults.environment.clone()),
+        query
+            .wear_law
+            .clone()
+            .unwrap_or_else(|| defaults.wear_law.clone()),
+    ))
 }
 
 /// Pattern of a rail serial: a letter or digit, then up to 63 letters, digits, `-`, `_` or
@@ -353,7 +413,8 @@ fn check_serial(serial: &str) -> Result<(), Problem> {
         Err(Problem::bad_parameter(
             "serial",
             format!(
-                "must match {SERIAL_PATTERN}: 1-64 characters, letters, digits, '-', '_' or '.',                  starting with a letter or digit"
+                "must match {SERIAL_PATTERN}: 1-64 characters, letters, digits, '-', '_' or '.', \
+                 starting with a letter or digit"
             ),
         ))
     }
@@ -494,7 +555,9 @@ pub async fn list_measurements(
     params(("serial" = String, Path, pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$"), ReportQuery),
     responses(
         (status = 200, description = "Report; `service_life` when a curve covers the rail, otherwise `missing_curve` says which sweep to run", body = ReportView),
+        (status = 400, description = "Malformed serial or design_life_h, unknown or repeated parameter", body = Problem, content_type = "application/problem+json"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "vehicle_profile, environment or wear_law names nothing a sweep can run; `field` is the parameter", body = Problem, content_type = "application/problem+json"),
     ),
     security(("bearer" = []))
 )]
@@ -505,30 +568,30 @@ pub async fn get_report(
     query: Result<Query<ReportQuery>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Json<ReportView>, Problem> {
     caller.require(Area::Rails, &Method::GET)?;
-    let Query(query) = query.map_err(|_| {
-        Problem::bad_parameter("design_life_h", "must be a positive number of hours")
+    // A repeated or unknown key is named by serde_urlencoded's message.
+    let Query(query) = query.map_err(|rejection| {
+        super::problem::bare_error_problem(StatusCode::BAD_REQUEST, &rejection.body_text())
     })?;
+    let defaults = &state.config.report;
+    let design_life_h = match &query.design_life_h {
+        None => defaults.design_life_h,
+        Some(text) => text
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|h| h.is_finite() && *h > 0.0)
+            .ok_or_else(|| {
+                Problem::bad_parameter("design_life_h", "must be a positive number of hours")
+            })?,
+    };
+    let (profile, environment, wear_law) =
+        report_labels(&query, defaults, &state.config.configs_dir)?;
     load_rail(&state, &serial).await?;
     let measurement = state
         .store
         .latest_measurement(&serial)
         .await?
         .ok_or_else(|| Problem::not_found(format!("rail `{serial}` has no measurement")))?;
-    let defaults = &state.config.report;
-    let design_life_h = query.design_life_h.unwrap_or(defaults.design_life_h);
-    if !(design_life_h.is_finite() && design_life_h > 0.0) {
-        return Err(Problem::bad_parameter(
-            "design_life_h",
-            "must be a positive number of hours",
-        ));
-    }
-    let profile = query
-        .vehicle_profile
-        .unwrap_or_else(|| defaults.vehicle_profile.clone());
-    let environment = query
-        .environment
-        .unwrap_or_else(|| defaults.environment.clone());
-    let wear_law = query.wear_law.unwrap_or_else(|| defaults.wear_law.clone());
     let key = curve_key(&profile, &environment, &wear_law);
     let k_rs = measurement.rattle_space;
 

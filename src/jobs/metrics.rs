@@ -46,6 +46,23 @@ struct Inner {
     running: HashMap<Uuid, (Instant, f64)>,
 }
 
+impl Inner {
+    /// One job (or attempt) of `kind` that ended with `status` after `seconds`.
+    fn observe(&mut self, kind: JobKind, status: JobStatus, seconds: f64) {
+        let h = self
+            .durations
+            .entry((kind.as_str(), status.as_str()))
+            .or_default();
+        for (slot, bound) in h.counts.iter_mut().zip(DURATION_BUCKETS_S) {
+            if seconds <= bound {
+                *slot += 1;
+            }
+        }
+        h.count += 1;
+        h.sum_s += seconds;
+    }
+}
+
 /// Counters and gauges of this process.
 #[derive(Default)]
 pub struct Metrics {
@@ -80,24 +97,42 @@ impl Metrics {
         });
     }
 
-    /// An attempt ended with `status`.
+    /// An attempt ended with `status`: its wall time goes to the duration histogram.
     pub fn attempt_finished(&self, id: Uuid, kind: JobKind, status: JobStatus) {
         self.with(|m| {
             if let Some((start, _)) = m.running.remove(&id) {
-                let seconds = start.elapsed().as_secs_f64();
-                let h = m
-                    .durations
-                    .entry((kind.as_str(), status.as_str()))
-                    .or_default();
-                for (slot, bound) in h.counts.iter_mut().zip(DURATION_BUCKETS_S) {
-                    if seconds <= bound {
-                        *slot += 1;
-                    }
-                }
-                h.count += 1;
-                h.sum_s += seconds;
+                m.observe(kind, status, start.elapsed().as_secs_f64());
             }
         });
+    }
+
+    /// An attempt was given back at shutdown: no longer running here, not a finished job.
+    pub fn attempt_released(&self, id: Uuid) {
+        self.with(|m| {
+            m.running.remove(&id);
+        });
+    }
+
+    /// The attempt that ended a fanned-out job (a sweep's assembly) ended with `status`; the
+    /// job took `whole_s` from its first claim (fan-out, children, assembly), which is what the
+    /// duration histogram counts for it, not the assembly alone.
+    pub fn fanned_out_job_finished(
+        &self,
+        id: Uuid,
+        kind: JobKind,
+        status: JobStatus,
+        whole_s: f64,
+    ) {
+        self.with(|m| {
+            m.running.remove(&id);
+            m.observe(kind, status, whole_s.max(0.0));
+        });
+    }
+
+    /// A fanned-out job ended without an attempt of its own (a child's failure failed it),
+    /// `whole_s` after its first claim.
+    pub fn job_ended(&self, kind: JobKind, status: JobStatus, whole_s: f64) {
+        self.with(|m| m.observe(kind, status, whole_s.max(0.0)));
     }
 
     /// One HTTP request answered: `route` is the matched route template (`/v1/jobs/{id}`), or
@@ -145,7 +180,7 @@ impl Metrics {
         self.with(|m| {
             let _ = writeln!(
                 out,
-                "# HELP railwear_job_duration_seconds Wall time of finished attempts in this process."
+                "# HELP railwear_job_duration_seconds Wall time of jobs ended by this process: an attempt's, or for a job that fanned out (a sweep) the whole job's, from its first claim through its children to its assembly."
             );
             let _ = writeln!(out, "# TYPE railwear_job_duration_seconds histogram");
             let mut keys: Vec<_> = m.durations.keys().copied().collect();
@@ -275,6 +310,24 @@ mod tests {
         assert!(text.contains(
             "railwear_job_duration_seconds_count{kind=\"simulate\",status=\"succeeded\"} 1"
         ));
+        assert!(text.contains("railwear_running_attempts 0"));
+    }
+
+    #[test]
+    fn a_fanned_out_job_counts_whole() {
+        let metrics = Metrics::default();
+        let id = Uuid::new_v4();
+        metrics.attempt_started(id);
+        metrics.fanned_out_job_finished(id, JobKind::Sweep, JobStatus::Succeeded, 42.0);
+        metrics.job_ended(JobKind::Sweep, JobStatus::Failed, 7.5);
+        let text = metrics.render(&[]);
+        assert!(text
+            .contains("railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"succeeded\"} 42"));
+        assert!(text.contains(
+            "railwear_job_duration_seconds_bucket{kind=\"sweep\",status=\"succeeded\",le=\"30\"} 0"
+        ));
+        assert!(text
+            .contains("railwear_job_duration_seconds_count{kind=\"sweep\",status=\"failed\"} 1"));
         assert!(text.contains("railwear_running_attempts 0"));
     }
 

@@ -2,13 +2,14 @@
 //! heartbeats, fenced completion, cancellation, progress. Computations run on tokio's blocking
 //! threads through the [`CaseRunner`] interface.
 
+pub mod host;
 pub mod metrics;
 /// The job records live with the store that keeps them (`store::job_records`).
 pub use crate::store::job_records as model;
 pub mod runner;
 pub mod worker;
 
-use crate::store::{clock, NewJob, Store, StoreError, Submitted};
+use crate::store::{clock, NewJob, Store, StoreError, Submitted, WorkerHost};
 pub use metrics::Metrics;
 pub use model::{ChildCounts, ChildOf, JobKind, JobProgress, JobRecord, JobStatus};
 pub use runner::{CaseRunner, ChildJob, CurveInfo, FanOutPlan, JobOutput, LibraryRunner};
@@ -44,6 +45,8 @@ pub struct WorkerSettings {
     pub max_attempts: u32,
     /// Samples per stored track block.
     pub track_block_samples: usize,
+    /// At shutdown, how long a running attempt gets to stop before its job is given back.
+    pub shutdown_grace: Duration,
 }
 
 /// Defaults for the curve key of a sweep whose params do not name all three parts.
@@ -76,6 +79,10 @@ pub struct Jobs {
     /// Cancel flags of attempts running in this process, so a cancel request reaches the
     /// computation at once instead of at the next heartbeat.
     running: Mutex<HashMap<Uuid, Arc<AtomicBool>>>,
+    /// Host, pid and instance of this process, recorded with each claim.
+    pub host: WorkerHost,
+    /// True once shutdown began: workers take no more jobs and give running ones back.
+    stopping: tokio::sync::watch::Sender<bool>,
 }
 
 impl Jobs {
@@ -93,7 +100,69 @@ impl Jobs {
             curve_defaults,
             wake: Notify::new(),
             running: Mutex::new(HashMap::new()),
+            host: WorkerHost::current(),
+            stopping: tokio::sync::watch::Sender::new(false),
         })
+    }
+
+    /// Prefix of this process's worker names: `<host>-<pid>` (workers are `<host>-<pid>-<n>`).
+    pub fn worker_prefix(&self) -> String {
+        format!("{}-{}", self.host.host, self.host.pid)
+    }
+
+    /// Give the jobs held by dead processes of this host back to the queue at once (their
+    /// attempts logged `lost`; or failed after `max_attempts`, or cancelled if asked), instead
+    /// of waiting for their leases to expire. Run at start-up, before the workers claim.
+    /// Returns how many leases were ended.
+    pub async fn release_dead_leases(&self) -> Result<u64, StoreError> {
+        let leases = self.store.host_leases(&self.host.host).await?;
+        let dead: Vec<(Uuid, i64)> = leases
+            .iter()
+            .filter(|lease| self.host.holder_is_dead(lease))
+            .map(|lease| (lease.job, lease.attempt))
+            .collect();
+        if dead.is_empty() {
+            return Ok(0);
+        }
+        let now = clock::now_ms();
+        let ended = self.store.expire_leases(dead, now).await?;
+        self.store
+            .requeue_expired(now, i64::from(self.settings.max_attempts))
+            .await?;
+        tracing::info!(
+            host = %self.host.host,
+            jobs = ended,
+            "released the leases of dead workers of this host"
+        );
+        self.wake.notify_waiters();
+        Ok(ended)
+    }
+
+    /// A receiver that sees `true` once shutdown began.
+    pub(crate) fn stopping(&self) -> tokio::sync::watch::Receiver<bool> {
+        self.stopping.subscribe()
+    }
+
+    /// Clean shutdown of this process's workers: they take no more jobs; each running attempt
+    /// is asked to stop at its next step boundary and its job is given back to the queue
+    /// (`released`), at the latest `shutdown_grace` after this call. Returns once every worker
+    /// has ended (workers still busy after the grace and a margin for the release's write are
+    /// aborted).
+    pub async fn shutdown(&self, mut workers: Vec<tokio::task::JoinHandle<()>>) {
+        self.stopping.send_replace(true);
+        let bound = self.settings.shutdown_grace + Duration::from_secs(3);
+        let joined = tokio::time::timeout(bound, async {
+            for worker in workers.iter_mut() {
+                let _ = worker.await;
+            }
+        })
+        .await;
+        if joined.is_err() {
+            tracing::warn!("workers still busy after the shutdown grace; stopping them");
+        }
+        for worker in workers {
+            worker.abort();
+        }
     }
 
     fn running_flags(&self) -> std::sync::MutexGuard<'_, HashMap<Uuid, Arc<AtomicBool>>> {

@@ -11,7 +11,7 @@ use super::runner::FanOutPlan;
 use super::Jobs;
 use crate::pipeline::{Progress, RunControl, RunError};
 use crate::store::{
-    clock, tracks, CurveFidelity, FanOut, FanOutResult, Finish, NewChild, NewCurve,
+    clock, tracks, CurveFidelity, FanOut, FanOutResult, Finish, NewChild, NewCurve, ReleaseOutcome,
 };
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -32,7 +32,12 @@ impl Jobs {
 
     async fn worker_loop(self: Arc<Self>, worker: String) {
         let lease_ms = self.settings.lease.as_millis() as i64;
+        let mut stopping = self.stopping();
         loop {
+            if *stopping.borrow_and_update() {
+                tracing::info!(%worker, "worker stopped");
+                return;
+            }
             let now = clock::now_ms();
             if let Err(e) = self
                 .store
@@ -41,12 +46,17 @@ impl Jobs {
             {
                 tracing::warn!(%worker, error = %e, "re-queue of expired leases failed");
             }
-            match self.store.claim_job(&worker, now, lease_ms).await {
+            match self
+                .store
+                .claim_job_on(&worker, Some(&self.host), now, lease_ms)
+                .await
+            {
                 Ok(Some(job)) => self.run_attempt(&worker, job).await,
                 Ok(None) => {
                     tokio::select! {
                         _ = self.wake.notified() => {}
                         _ = tokio::time::sleep(self.settings.poll) => {}
+                        _ = stopping.changed() => {}
                     }
                 }
                 Err(e) => {
@@ -116,9 +126,20 @@ impl Jobs {
         let mut ticker = tokio::time::interval(self.settings.heartbeat);
         ticker.tick().await; // the first tick is immediate
         let mut lost = false;
+        // Shutdown: the computation is asked to stop (the cancel flag: at its next step
+        // boundary) and the job is given back by `give_back_by` at the latest.
+        let mut stopping = self.stopping();
+        let mut give_back_by: Option<tokio::time::Instant> = None;
         let outcome = loop {
             tokio::select! {
-                result = &mut computation => break result,
+                result = &mut computation => break Some(result),
+                _ = shutdown_begun(&mut stopping), if give_back_by.is_none() => {
+                    tracing::info!(job = %id, attempt, "shutdown: stopping the attempt to give its job back");
+                    cancel.store(true, Ordering::Relaxed);
+                    give_back_by = Some(tokio::time::Instant::now() + self.settings.shutdown_grace);
+                }
+                _ = tokio::time::sleep_until(give_back_by.unwrap_or_else(tokio::time::Instant::now)),
+                    if give_back_by.is_some() => break None,
                 _ = ticker.tick() => {
                     let progress = latest
                         .lock()
@@ -147,6 +168,16 @@ impl Jobs {
                 }
             }
         };
+
+        let Some(outcome) = outcome else {
+            // The grace ran out: give the job back now; the computation is left to the
+            // process's exit (a late result would be fenced out by the next attempt).
+            self.running_flags().remove(&id);
+            self.metrics.attempt_released(id);
+            return self.give_back(id, attempt).await;
+        };
+        let released =
+            give_back_by.is_some() && matches!(outcome, Ok(Err(RunError::Cancelled))) && !lost;
 
         // Write the last progress the computation reported (a short run may end before the
         // first heartbeat).
@@ -195,14 +226,79 @@ impl Jobs {
                 Finish::Failed("internal error: the computation panicked".into())
             }
         };
+        if released {
+            // Stopped for the shutdown, not cancelled by anyone: back to the queue.
+            self.running_flags().remove(&id);
+            self.metrics.attempt_released(id);
+            return self.give_back(id, attempt).await;
+        }
         let status = finish.status();
         self.running_flags().remove(&id);
-        self.metrics.attempt_finished(id, kind, status);
+        match job.started_ms {
+            // A fanned-out job's duration is the whole job's, from its first claim.
+            Some(first_claim) if job.children.is_some() => {
+                let whole_s = (clock::now_ms() - first_claim) as f64 / 1000.0;
+                self.metrics
+                    .fanned_out_job_finished(id, kind, status, whole_s);
+            }
+            _ => self.metrics.attempt_finished(id, kind, status),
+        }
         if lost {
             tracing::warn!(job = %id, attempt, "lease lost to a newer attempt; result discarded");
             return;
         }
         self.finish(id, attempt, finish).await;
+        if let (Some(child_of), JobStatus::Failed | JobStatus::Cancelled) = (job.parent, status) {
+            self.observe_parent_end(child_of.parent_id, id).await;
+        }
+    }
+
+    /// After child `child` ended unsuccessfully: when that failed its parent (the parent's
+    /// error names this child; the store writes it in the child's finishing transaction), the
+    /// parent ended without an attempt of its own, and its whole duration goes to the
+    /// histogram here, once.
+    async fn observe_parent_end(&self, parent: uuid::Uuid, child: uuid::Uuid) {
+        let Ok(Some(record)) = self.store.get_job(parent).await else {
+            return;
+        };
+        let named = record
+            .error
+            .as_deref()
+            .is_some_and(|e| e.contains(&format!("(job {child})")));
+        if let (JobStatus::Failed, true, Some(started), Some(finished)) =
+            (record.status, named, record.started_ms, record.finished_ms)
+        {
+            self.metrics.job_ended(
+                record.kind,
+                record.status,
+                (finished - started) as f64 / 1000.0,
+            );
+        }
+    }
+
+    /// Give attempt `attempt` back to the queue (shutdown). A cancellation requested
+    /// meanwhile ends it as cancelled instead.
+    async fn give_back(&self, id: uuid::Uuid, attempt: i64) {
+        for retry in 0..3u32 {
+            match self.store.release_job(id, attempt, clock::now_ms()).await {
+                Ok(ReleaseOutcome::Released) => {
+                    tracing::info!(job = %id, attempt, "attempt released: the job is queued again");
+                    return;
+                }
+                Ok(ReleaseOutcome::CancelRequested) => {
+                    return self.finish(id, attempt, Finish::Cancelled).await;
+                }
+                Ok(ReleaseOutcome::Stale) => {
+                    tracing::warn!(job = %id, attempt, "stale attempt; nothing to release");
+                    return;
+                }
+                Err(e) => {
+                    // If it never lands, the lease expires as after a crash.
+                    tracing::warn!(job = %id, attempt, retry, error = %e, "release failed");
+                    tokio::time::sleep(Duration::from_millis(100 << retry)).await;
+                }
+            }
+        }
     }
 
     /// End an attempt. A finish that fails on a transient database error is retried; a
@@ -273,6 +369,19 @@ impl Jobs {
                     tokio::time::sleep(Duration::from_millis(200 << retry)).await;
                 }
             }
+        }
+    }
+}
+
+/// Resolves once shutdown has begun (at once if it already has).
+async fn shutdown_begun(stopping: &mut tokio::sync::watch::Receiver<bool>) {
+    loop {
+        if *stopping.borrow_and_update() {
+            return;
+        }
+        if stopping.changed().await.is_err() {
+            // The sender is gone with the job system: no shutdown will come.
+            return std::future::pending().await;
         }
     }
 }

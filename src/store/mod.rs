@@ -136,8 +136,11 @@ pub enum AttemptOutcome {
     Cancelled,
     /// The attempt created the job's children and left it waiting for them.
     FannedOut,
-    /// The lease expired: the worker died or lost contact; its later writes are fenced out.
+    /// The lease expired (or its process was found dead on its host): the worker died or lost
+    /// contact; its later writes are fenced out.
     Lost,
+    /// Given back by its worker at shutdown: the job went back to the queue at once.
+    Released,
 }
 
 impl AttemptOutcome {
@@ -150,6 +153,7 @@ impl AttemptOutcome {
             AttemptOutcome::Cancelled => "cancelled",
             AttemptOutcome::FannedOut => "fanned_out",
             AttemptOutcome::Lost => "lost",
+            AttemptOutcome::Released => "released",
         }
     }
 
@@ -162,6 +166,7 @@ impl AttemptOutcome {
             AttemptOutcome::Cancelled,
             AttemptOutcome::FannedOut,
             AttemptOutcome::Lost,
+            AttemptOutcome::Released,
         ]
         .into_iter()
         .find(|o| o.as_str() == text)
@@ -207,6 +212,39 @@ pub struct AttemptRecord {
     pub started_ms: i64,
     pub ended_ms: Option<i64>,
     pub outcome: AttemptOutcome,
+}
+
+/// Where a worker process runs, recorded with each claim so that a worker starting on the same
+/// host can tell a dead holder's lease from a live one.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WorkerHost {
+    /// Host name (`HOSTNAME`, else the kernel's).
+    pub host: String,
+    /// Process id.
+    pub pid: u32,
+    /// Random id of this process start (a restarted process may get the same pid, PID 1 in a
+    /// container).
+    pub instance: String,
+}
+
+/// A running job's lease held by a process of some host.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HostLease {
+    pub job: Uuid,
+    pub attempt: i64,
+    pub pid: u32,
+    pub instance: String,
+}
+
+/// What [`Store::release_job`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReleaseOutcome {
+    /// The job is queued again and the attempt logged `released`.
+    Released,
+    /// Cancellation was requested: nothing written; end the attempt as cancelled.
+    CancelRequested,
+    /// The attempt no longer owns the job: nothing written.
+    Stale,
 }
 
 /// Which jobs a list shows.
@@ -391,6 +429,66 @@ pub struct CurveFilter {
     pub key: Option<String>,
 }
 
+/// How much a campaign holds (what a list shows without reading the content).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CampaignCounts {
+    pub tests: i64,
+    /// Specimens (repeats) over all tests.
+    pub specimens: i64,
+    /// Increments over all specimens.
+    pub increments: i64,
+    /// Accelerometer records over all specimens.
+    pub accelerometer_records: i64,
+}
+
+/// A validated test campaign to store (issue 14): its canonical JSON text (samples inline),
+/// what `GET /v1/campaigns/{id}` answers with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewCampaign {
+    pub id: Uuid,
+    /// The campaign's `name`.
+    pub name: String,
+    /// Token name of the uploader.
+    pub created_by: String,
+    pub created_ms: i64,
+    /// Canonical JSON (`gap::Campaign` as serde_json writes it).
+    pub content: String,
+    /// SHA-256 of `content`, lower-case hex. The same content is stored once.
+    pub content_sha256: String,
+    pub counts: CampaignCounts,
+}
+
+/// A stored campaign without its content.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CampaignSummary {
+    pub id: Uuid,
+    /// Upload order (list cursor).
+    pub seq: i64,
+    pub name: String,
+    pub created_by: String,
+    pub created_ms: i64,
+    pub content_sha256: String,
+    /// Length of the canonical JSON, bytes.
+    pub content_bytes: i64,
+    pub counts: CampaignCounts,
+}
+
+/// A stored campaign with its canonical JSON text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CampaignRecord {
+    pub summary: CampaignSummary,
+    pub content: String,
+}
+
+/// What [`Store::insert_campaign`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CampaignInsert {
+    /// A new record.
+    Created(CampaignSummary),
+    /// A campaign with the same content (SHA-256) was already stored: that one, unchanged.
+    Existing(CampaignSummary),
+}
+
 /// An API token as stored (the secret itself is only kept as its SHA-256).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TokenRecord {
@@ -419,7 +517,27 @@ pub trait Store: Send + Sync {
         worker: &str,
         now_ms: i64,
         lease_ms: i64,
+    ) -> StoreFuture<'_, Option<JobRecord>> {
+        self.claim_job_on(worker, None, now_ms, lease_ms)
+    }
+    /// [`Store::claim_job`], recording the host, pid and instance of the worker's process.
+    fn claim_job_on(
+        &self,
+        worker: &str,
+        host: Option<&WorkerHost>,
+        now_ms: i64,
+        lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>>;
+    /// Running jobs whose lease is held by a process of `host`.
+    fn host_leases(&self, host: &str) -> StoreFuture<'_, Vec<HostLease>>;
+    /// End the leases of these attempts now (fenced: a job whose attempt moved on is left
+    /// alone), so that [`Store::requeue_expired`] re-queues them at once. Returns how many.
+    fn expire_leases(&self, attempts: Vec<(Uuid, i64)>, now_ms: i64) -> StoreFuture<'_, u64>;
+    /// Give attempt `attempt` back (shutdown): the job is queued again at once (ahead of later
+    /// submissions, it keeps its place) and the attempt is logged `released`; a fanned-out
+    /// job keeps its children's progress. Fenced by the attempt; refused when cancellation was
+    /// requested.
+    fn release_job(&self, id: Uuid, attempt: i64, now_ms: i64) -> StoreFuture<'_, ReleaseOutcome>;
     /// Renew the lease of attempt `attempt` and write its progress (fenced).
     fn heartbeat(
         &self,
@@ -506,6 +624,14 @@ pub trait Store: Send + Sync {
         now_ms: i64,
     ) -> StoreFuture<'_, PublishOutcome>;
 
+    /// Store a validated campaign; when one with the same content SHA-256 exists, nothing is
+    /// written and that one is returned (also under concurrent uploads of the same content).
+    fn insert_campaign(&self, campaign: NewCampaign) -> StoreFuture<'_, CampaignInsert>;
+    /// One campaign with its content.
+    fn get_campaign(&self, id: Uuid) -> StoreFuture<'_, Option<CampaignRecord>>;
+    /// Campaign summaries, newest first (cursor: the upload sequence number).
+    fn list_campaigns(&self, page: PageRequest) -> StoreFuture<'_, Page<CampaignSummary>>;
+
     fn create_token(
         &self,
         name: &str,
@@ -591,6 +717,7 @@ mod tests {
             AttemptOutcome::Cancelled,
             AttemptOutcome::FannedOut,
             AttemptOutcome::Lost,
+            AttemptOutcome::Released,
         ] {
             assert_eq!(AttemptOutcome::parse(outcome.as_str()), Some(outcome));
         }

@@ -7,10 +7,11 @@
 
 use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
-    publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
-    CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
-    MeasurementRecord, NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication,
-    PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    publish_refusal, AttemptOutcome, AttemptRecord, CampaignCounts, CampaignInsert, CampaignRecord,
+    CampaignSummary, ChildCounts, ChildOf, ChildRecord, CurveFidelity, CurveFilter, CurveRecord,
+    FanOut, FanOutResult, Finish, Heartbeat, HostLease, JobFilter, MeasurementRecord, NewCampaign,
+    NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord,
+    ReleaseOutcome, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
 use crate::config::Role;
 use sqlx::postgres::{PgConnectOptions, PgConnection, PgPool, PgPoolOptions, PgRow};
@@ -393,6 +394,28 @@ fn token_from_row(row: &PgRow) -> Result<TokenRecord, StoreError> {
     })
 }
 
+/// Columns of a campaign summary (everything but the content).
+const CAMPAIGN_SUMMARY: &str = "seq, id, name, created_by, created_ms, content_sha256, \
+    content_bytes, tests, specimens, increments, accelerometer_records";
+
+fn campaign_from_row(row: &PgRow) -> Result<CampaignSummary, StoreError> {
+    Ok(CampaignSummary {
+        id: row.try_get("id")?,
+        seq: row.try_get("seq")?,
+        name: row.try_get("name")?,
+        created_by: row.try_get("created_by")?,
+        created_ms: row.try_get("created_ms")?,
+        content_sha256: row.try_get("content_sha256")?,
+        content_bytes: row.try_get("content_bytes")?,
+        counts: CampaignCounts {
+            tests: row.try_get("tests")?,
+            specimens: row.try_get("specimens")?,
+            increments: row.try_get("increments")?,
+            accelerometer_records: row.try_get("accelerometer_records")?,
+        },
+    })
+}
+
 /// Cut a fetched `limit + 1` list into a page.
 fn paginate<T>(mut items: Vec<T>, limit: i64, seq: impl Fn(&T) -> i64) -> Page<T> {
     let limit = limit.max(0) as usize;
@@ -501,13 +524,15 @@ impl Store for PgStore {
         })
     }
 
-    fn claim_job(
+    fn claim_job_on(
         &self,
         worker: &str,
+        host: Option<&WorkerHost>,
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
         let worker = worker.to_string();
+        let host = host.cloned();
         Box::pin(async move {
             let mut tx = self.pool.begin().await?;
             // The row lock is held to commit; a concurrent claimer skips the locked row and
@@ -527,7 +552,7 @@ impl Store for PgStore {
             let sql = format!(
                 "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $2, \
                  lease_expires_ms = $3 + $4, started_ms = COALESCE(started_ms, $3), \
-                 attempt_started_ms = $3, \
+                 attempt_started_ms = $3, lease_host = $5, lease_pid = $6, lease_instance = $7, \
                  progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
                  progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
                  progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
@@ -539,6 +564,9 @@ impl Store for PgStore {
                 .bind(&worker)
                 .bind(now_ms)
                 .bind(lease_ms)
+                .bind(host.as_ref().map(|h| h.host.clone()))
+                .bind(host.as_ref().map(|h| i64::from(h.pid)))
+                .bind(host.as_ref().map(|h| h.instance.clone()))
                 .fetch_optional(&mut *tx)
                 .await?;
             let record = row.as_ref().map(job_from_row).transpose()?;
@@ -556,6 +584,85 @@ impl Store for PgStore {
             }
             tx.commit().await?;
             Ok(record)
+        })
+    }
+
+    fn host_leases(&self, host: &str) -> StoreFuture<'_, Vec<HostLease>> {
+        let host = host.to_string();
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT id, attempt, lease_pid, lease_instance FROM jobs \
+                 WHERE status = 'running' AND lease_host = $1 AND lease_pid IS NOT NULL \
+                 AND lease_instance IS NOT NULL ORDER BY seq",
+            )
+            .bind(host)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let pid: i64 = row.try_get("lease_pid")?;
+                    Ok(HostLease {
+                        job: row.try_get("id")?,
+                        attempt: row.try_get("attempt")?,
+                        pid: u32::try_from(pid).map_err(|_| corrupt(format!("pid {pid}")))?,
+                        instance: row.try_get("lease_instance")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn expire_leases(&self, attempts: Vec<(Uuid, i64)>, now_ms: i64) -> StoreFuture<'_, u64> {
+        Box::pin(async move {
+            let mut n = 0;
+            // One statement per job (no other row touched): no lock order to keep.
+            for (id, attempt) in attempts {
+                n += sqlx::query(
+                    "UPDATE jobs SET lease_expires_ms = $3 - 1 \
+                     WHERE id = $1 AND attempt = $2 AND status = 'running'",
+                )
+                .bind(id)
+                .bind(attempt)
+                .bind(now_ms)
+                .execute(&self.pool)
+                .await?
+                .rows_affected();
+            }
+            Ok(n)
+        })
+    }
+
+    fn release_job(&self, id: Uuid, attempt: i64, now_ms: i64) -> StoreFuture<'_, ReleaseOutcome> {
+        Box::pin(async move {
+            // Only the job's own row (and its attempt) is written: no parent lock needed.
+            let mut tx = self.pool.begin().await?;
+            let row = sqlx::query(
+                "SELECT cancel_requested FROM jobs WHERE id = $1 AND attempt = $2 \
+                 AND status = 'running' FOR UPDATE",
+            )
+            .bind(id)
+            .bind(attempt)
+            .fetch_optional(&mut *tx)
+            .await?;
+            let outcome = match row {
+                None => ReleaseOutcome::Stale,
+                Some(row) if row.try_get::<bool, _>("cancel_requested")? => {
+                    ReleaseOutcome::CancelRequested
+                }
+                Some(_) => {
+                    sqlx::query(
+                        "UPDATE jobs SET status = 'queued', lease_owner = NULL, \
+                         lease_expires_ms = NULL, progress_eta_s = NULL WHERE id = $1",
+                    )
+                    .bind(id)
+                    .execute(&mut *tx)
+                    .await?;
+                    end_attempt(&mut tx, id, attempt, AttemptOutcome::Released, now_ms).await?;
+                    ReleaseOutcome::Released
+                }
+            };
+            tx.commit().await?;
+            Ok(outcome)
         })
     }
 
@@ -1222,6 +1329,78 @@ impl Store for PgStore {
             let record = curve_from_row(&record)?;
             tx.commit().await?;
             Ok(PublishOutcome::Published(record))
+        })
+    }
+
+    fn insert_campaign(&self, c: NewCampaign) -> StoreFuture<'_, CampaignInsert> {
+        Box::pin(async move {
+            // A concurrent insert of the same content waits for the first to commit, then does
+            // nothing; the select below then sees the committed row.
+            let inserted = sqlx::query(&format!(
+                "INSERT INTO campaigns (id, name, created_by, created_ms, content, \
+                 content_sha256, content_bytes, tests, specimens, increments, \
+                 accelerometer_records) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) \
+                 ON CONFLICT (content_sha256) DO NOTHING RETURNING {CAMPAIGN_SUMMARY}"
+            ))
+            .bind(c.id)
+            .bind(&c.name)
+            .bind(&c.created_by)
+            .bind(c.created_ms)
+            .bind(&c.content)
+            .bind(&c.content_sha256)
+            .bind(c.content.len() as i64)
+            .bind(c.counts.tests)
+            .bind(c.counts.specimens)
+            .bind(c.counts.increments)
+            .bind(c.counts.accelerometer_records)
+            .fetch_optional(&self.pool)
+            .await?;
+            if let Some(row) = inserted {
+                return Ok(CampaignInsert::Created(campaign_from_row(&row)?));
+            }
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns WHERE content_sha256 = $1"
+            ))
+            .bind(&c.content_sha256)
+            .fetch_one(&self.pool)
+            .await?;
+            Ok(CampaignInsert::Existing(campaign_from_row(&row)?))
+        })
+    }
+
+    fn get_campaign(&self, id: Uuid) -> StoreFuture<'_, Option<CampaignRecord>> {
+        Box::pin(async move {
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY}, content FROM campaigns WHERE id = $1"
+            ))
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await?;
+            row.map(|row| {
+                Ok(CampaignRecord {
+                    summary: campaign_from_row(&row)?,
+                    content: row.try_get("content")?,
+                })
+            })
+            .transpose()
+        })
+    }
+
+    fn list_campaigns(&self, page: PageRequest) -> StoreFuture<'_, Page<CampaignSummary>> {
+        Box::pin(async move {
+            let rows = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns \
+                 WHERE ($1::BIGINT IS NULL OR seq < $1) ORDER BY seq DESC LIMIT $2"
+            ))
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(campaign_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |c| c.seq))
         })
     }
 

@@ -4,10 +4,11 @@
 
 use super::job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::{
-    publish_refusal, AttemptOutcome, AttemptRecord, ChildCounts, ChildOf, ChildRecord,
-    CurveFidelity, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish, Heartbeat, JobFilter,
-    MeasurementRecord, NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication,
-    PublishOutcome, RailRecord, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock,
+    publish_refusal, AttemptOutcome, AttemptRecord, CampaignCounts, CampaignInsert, CampaignRecord,
+    CampaignSummary, ChildCounts, ChildOf, ChildRecord, CurveFidelity, CurveFilter, CurveRecord,
+    FanOut, FanOutResult, Finish, Heartbeat, HostLease, JobFilter, MeasurementRecord, NewCampaign,
+    NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord,
+    ReleaseOutcome, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
 use crate::config::Role;
 use sqlx::sqlite::{
@@ -226,6 +227,29 @@ fn token_from_row(row: &SqliteRow) -> Result<TokenRecord, StoreError> {
         role: Role::parse(&role).ok_or_else(|| corrupt(format!("token role `{role}`")))?,
         created_ms: row.try_get("created_ms")?,
         revoked: row.try_get::<Option<i64>, _>("revoked_ms")?.is_some(),
+    })
+}
+
+/// Columns of a campaign summary (everything but the content).
+const CAMPAIGN_SUMMARY: &str = "seq, id, name, created_by, created_ms, content_sha256, \
+    content_bytes, tests, specimens, increments, accelerometer_records";
+
+fn campaign_from_row(row: &SqliteRow) -> Result<CampaignSummary, StoreError> {
+    let id: String = row.try_get("id")?;
+    Ok(CampaignSummary {
+        id: parse_uuid(&id)?,
+        seq: row.try_get("seq")?,
+        name: row.try_get("name")?,
+        created_by: row.try_get("created_by")?,
+        created_ms: row.try_get("created_ms")?,
+        content_sha256: row.try_get("content_sha256")?,
+        content_bytes: row.try_get("content_bytes")?,
+        counts: CampaignCounts {
+            tests: row.try_get("tests")?,
+            specimens: row.try_get("specimens")?,
+            increments: row.try_get("increments")?,
+            accelerometer_records: row.try_get("accelerometer_records")?,
+        },
     })
 }
 
@@ -459,13 +483,15 @@ impl Store for SqliteStore {
         })
     }
 
-    fn claim_job(
+    fn claim_job_on(
         &self,
         worker: &str,
+        host: Option<&WorkerHost>,
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
         let worker = worker.to_string();
+        let host = host.cloned();
         Box::pin(async move {
             // One statement: the sub-select and the update run under the same write lock, so
             // two workers can never take the same job. A parent queued for its assembly keeps
@@ -474,7 +500,7 @@ impl Store for SqliteStore {
             let sql = format!(
                 "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = ?1, \
                  lease_expires_ms = ?2 + ?3, started_ms = COALESCE(started_ms, ?2), \
-                 attempt_started_ms = ?2, \
+                 attempt_started_ms = ?2, lease_host = ?4, lease_pid = ?5, lease_instance = ?6, \
                  progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
                  progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
                  progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
@@ -486,6 +512,9 @@ impl Store for SqliteStore {
                 .bind(&worker)
                 .bind(now_ms)
                 .bind(lease_ms)
+                .bind(host.as_ref().map(|h| h.host.clone()))
+                .bind(host.as_ref().map(|h| i64::from(h.pid)))
+                .bind(host.as_ref().map(|h| h.instance.clone()))
                 .fetch_optional(&mut *tx)
                 .await?;
             let Some(job) = row.as_ref().map(job_from_row).transpose()? else {
@@ -504,6 +533,93 @@ impl Store for SqliteStore {
             .await?;
             tx.commit().await?;
             Ok(Some(job))
+        })
+    }
+
+    fn host_leases(&self, host: &str) -> StoreFuture<'_, Vec<HostLease>> {
+        let host = host.to_string();
+        Box::pin(async move {
+            let rows = sqlx::query(
+                "SELECT id, attempt, lease_pid, lease_instance FROM jobs \
+                 WHERE status = 'running' AND lease_host = ?1 AND lease_pid IS NOT NULL \
+                 AND lease_instance IS NOT NULL ORDER BY seq",
+            )
+            .bind(host)
+            .fetch_all(&self.pool)
+            .await?;
+            rows.iter()
+                .map(|row| {
+                    let id: String = row.try_get("id")?;
+                    let pid: i64 = row.try_get("lease_pid")?;
+                    Ok(HostLease {
+                        job: parse_uuid(&id)?,
+                        attempt: row.try_get("attempt")?,
+                        pid: u32::try_from(pid).map_err(|_| corrupt(format!("pid {pid}")))?,
+                        instance: row.try_get("lease_instance")?,
+                    })
+                })
+                .collect()
+        })
+    }
+
+    fn expire_leases(&self, attempts: Vec<(Uuid, i64)>, now_ms: i64) -> StoreFuture<'_, u64> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let mut n = 0;
+            for (id, attempt) in attempts {
+                n += sqlx::query(
+                    "UPDATE jobs SET lease_expires_ms = ?3 - 1 \
+                     WHERE id = ?1 AND attempt = ?2 AND status = 'running'",
+                )
+                .bind(id.to_string())
+                .bind(attempt)
+                .bind(now_ms)
+                .execute(&mut *tx)
+                .await?
+                .rows_affected();
+            }
+            tx.commit().await?;
+            Ok(n)
+        })
+    }
+
+    fn release_job(&self, id: Uuid, attempt: i64, now_ms: i64) -> StoreFuture<'_, ReleaseOutcome> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            let row = sqlx::query(
+                "SELECT cancel_requested FROM jobs WHERE id = ?1 AND attempt = ?2 \
+                 AND status = 'running'",
+            )
+            .bind(id.to_string())
+            .bind(attempt)
+            .fetch_optional(&mut *tx)
+            .await?;
+            let outcome = match row {
+                None => ReleaseOutcome::Stale,
+                Some(row) if row.try_get::<i64, _>("cancel_requested")? != 0 => {
+                    ReleaseOutcome::CancelRequested
+                }
+                Some(_) => {
+                    sqlx::query(
+                        "UPDATE jobs SET status = 'queued', lease_owner = NULL, \
+                         lease_expires_ms = NULL, progress_eta_s = NULL WHERE id = ?1",
+                    )
+                    .bind(id.to_string())
+                    .execute(&mut *tx)
+                    .await?;
+                    end_attempt(
+                        &mut tx,
+                        &id.to_string(),
+                        attempt,
+                        AttemptOutcome::Released,
+                        now_ms,
+                    )
+                    .await?;
+                    ReleaseOutcome::Released
+                }
+            };
+            tx.commit().await?;
+            Ok(outcome)
         })
     }
 
@@ -1172,6 +1288,76 @@ impl Store for SqliteStore {
             let record = curve_from_row(&record)?;
             tx.commit().await?;
             Ok(PublishOutcome::Published(record))
+        })
+    }
+
+    fn insert_campaign(&self, c: NewCampaign) -> StoreFuture<'_, CampaignInsert> {
+        Box::pin(async move {
+            let inserted = sqlx::query(&format!(
+                "INSERT INTO campaigns (id, name, created_by, created_ms, content, \
+                 content_sha256, content_bytes, tests, specimens, increments, \
+                 accelerometer_records) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11) \
+                 ON CONFLICT (content_sha256) DO NOTHING RETURNING {CAMPAIGN_SUMMARY}"
+            ))
+            .bind(c.id.to_string())
+            .bind(&c.name)
+            .bind(&c.created_by)
+            .bind(c.created_ms)
+            .bind(&c.content)
+            .bind(&c.content_sha256)
+            .bind(c.content.len() as i64)
+            .bind(c.counts.tests)
+            .bind(c.counts.specimens)
+            .bind(c.counts.increments)
+            .bind(c.counts.accelerometer_records)
+            .fetch_optional(&self.pool)
+            .await?;
+            if let Some(row) = inserted {
+                return Ok(CampaignInsert::Created(campaign_from_row(&row)?));
+            }
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns WHERE content_sha256 = ?1"
+            ))
+            .bind(&c.content_sha256)
+            .fetch_one(&self.pool)
+            .await?;
+            Ok(CampaignInsert::Existing(campaign_from_row(&row)?))
+        })
+    }
+
+    fn get_campaign(&self, id: Uuid) -> StoreFuture<'_, Option<CampaignRecord>> {
+        Box::pin(async move {
+            let row = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY}, content FROM campaigns WHERE id = ?1"
+            ))
+            .bind(id.to_string())
+            .fetch_optional(&self.pool)
+            .await?;
+            row.map(|row| {
+                Ok(CampaignRecord {
+                    summary: campaign_from_row(&row)?,
+                    content: row.try_get("content")?,
+                })
+            })
+            .transpose()
+        })
+    }
+
+    fn list_campaigns(&self, page: PageRequest) -> StoreFuture<'_, Page<CampaignSummary>> {
+        Box::pin(async move {
+            let rows = sqlx::query(&format!(
+                "SELECT {CAMPAIGN_SUMMARY} FROM campaigns WHERE (?1 IS NULL OR seq < ?1) \
+                 ORDER BY seq DESC LIMIT ?2"
+            ))
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(&self.pool)
+            .await?;
+            let items = rows
+                .iter()
+                .map(campaign_from_row)
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(paginate(items, page.limit, |c| c.seq))
         })
     }
 

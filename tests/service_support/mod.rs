@@ -13,10 +13,14 @@ use std::time::{Duration, Instant};
 pub const ADMIN: &str = "admin-token-0123456789abcdef";
 pub const ENGINEER: &str = "engineer-token-0123456789abcdef";
 pub const PLANNER: &str = "planner-token-0123456789abcdef";
+pub const TEST_ENGINEER: &str = "test-engineer-token-0123456789abcdef";
 
-/// `RAILWEAR_TOKENS` value for the three test tokens.
+/// `RAILWEAR_TOKENS` value for the four test tokens.
 pub fn tokens_env() -> String {
-    format!("root:admin:{ADMIN},eng:engineer:{ENGINEER},plan:planner:{PLANNER}")
+    format!(
+        "root:admin:{ADMIN},eng:engineer:{ENGINEER},plan:planner:{PLANNER},\
+         lab:test-engineer:{TEST_ENGINEER}"
+    )
 }
 
 /// A fresh directory under the system temp dir, removed on drop.
@@ -159,10 +163,16 @@ pub struct Binary {
 impl Binary {
     /// Start `railwear serve` with a fresh or given database and extra env vars.
     pub fn start(db_url: &str, extra_env: &[(&str, &str)]) -> Binary {
+        Self::start_with_args(db_url, extra_env, &[])
+    }
+
+    /// [`Binary::start`] with more `serve` arguments (e.g. `--no-workers`).
+    pub fn start_with_args(db_url: &str, extra_env: &[(&str, &str)], args: &[&str]) -> Binary {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_railwear"));
         cmd.current_dir(root)
             .args(["serve", "--listen", "127.0.0.1:0"])
+            .args(args)
             .env("DATABASE_URL", db_url)
             .env("RAILWEAR_TOKENS", tokens_env())
             .env("RAILWEAR_CONFIGS_DIR", root.join("configs"))

@@ -1,0 +1,283 @@
+//! Issue 17: clean shutdown with the counting test runner. Stopping the service stops the
+//! workers taking jobs and gives running attempts back to the queue at once (attempt logged
+//! `released`), within the shutdown grace even when the computation does not stop; the next
+//! worker runs the job to a result identical to an uninterrupted run. A sweep keeps the points
+//! that finished (the sweep-level checkpoint) and re-runs only the rest.
+
+mod service_support;
+
+use railwear::jobs::JobStatus;
+use railwear::store::{AttemptOutcome, Store};
+use serde_json::Value;
+use service_support::runner::{start, test_config};
+use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+async fn outcomes(store: &Arc<dyn Store>, id: &str) -> Vec<AttemptOutcome> {
+    let id = id.parse().expect("uuid");
+    store
+        .attempts(id)
+        .await
+        .expect("attempts")
+        .iter()
+        .map(|a| a.outcome)
+        .collect()
+}
+
+/// Tracks CSV and result summary of a succeeded job.
+fn results(base: &str, id: &str) -> (String, Value) {
+    let csv = curl(
+        "GET",
+        &format!("{base}/v1/jobs/{id}/tracks"),
+        Some(ENGINEER),
+        &[],
+        None,
+    );
+    assert_eq!(csv.status, 200, "{}", csv.body);
+    (
+        csv.body,
+        get_json(base, &format!("/v1/jobs/{id}/result"))["summary"].clone(),
+    )
+}
+
+fn wait_status(base: &str, id: &str, status: &str) -> Value {
+    wait_for(Duration::from_secs(30), status, || {
+        let j = get_job(base, id);
+        (j["status"] == status).then_some(j)
+    })
+}
+
+const BODY: &str =
+    r#"{"kind":"simulate","params":{"steps":30,"step_ms":50,"samples":400,"seed":8}}"#;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identically() {
+    // Reference: uninterrupted.
+    let ref_dir = TempDir::new("shutdown-ref");
+    let reference = start(test_config(&ref_dir.db_url()), true).await;
+    let base = format!("http://{}", reference.addr);
+    let expected = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, BODY);
+        wait_status(&base, &id, "succeeded");
+        results(&base, &id)
+    })
+    .await
+    .unwrap();
+    reference.stop().await;
+
+    let dir = TempDir::new("shutdown");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 1;
+    config.shutdown_grace_s = 1.0;
+    config.lease_s = 60.0; // only the release can hand the job on this fast
+    let first = start(config.clone(), true).await;
+    let store = first.state.store.clone();
+    let base = format!("http://{}", first.addr);
+    let id = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, BODY);
+        wait_for(Duration::from_secs(30), "progress", || {
+            let j = get_job(&base, &id);
+            (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.2).then_some(())
+        });
+        id
+    })
+    .await
+    .unwrap();
+    let asked = Instant::now();
+    first.stop().await;
+    // The runner stops at its next 50 ms step: far inside the grace.
+    assert!(
+        asked.elapsed() < Duration::from_millis(1000),
+        "{:?}",
+        asked.elapsed()
+    );
+    let job = store.get_job(id.parse().unwrap()).await.unwrap().unwrap();
+    assert_eq!(job.status, JobStatus::Queued, "given back at once");
+    assert_eq!(job.lease_owner, None);
+    assert_eq!(job.attempt, 1);
+    assert_eq!(outcomes(&store, &id).await, [AttemptOutcome::Released]);
+
+    let second = start(config, true).await;
+    let base = format!("http://{}", second.addr);
+    let (got, job) = tokio::task::spawn_blocking({
+        let id = id.clone();
+        move || {
+            let job = wait_status(&base, &id, "succeeded");
+            (results(&base, &id), job)
+        }
+    })
+    .await
+    .unwrap();
+    assert_eq!(job["attempt"], 2);
+    assert_eq!(
+        got.0, expected.0,
+        "tracks identical to the uninterrupted run"
+    );
+    assert_eq!(got.1, expected.1);
+    assert_eq!(
+        outcomes(&store, &id).await,
+        [AttemptOutcome::Released, AttemptOutcome::Succeeded]
+    );
+    second.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
+    let dir = TempDir::new("shutdown-grace");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 1;
+    config.shutdown_grace_s = 0.5;
+    config.lease_s = 60.0;
+    let service = start(config, true).await;
+    let store = service.state.store.clone();
+    let base = format!("http://{}", service.addr);
+    // One step of 4 s: the runner looks at its cancel flag only between steps.
+    let id = tokio::task::spawn_blocking(move || {
+        let id = submit_job(
+            &base,
+            r#"{"kind":"simulate","params":{"steps":2,"step_ms":4000,"seed":1}}"#,
+        );
+        wait_status(&base, &id, "running");
+        id
+    })
+    .await
+    .unwrap();
+    let asked = Instant::now();
+    service.stop().await;
+    let took = asked.elapsed();
+    assert!(
+        took >= Duration::from_millis(450) && took < Duration::from_millis(1500),
+        "{took:?}"
+    );
+    let id: uuid::Uuid = id.parse().unwrap();
+    let job = store.get_job(id).await.unwrap().unwrap();
+    assert_eq!(job.status, JobStatus::Queued);
+    let log: Vec<_> = store
+        .attempts(id)
+        .await
+        .unwrap()
+        .iter()
+        .map(|a| a.outcome)
+        .collect();
+    assert_eq!(log, [AttemptOutcome::Released]);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_result() {
+    let body = r#"{"kind":"sweep","params":{"children":6,"steps":8,"step_ms":50,"seed":77}}"#;
+    let ref_dir = TempDir::new("shutdown-sweep-ref");
+    let reference = start(test_config(&ref_dir.db_url()), true).await;
+    let base = format!("http://{}", reference.addr);
+    let expected = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, body);
+        wait_status(&base, &id, "succeeded");
+        get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
+    })
+    .await
+    .unwrap();
+    reference.stop().await;
+
+    let dir = TempDir::new("shutdown-sweep");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 2;
+    config.shutdown_grace_s = 1.0;
+    config.lease_s = 60.0;
+    let first = start(config.clone(), true).await;
+    let store = first.state.store.clone();
+    let base = format!("http://{}", first.addr);
+    let id = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, body);
+        // Stop once some points are done and others run.
+        wait_for(Duration::from_secs(30), "a point done", || {
+            let j = get_job(&base, &id);
+            (j["children"]["succeeded"].as_i64().unwrap_or(0) >= 2).then_some(())
+        });
+        id
+    })
+    .await
+    .unwrap();
+    first.stop().await;
+    let sweep: uuid::Uuid = id.parse().unwrap();
+    let parent = store.get_job(sweep).await.unwrap().unwrap();
+    assert_eq!(parent.status, JobStatus::Waiting);
+    let children = store.children(sweep).await.unwrap();
+    let done_before: Vec<_> = children
+        .iter()
+        .filter(|c| c.status == JobStatus::Succeeded)
+        .map(|c| c.id)
+        .collect();
+    assert!(
+        done_before.len() >= 2 && done_before.len() < 6,
+        "{children:?}"
+    );
+    assert!(
+        children
+            .iter()
+            .all(|c| matches!(c.status, JobStatus::Succeeded | JobStatus::Queued)),
+        "nothing left running: {children:?}"
+    );
+    let mut released = 0;
+    for c in &children {
+        let log: Vec<_> = store
+            .attempts(c.id)
+            .await
+            .unwrap()
+            .iter()
+            .map(|a| a.outcome)
+            .collect();
+        released += log
+            .iter()
+            .filter(|o| **o == AttemptOutcome::Released)
+            .count();
+    }
+    assert!(released >= 1, "a running point was given back");
+
+    let second = start(config, true).await;
+    let base = format!("http://{}", second.addr);
+    let summary = tokio::task::spawn_blocking({
+        let id = id.clone();
+        move || {
+            wait_status(&base, &id, "succeeded");
+            get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
+        }
+    })
+    .await
+    .unwrap();
+    assert_eq!(
+        summary, expected,
+        "the resumed sweep equals the uninterrupted one"
+    );
+    // The points finished before the shutdown were not run again; every point succeeded once.
+    for c in store.children(sweep).await.unwrap() {
+        let log: Vec<_> = store
+            .attempts(c.id)
+            .await
+            .unwrap()
+            .iter()
+            .map(|a| a.outcome)
+            .collect();
+        assert_eq!(
+            log.iter()
+                .filter(|o| **o == AttemptOutcome::Succeeded)
+                .count(),
+            1,
+            "{log:?}"
+        );
+        if done_before.contains(&c.id) {
+            assert_eq!(log, [AttemptOutcome::Succeeded]);
+        }
+    }
+    let parent_log: Vec<_> = store
+        .attempts(sweep)
+        .await
+        .unwrap()
+        .iter()
+        .map(|a| a.outcome)
+        .collect();
+    assert_eq!(
+        parent_log,
+        [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
+    );
+    second.stop().await;
+}
