@@ -121,6 +121,7 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
                 .simulation
                 .energy_rel_tolerance
                 .unwrap_or(10.0 * case.simulation.rel_tolerance),
+            error_control: case.simulation.error_control,
         },
         initial_step_s: 1e-6,
         max_step_s: 1e-3,
