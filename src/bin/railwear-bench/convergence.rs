@@ -168,29 +168,46 @@ pub(crate) struct ConvergenceBench {
     pub(crate) with_energy_off: bool,
 }
 
+/// An error-control mode of the study: its name, the mode and whether the energy account's
+/// work test is on.
+struct Mode {
+    name: &'static str,
+    control: ErrorControl,
+    energy_off: bool,
+}
+
+const MODES: [Mode; 3] = [
+    Mode {
+        name: "full",
+        control: ErrorControl::Full,
+        energy_off: false,
+    },
+    Mode {
+        name: "positions",
+        control: ErrorControl::Positions,
+        energy_off: false,
+    },
+    Mode {
+        name: "positions, no work test",
+        control: ErrorControl::Positions,
+        energy_off: true,
+    },
+];
+
 pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Table>> {
     if !(b.window > 0.0 && b.reference_factor > 0.0 && b.reference_factor < 1.0) {
         bail!("--window must be > 0 and --reference-factor in (0, 1)");
     }
+    let modes: Vec<&Mode> = MODES
+        .iter()
+        .filter(|m| b.with_energy_off || !m.energy_off)
+        .collect();
+    // Variant 0: the reference; 1: the nudge; then each mode at tol and tol/2.
     let mut variants = vec![
         Variant {
             label: "reference: full, tol × f".into(),
             mode: ErrorControl::Full,
             factor: b.reference_factor,
-            energy_off: false,
-            nudge_m: 0.0,
-        },
-        Variant {
-            label: "full, tol".into(),
-            mode: ErrorControl::Full,
-            factor: 1.0,
-            energy_off: false,
-            nudge_m: 0.0,
-        },
-        Variant {
-            label: "full, tol/2".into(),
-            mode: ErrorControl::Full,
-            factor: 0.5,
             energy_off: false,
             nudge_m: 0.0,
         },
@@ -201,35 +218,19 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             energy_off: false,
             nudge_m: 1e-9,
         },
-        Variant {
-            label: "positions, tol".into(),
-            mode: ErrorControl::Positions,
-            factor: 1.0,
-            energy_off: false,
-            nudge_m: 0.0,
-        },
-        Variant {
-            label: "positions, tol/2".into(),
-            mode: ErrorControl::Positions,
-            factor: 0.5,
-            energy_off: false,
-            nudge_m: 0.0,
-        },
     ];
-    if b.with_energy_off {
-        for factor in [1.0, 0.5] {
+    for m in &modes {
+        for (factor, tag) in [(1.0, "tol"), (0.5, "tol/2")] {
             variants.push(Variant {
-                label: format!(
-                    "positions, tol{}, no work test",
-                    if factor < 1.0 { "/2" } else { "" }
-                ),
-                mode: ErrorControl::Positions,
+                label: format!("{}, {tag}", m.name),
+                mode: m.control,
                 factor,
-                energy_off: true,
+                energy_off: m.energy_off,
                 nudge_m: 0.0,
             });
         }
     }
+    let at = |mode: usize, half: bool| 2 + 2 * mode + usize::from(half);
     let mut runs_table = Table::new(
         "Convergence study: runs (no track recording)",
         &[
@@ -246,25 +247,41 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             ("energy_residual", "energy residual / dissipated"),
         ],
     );
-    let mut quantity_table = Table::new(
-        "Convergence study: user quantities and their differences",
-        &[
-            ("case", "case"),
-            ("quantity", "quantity"),
-            ("reference", "reference"),
-            ("full_tol", "full tol"),
-            ("full_half", "Δ full tol/2 vs tol"),
+    // Quantity table: the reference value, then each mode's Δ at tol and tol/2 against the
+    // reference and its halving Δ, then the nudge.
+    const MODE_COLUMNS: [[(&str, &str); 3]; 3] = [
+        [
             ("full_ref", "Δ full tol vs ref"),
-            ("chaos", "Δ full tol, 1 nm nudge"),
-            ("pos_tol", "positions tol"),
-            ("pos_half", "Δ pos tol/2 vs tol"),
-            ("pos_ref", "Δ pos tol vs ref"),
-            ("pos_half_ref", "Δ pos tol/2 vs ref"),
+            ("full_half_ref", "Δ full tol/2 vs ref"),
+            ("full_half", "Δ full tol/2 vs tol"),
         ],
+        [
+            ("pos_ref", "Δ positions tol vs ref"),
+            ("pos_half_ref", "Δ positions tol/2 vs ref"),
+            ("pos_half", "Δ positions tol/2 vs tol"),
+        ],
+        [
+            ("posnw_ref", "Δ positions (no work test) tol vs ref"),
+            ("posnw_half_ref", "Δ positions (no work test) tol/2 vs ref"),
+            ("posnw_half", "Δ positions (no work test) tol/2 vs tol"),
+        ],
+    ];
+    let mut columns = vec![
+        ("case", "case"),
+        ("quantity", "quantity"),
+        ("reference", "reference"),
+    ];
+    for cols in MODE_COLUMNS.iter().take(modes.len()) {
+        columns.extend_from_slice(cols);
+    }
+    columns.push(("chaos", "Δ full tol, 1 nm nudge"));
+    let mut quantity_table = Table::new(
+        "Convergence study: user quantities, differences against the reference and on halving",
+        &columns,
     );
     let mut verdict = Table::new(
         format!(
-            "Convergence study: verdict (criterion |Δ| < {} % on every quantity)",
+            "Convergence study: verdict (criterion |Δ| < {} % on every quantity, halving and against the reference)",
             b.criterion * 100.0
         ),
         &[
@@ -275,6 +292,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             ("worst_ref", "worst |Δ| tol vs reference"),
             ("worst_ref_q", "at"),
             ("chaos", "worst |Δ| of the 1 nm nudge (chaos floor)"),
+            ("steps", "accepted steps / full at tol"),
             ("pass", "passes"),
         ],
     );
@@ -289,7 +307,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             eprintln!("convergence: {case_name} {} ...", v.label);
             measured.push(run_variant(configs_dir, case_name, settle, b.window, v)?);
         }
-        let full_steps = measured[1].accepted as f64;
+        let full_steps = measured[at(0, false)].accepted as f64;
         let case_tol = load_case(&configs_dir.join(format!("{case_name}.toml")))?
             .simulation
             .rel_tolerance;
@@ -308,69 +326,47 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 Cell::opt(m.energy_residual_rel),
             ]);
         }
-        let (reference, full, full_half, chaos, pos, pos_half) = (
-            &measured[0],
-            &measured[1],
-            &measured[2],
-            &measured[3],
-            &measured[4],
-            &measured[5],
-        );
+        let reference = &measured[0];
+        let chaos = &measured[1];
         // Worst differences per mode: (halving, vs reference).
-        let mut worst: [[(f64, String); 2]; 2] = Default::default();
+        let mut worst: Vec<[(f64, String); 2]> = vec![Default::default(); modes.len()];
         let mut worst_chaos = 0.0f64;
         for (i, (name, r, kind)) in reference.quantities.iter().enumerate() {
             let val = |m: &Measured| m.quantities.get(i).map(|q| q.1).unwrap_or(f64::NAN);
             let d = |a: f64, b: f64| difference(*kind, a, b);
-            let diffs = [
-                d(val(full_half), val(full)),
-                d(val(full), *r),
-                d(val(chaos), val(full)),
-                d(val(pos_half), val(pos)),
-                d(val(pos), *r),
-                d(val(pos_half), *r),
-            ];
             let show = |x: f64| match kind {
                 QuantityKind::Relative => Cell::text(format!("{:+.2} %", 100.0 * x)),
                 QuantityKind::Share => Cell::text(format!("{:+.2} pp", 100.0 * x)),
             };
-            quantity_table.row(vec![
-                Cell::text(case_name),
-                Cell::text(name),
-                Cell::Num(*r),
-                Cell::Num(val(full)),
-                show(diffs[0]),
-                show(diffs[1]),
-                show(diffs[2]),
-                Cell::Num(val(pos)),
-                show(diffs[3]),
-                show(diffs[4]),
-                show(diffs[5]),
-            ]);
-            for (mode, (half, vs_ref)) in [(diffs[0], diffs[1]), (diffs[3], diffs[4])]
-                .into_iter()
-                .enumerate()
-            {
-                for (k, x) in [half, vs_ref].into_iter().enumerate() {
-                    if !(x.abs() <= worst[mode][k].0) {
-                        worst[mode][k] = (x.abs(), name.clone());
+            let mut row = vec![Cell::text(case_name), Cell::text(name), Cell::Num(*r)];
+            for (mi, w) in worst.iter_mut().enumerate() {
+                let (tol, half) = (val(&measured[at(mi, false)]), val(&measured[at(mi, true)]));
+                let (vs_ref, half_ref, halving) = (d(tol, *r), d(half, *r), d(half, tol));
+                row.extend([show(vs_ref), show(half_ref), show(halving)]);
+                for (k, x) in [halving, vs_ref].into_iter().enumerate() {
+                    if !(x.abs() <= w[k].0) {
+                        w[k] = (x.abs(), name.clone());
                     }
                 }
             }
-            if !(diffs[2].abs() <= worst_chaos) {
-                worst_chaos = diffs[2].abs();
+            let nudge = d(val(chaos), val(&measured[at(0, false)]));
+            row.push(show(nudge));
+            quantity_table.row(row);
+            if !(nudge.abs() <= worst_chaos) {
+                worst_chaos = nudge.abs();
             }
         }
-        for (mode, name) in ["full", "positions"].into_iter().enumerate() {
-            let [(h, hq), (r, rq)] = &worst[mode];
+        for (mi, m) in modes.iter().enumerate() {
+            let [(h, hq), (r, rq)] = &worst[mi];
             verdict.row(vec![
                 Cell::text(case_name),
-                Cell::text(name),
+                Cell::text(m.name),
                 Cell::text(format!("{:.2} %", 100.0 * h)),
                 Cell::text(hq),
                 Cell::text(format!("{:.2} %", 100.0 * r)),
                 Cell::text(rq),
                 Cell::text(format!("{:.2} %", 100.0 * worst_chaos)),
+                Cell::Num(measured[at(mi, false)].accepted as f64 / full_steps),
                 Cell::text(if *h < b.criterion && *r < b.criterion {
                     "yes"
                 } else {
@@ -383,7 +379,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
         "settle {} s (rattle box) / {} s (launcher), window {} s; reference = full error control at {} × the case's \
          rel and abs tolerances (the work tolerance follows rel); response = x acceleration of the free body \
          (cube, missile) at 2 kHz, Welch PSD with 2048-sample Hann segments, power per base-10 1/3-octave band \
-         (edges fc·10^(±1/20))",
+         (edges fc·10^(±1/20)); \"no work test\" = energy_rel_tolerance 0 (the account is still kept)",
         b.settle_box, b.settle_launcher, b.window, b.reference_factor
     );
     runs_table.note(setup.clone());
