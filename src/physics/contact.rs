@@ -183,6 +183,20 @@ pub struct TrackLinearization {
     pub dforce_dslip: Matrix3<f64>,
 }
 
+impl TrackLinearization {
+    /// `∂F/∂v_rel` at the point: `∂F/∂s P − (∂f_n/∂ẇ) (∂F/∂f_n) nᵀ`, taking `∂F/∂s P = ∂F/∂s`
+    /// (the slip derivative maps and yields tangential vectors only, see
+    /// `friction_derivatives`), given `∂F/∂f_n` and the normal.
+    #[inline]
+    pub fn dforce_slip_with_rate(
+        &self,
+        dforce_dfn: &Vector3<f64>,
+        normal: &Vector3<f64>,
+    ) -> Matrix3<f64> {
+        self.dforce_dslip - dforce_dfn * (normal.transpose() * self.dfn_dwdot)
+    }
+}
+
 /// What [`Contact::evaluate`] does with the overlap geometry of each (piece, face) pair.
 ///
 /// The finite-difference Jacobian perturbs one state entry per column. Velocity columns leave
@@ -737,7 +751,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let (mut culled, mut touching) = (0usize, 0usize);
         for trial in 0..2000 {
-            let rot = UnitQuaternion::from_euler_angles(
+            let rot: UnitQuaternion<f64> = UnitQuaternion::from_euler_angles(
                 rng.gen_range(-0.05..0.05),
                 rng.gen_range(-3.2..3.2),
                 rng.gen_range(-0.05..0.05),
@@ -745,7 +759,7 @@ mod tests {
             // Centre so that the lowest point sits within ±1 mm of the plane.
             let half_height: f64 = (0..3)
                 .map(|k| {
-                    let axis = rot.inverse_transform_vector(&Vector3::y());
+                    let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
                     (shape_half(&shape, k) - 5e-4) * axis[k].abs()
                 })
                 .sum::<f64>()
