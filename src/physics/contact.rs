@@ -534,26 +534,34 @@ impl Contact {
                     let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
                     let wdot = -v_rel.dot(&normal);
                     let beta = point.weight;
-                    let fn_mag = beta * self.impact.force(w, wdot);
-                    let elastic = beta * self.impact.elastic_force(w);
+                    // The force's parts once (each STEP evaluated once per point): the same
+                    // numbers as `ImpactParams::force`, `elastic_force` and `force_gradient`.
+                    let (spring, damping) = self.impact.force_parts(w);
+                    let fn_mag = beta * (spring + damping * wdot).max(0.0);
+                    let elastic = beta * spring;
                     let slip = v_rel - normal * v_rel.dot(&normal);
                     let speed = slip.norm();
                     let mut ft = 0.0;
+                    let mut mu = None;
                     let mut force = normal * fn_mag;
                     if let Some(fr) = &self.friction {
                         if speed > 0.0 && fn_mag > 0.0 {
-                            ft = fr.coefficient(speed) * fn_mag;
+                            let m = fr.coefficient(speed);
+                            mu = Some(m);
+                            ft = m * fn_mag;
                             force -= slip * (ft / speed);
                         }
                     }
                     if let Some(lin) = linearizations.as_deref_mut() {
                         if fn_mag > 0.0 {
-                            let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
+                            let (dfn_dw, dfn_dwdot) =
+                                self.impact.unclamped_gradient(w, wdot, damping);
                             let (dforce_dfn, dforce_dslip) = friction_derivatives(
                                 self.friction.as_ref(),
                                 &normal,
                                 &slip,
                                 fn_mag,
+                                mu,
                             );
                             lin.push(TrackLinearization {
                                 body_a: self.body_a,
@@ -688,7 +696,7 @@ impl TrackSum {
 }
 
 /// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
-/// and slip `slip` (tangential): `∂F/∂f_n = n − μ ŝ` and
+/// and slip `slip` (tangential; `mu` = μ(|s|) when already known): `∂F/∂f_n = n − μ ŝ` and
 /// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
 /// `μ/|s| → μ'(0)` is used.
 fn friction_derivatives(
@@ -696,6 +704,7 @@ fn friction_derivatives(
     normal: &Vector3<f64>,
     slip: &Vector3<f64>,
     fn_mag: f64,
+    mu: Option<f64>,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let Some(fr) = friction else {
         return (*normal, Matrix3::zeros());
@@ -705,7 +714,7 @@ fn friction_derivatives(
     if speed > 0.0 {
         let dir = slip / speed;
         let along = dir * dir.transpose();
-        let mu = fr.coefficient(speed);
+        let mu = mu.unwrap_or_else(|| fr.coefficient(speed));
         let dmu = fr.coefficient_derivative(speed);
         (
             normal - dir * mu,
