@@ -116,6 +116,13 @@ enum Command {
         /// Skip the memory run.
         #[arg(long)]
         no_mem: bool,
+        /// Only the engine's default variant in the timed run (the earlier Newton variants
+        /// are slow and were measured in earlier passes).
+        #[arg(long)]
+        default_only: bool,
+        /// Windows (s) of the duration-linearity table, comma list (empty: no table).
+        #[arg(long, default_value = "")]
+        durations: String,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -293,7 +300,28 @@ fn main() -> Result<()> {
             window,
             mem_window,
             no_mem,
-        } => launcher(&cli.configs_dir, *settle, *window, *mem_window, *no_mem)?,
+            default_only,
+            durations,
+        } => {
+            let mut tables = launcher(
+                &cli.configs_dir,
+                *settle,
+                *window,
+                *mem_window,
+                *no_mem,
+                *default_only,
+            )?;
+            let windows: Vec<f64> = durations
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(|s| s.parse::<f64>().context("--durations"))
+                .collect::<Result<_>>()?;
+            if !windows.is_empty() {
+                tables.push(launcher_linearity(&cli.configs_dir, *settle, &windows)?);
+            }
+            tables
+        }
         Command::Convergence {
             cases,
             settle_box,
