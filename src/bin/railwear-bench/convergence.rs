@@ -145,6 +145,11 @@ fn run_variant(
     })
 }
 
+/// `x` replaces the worst difference so far (a NaN always does: it is reported, not hidden).
+fn worse(x: f64, worst: f64) -> bool {
+    x.is_nan() || x > worst
+}
+
 fn difference(kind: QuantityKind, a: f64, b: f64) -> f64 {
     match kind {
         QuantityKind::Relative => {
@@ -344,7 +349,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 let (vs_ref, half_ref, halving) = (d(tol, *r), d(half, *r), d(half, tol));
                 row.extend([show(vs_ref), show(half_ref), show(halving)]);
                 for (k, x) in [halving, vs_ref].into_iter().enumerate() {
-                    if !(x.abs() <= w[k].0) {
+                    if worse(x.abs(), w[k].0) {
                         w[k] = (x.abs(), name.clone());
                     }
                 }
@@ -352,7 +357,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             let nudge = d(val(chaos), val(&measured[at(0, false)]));
             row.push(show(nudge));
             quantity_table.row(row);
-            if !(nudge.abs() <= worst_chaos) {
+            if worse(nudge.abs(), worst_chaos) {
                 worst_chaos = nudge.abs();
             }
         }
