@@ -144,34 +144,35 @@ struct TrackAcc {
 }
 
 /// Runs the model and post-processes wear.
+///
+/// A model whose dynamic bodies fall into independent parts (several missiles on rails of one
+/// prescribed launcher: [`crate::physics::partition`]) is run part by part, each with its own
+/// integrator and step sizes, and the parts' reports are merged in the model's contact and
+/// body order.
 pub fn run_model(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
 ) -> Result<RunReport, ModelRunError> {
-    run_model_observed(model, options, control, &mut |_| {})
+    let parts = independent_parts(&model.system);
+    if parts.len() > 1 {
+        return run_parts(model, &parts, options, control);
+    }
+    run_whole(model, options, control, &mut |_| {})
 }
 
 /// [`run_model`], also handing every accepted step of the excitation window (`t >=`
 /// excitation start) to `extra` before the run's own post-processing sees it. The gap
 /// diagnosis keeps each step's contact tracks this way, on the integrator's own time grid, so
-/// that wear-law variants can be re-integrated exactly as the run integrates wear.
-///
-/// A model whose dynamic bodies fall into independent parts (several missiles on rails of one
-/// prescribed launcher: [`crate::physics::partition`]) is run part by part, each with its own
-/// integrator and step sizes, and the parts' reports are merged in the model's contact and
-/// body order; `extra` then sees each part's steps in turn, with the part's system and state
-/// and the tracks' contact indices those of the whole model.
+/// that wear-law variants can be re-integrated exactly as the run integrates wear. The model is
+/// integrated as one system (also when it has independent parts), so the steps come in time
+/// order with the whole model's state.
 pub fn run_model_observed(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
 ) -> Result<RunReport, ModelRunError> {
-    let parts = independent_parts(&model.system);
-    if parts.len() > 1 {
-        return run_parts(model, &parts, options, control, extra);
-    }
     run_whole(model, options, control, extra)
 }
 
@@ -181,7 +182,6 @@ fn run_parts(
     parts: &[Part],
     options: &RunOptions,
     control: &RunControl,
-    extra: &mut dyn FnMut(&StepView),
 ) -> Result<RunReport, ModelRunError> {
     let count = parts.len() as f64;
     let mut reports = Vec::with_capacity(parts.len());
@@ -219,22 +219,7 @@ fn run_parts(
                 })
             }),
         };
-        let mut global_tracks: Vec<TrackState> = Vec::new();
-        let mut remap = |v: &StepView| {
-            global_tracks.clear();
-            global_tracks.extend(v.tracks.iter().map(|tr| TrackState {
-                contact: part.contacts[tr.contact as usize] as u32,
-                ..*tr
-            }));
-            extra(&StepView {
-                t_prev: v.t_prev,
-                t: v.t,
-                state: v.state,
-                tracks: &global_tracks,
-                system: v.system,
-            });
-        };
-        let report = run_whole(&sub, options, &sub_control, &mut remap)?;
+        let report = run_whole(&sub, options, &sub_control, &mut |_| {})?;
         let holds_response = part.bodies.contains(&model.response_body);
         reports.push((report, holds_response));
     }
@@ -349,7 +334,7 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
     }
 }
 
-/// [`run_model_observed`] of a model integrated as one system.
+/// The run of a model integrated as one system.
 fn run_whole(
     model: &BuiltModel,
     options: &RunOptions,
