@@ -45,7 +45,7 @@ pub(crate) fn launcher_linearity(
         eprintln!("launcher: linearity run, window {d} s ...");
         let case = launcher_case(configs_dir, settle, d)?;
         let cpu0 = super::convergence::thread_cpu_s();
-        let (report, _) = run_case(&case, configs_dir, &RunControl::silent())
+        let (report, outcome) = run_case(&case, configs_dir, &RunControl::silent())
             .map_err(|e| anyhow!("launcher run: {e}"))?;
         let cpu = super::convergence::thread_cpu_s()
             .zip(cpu0)
@@ -62,7 +62,7 @@ pub(crate) fn launcher_linearity(
             Cell::Num(per / base),
             Cell::Num(simulated / cpu.max(1e-9)),
             Cell::Int(report.integrator.accepted),
-            Cell::Int(report.tracks.len() as u64),
+            Cell::Int(outcome.tracks.len() as u64),
         ]);
     }
     t.note(
@@ -111,7 +111,7 @@ pub(crate) fn launcher(
         variant.simulation.newton_jacobian = engine.newton;
         variant.simulation.contact_patches = engine.patches;
         eprintln!("launcher: timed run ({}) ...", engine.name);
-        let (report, _) = run_case(&variant, configs_dir, &RunControl::silent())
+        let (report, outcome) = run_case(&variant, configs_dir, &RunControl::silent())
             .map_err(|e| anyhow!("launcher run: {e}"))?;
         let simulated = settle + window;
         let wall = report.wall_s.max(1e-9);
@@ -127,7 +127,7 @@ pub(crate) fn launcher(
             Cell::Num(report.integrator.accepted as f64 / wall),
             Cell::Int(report.integrator.accepted),
             Cell::Int(report.integrator.rejected),
-            Cell::Int(report.tracks.len() as u64),
+            Cell::Int(outcome.tracks.len() as u64),
             Cell::opt(vm_kb("VmHWM:").map(|k| k as f64 / 1024.0)),
             Cell::opt(rail),
         ]);
@@ -180,7 +180,7 @@ pub(crate) fn launcher(
             t.note(format!(
                 "memory run: peak RSS (VmHWM of a fresh child process) {:.1} MB; {:.1} MB before the run \
                  (binary, configs); track sample = {} bytes in memory, recorded every {} s per active track; \
-                 the run as the service does it (run_case: report plus packaged outcome, tracks held twice)",
+                 the run as the service does it (run_case: report plus packaged outcome; the track samples are held once, in the outcome)",
                 h / 1024.0,
                 b / 1024.0,
                 f("track_sample_bytes").unwrap_or(f64::NAN),
@@ -190,9 +190,9 @@ pub(crate) fn launcher(
                 if sim < 60.0 && mem_window > 0.0 {
                     // Samples accrue over the window only (recording starts with the excitation).
                     let n60 = n * (60.0 - settle).max(0.0) / mem_window;
-                    let est_mb = h / 1024.0 + (n60 - n) * bytes * 2.0 / 1048576.0;
+                    let est_mb = h / 1024.0 + (n60 - n) * bytes / 1048576.0;
                     t.note(format!(
-                        "ESTIMATE, not measured: at this run's rate a 60 s run stores about {n60:.0}                          track samples; with two copies of {bytes} bytes each the peak would be about                          {est_mb:.0} MB (plus up to 2x Vec growth slack on the track buffers)"
+                        "ESTIMATE, not measured: at this run's rate a 60 s run stores about {n60:.0}                          track samples; with one copy of {bytes} bytes each the peak would be about                          {est_mb:.0} MB (plus up to 2x Vec growth slack on the track buffers)"
                     ));
                 }
             }
