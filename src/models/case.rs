@@ -121,6 +121,7 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
                 .simulation
                 .energy_rel_tolerance
                 .unwrap_or(10.0 * case.simulation.rel_tolerance),
+            error_control: case.simulation.error_control,
         },
         initial_step_s: 1e-6,
         max_step_s: 1e-3,
@@ -164,9 +165,19 @@ pub fn run_case(
 ) -> Result<(RunReport, CaseOutcome), RunError> {
     let model = build(case, configs_dir)?;
     let options = run_options(case)?;
-    let report = run_model(&model, &options, control)?;
-    let outcome = package(case, &model, &options, &report);
-    Ok((report, outcome))
+    let mut report = run_model(&model, &options, control)?;
+    // The track samples move to the outcome (the report's `tracks` is left empty): a long run
+    // holds them once (a 60 s launcher run records ~0.7 million).
+    let tracks = std::mem::take(&mut report.tracks);
+    let (summary, plots) = package_parts(case, &model, &options, &report, tracks.len());
+    Ok((
+        report,
+        CaseOutcome {
+            summary,
+            tracks,
+            plots,
+        },
+    ))
 }
 
 /// Summary JSON and plots of a finished run.
@@ -176,6 +187,22 @@ pub fn package(
     options: &RunOptions,
     r: &RunReport,
 ) -> CaseOutcome {
+    let (summary, plots) = package_parts(case, model, options, r, r.tracks.len());
+    CaseOutcome {
+        summary,
+        tracks: r.tracks.clone(),
+        plots,
+    }
+}
+
+/// The summary JSON and the plots of a finished run with `track_samples` recorded samples.
+fn package_parts(
+    case: &CaseSpec,
+    model: &BuiltModel,
+    options: &RunOptions,
+    r: &RunReport,
+    track_samples: usize,
+) -> (Value, Vec<(String, String)>) {
     let simulated = model.end_time_s;
     let rattle_space = match case.model_spec() {
         Ok(ModelSpecRef::RattleBox(s)) => s.rattle_space().ok(),
@@ -211,13 +238,9 @@ pub fn package(
             "vdv_x_m_s2": vdv,
             "psd_x": psd.as_ref().map(|p| json!({"frequency_hz": p.frequency_hz, "density_m2_s4_per_hz": p.density})),
         },
-        "track_samples": r.tracks.len(),
+        "track_samples": track_samples,
     });
-    CaseOutcome {
-        summary,
-        tracks: r.tracks.clone(),
-        plots: plots(case, r, psd.as_ref()),
-    }
+    (summary, plots(case, r, psd.as_ref()))
 }
 
 fn plots(

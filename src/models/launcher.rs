@@ -27,6 +27,7 @@ use crate::physics::contact::Contact;
 use crate::physics::forces::{
     Attachment, Bushing, ConstantForce, ForceElement, OneSidedSpring, SpringDamper,
 };
+use crate::physics::partition::remap_force;
 use crate::physics::system::MultibodySystem;
 use crate::pipeline::RunError;
 use crate::units::STANDARD_GRAVITY;
@@ -40,6 +41,10 @@ pub const MISSILE: usize = 0;
 pub const LATCH: usize = 1;
 /// Rail body index (kinematic).
 pub const RAIL: usize = 2;
+
+/// Bodies per rail station (missile, latch, rail): station `s` (from 0) holds bodies
+/// `3 s .. 3 s + 3` and contacts `5 s .. 5 s + 5` (`LauncherSpec::stations`).
+pub const STATION_BODIES: usize = 3;
 
 /// Contact names in thesis numbering 1-5 (Figures 6.59-6.62): missile (front pad) - rail,
 /// latch - rail, mid shoe - rail, mid shoe - latch, rear shoe - rail.
@@ -349,7 +354,7 @@ pub fn build(
         },
         kind: BodyKind::Kinematic(Arc::new(TranslatingBase {
             reference: Isometry3::identity(),
-            motion,
+            motion: motion.clone(),
         })),
     };
 
@@ -534,21 +539,72 @@ pub fn build(
         .with_face_extents(chamber_extents()),
     ];
 
-    let contacts = contacts
+    let contacts: Vec<Contact> = contacts
         .into_iter()
         .map(|c| c.with_points_per_edge(case.simulation.contact_points_per_edge))
         .collect();
+    // Stations: the first is the rail above (bodies 0-2, the thesis' names); each further one
+    // a copy with its own missile, latch and rail body (placed at its offset, driven by the
+    // same launcher motion), its own force elements and contacts.
+    let mut bodies = Vec::new();
+    let mut all_forces = Vec::new();
+    let mut all_contacts = Vec::new();
+    for (s, offset) in spec.stations.iter().enumerate() {
+        let shift = |b: usize| b + STATION_BODIES * s;
+        let suffix = |name: &str| {
+            if s == 0 {
+                name.to_string()
+            } else {
+                format!("{name}#{}", s + 1)
+            }
+        };
+        let reference = Isometry3::translation(offset[0], offset[1], offset[2]);
+        for body in [&missile, &latch, &rail] {
+            let mut b = body.clone();
+            b.name = suffix(&body.name);
+            if let BodyKind::Kinematic(_) = b.kind {
+                b.kind = BodyKind::Kinematic(Arc::new(TranslatingBase {
+                    reference,
+                    motion: motion.clone(),
+                }));
+            }
+            bodies.push(b);
+        }
+        for f in &forces {
+            let mut f = f.clone();
+            remap_force(&mut f, &shift);
+            all_forces.push(f);
+        }
+        for c in &contacts {
+            let mut c = c.clone();
+            c.name = suffix(&c.name);
+            c.body_a = shift(c.body_a);
+            c.body_b = shift(c.body_b);
+            all_contacts.push(c);
+        }
+    }
+    let stations = spec.stations.len();
     let system = MultibodySystem::new(
-        vec![missile, latch, rail],
+        bodies,
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
-        forces,
-        contacts,
+        all_forces,
+        all_contacts,
     );
     let est = static_estimate(spec);
     let mut y = vec![0.0; system.state_len()];
-    for (body, pose) in [(MISSILE, est.missile_pose), (LATCH, est.latch_pose)] {
-        if let BodyKind::Dynamic { offset } = system.bodies[body].kind {
-            write_state(&mut y, offset, &pose, Vector3::zeros(), Vector3::zeros());
+    for (s, offset) in spec.stations.iter().enumerate() {
+        let reference = Isometry3::translation(offset[0], offset[1], offset[2]);
+        for (body, pose) in [(MISSILE, est.missile_pose), (LATCH, est.latch_pose)] {
+            let body = body + STATION_BODIES * s;
+            if let BodyKind::Dynamic { offset } = system.bodies[body].kind {
+                write_state(
+                    &mut y,
+                    offset,
+                    &(reference * pose),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                );
+            }
         }
     }
     if y.iter().any(|v| !v.is_finite()) {
@@ -564,7 +620,7 @@ pub fn build(
         initial_state: y,
         excitation_start_s: case.simulation.settle_s,
         end_time_s: case.simulation.settle_s + case.simulation.duration_s,
-        contact_materials: vec![(mat, mat); 5],
+        contact_materials: vec![(mat, mat); 5 * stations],
         response_body: MISSILE,
     })
 }

@@ -183,6 +183,20 @@ pub struct TrackLinearization {
     pub dforce_dslip: Matrix3<f64>,
 }
 
+impl TrackLinearization {
+    /// `∂F/∂v_rel` at the point: `∂F/∂s P − (∂f_n/∂ẇ) (∂F/∂f_n) nᵀ`, taking `∂F/∂s P = ∂F/∂s`
+    /// (the slip derivative maps and yields tangential vectors only, see
+    /// `friction_derivatives`), given `∂F/∂f_n` and the normal.
+    #[inline]
+    pub fn dforce_slip_with_rate(
+        &self,
+        dforce_dfn: &Vector3<f64>,
+        normal: &Vector3<f64>,
+    ) -> Matrix3<f64> {
+        self.dforce_dslip - dforce_dfn * (normal.transpose() * self.dfn_dwdot)
+    }
+}
+
 /// What [`Contact::evaluate`] does with the overlap geometry of each (piece, face) pair.
 ///
 /// The finite-difference Jacobian perturbs one state entry per column. Velocity columns leave
@@ -223,6 +237,43 @@ pub enum GeometryMode {
 /// `12 PATCH_REUSE R`: with 1e-4, 0.07 % of the area (0.01 % of the wear rate through
 /// `K(σ) ∝ σ^(1/6.3)`) and 0.12 % of the piece's size. Tested in `physics::system`.
 pub const PATCH_REUSE: f64 = 1e-4;
+
+/// Absolute part of the margin of the contact points' plane cull, m: far above the rounding
+/// difference (~1e-16 of the coordinates) between the plane distance in the piece's frame and
+/// in the world.
+const CULL_MARGIN_M: f64 = 1e-12;
+/// Relative part of the cull margin (of the plane offset and the piece's distance from the
+/// world origin, the magnitudes the two frames' roundings scale with).
+const CULL_MARGIN_REL: f64 = 1e-13;
+
+/// The contact points' plane cull: a face's plane in a piece's frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PlaneCull {
+    normal: Vector3<f64>,
+    offset: f64,
+    margin: f64,
+}
+
+impl PlaneCull {
+    /// The plane of `hs` (world) seen from a piece placed by `pose`.
+    #[inline]
+    pub(crate) fn new(pose: &Isometry3<f64>, hs: &HalfSpace) -> Self {
+        let n_world = hs.normal.into_inner();
+        Self {
+            normal: pose.rotation.inverse_transform_vector(&n_world),
+            offset: hs.offset - n_world.dot(&pose.translation.vector),
+            margin: CULL_MARGIN_M
+                + CULL_MARGIN_REL * (hs.offset.abs() + pose.translation.vector.norm()),
+        }
+    }
+
+    /// True when the point's ball centre lies farther above the plane than its radius (plus
+    /// the rounding margin): then its penetration into the face's solid is negative.
+    #[inline]
+    pub(crate) fn misses(&self, point: &ContactPoint) -> bool {
+        self.normal.dot(&point.local.coords) - self.offset > point.radius + self.margin
+    }
+}
 
 /// Overlaps remembered between a `Record` pass and replays over the same poses.
 #[derive(Debug, Clone, Default)]
@@ -462,7 +513,17 @@ impl Contact {
                     &iso_b,
                 );
                 let mut track = TrackSum::default();
+                // Narrow-phase cull: a point whose ball centre lies farther above the face's
+                // plane than its radius cannot touch the face's solid (the distance to the
+                // solid is at least the distance to its plane). The test runs in the piece's
+                // frame (three multiply-adds instead of placing the point in the world);
+                // `cull_margin` covers the rounding between the two frames, so only points
+                // whose world evaluation gives `w <= 0` are skipped: no result changes.
+                let cull = PlaneCull::new(&pose, &hs);
                 for point in &self.points[ip] {
+                    if cull.misses(point) {
+                        continue;
+                    }
                     let centre = pose * point.local;
                     let (distance, normal) = placed.signed_distance(&centre);
                     let w = point.radius - distance;
@@ -473,26 +534,34 @@ impl Contact {
                     let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
                     let wdot = -v_rel.dot(&normal);
                     let beta = point.weight;
-                    let fn_mag = beta * self.impact.force(w, wdot);
-                    let elastic = beta * self.impact.elastic_force(w);
+                    // The force's parts once (each STEP evaluated once per point): the same
+                    // numbers as `ImpactParams::force`, `elastic_force` and `force_gradient`.
+                    let (spring, damping) = self.impact.force_parts(w);
+                    let fn_mag = beta * (spring + damping * wdot).max(0.0);
+                    let elastic = beta * spring;
                     let slip = v_rel - normal * v_rel.dot(&normal);
                     let speed = slip.norm();
                     let mut ft = 0.0;
+                    let mut mu = None;
                     let mut force = normal * fn_mag;
                     if let Some(fr) = &self.friction {
                         if speed > 0.0 && fn_mag > 0.0 {
-                            ft = fr.coefficient(speed) * fn_mag;
+                            let m = fr.coefficient(speed);
+                            mu = Some(m);
+                            ft = m * fn_mag;
                             force -= slip * (ft / speed);
                         }
                     }
                     if let Some(lin) = linearizations.as_deref_mut() {
                         if fn_mag > 0.0 {
-                            let (dfn_dw, dfn_dwdot) = self.impact.force_gradient(w, wdot);
+                            let (dfn_dw, dfn_dwdot) =
+                                self.impact.unclamped_gradient(w, wdot, damping);
                             let (dforce_dfn, dforce_dslip) = friction_derivatives(
                                 self.friction.as_ref(),
                                 &normal,
                                 &slip,
                                 fn_mag,
+                                mu,
                             );
                             lin.push(TrackLinearization {
                                 body_a: self.body_a,
@@ -627,7 +696,7 @@ impl TrackSum {
 }
 
 /// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
-/// and slip `slip` (tangential): `∂F/∂f_n = n − μ ŝ` and
+/// and slip `slip` (tangential; `mu` = μ(|s|) when already known): `∂F/∂f_n = n − μ ŝ` and
 /// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
 /// `μ/|s| → μ'(0)` is used.
 fn friction_derivatives(
@@ -635,6 +704,7 @@ fn friction_derivatives(
     normal: &Vector3<f64>,
     slip: &Vector3<f64>,
     fn_mag: f64,
+    mu: Option<f64>,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let Some(fr) = friction else {
         return (*normal, Matrix3::zeros());
@@ -644,7 +714,7 @@ fn friction_derivatives(
     if speed > 0.0 {
         let dir = slip / speed;
         let along = dir * dir.transpose();
-        let mu = fr.coefficient(speed);
+        let mu = mu.unwrap_or_else(|| fr.coefficient(speed));
         let dmu = fr.coefficient_derivative(speed);
         (
             normal - dir * mu,
@@ -655,5 +725,91 @@ fn friction_derivatives(
             *normal,
             -tangent * (fr.coefficient_derivative(0.0) * fn_mag),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Translation3, UnitQuaternion};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn the_plane_cull_skips_only_points_that_cannot_touch() {
+        // A rounded box (a launcher shoe head's size) far from the origin, in random poses
+        // around a bounded face (a lip top ending at a slot edge) and an unbounded one: every
+        // culled point has a negative penetration by the exact world evaluation, and the cull
+        // removes the points clear of the plane.
+        let shape = ConvexShape::RoundedBox {
+            half_extents: Vector3::new(0.019, 0.005, 0.04),
+            roundover: 5e-4,
+        };
+        let points = contact_points(&shape, DEFAULT_POINTS_PER_EDGE);
+        let hs = HalfSpace {
+            normal: Unit::new_normalize(Vector3::new(0.0, 1.0, 0.0)),
+            offset: -0.03,
+        };
+        let extent = FaceExtent {
+            origin: Point3::new(0.0, -0.03, 0.6),
+            tangent: Vector3::z_axis(),
+            s_range_m: (-0.85, 0.85),
+            t_range_m: (f64::NEG_INFINITY, 0.005),
+        };
+        let base = Isometry3::translation(0.2, 0.4, 0.6);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let (mut culled, mut touching) = (0usize, 0usize);
+        for trial in 0..2000 {
+            let rot: UnitQuaternion<f64> = UnitQuaternion::from_euler_angles(
+                rng.gen_range(-0.05..0.05),
+                rng.gen_range(-3.2..3.2),
+                rng.gen_range(-0.05..0.05),
+            );
+            // Centre so that the lowest point sits within ±1 mm of the plane.
+            let half_height: f64 = (0..3)
+                .map(|k| {
+                    let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
+                    (shape_half(&shape, k) - 5e-4) * axis[k].abs()
+                })
+                .sum::<f64>()
+                + 5e-4;
+            let y = -0.03 + half_height + rng.gen_range(-1e-3..1e-3);
+            let pose = Isometry3::from_parts(
+                Translation3::new(rng.gen_range(-0.03..0.03), y, rng.gen_range(-0.5..0.5)),
+                rot,
+            );
+            let frame = base; // the face's body, placed away from the origin
+            let pose = frame * pose;
+            let hs_world = HalfSpace {
+                normal: Unit::new_normalize(frame.rotation * hs.normal.into_inner()),
+                offset: hs.offset
+                    + (frame.rotation * hs.normal.into_inner()).dot(&frame.translation.vector),
+            };
+            let ext = (trial % 2 == 0).then_some(&extent);
+            let placed = PlacedFace::new(hs_world, ext, &frame);
+            let cull = PlaneCull::new(&pose, &hs_world);
+            for p in &points {
+                let (d, _) = placed.signed_distance(&(pose * p.local));
+                let w = p.radius - d;
+                if cull.misses(p) {
+                    culled += 1;
+                    assert!(w <= 0.0, "culled point penetrates by {w:e} m");
+                } else if w > 0.0 {
+                    touching += 1;
+                }
+            }
+        }
+        assert!(touching > 1000, "the poses must press points into the face");
+        assert!(
+            culled > 2000 * points.len() / 2,
+            "most points are clear of the plane: {culled} culled"
+        );
+    }
+
+    fn shape_half(shape: &ConvexShape, k: usize) -> f64 {
+        match shape {
+            ConvexShape::RoundedBox { half_extents, .. } => half_extents[k],
+            ConvexShape::Sphere { radius } => *radius,
+        }
     }
 }

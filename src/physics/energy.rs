@@ -64,6 +64,65 @@ pub struct EnergyAudit {
     pub balanced: bool,
 }
 
+impl EnergyAudit {
+    /// The account of a system integrated as independent parts (`physics::partition`): the
+    /// energies and works add; each part's contacts (`(indices in the whole system, audit)`)
+    /// go to their places among `names`. The largest rise without drive is the sum of the
+    /// parts' (an upper bound of the whole's: the parts' intervals need not coincide).
+    pub fn merge(names: &[String], parts: Vec<(Vec<usize>, EnergyAudit)>) -> EnergyAudit {
+        let mut contacts: Vec<ContactDissipation> = names
+            .iter()
+            .map(|n| ContactDissipation {
+                name: n.clone(),
+                damping_j: 0.0,
+                friction_j: 0.0,
+            })
+            .collect();
+        let (mut initial, mut fin, mut drive, mut applied, mut elements, mut rise) =
+            (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for (indices, a) in parts {
+            initial += a.initial_energy_j;
+            fin += a.final_energy_j;
+            drive += a.drive_work_j;
+            applied += a.applied_work_j;
+            elements += a.element_dissipated_j;
+            rise += a.max_rise_without_drive_j;
+            for (local, c) in a.contacts.into_iter().enumerate() {
+                if let Some(slot) = indices.get(local).and_then(|&g| contacts.get_mut(g)) {
+                    slot.damping_j += c.damping_j;
+                    slot.friction_j += c.friction_j;
+                }
+            }
+        }
+        let dissipated = elements
+            + contacts
+                .iter()
+                .map(|c| c.damping_j + c.friction_j)
+                .sum::<f64>();
+        let residual = fin + dissipated - drive - applied - initial;
+        let throughput = (drive.abs() + applied.abs()).max(dissipated);
+        EnergyAudit {
+            initial_energy_j: initial,
+            final_energy_j: fin,
+            drive_work_j: drive,
+            applied_work_j: applied,
+            dissipated_j: dissipated,
+            element_dissipated_j: elements,
+            contacts,
+            residual_j: residual,
+            residual_relative_to_drive: (drive != 0.0).then(|| residual / drive),
+            residual_relative: if throughput > 0.0 {
+                residual.abs() / throughput
+            } else {
+                0.0
+            },
+            max_rise_without_drive_j: rise,
+            balanced: residual.abs()
+                <= ENERGY_BALANCE_TOLERANCE * throughput + ENERGY_BALANCE_FLOOR_J,
+        }
+    }
+}
+
 /// Accumulates the account over accepted states.
 #[derive(Debug, Clone)]
 pub struct EnergyMeter {

@@ -112,6 +112,32 @@ impl ImpactParams {
         )
     }
 
+    /// The elastic force `k w^e` (N) and the damping coefficient `c STEP(w)` (N·s/m) at
+    /// `w > 0`: [`ImpactParams::force`] is `(spring + damping · ẇ).max(0)` of these, bit for bit.
+    #[inline]
+    pub fn force_parts(&self, w: f64) -> (f64, f64) {
+        (self.stiffness * power(w, self.exponent), self.damping_at(w))
+    }
+
+    /// [`ImpactParams::force_gradient`] at a point where the force is positive (not clamped),
+    /// given its damping coefficient from [`ImpactParams::force_parts`]: the same numbers
+    /// without evaluating the damping STEP again.
+    #[inline]
+    pub fn unclamped_gradient(&self, w: f64, wdot: f64, damping: f64) -> (f64, f64) {
+        let dstep = if w < self.full_damping_depth {
+            self.max_damping
+                * self
+                    .step
+                    .derivative(w, 0.0, 0.0, self.full_damping_depth, 1.0)
+        } else {
+            0.0
+        };
+        (
+            self.exponent * self.stiffness * power(w, self.exponent - 1.0) + dstep * wdot,
+            damping,
+        )
+    }
+
     /// Elastic energy stored at penetration `w`, J: `∫ k w^e dw = k w^(e+1) / (e+1)`.
     #[inline]
     pub fn potential(&self, w: f64) -> f64 {
@@ -148,6 +174,25 @@ fn power(w: f64, e: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn force_parts_and_unclamped_gradient_are_force_and_force_gradient_bit_for_bit() {
+        let p = ImpactParams::from_adams_units(1000.0, 2.0, 500.0, 0.01);
+        for i in 1..200 {
+            let w = 2e-7 * i as f64; // across the damping ramp (0.01 mm) and beyond it
+            for wdot in [-0.3, -1e-3, 0.0, 2e-3, 0.5] {
+                let (spring, damping) = p.force_parts(w);
+                let f = (spring + damping * wdot).max(0.0);
+                assert_eq!(f.to_bits(), p.force(w, wdot).to_bits(), "w {w} wdot {wdot}");
+                assert_eq!(spring.to_bits(), p.elastic_force(w).to_bits());
+                if f > 0.0 {
+                    let (a, b) = p.unclamped_gradient(w, wdot, damping);
+                    let (c, d) = p.force_gradient(w, wdot);
+                    assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
+                }
+            }
+        }
+    }
 
     #[test]
     fn integer_exponents_match_powf() {

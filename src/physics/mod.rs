@@ -9,6 +9,7 @@ pub mod friction;
 pub mod impact;
 pub mod integrator;
 pub mod newton_matrix;
+pub mod partition;
 pub mod simulate;
 pub mod step;
 pub mod system;

@@ -293,10 +293,13 @@ impl MultibodySystem {
         for lin in &ws.linearizations {
             let ends = [(lin.body_a, 1.0), (lin.body_b, -1.0)];
             let nrm = lin.normal;
-            let tangent = Matrix3::identity() - nrm * nrm.transpose();
             let g = lin.dforce_dfn;
-            // ∂F/∂v_rel at the point: through ẇ = −n·v_rel and s = P v_rel.
-            let df_dvrel = g * (nrm.transpose() * (-lin.dfn_dwdot)) + lin.dforce_dslip * tangent;
+            // The rate terms below use ∂w/∂θ = ∂ẇ/∂ω = −σ (r × n)ᵀ at the force's own point:
+            // force, rates and penetration belong to one material point.
+            debug_assert_eq!(lin.deepest_point, lin.point);
+            // ∂F/∂v_rel at the point, through ẇ = −n·v_rel and s = P v_rel: `D P − c g nᵀ`,
+            // with `D P = D` (the slip derivative `D` is tangential on both sides: D n = 0).
+            let df_dvrel = lin.dforce_slip_with_rate(&g, &nrm);
             let omega_a = ws.frames[lin.body_a].angular_velocity;
             let omega_b = ws.frames[lin.body_b].angular_velocity;
             let r_centre = lin.centre.coords - ws.frames[lin.body_a].position;
@@ -307,84 +310,78 @@ impl MultibodySystem {
                     continue;
                 }
                 let fk = &ws.frames[k];
-                let r_deep = lin.deepest_point.coords - fk.position;
                 let r_point = lin.point.coords - fk.position;
-                // ∂w/∂(δx, δθ) and ∂ẇ/∂(v, ω_world): −σ (nᵀ, (r_deep × n)ᵀ).
-                let lever = r_deep.cross(&nrm);
-                // ∂s/∂v = σ P, ∂s/∂ω_world = −σ P [r_point]×.
-                let ds_dw = -tangent * r_point.cross_matrix() * sign_k;
-                // ∂v_rel/∂(δx, δθ) through the point's motion (a), its lever (a, b) and the turn
-                // of a's world angular velocity (its state is in body axes).
-                let (dvrel_dx, dvrel_dtheta) = if sign_k > 0.0 {
-                    (
-                        -omega_b.cross_matrix(),
-                        -(omega_a - omega_b).cross_matrix() * r_centre_x
-                            + r_point.cross_matrix() * omega_a.cross_matrix(),
-                    )
-                } else {
-                    (omega_b.cross_matrix(), Matrix3::zeros())
-                };
-                // dF/d(k's δx, δθ, δv, δω_world), 3 × 12.
-                let mut df = nalgebra::Matrix3x6::<f64>::zeros();
+                // ∂w/∂(δx, δθ) and ∂ẇ/∂(v, ω_world): −σ (nᵀ, (r × n)ᵀ).
+                let lever = r_point.cross(&nrm);
+                // dF/d(k's δv, δω_world) = σ ∂F/∂v_rel [I, −[r]×] (the point's velocity).
+                let a_r = df_dvrel * r_point.cross_matrix();
                 let mut df_rates = nalgebra::Matrix3x6::<f64>::zeros();
-                df.fixed_view_mut::<3, 3>(0, 0).copy_from(
-                    &(g * (nrm.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dx),
-                );
-                df.fixed_view_mut::<3, 3>(0, 3).copy_from(
-                    &(g * (lever.transpose() * (-sign_k * lin.dfn_dw)) + df_dvrel * dvrel_dtheta),
-                );
-                df_rates.fixed_view_mut::<3, 3>(0, 0).copy_from(
-                    &(g * (nrm.transpose() * (-sign_k * lin.dfn_dwdot))
-                        + lin.dforce_dslip * tangent * sign_k),
-                );
-                df_rates.fixed_view_mut::<3, 3>(0, 3).copy_from(
-                    &(g * (lever.transpose() * (-sign_k * lin.dfn_dwdot))
-                        + lin.dforce_dslip * ds_dw),
-                );
+                df_rates
+                    .fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&(df_dvrel * sign_k));
+                df_rates
+                    .fixed_view_mut::<3, 3>(0, 3)
+                    .copy_from(&(a_r * -sign_k));
+                // dF/d(k's δx, δθ): the penetration, and v_rel through the point's motion (a),
+                // its lever (a, b) and the turn of a's world angular velocity (its state is in
+                // body axes): ∂v_rel/∂δx = −[ω_b]× (a), [ω_b]× (b); ∂v_rel/∂δθ (a) =
+                // −[ω_a − ω_b]× [r_c]× + [r]× [ω_a]× ([u]× [v]× = v uᵀ − (u·v) I).
+                let mut df = nalgebra::Matrix3x6::<f64>::zeros();
+                let mut d_x = g * (nrm.transpose() * (-sign_k * lin.dfn_dw));
+                if omega_b != Vector3::zeros() {
+                    d_x += df_dvrel * (omega_b.cross_matrix() * -sign_k);
+                }
+                let mut d_theta = g * (lever.transpose() * (-sign_k * lin.dfn_dw));
+                if sign_k > 0.0 {
+                    let u = omega_b - omega_a;
+                    let dvrel_dtheta = r_centre * u.transpose()
+                        - Matrix3::from_diagonal_element(u.dot(&r_centre))
+                        + omega_a * r_point.transpose()
+                        - Matrix3::from_diagonal_element(r_point.dot(&omega_a));
+                    d_theta += df_dvrel * dvrel_dtheta;
+                }
+                df.fixed_view_mut::<3, 3>(0, 0).copy_from(&d_x);
+                df.fixed_view_mut::<3, 3>(0, 3).copy_from(&d_theta);
                 // Torque change through the lever (p − o_m) at fixed force, per target body m.
-                let (dtau_a_dx, dtau_a_dtheta, dtau_b_dx, dtau_b_dtheta) = if sign_k > 0.0 {
-                    (
-                        Matrix3::zeros(),
-                        force_x * r_centre_x,
-                        force_x,
-                        -force_x * r_centre_x,
-                    )
+                let (dtau_a_dtheta, dtau_b_dx, dtau_b_dtheta) = if sign_k > 0.0 {
+                    let fr = force_x * r_centre_x;
+                    (Some(fr), force_x, Some(-fr))
                 } else {
-                    (
-                        Matrix3::zeros(),
-                        Matrix3::zeros(),
-                        -force_x,
-                        Matrix3::zeros(),
-                    )
+                    (None, -force_x, None)
                 };
                 for &(m, sign_m) in &ends {
                     if !matches!(self.bodies[m].kind, BodyKind::Dynamic { .. }) {
                         continue;
                     }
-                    let r_m = (lin.point.coords - ws.frames[m].position).cross_matrix();
-                    let (dtau_dx, mut dtau_dtheta) = if sign_m > 0.0 {
-                        (dtau_a_dx, dtau_a_dtheta)
-                    } else {
-                        (dtau_b_dx, dtau_b_dtheta)
-                    };
-                    if m == k {
-                        // The body-frame torque Rᵀ τ turns with the body: δ(Rᵀ τ) = Rᵀ [τ]× δθ.
-                        let tau =
-                            (lin.point.coords - ws.frames[m].position).cross(&(lin.force * sign_m));
-                        dtau_dtheta += tau.cross_matrix();
-                    }
+                    let r_m = lin.point.coords - ws.frames[m].position;
                     let block = blocks[k * nb + m].get_or_insert_with(Matrix6x12::zeros);
                     let force = df * sign_m;
                     let force_rates = df_rates * sign_m;
-                    let mut torque = r_m * force;
-                    torque.fixed_view_mut::<3, 3>(0, 0).add_assign(&dtau_dx);
-                    torque.fixed_view_mut::<3, 3>(0, 3).add_assign(&dtau_dtheta);
+                    let mut torque = cross_columns(&r_m, &force);
+                    let (dtau_dx, dtau_dtheta) = if sign_m > 0.0 {
+                        (None, dtau_a_dtheta)
+                    } else {
+                        (Some(dtau_b_dx), dtau_b_dtheta)
+                    };
+                    if let Some(d) = dtau_dx {
+                        torque.fixed_view_mut::<3, 3>(0, 0).add_assign(&d);
+                    }
+                    if let Some(d) = dtau_dtheta {
+                        torque.fixed_view_mut::<3, 3>(0, 3).add_assign(&d);
+                    }
+                    if m == k {
+                        // The body-frame torque Rᵀ τ turns with the body: δ(Rᵀ τ) = Rᵀ [τ]× δθ.
+                        let tau = r_m.cross(&(lin.force * sign_m));
+                        torque
+                            .fixed_view_mut::<3, 3>(0, 3)
+                            .add_assign(&tau.cross_matrix());
+                    }
                     block.fixed_view_mut::<3, 6>(0, 0).add_assign(&force);
                     block.fixed_view_mut::<3, 6>(0, 6).add_assign(&force_rates);
                     block.fixed_view_mut::<3, 6>(3, 0).add_assign(&torque);
                     block
                         .fixed_view_mut::<3, 6>(3, 6)
-                        .add_assign(&(r_m * force_rates));
+                        .add_assign(&cross_columns(&r_m, &force_rates));
                 }
             }
         }
@@ -515,6 +512,19 @@ impl MultibodySystem {
 /// differentiated by another body's `[δx, δθ, δv, δω_world]` (columns), in
 /// [`MultibodySystem::contact_jacobian`].
 type Matrix6x12 = nalgebra::SMatrix<f64, 6, 12>;
+
+/// `[r]× M`: the cross product of `r` with each column of `M`.
+#[inline]
+fn cross_columns(r: &Vector3<f64>, m: &nalgebra::Matrix3x6<f64>) -> nalgebra::Matrix3x6<f64> {
+    let mut out = nalgebra::Matrix3x6::<f64>::zeros();
+    for c in 0..6 {
+        let (x, y, z) = (m[(0, c)], m[(1, c)], m[(2, c)]);
+        out[(0, c)] = r.y * z - r.z * y;
+        out[(1, c)] = r.z * x - r.x * z;
+        out[(2, c)] = r.x * y - r.y * x;
+    }
+    out
+}
 
 /// Length of the quaternion of the body at `offset`, when positive and finite.
 fn quaternion_norm(y: &[f64], offset: usize) -> Option<f64> {

@@ -19,12 +19,66 @@ pub(crate) fn vm_kb(key: &str) -> Option<u64> {
         .and_then(|v| v.parse().ok())
 }
 
+/// Wall time against simulated duration (issue 16: 10, 30, 60, 120 s within 10 % of
+/// proportional): launcher-design with the default engine and tracks recorded at the case's
+/// rate, each duration one run after a 1 s settle.
+pub(crate) fn launcher_linearity(
+    configs_dir: &Path,
+    settle: f64,
+    durations: &[f64],
+) -> Result<Table> {
+    let mut t = Table::new(
+        "Launcher cost against duration (launcher-design, default engine, tracks recorded)",
+        &[
+            ("simulated_s", "simulated s (settle + window)"),
+            ("cpu_s", "CPU s"),
+            ("wall_s", "wall s"),
+            ("cpu_per_simulated_s", "CPU s per simulated s"),
+            ("vs_shortest", "per simulated s / shortest run"),
+            ("real_time_factor_cpu", "real-time factor (CPU)"),
+            ("accepted", "accepted"),
+            ("track_samples", "track samples"),
+        ],
+    );
+    let mut first: Option<f64> = None;
+    for &d in durations {
+        eprintln!("launcher: linearity run, window {d} s ...");
+        let case = launcher_case(configs_dir, settle, d)?;
+        let cpu0 = super::convergence::thread_cpu_s();
+        let (report, outcome) = run_case(&case, configs_dir, &RunControl::silent())
+            .map_err(|e| anyhow!("launcher run: {e}"))?;
+        let cpu = super::convergence::thread_cpu_s()
+            .zip(cpu0)
+            .map(|(b, a)| b - a)
+            .unwrap_or(report.wall_s);
+        let simulated = settle + d;
+        let per = cpu / simulated;
+        let base = *first.get_or_insert(per);
+        t.row(vec![
+            Cell::Num(simulated),
+            Cell::Num(cpu),
+            Cell::Num(report.wall_s),
+            Cell::Num(per),
+            Cell::Num(per / base),
+            Cell::Num(simulated / cpu.max(1e-9)),
+            Cell::Int(report.integrator.accepted),
+            Cell::Int(outcome.tracks.len() as u64),
+        ]);
+    }
+    t.note(
+        "CPU s = this thread's user + system time of the run (simulation, wear, track recording);          the target is every row's per-second cost within 10 % of the others",
+    );
+    t.note(machine_note());
+    Ok(t)
+}
+
 pub(crate) fn launcher(
     configs_dir: &Path,
     settle: f64,
     window: f64,
     mem_window: f64,
     no_mem: bool,
+    default_only: bool,
 ) -> Result<Vec<Table>> {
     if !(settle >= 0.0 && window > 0.0 && mem_window > 0.0) {
         bail!("--settle must be >= 0 and --window, --mem-window > 0");
@@ -47,12 +101,17 @@ pub(crate) fn launcher(
     let case = launcher_case(configs_dir, settle, window)?;
     let options = run_options(&case)?;
     // Every engine variant (the default first) for the same-run comparison.
-    for engine in ENGINE_VARIANTS {
+    let variants = if default_only {
+        1
+    } else {
+        ENGINE_VARIANTS.len()
+    };
+    for engine in ENGINE_VARIANTS.into_iter().take(variants) {
         let mut variant = case.clone();
         variant.simulation.newton_jacobian = engine.newton;
         variant.simulation.contact_patches = engine.patches;
         eprintln!("launcher: timed run ({}) ...", engine.name);
-        let (report, _) = run_case(&variant, configs_dir, &RunControl::silent())
+        let (report, outcome) = run_case(&variant, configs_dir, &RunControl::silent())
             .map_err(|e| anyhow!("launcher run: {e}"))?;
         let simulated = settle + window;
         let wall = report.wall_s.max(1e-9);
@@ -68,7 +127,7 @@ pub(crate) fn launcher(
             Cell::Num(report.integrator.accepted as f64 / wall),
             Cell::Int(report.integrator.accepted),
             Cell::Int(report.integrator.rejected),
-            Cell::Int(report.tracks.len() as u64),
+            Cell::Int(outcome.tracks.len() as u64),
             Cell::opt(vm_kb("VmHWM:").map(|k| k as f64 / 1024.0)),
             Cell::opt(rail),
         ]);
@@ -121,7 +180,7 @@ pub(crate) fn launcher(
             t.note(format!(
                 "memory run: peak RSS (VmHWM of a fresh child process) {:.1} MB; {:.1} MB before the run \
                  (binary, configs); track sample = {} bytes in memory, recorded every {} s per active track; \
-                 the run as the service does it (run_case: report plus packaged outcome, tracks held twice)",
+                 the run as the service does it (run_case: report plus packaged outcome; the track samples are held once, in the outcome)",
                 h / 1024.0,
                 b / 1024.0,
                 f("track_sample_bytes").unwrap_or(f64::NAN),
@@ -131,9 +190,9 @@ pub(crate) fn launcher(
                 if sim < 60.0 && mem_window > 0.0 {
                     // Samples accrue over the window only (recording starts with the excitation).
                     let n60 = n * (60.0 - settle).max(0.0) / mem_window;
-                    let est_mb = h / 1024.0 + (n60 - n) * bytes * 2.0 / 1048576.0;
+                    let est_mb = h / 1024.0 + (n60 - n) * bytes / 1048576.0;
                     t.note(format!(
-                        "ESTIMATE, not measured: at this run's rate a 60 s run stores about {n60:.0}                          track samples; with two copies of {bytes} bytes each the peak would be about                          {est_mb:.0} MB (plus up to 2x Vec growth slack on the track buffers)"
+                        "ESTIMATE, not measured: at this run's rate a 60 s run stores about {n60:.0}                          track samples; with one copy of {bytes} bytes each the peak would be about                          {est_mb:.0} MB (plus up to 2x Vec growth slack on the track buffers)"
                     ));
                 }
             }

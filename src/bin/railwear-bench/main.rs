@@ -25,18 +25,22 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 mod budget;
+mod convergence;
 mod engine;
 mod launcher;
 mod load;
+mod missiles;
 mod peers;
 mod sweep;
 mod sweep_procs;
 mod table;
 
 use budget::*;
+use convergence::*;
 use engine::*;
 use launcher::*;
 use load::*;
+use missiles::*;
 use peers::*;
 use sweep::*;
 use sweep_procs::*;
@@ -112,6 +116,52 @@ enum Command {
         /// Skip the memory run.
         #[arg(long)]
         no_mem: bool,
+        /// Only the engine's default variant in the timed run (the earlier Newton variants
+        /// are slow and were measured in earlier passes).
+        #[arg(long)]
+        default_only: bool,
+        /// Windows (s) of the duration-linearity table, comma list (empty: no table).
+        #[arg(long, default_value = "")]
+        durations: String,
+    },
+    /// Issue 16's error-control decision: user quantities (friction power, wear rate and
+    /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
+    /// case tolerance and half of it, for full and position-only error control, against a
+    /// tight full-control reference, with the chaotic spread of a 1 nm nudge.
+    Convergence {
+        /// Cases (config names, comma list).
+        #[arg(long, default_value = "rattle-box-c,rattle-box-d,launcher-design")]
+        cases: String,
+        /// Settle time of the rattle boxes, s.
+        #[arg(long, default_value_t = 0.5)]
+        settle_box: f64,
+        /// Settle time of the launcher, s.
+        #[arg(long, default_value_t = 1.0)]
+        settle_launcher: f64,
+        /// Averaging window after the settle, s.
+        #[arg(long, default_value_t = 8.0)]
+        window: f64,
+        /// Tolerance factor of the reference run (full error control).
+        #[arg(long, default_value_t = 0.25)]
+        reference_factor: f64,
+        /// Largest admissible |difference| (0.02 = the issue's 2 %).
+        #[arg(long, default_value_t = 0.02)]
+        criterion: f64,
+        /// Also run the position-only mode without the energy account's work test.
+        #[arg(long)]
+        with_energy_off: bool,
+    },
+    /// Cost per missile of a launcher with 1, 2 and 4 missiles (issue 16).
+    Missiles {
+        /// Settle time, s.
+        #[arg(long, default_value_t = 1.0)]
+        settle: f64,
+        /// Excitation window, s.
+        #[arg(long, default_value_t = 2.0)]
+        window: f64,
+        /// Also integrate each launcher as one system with one integrator.
+        #[arg(long)]
+        monolithic: bool,
     },
     /// Internal: one memory run in a fresh process; prints one JSON line.
     #[command(hide = true)]
@@ -250,7 +300,53 @@ fn main() -> Result<()> {
             window,
             mem_window,
             no_mem,
-        } => launcher(&cli.configs_dir, *settle, *window, *mem_window, *no_mem)?,
+            default_only,
+            durations,
+        } => {
+            let mut tables = launcher(
+                &cli.configs_dir,
+                *settle,
+                *window,
+                *mem_window,
+                *no_mem,
+                *default_only,
+            )?;
+            let windows: Vec<f64> = durations
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(|s| s.parse::<f64>().context("--durations"))
+                .collect::<Result<_>>()?;
+            if !windows.is_empty() {
+                tables.push(launcher_linearity(&cli.configs_dir, *settle, &windows)?);
+            }
+            tables
+        }
+        Command::Convergence {
+            cases,
+            settle_box,
+            settle_launcher,
+            window,
+            reference_factor,
+            criterion,
+            with_energy_off,
+        } => convergence(
+            &cli.configs_dir,
+            &ConvergenceBench {
+                cases: cases.clone(),
+                settle_box: *settle_box,
+                settle_launcher: *settle_launcher,
+                window: *window,
+                reference_factor: *reference_factor,
+                criterion: *criterion,
+                with_energy_off: *with_energy_off,
+            },
+        )?,
+        Command::Missiles {
+            settle,
+            window,
+            monolithic,
+        } => missiles(&cli.configs_dir, *settle, *window, *monolithic)?,
         Command::LauncherMem { settle, window } => {
             launcher_mem(&cli.configs_dir, *settle, *window)?;
             return Ok(());

@@ -263,7 +263,28 @@ pub struct LauncherSpec {
     pub contacts: LauncherContacts,
     /// Friction for all contacts (Table 6.1).
     pub friction: FrictionSpec,
+    /// Rail stations of a multi-rail launcher (the AH-64's M299 carries four missiles): the
+    /// offset of each rail's frame from the launcher's reference, m. Every station is the
+    /// rail above with its own missile, latch, springs and five contacts; all rails move with
+    /// the launcher's one prescribed motion. Default: one station at the origin (the thesis'
+    /// single rail).
+    #[serde(
+        default = "default_stations",
+        skip_serializing_if = "is_single_station"
+    )]
+    pub stations: Vec<[f64; 3]>,
 }
+
+fn default_stations() -> Vec<[f64; 3]> {
+    vec![[0.0; 3]]
+}
+
+fn is_single_station(s: &[[f64; 3]]) -> bool {
+    s == [[0.0; 3]]
+}
+
+/// Most rail stations on one launcher.
+pub const MAX_STATIONS: usize = 8;
 
 impl LauncherSpec {
     /// Rattle space of the rail, eq. 6.1-6.3.
@@ -411,6 +432,34 @@ impl LauncherSpec {
     pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
         let p = |name: &str| path(prefix, name);
         self.material.validate(&p("material"))?;
+        if self.stations.is_empty() || self.stations.len() > MAX_STATIONS {
+            return Err(err(
+                p("stations"),
+                format!(
+                    "must list 1 to {MAX_STATIONS} rail offsets, got {}",
+                    self.stations.len()
+                ),
+            ));
+        }
+        for (i, a) in self.stations.iter().enumerate() {
+            if a.iter().any(|v| !v.is_finite()) {
+                return Err(err(format!("{}[{i}]", p("stations")), "must be finite"));
+            }
+            // No missile-missile contact is modelled: the missiles must not overlap.
+            for b in &self.stations[..i] {
+                let apart = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                if apart < self.missile.diameter_m {
+                    return Err(err(
+                        format!("{}[{i}]", p("stations")),
+                        format!(
+                            "is {apart} m across the rails from another station: the missiles \
+                             ({} m diameter) would overlap",
+                            self.missile.diameter_m
+                        ),
+                    ));
+                }
+            }
+        }
         self.dimensions.validate().map_err(
             |RattleSpaceError::InvalidDimension { field, rule }| {
                 err(path(&p("dimensions"), field), rule)

@@ -276,6 +276,12 @@ pub struct SimulationSpec {
     /// off (the account is still kept, by the same quadrature, and may not close).
     #[serde(default)]
     pub energy_rel_tolerance: Option<f64>,
+    /// Which state entries the implicit integrators' local error test weighs: `full` (default;
+    /// positions, rotations, velocities, angular velocities) or `positions` (poses only, the
+    /// analogue of ADAMS WSTIFF-I3: velocities in conditional accuracy). The energy account's
+    /// work test (`energy_rel_tolerance`) applies in both. docs/performance.md, seventh pass.
+    #[serde(default)]
+    pub error_control: crate::physics::integrator::ErrorControl,
     /// Contact points per box edge (docs/models.md "Contact formulation"): each face of a
     /// rounded box is resolved by `n × n` points whose stiffness shares sum to the thesis' face
     /// law. Default 5 (25 per face); more points resolve rocking and edge contacts more finely

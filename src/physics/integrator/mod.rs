@@ -44,8 +44,8 @@ mod settings;
 
 pub use diagnostics::{StepDiagnostics, STEP_DECADES};
 pub use settings::{
-    ContactPatches, IntegratorError, IntegratorKind, IntegratorSettings, IntegratorStats,
-    NewtonJacobian, Tolerances, ENERGY_ABS_TOLERANCE_J,
+    ContactPatches, ErrorControl, IntegratorError, IntegratorKind, IntegratorSettings,
+    IntegratorStats, NewtonJacobian, Tolerances, ENERGY_ABS_TOLERANCE_J,
 };
 
 use super::body::{BodyKind, BODY_STATE_LEN};
@@ -94,6 +94,9 @@ pub struct Integrator {
     abs_tol: Vec<f64>,
     /// Body owning each state entry.
     column_body: Vec<usize>,
+    /// Entries the implicit methods' local error test weighs (all, or the poses only:
+    /// [`ErrorControl`]).
+    error_entries: Vec<usize>,
     h: f64,
     k: [Vec<f64>; 7],
     fsal_valid: bool,
@@ -195,12 +198,19 @@ impl Integrator {
                 _ => tol.abs_angular_velocity_rad_s,
             })
             .collect();
+        let error_entries = (0..n)
+            .filter(|&i| match tol.error_control {
+                ErrorControl::Full => true,
+                ErrorControl::Positions => kinds[i] <= 1,
+            })
+            .collect();
         let v = || vec![0.0; n];
         Self {
             settings,
             n,
             abs_tol,
             column_body,
+            error_entries,
             h: settings.initial_step_s,
             k: [v(), v(), v(), v(), v(), v(), v()],
             fsal_valid: false,
@@ -273,16 +283,22 @@ impl Integrator {
         (s / self.n.max(1) as f64).sqrt()
     }
 
-    /// The error norm of an implicit attempt of size `h`; with `diagnose`, counted by the kind
-    /// of the entry that limits it.
+    /// The error norm of an implicit attempt of size `h` over the entries
+    /// [`ErrorControl`] selects; with `diagnose`, counted by the kind of the entry that limits
+    /// it.
     fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
-        let norm = self.weighted_norm(e, y0, &self.ynew);
+        let mut s = 0.0;
+        for &i in &self.error_entries {
+            let r = self.weighted_entry(i, e, y0, &self.ynew);
+            s += r * r;
+        }
+        let norm = (s / self.error_entries.len().max(1) as f64).sqrt();
         if !self.diagnose {
             return norm;
         }
         // The first entry of largest weighted size.
         let mut worst = (0.0, 0);
-        for i in 0..self.n {
+        for &i in &self.error_entries {
             let r = self.weighted_entry(i, e, y0, &self.ynew).abs();
             if r > worst.0 {
                 worst = (r, i);
