@@ -291,6 +291,7 @@ fn sigterm(server: &mut Binary) -> Duration {
     loop {
         if let Some(exit) = server.child.try_wait().expect("try_wait") {
             assert!(exit.success(), "exit status {exit}");
+            eprintln!("exited {:?} after SIGTERM", asked.elapsed());
             return asked.elapsed();
         }
         assert!(

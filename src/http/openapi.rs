@@ -99,6 +99,150 @@ impl Modify for CommonErrors {
     }
 }
 
+/// OpenAPI links from what creates a resource to what reads it (a job's id to its status,
+/// attempts, result and cancel; a campaign's id to its JSON; a rail's serial to the rail, its
+/// history and report; a token's id to its revocation), so clients and the property-based run
+/// can follow them.
+struct Links;
+
+impl Links {
+    /// (path, method, status, link name, target operation id, target parameter, expression).
+    const LINKS: &'static [(
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+    )] = &[
+        (
+            "/v1/jobs",
+            "post",
+            "201",
+            "GetJob",
+            "get_job",
+            "id",
+            "$response.body#/id",
+        ),
+        (
+            "/v1/jobs",
+            "post",
+            "201",
+            "GetAttempts",
+            "get_attempts",
+            "id",
+            "$response.body#/id",
+        ),
+        (
+            "/v1/jobs",
+            "post",
+            "201",
+            "GetResult",
+            "get_result",
+            "id",
+            "$response.body#/id",
+        ),
+        (
+            "/v1/jobs",
+            "post",
+            "201",
+            "CancelJob",
+            "cancel_job",
+            "id",
+            "$response.body#/id",
+        ),
+        (
+            "/v1/campaigns",
+            "post",
+            "201",
+            "GetCampaign",
+            "get_campaign",
+            "id",
+            "$response.body#/id",
+        ),
+        (
+            "/v1/rails/{serial}/measurements",
+            "post",
+            "201",
+            "GetRail",
+            "get_rail",
+            "serial",
+            "$request.path.serial",
+        ),
+        (
+            "/v1/rails/{serial}/measurements",
+            "post",
+            "201",
+            "ListMeasurements",
+            "list_measurements",
+            "serial",
+            "$request.path.serial",
+        ),
+        (
+            "/v1/rails/{serial}/measurements",
+            "post",
+            "201",
+            "GetReport",
+            "get_report",
+            "serial",
+            "$request.path.serial",
+        ),
+        (
+            "/v1/tokens",
+            "post",
+            "201",
+            "RevokeToken",
+            "revoke_token",
+            "id",
+            "$response.body#/id",
+        ),
+    ];
+}
+
+impl Modify for Links {
+    fn modify(&self, openapi: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::link::LinkBuilder;
+        use utoipa::openapi::RefOr;
+        for (path, method, status, name, target, parameter, expression) in Self::LINKS {
+            let Some(item) = openapi.paths.paths.get_mut(*path) else {
+                continue;
+            };
+            let operation = match *method {
+                "post" => item.post.as_mut(),
+                _ => item.get.as_mut(),
+            };
+            let Some(RefOr::T(response)) =
+                operation.and_then(|op| op.responses.responses.get_mut(*status))
+            else {
+                continue;
+            };
+            response.links.insert(
+                name.to_string(),
+                RefOr::T(
+                    LinkBuilder::new()
+                        .operation_id(*target)
+                        .parameter(*parameter, *expression)
+                        .build(),
+                ),
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn links_name_their_target_operation_as_openapi_spells_it() {
+        let doc: serde_json::Value =
+            serde_json::from_str(&super::openapi_json()).expect("the document is JSON");
+        let link = &doc["paths"]["/v1/jobs"]["post"]["responses"]["201"]["links"]["GetJob"];
+        assert_eq!(link["operationId"], "get_job", "{link}");
+        assert_eq!(link["parameters"]["id"], "$response.body#/id");
+        assert!(!super::openapi_json().contains("\"operation_id\""));
+    }
+}
+
 #[derive(OpenApi)]
 #[openapi(
     info(
@@ -136,7 +280,7 @@ impl Modify for CommonErrors {
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
         crate::config::Role,
     )),
-    modifiers(&BearerAuth, &CommonErrors),
+    modifiers(&BearerAuth, &CommonErrors, &Links),
     tags(
         (name = "jobs", description = "Simulation, sweep and calibration jobs (engineer)"),
         (name = "rails", description = "Rail registry, measurements and service-life reports (planner)"),
@@ -165,9 +309,12 @@ pub async fn openapi() -> Response {
 pub fn openapi_json() -> String {
     let mut doc = ApiDoc::openapi();
     doc.info.version = env!("CARGO_PKG_VERSION").to_string();
-    let mut text = doc
+    let text = doc
         .to_pretty_json()
         .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
+    // utoipa 5.5 writes a Link Object's fields in snake case; OpenAPI spells them
+    // `operationId` (no other key of this document is `operation_id`).
+    let mut text = text.replace("\"operation_id\": ", "\"operationId\": ");
     text.push('\n');
     text
 }
