@@ -351,9 +351,9 @@ increments = [{ mass_loss_mg = { cube = 0.002 } }, { mass_loss_mg = { cube = 0.0
     // share x the amplitude on each), and the response on them grows.
     let top = cross.predictions.last().unwrap();
     let share = *cross.magnitudes.last().unwrap();
-    for t in 0..2 {
+    for (t, with) in top.iter().enumerate().take(2) {
         let nominal = &em.nominal[t][0];
-        let with = &top[t][0];
+        let with = &with[0];
         let drive_axis = (0..3)
             .max_by(|a, b| nominal.input_ms[*a].total_cmp(&nominal.input_ms[*b]))
             .unwrap();
