@@ -12,14 +12,14 @@
 
 use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
-use super::problem::{check_json_syntax, json_body_bytes, Problem};
+use super::problem::{check_json_syntax, json_body_bytes, read_json, Problem};
 use super::AppState;
 use crate::gap::{Campaign, GapError};
 use crate::store::{clock, CampaignCounts, CampaignInsert, CampaignSummary, NewCampaign};
 use axum::extract::{Path, Query, State};
 use axum::http::{header, HeaderValue, Method, StatusCode};
 use axum::response::{IntoResponse, Response};
-use axum::routing::get;
+use axum::routing::{get, post};
 use axum::{Json, Router};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -32,6 +32,25 @@ pub fn router() -> Router<AppState> {
     Router::new()
         .route("/v1/campaigns", get(list_campaigns).post(upload_campaign))
         .route("/v1/campaigns/{id}", get(get_campaign))
+        .route("/v1/campaigns/{id}/diagnoses", post(submit_diagnosis))
+}
+
+/// A diagnosis request: every field optional, unknown ones refused.
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)] // documents the body; the handler reads it as JSON and checks each key
+pub struct DiagnosisRequest {
+    /// Simulated excitation per increment, s, in [0.05, 600] (default 2).
+    pub window_s: Option<f64>,
+    /// Settle before each window, s, in [0, 600] (default 0.3).
+    pub settle_s: Option<f64>,
+    /// Grid points of each dynamics effect, 2..=12 (default 5).
+    pub grid_points: Option<u32>,
+    /// Library effects to consider (`railwear effects`); default: every effect that applies
+    /// to the campaign's models.
+    pub effects: Option<Vec<String>>,
+    /// Seed (integer in [0, 2^53)); drawn when absent.
+    pub seed: Option<u64>,
 }
 
 /// What a campaign holds.
@@ -387,6 +406,73 @@ pub async fn get_campaign(
         response.headers_mut().insert(header::ETAG, value);
     }
     Ok(response)
+}
+
+/// Diagnose a stored campaign (test engineer, engineer, admin): queues a `diagnose` job.
+///
+/// The job simulates the campaign's tests (its progress is the fraction of those simulations
+/// done), then locates the sim-to-real gap and ranks the library's effects on held-out tests
+/// (docs/diagnosis.md). `GET /v1/jobs/{id}` follows it; once it succeeded,
+/// `GET /v1/jobs/{id}/result` holds the report as `summary` and lists its SVG figures, served
+/// by `GET /v1/jobs/{id}/plots/{name}`. `POST /v1/jobs/{id}/cancel` stops it. The params are
+/// checked at submission (a broken rule is a 422 naming the field, e.g. `window_s` or
+/// `effects[0]`); `Idempotency-Key` works as for `POST /v1/jobs`.
+#[utoipa::path(
+    post, path = "/v1/campaigns/{id}/diagnoses", tag = "campaigns",
+    params(
+        ("id" = Uuid, Path, description = "Campaign id"),
+        ("Idempotency-Key" = Option<String>, Header, description = "Makes retries safe: same key + same body = same job. 1 to 255 visible ASCII characters (inner spaces allowed).", pattern = "^[!-~]([ !-~]{0,253}[!-~])?$"),
+    ),
+    request_body = DiagnosisRequest,
+    responses(
+        (status = 201, description = "Diagnosis job queued; `Location` names it", body = crate::http::jobs::JobView),
+        (status = 200, description = "Replay of an earlier submission with the same Idempotency-Key", body = crate::http::jobs::JobView),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 401, body = Problem, content_type = "application/problem+json"),
+        (status = 403, description = "Role may not diagnose (planner)", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "No such campaign", body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "A parameter breaks a rule (`field` names it), or Idempotency-Key reused with a different body", body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn submit_diagnosis(
+    State(state): State<AppState>,
+    caller: Caller,
+    Path(id): Path<String>,
+    headers: axum::http::HeaderMap,
+    body: axum::extract::Request,
+) -> Result<Response, Problem> {
+    if !(caller.allowed(Area::Campaigns, &Method::POST)
+        || caller.allowed(Area::Jobs, &Method::POST))
+    {
+        return Err(Problem::forbidden(format!(
+            "role `{}` may not diagnose campaigns",
+            caller.role.as_str()
+        )));
+    }
+    let id = Uuid::parse_str(&id).map_err(|_| Problem::bad_parameter("id", "must be a UUID"))?;
+    let key = super::jobs::idempotency_key(&headers)?;
+    let options: serde_json::Value = read_json(body).await?;
+    let record = state
+        .store
+        .get_campaign(id)
+        .await?
+        .ok_or_else(|| Problem::not_found(format!("no campaign {id}")))?;
+    let campaign: serde_json::Value =
+        serde_json::from_str(&record.content).map_err(|e| Problem::internal(&e))?;
+    let submitted = state
+        .jobs
+        .submit_diagnosis(id, campaign, options, &caller.name, key)
+        .await
+        .map_err(|e| match e {
+            crate::jobs::SubmitError::Invalid { field, rule } => {
+                Problem::invalid_field(field, rule)
+            }
+            crate::jobs::SubmitError::Store(e) => Problem::from(e),
+        })?;
+    super::jobs::submitted_response(submitted)
 }
 
 #[cfg(test)]

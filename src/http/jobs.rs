@@ -52,6 +52,7 @@ pub struct JobRequest {
     /// key. A sweep fans out into one `sweep_point` child job per point (`sweep_point` jobs
     /// cannot be submitted). `calibrate`: `{"friction": {"fixture": {...}, "records":
     /// [...]}}` and/or `{"wear_law": {"density_kg_m3", "cutoff_pressure_pa", "records"}}`.
+    /// `diagnose` jobs are submitted with `POST /v1/campaigns/{id}/diagnoses`, not here.
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
 }
@@ -63,7 +64,8 @@ pub struct JobView {
     pub kind: JobKind,
     pub status: JobStatus,
     /// Parameters as submitted (a sweep's `vehicle_profile`, `environment` and `wear_law`
-    /// filled in from the defaults when absent).
+    /// filled in from the defaults when absent; a diagnosis shows its `campaign_id`, not the
+    /// campaign's content stored with it).
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
     /// Seed the run uses (from `params.seed` or drawn at submission).
@@ -153,11 +155,19 @@ pub struct JobLinks {
 impl From<JobRecord> for JobView {
     fn from(j: JobRecord) -> Self {
         let base = format!("/v1/jobs/{}", j.id);
+        // A diagnosis stores its campaign's content with its params; the view names the
+        // campaign (`params.campaign_id`) instead of repeating it.
+        let mut params = j.params;
+        if j.kind == JobKind::Diagnose {
+            if let Some(map) = params.as_object_mut() {
+                map.remove("campaign");
+            }
+        }
         JobView {
             id: j.id,
             kind: j.kind,
             status: j.status,
-            params: j.params,
+            params,
             seed: j.seed,
             code_version: j.code_version,
             submitted_by: j.submitted_by,
@@ -283,7 +293,7 @@ async fn load_job(state: &AppState, id: &str) -> Result<JobRecord, Problem> {
         .ok_or_else(|| Problem::not_found(format!("no job {id}")))
 }
 
-fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, Problem> {
+pub(super) fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, Problem> {
     match headers.get("idempotency-key") {
         None => Ok(None),
         Some(value) => {
@@ -338,6 +348,12 @@ pub async fn submit_job(
             SubmitError::Invalid { field, rule } => Problem::invalid_field(field, rule),
             SubmitError::Store(e) => Problem::from(e),
         })?;
+    submitted_response(submitted)
+}
+
+/// The response to a submission: 201 with the job and `Location`, 200 for a replay, 422 for an
+/// Idempotency-Key reused with another body.
+pub(super) fn submitted_response(submitted: Submitted) -> Result<Response, Problem> {
     match submitted {
         Submitted::Created(job) => {
             let location = format!("/v1/jobs/{}", job.id);

@@ -247,7 +247,7 @@ mod tests {
 #[openapi(
     info(
         title = "railwear",
-        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs, curves), test_engineer (test campaigns), admin (tokens, and everything)."
+        description = "Launcher-rail and missile-shoe wear prediction: jobs (simulate, sweep, calibrate, diagnose), rail measurements and service-life reports. Errors are application/problem+json. Send `Authorization: Bearer <token>`; roles: planner (rails), engineer (jobs, curves), test_engineer (test campaigns and their diagnoses), admin (tokens, and everything)."
     ),
     paths(
         jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::get_attempts, jobs::cancel_job,
@@ -257,6 +257,7 @@ mod tests {
         rails::get_report,
         curves::list_curves, curves::get_curve, curves::publish_curve,
         campaigns::upload_campaign, campaigns::list_campaigns, campaigns::get_campaign,
+        campaigns::submit_diagnosis,
         tokens::create_token, tokens::list_tokens, tokens::revoke_token,
         ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
@@ -273,6 +274,7 @@ mod tests {
         curves::CurveView, curves::FidelityView, curves::CurveLinks, curves::PublishRequest,
         pagination::PageView<curves::CurveView>,
         campaigns::CampaignView, campaigns::CampaignCountsView, campaigns::CampaignLinks,
+        campaigns::DiagnosisRequest,
         campaigns::CampaignDocument, campaigns::CampaignTestDocument, campaigns::DriveDocument,
         campaigns::SpecimenDocument, campaigns::IncrementDocument,
         campaigns::AccelRecordDocument, campaigns::AccelLocationDocument,

@@ -188,6 +188,77 @@ impl Jobs {
                     .into(),
             });
         }
+        if kind == JobKind::Diagnose {
+            return Err(SubmitError::Invalid {
+                field: "kind".into(),
+                rule: "diagnose jobs are submitted for a stored campaign: POST \
+                       /v1/campaigns/{id}/diagnoses"
+                    .into(),
+            });
+        }
+        self.submit_checked(kind, params, submitted_by, idempotency_key)
+            .await
+    }
+
+    /// Queue a diagnosis of a stored campaign: `options` are the client's params (keys of
+    /// [`runner::DIAGNOSE_CLIENT_KEYS`]; others are refused, naming the key); the campaign's
+    /// id and content are stored with them so the job's result depends on its params alone.
+    /// Errors name the client's field (`window_s`, `effects[0]`, ...).
+    pub async fn submit_diagnosis(
+        &self,
+        campaign_id: Uuid,
+        campaign: serde_json::Value,
+        options: serde_json::Value,
+        submitted_by: &str,
+        idempotency_key: Option<String>,
+    ) -> Result<Submitted, SubmitError> {
+        let Some(map) = options.as_object() else {
+            return Err(SubmitError::Invalid {
+                field: "body".into(),
+                rule: "must be a JSON object".into(),
+            });
+        };
+        if let Some(key) = map
+            .keys()
+            .find(|k| !runner::DIAGNOSE_CLIENT_KEYS.contains(&k.as_str()))
+        {
+            return Err(SubmitError::Invalid {
+                field: key.clone(),
+                rule: format!(
+                    "is not a known parameter (known: {})",
+                    runner::DIAGNOSE_CLIENT_KEYS.join(", ")
+                ),
+            });
+        }
+        let mut params = map.clone();
+        params.insert("campaign_id".into(), campaign_id.to_string().into());
+        params.insert("campaign".into(), campaign);
+        self.submit_checked(
+            JobKind::Diagnose,
+            serde_json::Value::Object(params),
+            submitted_by,
+            idempotency_key,
+        )
+        .await
+        .map_err(|e| match e {
+            SubmitError::Invalid { field, rule } => SubmitError::Invalid {
+                field: field
+                    .strip_prefix("params.")
+                    .map(str::to_string)
+                    .unwrap_or(field),
+                rule,
+            },
+            other => other,
+        })
+    }
+
+    async fn submit_checked(
+        &self,
+        kind: JobKind,
+        params: serde_json::Value,
+        submitted_by: &str,
+        idempotency_key: Option<String>,
+    ) -> Result<Submitted, SubmitError> {
         if !params.is_object() {
             return Err(SubmitError::Invalid {
                 field: "params".into(),

@@ -117,6 +117,118 @@ pub enum JobPlan {
     SweepPoint(Box<SweepPlan>, usize, usize),
     /// The calibration data.
     Calibrate(CalibrateParams),
+    /// The campaign to diagnose and how.
+    Diagnose(Box<DiagnosePlan>),
+}
+
+/// A `diagnose` job, parsed: the campaign (stored with the params at submission) and the
+/// options.
+#[derive(Debug, Clone)]
+pub struct DiagnosePlan {
+    pub campaign: crate::gap::Campaign,
+    pub options: crate::gap::diagnose::DiagnoseOptions,
+}
+
+/// Params a client may give a diagnosis (`POST /v1/campaigns/{id}/diagnoses`).
+pub const DIAGNOSE_CLIENT_KEYS: &[&str] =
+    &["window_s", "settle_s", "grid_points", "effects", "seed"];
+
+/// Params of a stored `diagnose` job: the client's plus the campaign's id and content, which
+/// the service adds at submission.
+pub const DIAGNOSE_KEYS: &[&str] = &[
+    "campaign_id",
+    "campaign",
+    "window_s",
+    "settle_s",
+    "grid_points",
+    "effects",
+    "seed",
+];
+
+impl DiagnosePlan {
+    /// Parse a `diagnose` job's params. Errors name the params field.
+    pub fn from_params(
+        params: &serde_json::Value,
+        configs_dir: &std::path::Path,
+    ) -> Result<Self, RunError> {
+        let invalid = |field: &str, rule: String| RunError::InvalidConfig {
+            field: field.to_string(),
+            rule,
+        };
+        let map = params
+            .as_object()
+            .ok_or_else(|| invalid("params", "must be a JSON object".into()))?;
+        for key in map.keys() {
+            if !DIAGNOSE_KEYS.contains(&key.as_str()) {
+                return Err(invalid(
+                    key,
+                    format!(
+                        "is not a known parameter (known: {})",
+                        DIAGNOSE_CLIENT_KEYS.join(", ")
+                    ),
+                ));
+            }
+        }
+        let campaign_value = map.get("campaign").ok_or_else(|| {
+            invalid(
+                "campaign",
+                "is required (submit through POST /v1/campaigns/{id}/diagnoses)".into(),
+            )
+        })?;
+        let campaign = crate::gap::Campaign::from_json_str(&campaign_value.to_string())
+            .and_then(|c| c.validate(configs_dir).map(|_| c))
+            .map_err(|e| invalid("campaign", e.to_string()))?;
+        let mut options = crate::gap::diagnose::DiagnoseOptions::default();
+        let number =
+            |name: &str, lo: f64, lo_open: bool, hi: f64| -> Result<Option<f64>, RunError> {
+                let Some(value) = map.get(name) else {
+                    return Ok(None);
+                };
+                let bound = if lo_open { "(" } else { "[" };
+                let rule = || format!("must be a number in {bound}{lo}, {hi}] s");
+                let x = value.as_f64().ok_or_else(|| invalid(name, rule()))?;
+                let above = if lo_open { x > lo } else { x >= lo };
+                if !(x.is_finite() && above && x <= hi) {
+                    return Err(invalid(name, rule()));
+                }
+                Ok(Some(x))
+            };
+        if let Some(x) = number("window_s", 0.05, false, 600.0)? {
+            options.emulator.window_s = x;
+        }
+        if let Some(x) = number("settle_s", 0.0, false, 600.0)? {
+            options.emulator.settle_s = x;
+        }
+        if let Some(value) = map.get("grid_points") {
+            let n = value
+                .as_u64()
+                .filter(|n| (2..=12).contains(n))
+                .ok_or_else(|| invalid("grid_points", "must be an integer in 2..=12".into()))?;
+            options.emulator.grid_points = n as usize;
+        }
+        if let Some(value) = map.get("effects") {
+            let names: Vec<String> = serde_json::from_value(value.clone())
+                .map_err(|_| invalid("effects", "must be a list of effect names".into()))?;
+            if names.is_empty() {
+                return Err(invalid("effects", "must name at least one effect".into()));
+            }
+            let library = crate::gap::effects::LIBRARY;
+            for (i, name) in names.iter().enumerate() {
+                if !library.iter().any(|e| e.name == name) {
+                    let known: Vec<&str> = library.iter().map(|e| e.name).collect();
+                    return Err(invalid(
+                        &format!("effects[{i}]"),
+                        format!(
+                            "`{name}` is not a library effect (known: {})",
+                            known.join(", ")
+                        ),
+                    ));
+                }
+            }
+            options.emulator.effects = Some(names);
+        }
+        Ok(Self { campaign, options })
+    }
 }
 
 /// The production runner: calls `railwear::pipeline` with reference configs from `configs_dir`.
@@ -158,6 +270,9 @@ impl LibraryRunner {
                 Ok(JobPlan::SweepPoint(Box::new(plan), index, replica))
             }
             JobKind::Calibrate => Ok(JobPlan::Calibrate(CalibrateParams::parse(params)?)),
+            JobKind::Diagnose => Ok(JobPlan::Diagnose(Box::new(DiagnosePlan::from_params(
+                params, dir,
+            )?))),
         }
     }
 }
@@ -200,6 +315,7 @@ impl CaseRunner for LibraryRunner {
                 summary: crate::pipeline::run_calibration(&data)?,
                 ..JobOutput::default()
             }),
+            JobPlan::Diagnose(plan) => run_diagnosis(&plan, &self.configs_dir, control),
         }
     }
 
@@ -269,6 +385,60 @@ impl CaseRunner for LibraryRunner {
             .collect::<Result<Vec<_>, _>>()?;
         sweep_output(&plan, params, &plan.outcome(points)?)
     }
+}
+
+/// Runs a diagnosis: progress is the fraction of its test simulations done (reported as
+/// `simulated_time_s` = simulations done of `end_time_s` = simulations in all); the summary is
+/// the report, the plots its figures.
+pub fn run_diagnosis(
+    plan: &DiagnosePlan,
+    configs_dir: &std::path::Path,
+    control: &RunControl,
+) -> Result<JobOutput, RunError> {
+    // The window simulations see the cancel flag but not the progress sink: the job's progress
+    // counts simulations, not one window's simulated time.
+    let inner = RunControl {
+        cancel: control.cancel.clone(),
+        progress: std::sync::Arc::new(|_| {}),
+    };
+    let report_progress = |done: usize, total: usize| {
+        let total = total.max(1);
+        (control.progress)(crate::physics::control::Progress {
+            simulated_time_s: done as f64,
+            end_time_s: total as f64,
+            fraction: (done as f64 / total as f64).clamp(0.0, 1.0),
+        });
+    };
+    let cache = crate::gap::window::WindowCache::new();
+    let (report, _) = crate::gap::diagnose::diagnose(
+        &plan.campaign,
+        configs_dir,
+        &plan.options,
+        &inner,
+        &cache,
+        &report_progress,
+    )
+    .map_err(|e| {
+        if control.is_cancelled() {
+            RunError::Cancelled
+        } else {
+            match e {
+                crate::gap::GapError::Field { field, rule } => {
+                    RunError::InvalidConfig { field, rule }
+                }
+                other => RunError::Diverged(other.to_string()),
+            }
+        }
+    })?;
+    let summary = serde_json::to_value(&report).map_err(|e| RunError::InvalidConfig {
+        field: "report".into(),
+        rule: format!("could not be serialized: {e}"),
+    })?;
+    Ok(JobOutput {
+        summary,
+        plots: crate::gap::diagnose::plots::plots(&report),
+        ..JobOutput::default()
+    })
 }
 
 /// Result summary of a `sweep_point` child job: its point and replica indices and the run.

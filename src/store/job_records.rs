@@ -18,6 +18,10 @@ pub enum JobKind {
     /// One point of a sweep: a child job the service creates when a sweep fans out (not
     /// submitted directly). Its result is the point's rattle space and rail wear rate.
     SweepPoint,
+    /// Gap diagnosis of a stored test campaign (issue 15): submitted through
+    /// `POST /v1/campaigns/{id}/diagnoses`, which stores the campaign with the params. Its
+    /// result is the diagnosis report; its plots are the report's SVG figures.
+    Diagnose,
 }
 
 impl JobKind {
@@ -28,6 +32,7 @@ impl JobKind {
             JobKind::Sweep => "sweep",
             JobKind::Calibrate => "calibrate",
             JobKind::SweepPoint => "sweep_point",
+            JobKind::Diagnose => "diagnose",
         }
     }
 
@@ -38,6 +43,7 @@ impl JobKind {
             "sweep" => Some(JobKind::Sweep),
             "calibrate" => Some(JobKind::Calibrate),
             "sweep_point" => Some(JobKind::SweepPoint),
+            "diagnose" => Some(JobKind::Diagnose),
             _ => None,
         }
     }
