@@ -158,8 +158,7 @@ fn scenarios(
         .collect::<Result<_, _>>()?;
     let lib = super::emulator::applicable(&cases, None)?;
     let mut list = Vec::new();
-    for (pass, &noise) in o.noise_levels.iter().enumerate() {
-        let _ = pass;
+    for &noise in &o.noise_levels {
         for _ in 0..6 {
             list.push(("control".to_string(), true, 0.0, noise));
         }
@@ -322,7 +321,7 @@ pub fn run(
             s.magnitude,
             s.noise_rel
         ));
-        let (noisy, truth): (Campaign, Truth) = run_cached(
+        let (noisy, _truth): (Campaign, Truth) = run_cached(
             skeleton,
             configs_dir,
             &rig_options(s, o, true)?,
@@ -336,7 +335,6 @@ pub fn run(
             control,
             &cache,
         )?;
-        let _ = truth;
         let det = if s.truth == "control" {
             0.0
         } else {

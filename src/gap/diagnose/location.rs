@@ -10,7 +10,7 @@
 
 use super::emulator::{PRESSURE_BANDS, SLIP_BANDS};
 use super::noise::Quantity;
-use super::{stats, DiagnoseOptions, Problem};
+use super::{stats, Problem};
 use crate::analysis::spectra::welch_psd;
 use crate::gap::accel::AccelLocation;
 use crate::gap::Campaign;
@@ -135,7 +135,7 @@ fn test_label(campaign: &Campaign, ti: usize) -> String {
 }
 
 /// The residual breakdown of the nominal model.
-pub(super) fn locate(campaign: &Campaign, problem: &Problem, _options: &DiagnoseOptions) -> Where {
+pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
     let em = problem.emulator;
     let nominal = &em.nominal;
     let ntests = campaign.tests.len();

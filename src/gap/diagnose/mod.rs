@@ -34,7 +34,6 @@ pub mod noise;
 pub mod plots;
 pub mod stats;
 
-use crate::gap::accel::AccelLocation;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
@@ -593,7 +592,7 @@ pub fn diagnose_with(
     let chi2: f64 = nominal_score.r2.iter().sum();
     let dof: f64 = nominal_score.w.iter().sum();
     let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
-    let location = location::locate(campaign, &problem, options);
+    let location = location::locate(campaign, &problem);
     let any_flag = location.any_flagged();
 
     let singles: Vec<Candidate> = (0..emulator.effects.len())
@@ -779,10 +778,9 @@ fn best_effect(
         })
         .collect();
     let mut parameters = Vec::new();
-    for (slot, (&e, &m)) in c.effects.iter().zip(&c.magnitudes).enumerate() {
+    for (&e, &m) in c.effects.iter().zip(&c.magnitudes) {
         let info = problem.emulator.effects[e].info;
         let interval = (c.effects.len() == 1).then(|| profile_interval(problem, e, m));
-        let _ = slot;
         for (pi, p) in info.parameters.iter().enumerate() {
             parameters.push(FittedParameter {
                 effect: info.name.to_string(),
@@ -832,9 +830,4 @@ fn profile_interval(problem: &Problem, e: usize, best: f64) -> [f64; 2] {
     let lo = inside.iter().copied().fold(best, f64::min);
     let hi = inside.iter().copied().fold(best, f64::max);
     [lo, hi]
-}
-
-/// Location of an accelerometer quantity, for labels.
-pub fn location_label(l: AccelLocation) -> &'static str {
-    l.as_str()
 }

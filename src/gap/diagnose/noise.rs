@@ -123,19 +123,26 @@ pub fn observations(campaign: &Campaign) -> Vec<Observation> {
                 if records.is_empty() {
                     continue;
                 }
+                // Each record's mean squares (mean removed), once: (per axis, samples, σ²).
+                let stats: Vec<([f64; 3], usize, f64)> = records
+                    .iter()
+                    .map(|r| {
+                        let xyz: Vec<[f64; 3]> =
+                            r.samples.iter().map(|s| [s[1], s[2], s[3]]).collect();
+                        (mean_square(&xyz), xyz.len(), r.sensor_noise_m_s2.powi(2))
+                    })
+                    .collect();
+                let scale = stats
+                    .iter()
+                    .flat_map(|(ms, _, _)| ms.iter().copied())
+                    .fold(0.0, f64::max);
                 for axis in 0..3 {
                     let mut values = Vec::new();
                     let mut fixed = 0.0;
-                    let mut scale: f64 = 0.0;
-                    for r in &records {
-                        let xyz: Vec<[f64; 3]> =
-                            r.samples.iter().map(|s| [s[1], s[2], s[3]]).collect();
-                        let ms = mean_square(&xyz)[axis];
-                        let s2 = r.sensor_noise_m_s2.powi(2);
-                        let m = (ms - s2).max(0.0);
-                        values.push(ms - s2);
-                        fixed += (4.0 * m * s2 + 2.0 * s2 * s2) / xyz.len().max(1) as f64;
-                        scale = scale.max(mean_square(&xyz).iter().copied().fold(0.0, f64::max));
+                    for (ms, len, s2) in &stats {
+                        let m = (ms[axis] - s2).max(0.0);
+                        values.push(ms[axis] - s2);
+                        fixed += (4.0 * m * s2 + 2.0 * s2 * s2) / (*len).max(1) as f64;
                     }
                     if let Some(o) = mean_obs(ti, k, Quantity::Accel(location, axis), &values) {
                         let n = o.specimens as f64;
@@ -305,7 +312,6 @@ impl NoiseModel {
             num_accel.iter().map(|(k, v)| (k.clone(), rms(v))).collect();
         let friction_mass_rel = rms(&fr_mass);
         for o in obs.iter_mut() {
-            let (ti, k) = (o.test, o.increment);
             let nominal = o.predicted(&emulator.nominal);
             let fr = rel_diff(nominal, o.predicted(&emulator.friction_step)).unwrap_or(0.0);
             o.model_rel_var = match &o.quantity {
@@ -321,7 +327,6 @@ impl NoiseModel {
                         + fr * fr
                 }
             };
-            let _ = (ti, k);
         }
         Self {
             mass_rel,
