@@ -1,0 +1,193 @@
+//! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, and the run.
+
+use super::{
+    check_keys, invalid, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError,
+    SIMULATE_KEYS,
+};
+use crate::models::case::{load_case, run_case};
+use crate::models::specs::CaseSpec;
+use std::path::Path;
+
+/// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
+fn sets_path(value: &serde_json::Value, path: &str) -> bool {
+    let mut v = value;
+    for part in path.split('.') {
+        match v.get(part) {
+            Some(next) => v = next,
+            None => return false,
+        }
+    }
+    true
+}
+
+/// Where a case field's value came from, as a params path: the overrides when they set it (or
+/// a parent of it), otherwise the config.
+fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
+    let field = case_field.trim_matches('.');
+    if field.is_empty() || field == "toml" {
+        return "config".into();
+    }
+    if let Some(over) = overrides {
+        let parts: Vec<&str> = field.split('.').collect();
+        for n in (1..=parts.len()).rev() {
+            if sets_path(over, &parts[..n].join(".")) {
+                return format!("overrides.{field}");
+            }
+        }
+    }
+    format!("config.{field}")
+}
+
+/// Checks the run-control bounds of [`limits`]; the error's field is a case path.
+fn check_simulation_bounds(case: &CaseSpec) -> Result<(), (String, String)> {
+    let s = &case.simulation;
+    let bad = |field: &str, rule: String| Err((format!("simulation.{field}"), rule));
+    if !(s.duration_s.is_finite() && s.duration_s > 0.0 && s.duration_s <= limits::MAX_DURATION_S) {
+        return bad(
+            "duration_s",
+            format!(
+                "must be > 0 and <= {} s (24 h of simulated time), got {}",
+                limits::MAX_DURATION_S,
+                s.duration_s
+            ),
+        );
+    }
+    if !(s.settle_s.is_finite() && s.settle_s >= 0.0 && s.settle_s <= limits::MAX_SETTLE_S) {
+        return bad(
+            "settle_s",
+            format!(
+                "must be >= 0 and <= {} s (past the contact creep time constant), got {}",
+                limits::MAX_SETTLE_S,
+                s.settle_s
+            ),
+        );
+    }
+    let (lo, hi) = limits::REL_TOLERANCE_RANGE;
+    if !(s.rel_tolerance >= lo && s.rel_tolerance <= hi) {
+        return bad(
+            "rel_tolerance",
+            format!("must lie in [{lo:e}, {hi}], got {}", s.rel_tolerance),
+        );
+    }
+    let (lo, hi) = limits::ABS_TOLERANCE_M_RANGE;
+    if !(s.abs_tolerance_m >= lo && s.abs_tolerance_m <= hi) {
+        return bad(
+            "abs_tolerance_m",
+            format!("must lie in [{lo:e}, {hi:e}] m, got {}", s.abs_tolerance_m),
+        );
+    }
+    let dt = s.record_interval_s;
+    if !(dt.is_finite() && dt >= limits::MIN_RECORD_INTERVAL_S && dt <= s.duration_s) {
+        return bad(
+            "record_interval_s",
+            format!(
+                "must lie in [{:e} s, duration_s], got {dt}",
+                limits::MIN_RECORD_INTERVAL_S
+            ),
+        );
+    }
+    let points = (s.settle_s + s.duration_s) / dt;
+    if points > limits::MAX_RECORDED_POINTS {
+        return bad(
+            "record_interval_s",
+            format!(
+                "records {points:.3e} time points over settle_s + duration_s; at most {:e} \
+                 are kept in memory: raise record_interval_s or shorten the run",
+                limits::MAX_RECORDED_POINTS
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
+/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check). Overrides
+/// deep-merge into the case (e.g. `{"simulation": {"duration_s": 0.5}}`); `seed` sets
+/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
+/// excitation). The case is checked completely: unknown keys anywhere, the model's own rules,
+/// the bounds of [`limits`], and the model is built once (excitation, geometry, integrator),
+/// so an accepted job does not fail on its configuration later. Errors name the params path
+/// (`config`, `config.<path>` or `overrides.<path>`).
+pub fn resolve_case(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
+) -> Result<CaseSpec, RunError> {
+    let mut value = match params.get("config") {
+        Some(serde_json::Value::String(name)) => {
+            let path = crate::config::reference_config_path(configs_dir, name)
+                .map_err(|e| invalid("config", e.to_string()))?;
+            let case = load_case(&path)?;
+            serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?
+        }
+        Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
+        Some(_) => {
+            return Err(invalid(
+                "config",
+                "must be a reference config name or a config object",
+            ))
+        }
+        None => {
+            return Err(invalid(
+                "config",
+                "is required (a reference config name or a config object)",
+            ))
+        }
+    };
+    let overrides = params.get("overrides");
+    if let Some(over) = overrides {
+        if !over.is_object() {
+            return Err(invalid("overrides", "must be an object"));
+        }
+        merge_json(&mut value, over);
+    }
+    if let Some(seed) = params.get("seed") {
+        let seed = parse_seed(seed)?;
+        merge_json(
+            &mut value,
+            &serde_json::json!({"simulation": {"seed": seed}}),
+        );
+    }
+    let mut case: CaseSpec = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        invalid(&locate(&path, overrides), e.into_inner().to_string())
+    })?;
+    adjust(&mut case)?;
+    let relocate = |e: RunError| match e {
+        RunError::InvalidConfig { field, rule } => RunError::InvalidConfig {
+            field: locate(&field, overrides),
+            rule,
+        },
+        other => other,
+    };
+    case.validate().map_err(|e| relocate(e.into()))?;
+    check_simulation_bounds(&case).map_err(|(field, rule)| relocate(invalid(&field, rule)))?;
+    crate::models::case::run_options(&case).map_err(relocate)?;
+    crate::models::case::build(&case, configs_dir).map_err(relocate)?;
+    Ok(case)
+}
+
+/// [`resolve_case`] without adjustment (the params' other keys are not checked).
+pub fn case_from_params(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+) -> Result<CaseSpec, RunError> {
+    resolve_case(params, configs_dir, |_| Ok(()))
+}
+
+/// A simulate job's params, parsed and checked: [`SIMULATE_KEYS`] only, `config` required.
+pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
+    check_keys(params, "params", SIMULATE_KEYS)?;
+    case_from_params(params, configs_dir)
+}
+
+/// A simulate job: one case end to end.
+pub fn simulate_job(
+    params: &serde_json::Value,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<CaseOutcome, RunError> {
+    let case = simulate_case(params, configs_dir)?;
+    let (_, outcome) = run_case(&case, configs_dir, control)?;
+    Ok(outcome)
+}
