@@ -214,7 +214,7 @@ pub fn compare_rattle_box(
     md.push_str("Contact: Table 5.2 IMPACT and friction; wear law: Table 4.3 modified Archard in SI (sigma in Pa, K in m²/N), cutoff 2 Sy = 870 MPa; excitation 15 g at 20 Hz transverse. Wear rate = whole cube-tube contact volume × 2810 kg/m³ (the cube's share by inverse hardness is half of it: both bodies are 7075).\n\n");
     md.push_str("| case | k_rs | railwear mg/h | cube share mg/h | ADAMS Table 5.4 mg/h | measured Table 5.3 mg/h | railwear / ADAMS | work above cutoff | mean N·v W | mean N N | peak N N | K needed for ADAMS (m²/N) | energy residual / dissipated | wall s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for ((letter, measured, repeats), adams, k_rs, c, wall, _sim, residual) in &rows {
-        let density = crate::wear::material::Material::aluminium_7075_t73().density_kg_m3;
+        let density = crate::wear::material::Material::aluminium_7075_t73().density_kg_per_m3;
         let vol_rate_m3_s = adams * 1e-6 / density / 3600.0;
         let k_needed = vol_rate_m3_s / c.mean_friction_power_w.max(1e-30);
         let meas = if repeats.is_empty() {

@@ -57,13 +57,13 @@ pub fn fit_power_law(
     if !(max_interference_m.is_finite() && max_interference_m > 0.0) {
         return Err(ContactModelError::Invalid {
             field: "max_interference_m",
-            rule: "must be a finite number > 0",
+            rule: "must be a finite number > 0".into(),
         });
     }
     if !(3..=1_000_000).contains(&samples) {
         return Err(ContactModelError::Invalid {
             field: "samples",
-            rule: "must be in 3..=1000000",
+            rule: "must be in 3..=1000000".into(),
         });
     }
     let ws: Vec<f64> = match space {

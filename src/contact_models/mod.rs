@@ -21,8 +21,8 @@ pub enum ContactModelError {
     Invalid {
         /// Name of the field.
         field: &'static str,
-        /// The rule it broke.
-        rule: &'static str,
+        /// The rule it broke, with the value where useful.
+        rule: String,
     },
     /// The fit did not converge or the data could not be fitted.
     #[error("fit failed: {0}")]

@@ -131,7 +131,7 @@ impl SphereOnFlat {
         if !(radius_m.is_finite() && radius_m > 0.0) {
             return Err(ContactModelError::Invalid {
                 field: "radius_m",
-                rule: "must be a finite number > 0",
+                rule: "must be a finite number > 0".into(),
             });
         }
         for m in [&sphere, &flat] {
@@ -160,7 +160,7 @@ impl SphereOnFlat {
 
     /// Sphere mass 4/3 pi R³ rho, kg.
     pub fn sphere_mass_kg(&self) -> f64 {
-        4.0 / 3.0 * PI * self.radius_m.powi(3) * self.sphere.density_kg_m3
+        4.0 / 3.0 * PI * self.radius_m.powi(3) * self.sphere.density_kg_per_m3
     }
 
     /// E* (eq. 2.6; JG's E'), Pa.

@@ -142,7 +142,7 @@ pub fn simulate_window(
     let material = match case.model_spec() {
         Ok(ModelSpecRef::RattleBox(s)) => s.material,
         Ok(ModelSpecRef::Launcher(s)) => s.material,
-        _ => crate::models::specs::MaterialSpec::default(),
+        _ => Material::default(),
     };
     let contacts = model
         .system

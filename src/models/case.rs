@@ -255,7 +255,7 @@ fn plots(
     let material = match case.model_spec() {
         Ok(ModelSpecRef::RattleBox(s)) => s.material,
         Ok(ModelSpecRef::Launcher(s)) => s.material,
-        _ => super::specs::MaterialSpec::default(),
+        _ => crate::wear::material::Material::default(),
     };
     let density = material.density_kg_per_m3;
     let mut wear_plot = Plot::new(

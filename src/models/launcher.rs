@@ -16,7 +16,6 @@
 //! - the latch tooth against the floor, roof and chamber walls;
 //! - the mid shoe's front protrusion against the tooth's rear face (a latch half-space).
 
-use super::rattle_box::material;
 use super::run::BuiltModel;
 use super::specs::{CaseSpec, LatchJoint, LauncherSpec, PlanarFace, RoundedBoxSpec};
 use crate::excitation::BaseMotion;
@@ -613,7 +612,7 @@ pub fn build(
             "the static rest estimate is not finite (check masses, stiffnesses and positions)",
         ));
     }
-    let mat = material(&spec.material);
+    let mat = spec.material;
     Ok(BuiltModel {
         name: case.name.clone(),
         system,

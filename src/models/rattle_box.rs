@@ -2,7 +2,7 @@
 //! drives transversely. One contact "cube-tube" with one track per wall the cube touches.
 
 use super::run::BuiltModel;
-use super::specs::{CaseSpec, MaterialSpec, RattleBoxSpec};
+use super::specs::{CaseSpec, RattleBoxSpec};
 use crate::excitation::BaseMotion;
 use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};
 use crate::models::motion::TranslatingBase;
@@ -10,20 +10,8 @@ use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
 use crate::physics::contact::Contact;
 use crate::physics::system::MultibodySystem;
 use crate::units::STANDARD_GRAVITY;
-use crate::wear::material::Material;
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 use std::sync::Arc;
-
-/// Converts a config material to the wear module's material.
-pub fn material(m: &MaterialSpec) -> Material {
-    Material {
-        density_kg_m3: m.density_kg_per_m3,
-        yield_strength_pa: m.yield_strength_pa,
-        youngs_modulus_pa: m.youngs_modulus_pa,
-        poisson_ratio: m.poisson_ratio,
-        brinell_hardness_hb: m.brinell_hardness,
-    }
-}
 
 /// Wall thickness of the rattle-box tube, m (estimate: 1/8 in; it only sets how far each
 /// wall's face extends past the inner corners, so that the corners are solid).
@@ -129,7 +117,7 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         Vector3::zeros(),
         Vector3::zeros(),
     );
-    let mat = material(&spec.material);
+    let mat = spec.material;
     BuiltModel {
         name: case.name.clone(),
         system,

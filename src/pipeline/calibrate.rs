@@ -135,7 +135,7 @@ impl CalibrateParams {
                     w,
                     "density_kg_m3",
                     "wear_law.density_kg_m3",
-                    crate::wear::material::Material::aluminium_7075_t73().density_kg_m3,
+                    crate::wear::material::Material::aluminium_7075_t73().density_kg_per_m3,
                     limits::DENSITY_KG_M3_RANGE,
                     "kg/m³, polymers to the densest metals",
                 )?;

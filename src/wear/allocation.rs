@@ -37,7 +37,7 @@ impl VolumeSplit {
                 let (ha, hb) = (a.hardness_pa(), b.hardness_pa());
                 if !(ha.is_finite() && ha > 0.0 && hb.is_finite() && hb > 0.0) {
                     return Err(WearError::invalid(
-                        "brinell_hardness_hb",
+                        "brinell_hardness",
                         "must be a finite number > 0",
                     ));
                 }
@@ -71,11 +71,11 @@ impl VolumeSplit {
         Ok((
             BodyWear {
                 volume_m3: va,
-                mass_kg: a.density_kg_m3 * va,
+                mass_kg: a.density_kg_per_m3 * va,
             },
             BodyWear {
                 volume_m3: vb,
-                mass_kg: b.density_kg_m3 * vb,
+                mass_kg: b.density_kg_per_m3 * vb,
             },
         ))
     }
@@ -107,7 +107,7 @@ mod tests {
     fn inverse_hardness_split() {
         let a = Material::aluminium_7075_t73();
         let mut b = a;
-        b.brinell_hardness_hb = 3.0 * 135.0; // B three times harder: A takes 3/4.
+        b.brinell_hardness = 3.0 * 135.0; // B three times harder: A takes 3/4.
         let (wa, wb) = VolumeSplit::InverseHardness.split(4.0e-9, &a, &b).unwrap();
         assert!((wa.volume_m3 - 3.0e-9).abs() < 1e-21);
         assert!((wb.volume_m3 - 1.0e-9).abs() < 1e-21);

@@ -7,10 +7,15 @@ use serde::{Deserialize, Serialize};
 pub const PA_PER_HB: f64 = crate::units::STANDARD_GRAVITY * 1.0e6;
 
 /// Isotropic material of a body (thesis eq. 2.43-2.45 and SPEC section 3 for 7075-T73).
+///
+/// The one material type: case files name it `material` with these field names, the models
+/// build bodies and contacts from it, wear allocation splits volumes with it. Its default, and
+/// the one source of the thesis' material, is [`Material::aluminium_7075_t73`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Material {
     /// Bulk density rho, kg/m³ (eq. 4.17: wear mass = rho * wear volume).
-    pub density_kg_m3: f64,
+    pub density_kg_per_m3: f64,
     /// Yield strength S_y, Pa (eq. 2.45; sets the wear-law cutoff of eq. 3.11).
     pub yield_strength_pa: f64,
     /// Young's modulus E, Pa (eq. 2.43).
@@ -18,24 +23,31 @@ pub struct Material {
     /// Poisson's ratio nu, dimensionless (eq. 2.44).
     pub poisson_ratio: f64,
     /// Brinell hardness, HB (kgf/mm²). Used for the inverse-hardness volume split.
-    pub brinell_hardness_hb: f64,
+    pub brinell_hardness: f64,
+}
+
+impl Default for Material {
+    /// 7075-T73 aluminium, anodized (thesis 4.2.1, SPEC 3).
+    fn default() -> Self {
+        Self::aluminium_7075_t73()
+    }
 }
 
 impl Material {
     /// 7075-T73 aluminium: 2810 kg/m³, S_y 435 MPa, E 72 GPa, nu 0.33, 135 HB (eq. 2.43-2.45).
     pub fn aluminium_7075_t73() -> Self {
         Self {
-            density_kg_m3: 2810.0,
+            density_kg_per_m3: 2810.0,
             yield_strength_pa: 435.0e6,
             youngs_modulus_pa: 72.0e9,
             poisson_ratio: 0.33,
-            brinell_hardness_hb: 135.0,
+            brinell_hardness: 135.0,
         }
     }
 
     /// Brinell hardness in Pa (HB * 9.80665e6). 135 HB is about 1.324 GPa.
     pub fn hardness_pa(&self) -> f64 {
-        self.brinell_hardness_hb * PA_PER_HB
+        self.brinell_hardness * PA_PER_HB
     }
 
     /// Plane-strain modulus E / (1 - nu²), Pa: this body's share of eq. 2.6.
@@ -48,37 +60,28 @@ impl Material {
         1.0 / (1.0 / self.plane_strain_modulus_pa() + 1.0 / other.plane_strain_modulus_pa())
     }
 
-    /// Checks every field is finite and physical.
+    /// Checks every field is finite and physical: all > 0, Poisson's ratio in (-1, 0.5). The
+    /// error names the field and its value.
     pub fn validate(&self) -> Result<(), WearError> {
-        let positive = |x: f64| x.is_finite() && x > 0.0;
-        if !positive(self.density_kg_m3) {
-            return Err(WearError::invalid(
-                "density_kg_m3",
-                "must be a finite number > 0",
-            ));
+        let positive = [
+            ("density_kg_per_m3", self.density_kg_per_m3),
+            ("yield_strength_pa", self.yield_strength_pa),
+            ("youngs_modulus_pa", self.youngs_modulus_pa),
+            ("brinell_hardness", self.brinell_hardness),
+        ];
+        for (field, x) in positive {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(WearError::invalid(
+                    field,
+                    format!("must be a finite number > 0, got {x}"),
+                ));
+            }
         }
-        if !positive(self.yield_strength_pa) {
+        let nu = self.poisson_ratio;
+        if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
             return Err(WearError::invalid(
-                "yield_strength_pa",
-                "must be a finite number > 0",
-            ));
-        }
-        if !positive(self.youngs_modulus_pa) {
-            return Err(WearError::invalid(
-                "youngs_modulus_pa",
-                "must be a finite number > 0",
-            ));
-        }
-        if !(self.poisson_ratio.is_finite()
-            && self.poisson_ratio > -1.0
-            && self.poisson_ratio < 0.5)
-        {
-            return Err(WearError::invalid("poisson_ratio", "must lie in (-1, 0.5)"));
-        }
-        if !positive(self.brinell_hardness_hb) {
-            return Err(WearError::invalid(
-                "brinell_hardness_hb",
-                "must be a finite number > 0",
+                "poisson_ratio",
+                format!("must lie in (-1, 0.5), got {nu}"),
             ));
         }
         Ok(())
@@ -110,7 +113,31 @@ mod tests {
         m.poisson_ratio = 0.7;
         assert_eq!(
             m.validate(),
-            Err(WearError::invalid("poisson_ratio", "must lie in (-1, 0.5)"))
+            Err(WearError::invalid(
+                "poisson_ratio",
+                "must lie in (-1, 0.5), got 0.7"
+            ))
         );
+        m.poisson_ratio = 0.33;
+        m.density_kg_per_m3 = -1.0;
+        assert!(matches!(
+            m.validate(),
+            Err(WearError::Invalid {
+                field: "density_kg_per_m3",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn a_case_file_material_reads_into_the_one_type() {
+        // The field names of case files (configs/*.toml `[rattle_box.material]`).
+        let m: Material = toml::from_str(
+            "density_kg_per_m3 = 2810.0\nyield_strength_pa = 435.0e6\n\
+             youngs_modulus_pa = 72.0e9\npoisson_ratio = 0.33\nbrinell_hardness = 135.0\n",
+        )
+        .expect("material");
+        assert_eq!(m, Material::default());
+        assert!(toml::from_str::<Material>("density_kg_m3 = 2810.0").is_err());
     }
 }

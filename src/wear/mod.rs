@@ -26,13 +26,16 @@ pub enum WearError {
     Invalid {
         /// Name of the field or sample column.
         field: &'static str,
-        /// The rule it broke.
-        rule: &'static str,
+        /// The rule it broke, with the value where useful.
+        rule: String,
     },
 }
 
 impl WearError {
-    pub(crate) fn invalid(field: &'static str, rule: &'static str) -> Self {
-        Self::Invalid { field, rule }
+    pub(crate) fn invalid(field: &'static str, rule: impl Into<String>) -> Self {
+        Self::Invalid {
+            field,
+            rule: rule.into(),
+        }
     }
 }

@@ -237,7 +237,7 @@ pub struct LauncherContacts {
 pub struct LauncherSpec {
     /// Rail and shoe material (anodized 7075, thesis 4.2.1).
     #[serde(default)]
-    pub material: MaterialSpec,
+    pub material: Material,
     /// Rear shoe and rail cross-section dimensions (eq. 6.1-6.2), mm.
     pub dimensions: LauncherDimensions,
     /// Rail layout.
@@ -431,7 +431,7 @@ impl LauncherSpec {
     /// than the neck, front pad clear of the rail bottom, latch tooth not below the lip tops.
     pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
         let p = |name: &str| path(prefix, name);
-        self.material.validate(&p("material"))?;
+        validate_material(&self.material, &p("material"))?;
         if self.stations.is_empty() || self.stations.len() > MAX_STATIONS {
             return Err(err(
                 p("stations"),

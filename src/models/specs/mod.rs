@@ -14,6 +14,7 @@ use crate::physics::friction::FrictionParams;
 use crate::physics::impact::ImpactParams;
 use crate::physics::step::StepKind;
 use crate::units;
+pub use crate::wear::material::Material;
 use serde::{Deserialize, Serialize};
 
 /// A specification that breaks a rule. `field` is the dotted path of the offending field as it

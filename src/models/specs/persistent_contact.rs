@@ -63,7 +63,7 @@ impl PrescribedRotation {
 pub struct PersistentContactSpec {
     /// Pad and coupon material (thesis 4.2.1: 7075, anodized MIL-A-8625 Type II Class 1).
     #[serde(default)]
-    pub material: MaterialSpec,
+    pub material: Material,
     /// Number of pads (thesis 4.2: 3).
     pub pad_count: u32,
     /// Pad size, m: radial (x), height (y), tangential (z). Estimate (not in the thesis).
@@ -112,7 +112,7 @@ impl PersistentContactSpec {
     /// Field rules, plus: pads stay on the coupon at every angle (`r_avg` + pad half diagonal
     /// <= half coupon side) and do not overlap each other.
     pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
-        self.material.validate(&path(prefix, "material"))?;
+        validate_material(&self.material, &path(prefix, "material"))?;
         if self.pad_count == 0 {
             return Err(err(path(prefix, "pad_count"), "must be >= 1 (thesis: 3)"));
         }

@@ -16,7 +16,7 @@ pub struct RattleBoxSpec {
     pub case: String,
     /// Cube and tube material (thesis 5.3.1: anodized aluminium, as chapter 4).
     #[serde(default)]
-    pub material: MaterialSpec,
+    pub material: Material,
     /// Cube side, m (thesis 5.3.2: 1 in = 0.0254 m).
     pub cube_side_m: f64,
     /// Cube mass, kg. Omitted: density x side³ (the thesis matches the real fixture's mass but
@@ -63,7 +63,7 @@ impl RattleBoxSpec {
     /// Field rules, plus: the cube fits the tube (in section and length), the roundover is
     /// smaller than half the cube side, and a Table 5.1 letter uses Table 5.1's tube side.
     pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
-        self.material.validate(&path(prefix, "material"))?;
+        validate_material(&self.material, &path(prefix, "material"))?;
         positive(prefix, "cube_side_m", self.cube_side_m)?;
         if let Some(m) = self.cube_mass_kg {
             positive(prefix, "cube_mass_kg", m)?;

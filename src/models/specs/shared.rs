@@ -122,55 +122,12 @@ impl FrictionSpec {
     }
 }
 
-/// Bulk material of the contacting parts. Default 7075-T73, anodized (thesis 4.2.1, SPEC 3).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialSpec {
-    /// Density, kg/m³. 7075-T73: 2810.
-    pub density_kg_per_m3: f64,
-    /// Yield strength S_y, Pa. 7075-T73: 435 MPa (the wear-law cutoff is 2 S_y, eq. 3.11).
-    pub yield_strength_pa: f64,
-    /// Young's modulus E, Pa. 7075-T73: 72 GPa.
-    pub youngs_modulus_pa: f64,
-    /// Poisson's ratio. 7075-T73: 0.33.
-    pub poisson_ratio: f64,
-    /// Brinell hardness, HB. 7075-T73: 135 (used to split wear between bodies).
-    pub brinell_hardness: f64,
-}
-
-impl Default for MaterialSpec {
-    /// 7075-T73, from the one source of the thesis' material
-    /// ([`Material::aluminium_7075_t73`](crate::wear::material::Material::aluminium_7075_t73)).
-    fn default() -> Self {
-        let m = crate::wear::material::Material::aluminium_7075_t73();
-        Self {
-            density_kg_per_m3: m.density_kg_m3,
-            yield_strength_pa: m.yield_strength_pa,
-            youngs_modulus_pa: m.youngs_modulus_pa,
-            poisson_ratio: m.poisson_ratio,
-            brinell_hardness: m.brinell_hardness_hb,
-        }
-    }
-}
-
-impl MaterialSpec {
-    /// Field rules: all > 0, Poisson's ratio in (-1, 0.5).
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
-        positive(prefix, "density_kg_per_m3", self.density_kg_per_m3)?;
-        positive(prefix, "yield_strength_pa", self.yield_strength_pa)?;
-        positive(prefix, "youngs_modulus_pa", self.youngs_modulus_pa)?;
-        positive(prefix, "brinell_hardness", self.brinell_hardness)?;
-        if !(self.poisson_ratio.is_finite()
-            && self.poisson_ratio > -1.0
-            && self.poisson_ratio < 0.5)
-        {
-            return Err(err(
-                path(prefix, "poisson_ratio"),
-                format!("must lie in (-1, 0.5), got {}", self.poisson_ratio),
-            ));
-        }
-        Ok(())
-    }
+/// The material of a case's contacting parts: the one [`Material`] type, checked with its own
+/// rules and reported at `prefix` (e.g. `rattle_box.material.poisson_ratio`).
+pub fn validate_material(material: &Material, prefix: &str) -> Result<(), SpecError> {
+    material.validate().map_err(|e| match e {
+        crate::wear::WearError::Invalid { field, rule } => err(path(prefix, field), rule),
+    })
 }
 
 /// A box with rounded edges and corners (a convex contact piece, SPEC 2), given by its centre
