@@ -69,6 +69,13 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         let good =
             json!({"window_s": 0.1, "settle_s": 0.02, "grid_points": 2, "effects": ["third_body"]});
         post(PLANNER, &good).problem(403);
+        // What `GET /v1/whoami` tells a client (the dashboard shows the button by it) is what
+        // the service does.
+        for (token, may) in [(PLANNER, false), (TEST_ENGINEER, true)] {
+            let me = curl("GET", &format!("{base}/v1/whoami"), Some(token), &[], None).json();
+            assert_eq!(me["may"]["diagnose"], may, "{me}");
+            assert_eq!(me["may"]["upload_campaigns"], may, "{me}");
+        }
         for (bad, field) in [
             (json!({"window_s": 0}), "window_s"),
             (json!({"effects": ["third_body", "gremlins"]}), "effects[1]"),

@@ -51,7 +51,7 @@ pub struct Permissions {
 #[utoipa::path(
     get, path = "/v1/whoami", tag = "tokens",
     responses(
-        (status = 200, body = WhoAmI),
+        (status = 200, description = "The token's name, role and permissions", body = WhoAmI),
         (status = 401, body = Problem, content_type = "application/problem+json"),
     ),
     security(("bearer" = []))
