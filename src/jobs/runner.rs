@@ -182,11 +182,13 @@ impl DiagnosePlan {
             .as_str()
             .and_then(|s| uuid::Uuid::parse_str(s).ok())
             .ok_or_else(|| invalid("campaign_id", "must be a campaign's UUID".into()))?;
+        let is_sha256 =
+            |s: &&str| s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
         let sha256 = map
             .get("campaign_sha256")
             .ok_or_else(|| invalid("campaign_sha256", submit_here.into()))?
             .as_str()
-            .filter(|s| s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f')))
+            .filter(is_sha256)
             .ok_or_else(|| invalid("campaign_sha256", "must be 64 lower-case hex digits".into()))?;
         let content = inputs.campaign(campaign_id, sha256)?;
         let campaign = crate::gap::Campaign::from_json_str(&content)
