@@ -315,9 +315,7 @@ async fn serve(
     }
     init_logging(config.log_format == "json");
     log_start_up(&mut config);
-    let runner = Arc::new(LibraryRunner {
-        configs_dir: config.configs_dir.clone(),
-    });
+    let runner = Arc::new(LibraryRunner::new(config.configs_dir.clone()));
     let service = railwear::http::start(config, runner, !no_workers).await?;
     // Tests and scripts read this line to find the port.
     println!("listening on http://{}", service.addr);
@@ -355,9 +353,7 @@ async fn worker(
         environment: config.report.environment.clone(),
         wear_law: config.report.wear_law.clone(),
     };
-    let runner = Arc::new(LibraryRunner {
-        configs_dir: config.configs_dir.clone(),
-    });
+    let runner = Arc::new(LibraryRunner::new(config.configs_dir.clone()));
     let jobs = railwear::jobs::Jobs::new(store, runner, settings, curve_defaults);
     let count = config.worker_count();
     // Jobs left running by dead processes of this host go back to the queue at once.

@@ -1,14 +1,19 @@
 //! The dashboard in headless Chromium (driven through chromedriver's WebDriver HTTP API with
-//! curl): the page lists a submitted job and shows it reach success, then shows a rail report.
-//! Skipped with a message when Chromium is absent, unless RAILWEAR_REQUIRE_BROWSER is set
-//! (`.ci/run` sets it and installs the browser).
+//! curl): the page lists a submitted job and shows it reach success, then shows a rail report;
+//! a test engineer starts a diagnosis of a stored campaign from the page and sees its report
+//! (verdict, ranking, figures) as the API gives it. Skipped with a message when Chromium is
+//! absent, unless RAILWEAR_REQUIRE_BROWSER is set (`.ci/run` sets it and installs the browser).
 
 mod service_support;
 
+use railwear::gap::Campaign;
+use railwear::jobs::LibraryRunner;
 use serde_json::{json, Value};
 use service_support::runner::{start, test_config};
-use service_support::{curl, submit_job, wait_for, TempDir, ENGINEER};
+use service_support::{curl, submit_job, wait_for, TempDir, ENGINEER, PLANNER, TEST_ENGINEER};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
+use std::sync::Arc;
 use std::time::Duration;
 
 fn find(program: &str) -> Option<String> {
@@ -105,8 +110,9 @@ impl Drop for Driver {
     }
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn dashboard_shows_a_job_reach_success() {
+/// Chromium and chromedriver, or `None` (the test skips) when they are not installed and
+/// RAILWEAR_REQUIRE_BROWSER is not set.
+fn browser() -> Option<(String, String)> {
     let chromium = find("chromium").or_else(|| find("chromium-browser"));
     let chromedriver = find("chromedriver");
     let (Some(chromium), Some(chromedriver)) = (chromium, chromedriver) else {
@@ -115,6 +121,14 @@ async fn dashboard_shows_a_job_reach_success() {
             "RAILWEAR_REQUIRE_BROWSER is set but chromium/chromedriver are missing"
         );
         eprintln!("SKIPPED dashboard test: chromium and chromedriver are not installed (apt-get install chromium chromium-driver)");
+        return None;
+    };
+    Some((chromium, chromedriver))
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn dashboard_shows_a_job_reach_success() {
+    let Some((chromium, chromedriver)) = browser() else {
         return;
     };
     let dir = TempDir::new("dash");
@@ -158,6 +172,202 @@ async fn dashboard_shows_a_job_reach_success() {
                 .filter(|t| t.contains("force_sum_n"))
                 .map(|_| ())
         });
+    })
+    .await
+    .unwrap();
+    service.stop().await;
+}
+
+/// The smallest campaign that runs a real diagnosis (as tests/service_diagnose.rs): two rattle
+/// box tests, one specimen of two increments each, cube mass only.
+const CAMPAIGN: &str = r#"
+format_version = 1
+name = "dashboard-diagnosis"
+[[tests]]
+id = "C"
+config = "rattle-box-c"
+increment_duration_s = 5400.0
+scale_resolution_mg = 0.0001
+components = ["cube"]
+[[tests.specimens]]
+id = "C-1"
+increments = [{ mass_loss_mg = { cube = 0.004 } }, { mass_loss_mg = { cube = 0.005 } }]
+[[tests]]
+id = "D"
+config = "rattle-box-d"
+increment_duration_s = 5400.0
+scale_resolution_mg = 0.0001
+components = ["cube"]
+[[tests.specimens]]
+id = "D-1"
+increments = [{ mass_loss_mg = { cube = 0.002 } }, { mass_loss_mg = { cube = 0.003 } }]
+"#;
+
+/// Sets an input's value through the page (as typing would).
+fn fill(driver: &Driver, id: &str, value: &str) {
+    driver.script(&format!(
+        "document.getElementById({}).value = {}; return null;",
+        json!(id),
+        json!(value)
+    ));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let dir = TempDir::new("dash-diagnose");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let service = railwear::http::start(
+        test_config(&dir.db_url()),
+        Arc::new(LibraryRunner::new(root.join("configs"))),
+        true,
+    )
+    .await
+    .expect("service starts");
+    let base = format!("http://{}", service.addr);
+    tokio::task::spawn_blocking(move || {
+        let campaign = Campaign::from_toml_str(CAMPAIGN, Path::new(".")).expect("campaign");
+        let body = serde_json::to_string(&campaign).unwrap();
+        let r = curl(
+            "POST",
+            &format!("{base}/v1/campaigns"),
+            Some(TEST_ENGINEER),
+            &[],
+            Some(&body),
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let campaign_id = r.json()["id"].as_str().unwrap().to_string();
+        let driver = Driver::start(&chromium, &chromedriver);
+        let row = format!("document.getElementById('campaign-{campaign_id}')");
+        let buttons = format!("{row}.querySelectorAll('button.start-diagnosis').length");
+
+        // A planner sees the campaign but no way to start a diagnosis (the API would say 403).
+        driver.goto(&format!("{base}/?as=planner#token={PLANNER}"));
+        wait_for(Duration::from_secs(30), "the campaign listed", || {
+            (driver.script(&format!("return {row} !== null;")) == true).then_some(())
+        });
+        assert_eq!(driver.script(&format!("return {buttons};")), 0);
+        assert_eq!(
+            driver.script("return document.getElementById('diagnose-options').hidden;"),
+            true
+        );
+
+        // A test engineer does.
+        driver.goto(&format!("{base}/?as=lab#token={TEST_ENGINEER}"));
+        wait_for(Duration::from_secs(30), "the start button", || {
+            (driver.script(&format!("return {row} !== null && {buttons} === 1;")) == true)
+                .then_some(())
+        });
+        let start = format!("{row}.querySelector('button.start-diagnosis').click(); return null;");
+        let error = "return document.getElementById('diagnose-error').textContent;";
+
+        // A refused request shows the problem's detail, naming the field.
+        fill(&driver, "opt-window", "0");
+        driver.script(&start);
+        let shown = wait_for(Duration::from_secs(30), "the 422 detail", || {
+            driver
+                .script(error)
+                .as_str()
+                .filter(|t| !t.is_empty())
+                .map(str::to_string)
+        });
+        assert!(shown.starts_with("Error: 422: `window_s`"), "{shown}");
+
+        // Short windows and one effect: a real diagnosis that finishes in seconds.
+        fill(&driver, "opt-window", "0.1");
+        fill(&driver, "opt-settle", "0.02");
+        fill(&driver, "opt-grid", "2");
+        fill(&driver, "opt-effects", "third_body, wear_above_cutoff");
+        driver.script(&start);
+        let job = wait_for(Duration::from_secs(30), "the diagnosis listed", || {
+            driver
+                .script("return document.getElementById('diagnosis').dataset.job || null;")
+                .as_str()
+                .map(str::to_string)
+        });
+        assert_eq!(driver.script(error), "", "the new request succeeded");
+        let listed = format!("return document.getElementById('diagnosis-{job}') !== null;");
+        wait_for(Duration::from_secs(30), "the job row", || {
+            (driver.script(&listed) == true).then_some(())
+        });
+        let verdict = wait_for(Duration::from_secs(600), "the report on the page", || {
+            driver
+                .script("return document.getElementById('diagnosis').dataset.verdict || null;")
+                .as_str()
+                .map(str::to_string)
+        });
+
+        // The page shows what the API returns.
+        let r = curl(
+            "GET",
+            &format!("{base}/v1/jobs/{job}/result"),
+            Some(TEST_ENGINEER),
+            &[],
+            None,
+        );
+        assert_eq!(r.status, 200, "{}", r.body);
+        let result = r.json();
+        assert_eq!(result["kind"], "diagnose");
+        let report = &result["summary"];
+        assert_eq!(verdict, report["verdict"].as_str().unwrap());
+        assert_eq!(
+            driver.script("return document.querySelector('#diagnosis .verdict').textContent;"),
+            report["verdict"]
+        );
+        let candidates: Vec<Value> = report["ranking"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .chain(report["pairs"].as_array().unwrap())
+            .map(|e| e["name"].clone())
+            .collect();
+        assert!(candidates.contains(&json!("third_body")), "{report}");
+        let rows = driver.script(
+            "return [...document.querySelectorAll('#diagnosis-ranking tbody tr')]\
+             .map(r => r.dataset.effect);",
+        );
+        assert_eq!(rows, Value::Array(candidates));
+        let marked = driver.script(
+            "return [...document.querySelectorAll('#diagnosis-ranking tr.indistinguishable')]\
+             .map(r => r.dataset.effect);",
+        );
+        assert_eq!(marked, report["indistinguishable"]);
+        let flagged = report["where"]["groups"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|g| g["flagged"] == true)
+            .count();
+        let flagged_rows = driver.script(
+            "const t = document.getElementById('diagnosis-where'); \
+             return t ? t.querySelectorAll('tbody tr').length : 0;",
+        );
+        assert_eq!(flagged_rows, flagged);
+
+        // The three figures, each decoded by the browser as an image.
+        let mut names: Vec<&str> = result["plots"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        names.sort_unstable();
+        assert_eq!(names, ["before_after.svg", "ranking.svg", "residuals.svg"]);
+        let decoded = wait_for(Duration::from_secs(30), "the figures decoded", || {
+            let v = driver.script(
+                "const imgs = [...document.querySelectorAll('#diagnosis img[data-plot]')]; \
+                 return imgs.every(i => i.complete && i.naturalWidth > 0) \
+                 ? imgs.map(i => i.dataset.plot) : null;",
+            );
+            (!v.is_null()).then_some(v)
+        });
+        // In the report's order: where, which, how far.
+        assert_eq!(
+            decoded,
+            json!(["residuals.svg", "ranking.svg", "before_after.svg"])
+        );
     })
     .await
     .unwrap();

@@ -42,9 +42,7 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let service = railwear::http::start(
         test_config(&dir.db_url()),
-        Arc::new(LibraryRunner {
-            configs_dir: root.join("configs"),
-        }),
+        Arc::new(LibraryRunner::new(root.join("configs"))),
         true,
     )
     .await
@@ -71,6 +69,13 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         let good =
             json!({"window_s": 0.1, "settle_s": 0.02, "grid_points": 2, "effects": ["third_body"]});
         post(PLANNER, &good).problem(403);
+        // What `GET /v1/whoami` tells a client (the dashboard shows the button by it) is what
+        // the service does.
+        for (token, may) in [(PLANNER, false), (TEST_ENGINEER, true)] {
+            let me = curl("GET", &format!("{base}/v1/whoami"), Some(token), &[], None).json();
+            assert_eq!(me["may"]["diagnose"], may, "{me}");
+            assert_eq!(me["may"]["upload_campaigns"], may, "{me}");
+        }
         for (bad, field) in [
             (json!({"window_s": 0}), "window_s"),
             (json!({"effects": ["third_body", "gremlins"]}), "effects[1]"),
@@ -151,5 +156,107 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
     })
     .await
     .unwrap();
+    service.stop().await;
+}
+
+/// The job holds the campaign's id and SHA-256, not its content, and reads the campaign when
+/// it runs: a campaign gone from the store by then, or whose stored content no longer has
+/// that SHA-256, fails the job saying which.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_diagnosis_reads_its_campaign_when_it_runs() {
+    let dir = TempDir::new("diagnose-gone");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let db_url = dir.db_url();
+    // No workers yet: the jobs wait in the queue while their campaigns change.
+    let service = railwear::http::start(
+        test_config(&db_url),
+        Arc::new(LibraryRunner::new(root.join("configs"))),
+        false,
+    )
+    .await
+    .expect("service starts");
+    let base = format!("http://{}", service.addr);
+    let (gone, changed) = tokio::task::spawn_blocking(move || {
+        let mut jobs = Vec::new();
+        for name in ["to-be-deleted", "to-be-changed"] {
+            let text = CAMPAIGN.replace("small-diagnosis-http", name);
+            let campaign = Campaign::from_toml_str(&text, Path::new(".")).expect("campaign");
+            let body = serde_json::to_string(&campaign).unwrap();
+            let r = curl(
+                "POST",
+                &format!("{base}/v1/campaigns"),
+                Some(TEST_ENGINEER),
+                &[],
+                Some(&body),
+            );
+            assert_eq!(r.status, 201, "{}", r.body);
+            let stored = r.json();
+            let id = stored["id"].as_str().unwrap().to_string();
+            let r = curl(
+                "POST",
+                &format!("{base}/v1/campaigns/{id}/diagnoses"),
+                Some(TEST_ENGINEER),
+                &[],
+                Some(r#"{"window_s": 0.1, "effects": ["third_body"]}"#),
+            );
+            assert_eq!(r.status, 201, "{}", r.body);
+            let job = r.json();
+            assert_eq!(job["params"]["campaign_id"], id.as_str());
+            assert_eq!(job["params"]["campaign_sha256"], stored["content_sha256"]);
+            let keys: Vec<&String> = job["params"].as_object().unwrap().keys().collect();
+            assert_eq!(
+                keys,
+                ["campaign_id", "campaign_sha256", "effects", "window_s"],
+                "the params name the campaign, they do not copy it"
+            );
+            jobs.push((id, job["id"].as_str().unwrap().to_string()));
+        }
+        (jobs[0].clone(), jobs[1].clone())
+    })
+    .await
+    .unwrap();
+
+    // Campaigns cannot be deleted over the API: change the database behind the service.
+    let pool = sqlx::SqlitePool::connect(&db_url).await.expect("database");
+    sqlx::query("DELETE FROM campaigns WHERE id = ?1")
+        .bind(&gone.0)
+        .execute(&pool)
+        .await
+        .expect("delete");
+    sqlx::query("UPDATE campaigns SET content = replace(content, '0.004', '0.04') WHERE id = ?1")
+        .bind(&changed.0)
+        .execute(&pool)
+        .await
+        .expect("update");
+    pool.close().await;
+
+    let workers = service.state.jobs.spawn_workers(1, "diagnose-gone");
+    let base = format!("http://{}", service.addr);
+    let errors = tokio::task::spawn_blocking(move || {
+        [gone.1, changed.1].map(|job| {
+            let url = format!("{base}/v1/jobs/{job}");
+            service_support::wait_for(Duration::from_secs(60), "the job to end", || {
+                let j = curl("GET", &url, Some(TEST_ENGINEER), &[], None).json();
+                match j["status"].as_str() {
+                    Some("failed") => Some(j["error"].as_str().unwrap_or_default().to_string()),
+                    Some("succeeded" | "cancelled") => panic!("should fail: {j}"),
+                    _ => None,
+                }
+            })
+        })
+    })
+    .await
+    .unwrap();
+    assert!(
+        errors[0].contains("`campaign_id`") && errors[0].contains("no longer stored"),
+        "{}",
+        errors[0]
+    );
+    assert!(
+        errors[1].contains("`campaign_sha256`") && errors[1].contains("not the content"),
+        "{}",
+        errors[1]
+    );
+    service.state.jobs.shutdown(workers).await;
     service.stop().await;
 }

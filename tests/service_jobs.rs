@@ -15,9 +15,9 @@ use std::sync::Arc;
 
 async fn start_library(dir: &TempDir) -> railwear::http::RunningService {
     let config = test_config(&dir.db_url());
-    let runner = Arc::new(LibraryRunner {
-        configs_dir: Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
-    });
+    let runner = Arc::new(LibraryRunner::new(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
+    ));
     railwear::http::start(config, runner, false)
         .await
         .expect("service starts")

@@ -64,6 +64,12 @@ impl Caller {
         }
     }
 
+    /// May start a diagnosis of a stored campaign: those who upload campaigns (test
+    /// engineers) and those who run jobs (engineers), and admins.
+    pub fn may_diagnose(&self) -> bool {
+        self.allowed(Area::Campaigns, &Method::POST) || self.allowed(Area::Jobs, &Method::POST)
+    }
+
     /// 403 unless [`Caller::allowed`].
     pub fn require(&self, area: Area, method: &Method) -> Result<(), Problem> {
         if self.allowed(area, method) {

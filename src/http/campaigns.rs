@@ -444,9 +444,7 @@ pub async fn submit_diagnosis(
     headers: axum::http::HeaderMap,
     body: axum::extract::Request,
 ) -> Result<Response, Problem> {
-    if !(caller.allowed(Area::Campaigns, &Method::POST)
-        || caller.allowed(Area::Jobs, &Method::POST))
-    {
+    if !caller.may_diagnose() {
         return Err(Problem::forbidden(format!(
             "role `{}` may not diagnose campaigns",
             caller.role.as_str()
@@ -460,11 +458,15 @@ pub async fn submit_diagnosis(
         .get_campaign(id)
         .await?
         .ok_or_else(|| Problem::not_found(format!("no campaign {id}")))?;
-    let campaign: serde_json::Value =
-        serde_json::from_str(&record.content).map_err(|e| Problem::internal(&e))?;
     let submitted = state
         .jobs
-        .submit_diagnosis(id, campaign, options, &caller.name, key)
+        .submit_diagnosis(
+            id,
+            &record.summary.content_sha256,
+            options,
+            &caller.name,
+            key,
+        )
         .await
         .map_err(|e| match e {
             crate::jobs::SubmitError::Invalid { field, rule } => {

@@ -64,8 +64,8 @@ pub struct JobView {
     pub kind: JobKind,
     pub status: JobStatus,
     /// Parameters as submitted (a sweep's `vehicle_profile`, `environment` and `wear_law`
-    /// filled in from the defaults when absent; a diagnosis shows its `campaign_id`, not the
-    /// campaign's content stored with it).
+    /// filled in from the defaults when absent; a diagnosis adds `campaign_id` and
+    /// `campaign_sha256`, the content it reads from the store when it runs).
     #[schema(value_type = Object)]
     pub params: serde_json::Value,
     /// Seed the run uses (from `params.seed` or drawn at submission).
@@ -155,19 +155,11 @@ pub struct JobLinks {
 impl From<JobRecord> for JobView {
     fn from(j: JobRecord) -> Self {
         let base = format!("/v1/jobs/{}", j.id);
-        // A diagnosis stores its campaign's content with its params; the view names the
-        // campaign (`params.campaign_id`) instead of repeating it.
-        let mut params = j.params;
-        if j.kind == JobKind::Diagnose {
-            if let Some(map) = params.as_object_mut() {
-                map.remove("campaign");
-            }
-        }
         JobView {
             id: j.id,
             kind: j.kind,
             status: j.status,
-            params,
+            params: j.params,
             seed: j.seed,
             code_version: j.code_version,
             submitted_by: j.submitted_by,

@@ -258,7 +258,7 @@ mod tests {
         curves::list_curves, curves::get_curve, curves::publish_curve,
         campaigns::upload_campaign, campaigns::list_campaigns, campaigns::get_campaign,
         campaigns::submit_diagnosis,
-        tokens::create_token, tokens::list_tokens, tokens::revoke_token,
+        tokens::create_token, tokens::list_tokens, tokens::revoke_token, tokens::whoami,
         ops::healthz, ops::readyz, ops::metrics, openapi,
     ),
     components(schemas(
@@ -279,7 +279,8 @@ mod tests {
         campaigns::SpecimenDocument, campaigns::IncrementDocument,
         campaigns::AccelRecordDocument, campaigns::AccelLocationDocument,
         pagination::PageView<campaigns::CampaignView>,
-        tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken,
+        tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken, tokens::WhoAmI,
+        tokens::Permissions,
         crate::config::Role,
     )),
     modifiers(&BearerAuth, &CommonErrors, &Links),

@@ -17,6 +17,59 @@ pub fn router() -> Router<AppState> {
     Router::new()
         .route("/v1/tokens", get(list_tokens).post(create_token))
         .route("/v1/tokens/{id}", delete(revoke_token))
+        .route("/v1/whoami", get(whoami))
+}
+
+/// The caller's token: its name, role and what the role may do (so a client such as the
+/// dashboard shows only the actions it may take).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct WhoAmI {
+    /// Token name.
+    pub name: String,
+    pub role: Role,
+    pub may: Permissions,
+}
+
+/// What a role may do besides reading (every role reads rails, jobs, curves and campaigns).
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Permissions {
+    /// `POST /v1/jobs` (simulate, sweep, calibrate), cancel jobs.
+    pub submit_jobs: bool,
+    /// Record rail measurements.
+    pub record_measurements: bool,
+    /// Publish penalization curves.
+    pub publish_curves: bool,
+    /// `POST /v1/campaigns`.
+    pub upload_campaigns: bool,
+    /// `POST /v1/campaigns/{id}/diagnoses`.
+    pub diagnose: bool,
+    /// Create, list and revoke tokens.
+    pub manage_tokens: bool,
+}
+
+/// Who the token is and what its role may do (every valid token).
+#[utoipa::path(
+    get, path = "/v1/whoami", tag = "tokens",
+    responses(
+        (status = 200, description = "The token's name, role and permissions", body = WhoAmI),
+        (status = 401, body = Problem, content_type = "application/problem+json"),
+    ),
+    security(("bearer" = []))
+)]
+pub async fn whoami(caller: Caller) -> Json<WhoAmI> {
+    let post = Method::POST;
+    Json(WhoAmI {
+        may: Permissions {
+            submit_jobs: caller.allowed(Area::Jobs, &post),
+            record_measurements: caller.allowed(Area::Rails, &post),
+            publish_curves: caller.allowed(Area::Curves, &post),
+            upload_campaigns: caller.allowed(Area::Campaigns, &post),
+            diagnose: caller.may_diagnose(),
+            manage_tokens: caller.allowed(Area::Tokens, &post),
+        },
+        name: caller.name,
+        role: caller.role,
+    })
 }
 
 /// A token to create.

@@ -3,6 +3,7 @@
 //! threads through the [`CaseRunner`] interface.
 
 pub mod host;
+pub mod inputs;
 pub mod metrics;
 /// The job records live with the store that keeps them (`store::job_records`).
 pub use crate::store::job_records as model;
@@ -92,6 +93,8 @@ impl Jobs {
         settings: WorkerSettings,
         curve_defaults: CurveDefaults,
     ) -> Arc<Self> {
+        // Jobs read their stored inputs (a diagnosis's campaign) from the queue's store.
+        runner.bind_store(Arc::clone(&store));
         Arc::new(Self {
             store,
             runner,
@@ -202,12 +205,13 @@ impl Jobs {
 
     /// Queue a diagnosis of a stored campaign: `options` are the client's params (keys of
     /// [`runner::DIAGNOSE_CLIENT_KEYS`]; others are refused, naming the key); the campaign's
-    /// id and content are stored with them so the job's result depends on its params alone.
+    /// id and the SHA-256 of its content are stored with them, and the job reads the campaign
+    /// from the store when it runs (so its result depends on its params and that content).
     /// Errors name the client's field (`window_s`, `effects[0]`, ...).
     pub async fn submit_diagnosis(
         &self,
         campaign_id: Uuid,
-        campaign: serde_json::Value,
+        campaign_sha256: &str,
         options: serde_json::Value,
         submitted_by: &str,
         idempotency_key: Option<String>,
@@ -232,7 +236,7 @@ impl Jobs {
         }
         let mut params = map.clone();
         params.insert("campaign_id".into(), campaign_id.to_string().into());
-        params.insert("campaign".into(), campaign);
+        params.insert("campaign_sha256".into(), campaign_sha256.into());
         self.submit_checked(
             JobKind::Diagnose,
             serde_json::Value::Object(params),

@@ -77,6 +77,10 @@ pub trait CaseRunner: Send + Sync {
         Ok(())
     }
 
+    /// The store this runner's jobs read their stored inputs from (a diagnosis's campaign);
+    /// `Jobs::new` calls it with the queue's store. The default reads nothing.
+    fn bind_store(&self, _store: std::sync::Arc<dyn crate::store::Store>) {}
+
     /// The child jobs this job splits into, or `None` to run it whole with
     /// [`CaseRunner::run`] (the default). Called on a blocking thread; should be quick (no
     /// simulation).
@@ -121,8 +125,8 @@ pub enum JobPlan {
     Diagnose(Box<DiagnosePlan>),
 }
 
-/// A `diagnose` job, parsed: the campaign (stored with the params at submission) and the
-/// options.
+/// A `diagnose` job, parsed: the campaign (read from the store by the id in the params and
+/// checked against their SHA-256) and the options.
 #[derive(Debug, Clone)]
 pub struct DiagnosePlan {
     pub campaign: crate::gap::Campaign,
@@ -133,11 +137,11 @@ pub struct DiagnosePlan {
 pub const DIAGNOSE_CLIENT_KEYS: &[&str] =
     &["window_s", "settle_s", "grid_points", "effects", "seed"];
 
-/// Params of a stored `diagnose` job: the client's plus the campaign's id and content, which
-/// the service adds at submission.
+/// Params of a stored `diagnose` job: the client's plus the campaign's id and the SHA-256 of
+/// its content, which the service adds at submission.
 pub const DIAGNOSE_KEYS: &[&str] = &[
     "campaign_id",
-    "campaign",
+    "campaign_sha256",
     "window_s",
     "settle_s",
     "grid_points",
@@ -146,10 +150,12 @@ pub const DIAGNOSE_KEYS: &[&str] = &[
 ];
 
 impl DiagnosePlan {
-    /// Parse a `diagnose` job's params. Errors name the params field.
+    /// Parse a `diagnose` job's params and read its campaign from `inputs`. Errors name the
+    /// params field.
     pub fn from_params(
         params: &serde_json::Value,
         configs_dir: &std::path::Path,
+        inputs: &super::inputs::StoredInputs,
     ) -> Result<Self, RunError> {
         let invalid = |field: &str, rule: String| RunError::InvalidConfig {
             field: field.to_string(),
@@ -169,15 +175,30 @@ impl DiagnosePlan {
                 ));
             }
         }
-        let campaign_value = map.get("campaign").ok_or_else(|| {
-            invalid(
-                "campaign",
-                "is required (submit through POST /v1/campaigns/{id}/diagnoses)".into(),
-            )
-        })?;
-        let campaign = crate::gap::Campaign::from_json_str(&campaign_value.to_string())
+        let submit_here = "is required (submit through POST /v1/campaigns/{id}/diagnoses)";
+        let campaign_id = map
+            .get("campaign_id")
+            .ok_or_else(|| invalid("campaign_id", submit_here.into()))?
+            .as_str()
+            .and_then(|s| uuid::Uuid::parse_str(s).ok())
+            .ok_or_else(|| invalid("campaign_id", "must be a campaign's UUID".into()))?;
+        let is_sha256 =
+            |s: &&str| s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
+        let sha256 = map
+            .get("campaign_sha256")
+            .ok_or_else(|| invalid("campaign_sha256", submit_here.into()))?
+            .as_str()
+            .filter(is_sha256)
+            .ok_or_else(|| invalid("campaign_sha256", "must be 64 lower-case hex digits".into()))?;
+        let content = inputs.campaign(campaign_id, sha256)?;
+        let campaign = crate::gap::Campaign::from_json_str(&content)
             .and_then(|c| c.validate(configs_dir).map(|_| c))
-            .map_err(|e| invalid("campaign", e.to_string()))?;
+            .map_err(|e| {
+                invalid(
+                    "campaign_id",
+                    format!("names a campaign that no longer checks out against the configs: {e}"),
+                )
+            })?;
         let mut options = crate::gap::diagnose::DiagnoseOptions::default();
         let number =
             |name: &str, lo: f64, lo_open: bool, hi: f64| -> Result<Option<f64>, RunError> {
@@ -235,9 +256,19 @@ impl DiagnosePlan {
 pub struct LibraryRunner {
     /// Directory of the reference model configs (`configs/`).
     pub configs_dir: PathBuf,
+    /// Where a diagnosis reads its campaign (bound to the queue's store by `Jobs::new`).
+    pub inputs: super::inputs::StoredInputs,
 }
 
 impl LibraryRunner {
+    /// A runner for the reference configs in `configs_dir`, not yet bound to a store.
+    pub fn new(configs_dir: impl Into<PathBuf>) -> Self {
+        LibraryRunner {
+            configs_dir: configs_dir.into(),
+            inputs: super::inputs::StoredInputs::default(),
+        }
+    }
+
     /// Parse and check `params` for `kind` (the one set of rules; see [`JobPlan`]). Errors
     /// name the params field (`config`, `overrides.simulation.duration_s`, `points`, ...).
     pub fn plan(&self, kind: &JobKind, params: &serde_json::Value) -> Result<JobPlan, RunError> {
@@ -271,7 +302,9 @@ impl LibraryRunner {
             }
             JobKind::Calibrate => Ok(JobPlan::Calibrate(CalibrateParams::parse(params)?)),
             JobKind::Diagnose => Ok(JobPlan::Diagnose(Box::new(DiagnosePlan::from_params(
-                params, dir,
+                params,
+                dir,
+                &self.inputs,
             )?))),
         }
     }
@@ -321,6 +354,10 @@ impl CaseRunner for LibraryRunner {
 
     fn validate(&self, kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
         self.plan(kind, params).map(|_| ())
+    }
+
+    fn bind_store(&self, store: std::sync::Arc<dyn crate::store::Store>) {
+        self.inputs.bind(store);
     }
 
     /// A sweep fans out into one `sweep_point` child per point and seed (point-major).

@@ -132,9 +132,7 @@ pub(crate) fn sweep_procs(
     // Submissions go through the job system as an API process would (no workers here).
     let jobs = railwear::jobs::Jobs::new(
         Arc::clone(&store),
-        Arc::new(railwear::jobs::LibraryRunner {
-            configs_dir: configs_abs.clone(),
-        }),
+        Arc::new(railwear::jobs::LibraryRunner::new(configs_abs.clone())),
         railwear::jobs::WorkerSettings {
             lease: Duration::from_secs(15),
             heartbeat: Duration::from_secs(1),
