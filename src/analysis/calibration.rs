@@ -445,6 +445,46 @@ pub fn fit_wear_law(
     })
 }
 
+/// Synthetic torque records of the thesis' friction rig (eq. 4.1), for anchors and tests: a
+/// fixture of polar inertia 0.02 kg m² and mean radius 20 mm under 300 N, driven at
+/// theta-dot = 1.5 sin(2 pi 0.1 t) rad/s (slip up to 30 mm/s both ways), 20 s at 1 kHz, with
+/// the torque of `truth` times (1 + `noise` g), g standard normal (Box-Muller on ChaCha8 seeded
+/// with `seed`).
+pub fn synthetic_torque_records(
+    truth: &FrictionParams,
+    noise: f64,
+    seed: u64,
+) -> (Fixture, Vec<TorqueRecord>) {
+    use rand::{Rng, SeedableRng};
+    let fixture = Fixture {
+        polar_inertia_kg_m2: 0.02,
+        mean_radius_m: 0.02,
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let w = 2.0 * std::f64::consts::PI * 0.1;
+    let records = (0..20_000)
+        .map(|i| {
+            let t = i as f64 * 1e-3;
+            let thd = 1.5 * (w * t).sin();
+            let thdd = 1.5 * w * (w * t).cos();
+            let v = thd * fixture.mean_radius_m;
+            let mu = truth.coefficient(v.abs()) * v.signum();
+            let torque =
+                fixture.polar_inertia_kg_m2 * thdd + 3.0 * fixture.mean_radius_m * 300.0 * mu;
+            let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+            let gauss = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
+            TorqueRecord {
+                time_s: t,
+                angle_rad: -1.5 / w * (w * t).cos(),
+                angular_velocity_rad_s: thd,
+                normal_load_n: 300.0,
+                input_torque_n_m: torque * (1.0 + noise * gauss),
+            }
+        })
+        .collect();
+    (fixture, records)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -475,30 +515,7 @@ mod tests {
         // rad/s (slip up to 30 mm/s both ways), 20 s at 1 kHz; torque from eq. 4.1 with 2 %
         // multiplicative Gaussian noise.
         let truth = table_4_2();
-        let fixture = Fixture {
-            polar_inertia_kg_m2: 0.02,
-            mean_radius_m: 0.02,
-        };
-        let mut rng = ChaCha8Rng::seed_from_u64(42);
-        let w = 2.0 * std::f64::consts::PI * 0.1;
-        let records: Vec<TorqueRecord> = (0..20_000)
-            .map(|i| {
-                let t = i as f64 * 1e-3;
-                let thd = 1.5 * (w * t).sin();
-                let thdd = 1.5 * w * (w * t).cos();
-                let v = thd * fixture.mean_radius_m;
-                let mu = truth.coefficient(v.abs()) * v.signum();
-                let torque =
-                    fixture.polar_inertia_kg_m2 * thdd + 3.0 * fixture.mean_radius_m * 300.0 * mu;
-                TorqueRecord {
-                    time_s: t,
-                    angle_rad: -1.5 / w * (w * t).cos(),
-                    angular_velocity_rad_s: thd,
-                    normal_load_n: 300.0,
-                    input_torque_n_m: torque * (1.0 + 0.02 * gaussian(&mut rng)),
-                }
-            })
-            .collect();
+        let (fixture, records) = synthetic_torque_records(&truth, 0.02, 42);
         let samples = friction_samples(&records, &fixture).unwrap();
         let fit = fit_friction(&samples, StepKind::Cycloidal).unwrap();
         let p = fit.params;

@@ -581,51 +581,17 @@ fn filter_through_mount(
             })
             .collect()
     };
-    Ok(match spec {
-        ExcitationSpec::Sine {
-            tones,
-            settle_s,
-            ramp,
-        } => ExcitationSpec::Sine {
-            tones: filter_tones(tones),
-            settle_s,
-            ramp,
-        },
-        ExcitationSpec::SineOnRandom {
-            axes,
-            tones,
-            psd_breakpoints,
-            duration_s,
-            sample_rate_hz,
-            seed,
-            low_cutoff_hz,
-            settle_s,
-            ramp,
-        } => {
-            let psd_breakpoints = psd_breakpoints
-                .into_iter()
+    map_drive(
+        spec,
+        filter_tones,
+        |psd| {
+            psd.into_iter()
                 .map(|(f, g2)| (f, g2 * transmissibility(f, period_s, zeta).0.powi(2)))
-                .collect();
-            ExcitationSpec::SineOnRandom {
-                axes,
-                tones: filter_tones(tones),
-                psd_breakpoints,
-                duration_s,
-                sample_rate_hz,
-                seed,
-                low_cutoff_hz,
-                settle_s,
-                ramp,
-            }
-        }
-        ExcitationSpec::None => ExcitationSpec::None,
-        ExcitationSpec::Measured { .. } => {
-            return Err(GapError::field(
-                field,
-                "not available for a measured drive (it would need the record filtered)",
-            ));
-        }
-    })
+                .collect()
+        },
+        field,
+        "not available for a measured drive (it would need the record filtered)",
+    )
 }
 
 fn add_cross_axis(
@@ -650,13 +616,31 @@ fn add_cross_axis(
         }
         out
     };
+    map_drive(
+        spec,
+        cross,
+        |psd| psd,
+        field,
+        "not available for a measured drive (its axes are measured)",
+    )
+}
+
+/// `spec` with its tones and random PSD breakpoints mapped; a measured drive is refused at
+/// `field` with `measured_rule`.
+fn map_drive(
+    spec: ExcitationSpec,
+    tones_map: impl Fn(Vec<Tone>) -> Vec<Tone>,
+    psd_map: impl Fn(Vec<(f64, f64)>) -> Vec<(f64, f64)>,
+    field: &str,
+    measured_rule: &str,
+) -> Result<ExcitationSpec, GapError> {
     Ok(match spec {
         ExcitationSpec::Sine {
             tones,
             settle_s,
             ramp,
         } => ExcitationSpec::Sine {
-            tones: cross(tones),
+            tones: tones_map(tones),
             settle_s,
             ramp,
         },
@@ -672,8 +656,8 @@ fn add_cross_axis(
             ramp,
         } => ExcitationSpec::SineOnRandom {
             axes,
-            tones: cross(tones),
-            psd_breakpoints,
+            tones: tones_map(tones),
+            psd_breakpoints: psd_map(psd_breakpoints),
             duration_s,
             sample_rate_hz,
             seed,
@@ -682,11 +666,6 @@ fn add_cross_axis(
             ramp,
         },
         ExcitationSpec::None => ExcitationSpec::None,
-        ExcitationSpec::Measured { .. } => {
-            return Err(GapError::field(
-                field,
-                "not available for a measured drive (its axes are measured)",
-            ));
-        }
+        ExcitationSpec::Measured { .. } => return Err(GapError::field(field, measured_rule)),
     })
 }

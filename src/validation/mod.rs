@@ -488,35 +488,9 @@ pub fn synthesis_anchor() -> Anchor {
 /// Friction calibration (eq. 4.1-4.4) recovers Table 4.2 from torque records generated with it
 /// plus 2 % multiplicative noise (deterministic ChaCha8 with a fixed seed, Box-Muller).
 pub fn friction_calibration_anchors() -> Vec<Anchor> {
-    use crate::analysis::calibration::{fit_friction, friction_samples, Fixture, TorqueRecord};
-    use rand::{Rng, SeedableRng};
+    use crate::analysis::calibration::{fit_friction, friction_samples, synthetic_torque_records};
     let truth = FrictionParams::thesis_table_5_2();
-    let fixture = Fixture {
-        polar_inertia_kg_m2: 0.02,
-        mean_radius_m: 0.02,
-    };
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(42);
-    let w = 2.0 * std::f64::consts::PI * 0.1;
-    let records: Vec<TorqueRecord> = (0..20_000)
-        .map(|i| {
-            let t = i as f64 * 1e-3;
-            let thd = 1.5 * (w * t).sin();
-            let thdd = 1.5 * w * (w * t).cos();
-            let v = thd * fixture.mean_radius_m;
-            let mu = truth.coefficient(v.abs()) * v.signum();
-            let torque =
-                fixture.polar_inertia_kg_m2 * thdd + 3.0 * fixture.mean_radius_m * 300.0 * mu;
-            let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
-            let gauss = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
-            TorqueRecord {
-                time_s: t,
-                angle_rad: -1.5 / w * (w * t).cos(),
-                angular_velocity_rad_s: thd,
-                normal_load_n: 300.0,
-                input_torque_n_m: torque * (1.0 + 0.02 * gauss),
-            }
-        })
-        .collect();
+    let (fixture, records) = synthetic_torque_records(&truth, 0.02, 42);
     let fit = friction_samples(&records, &fixture)
         .ok()
         .and_then(|s| fit_friction(&s, crate::physics::step::StepKind::Cycloidal).ok())
