@@ -2,8 +2,12 @@
 //! and a PostgreSQL one (issue 6) serve the same code paths. Every method that writes more than
 //! one row does it in one transaction; every write by a worker is fenced by the job's attempt.
 
+mod bookkeeping;
 pub mod clock;
+mod dialect;
+mod portable;
 pub mod postgres;
+mod rows;
 pub mod sqlite;
 pub mod tracks;
 
@@ -286,7 +290,7 @@ pub struct PageRequest {
 }
 
 /// A registered rail.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, sqlx::FromRow)]
 pub struct RailRecord {
     pub serial: String,
     pub seq: i64,
