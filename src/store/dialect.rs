@@ -24,8 +24,8 @@ pub(crate) trait Dialect: sqlx::Database {
     /// Serialize the publishes of curve key `$1` (the comparison and the switch are one step).
     const LOCK_CURVE_KEY: Option<&'static str>;
 
-    /// After `SELECT <job columns> FROM jobs`: `$1` after seq, `$2` status, `$3` limit,
-    /// `$4` parent, `$5` top level only.
+    /// After `SELECT <job columns> FROM jobs`: `$1` status, `$2` parent, `$3` top level only,
+    /// `$4` after seq, `$5` limit (each page's cursor and limit are its last two parameters).
     const JOBS_PAGE: &'static str;
     /// Renew lease `$1` id, `$2` attempt, until `$3 + $4`; progress `$5`..`$8` (kept when
     /// NULL); returns `cancel_requested`.

@@ -7,13 +7,16 @@
 //!
 //! A generic `QueryResult` has no `rows_affected`, so statements that must say whether they
 //! wrote return a column (`RETURNING seq`).
+//!
+//! Over 700 lines on purpose: the operations share one `impl` block so that its bound list
+//! (what `DB` must encode, decode and execute) is written once; split, it would stand twice.
 
 use super::bookkeeping::{Bookkeeping, FinishColumns};
 use super::dialect::Dialect;
 use super::job_records::{JobProgress, JobRecord, JobStatus};
 use super::rows::{
-    child_of, corrupt, cut_page, fetch_page, records, AttemptRow, CampaignContentRow, CampaignRow,
-    ChildRow, CurveRow, DbUuid, HostLeaseRow, JobRow, MeasurementRow, ParentLinkRow, TokenRow,
+    child_of, corrupt, cut_page, records, AttemptRow, CampaignContentRow, CampaignRow, ChildRow,
+    CurveRow, DbUuid, HostLeaseRow, JobRow, MeasurementRow, ParentLinkRow, TokenRow,
     CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
 };
 use super::{
@@ -23,6 +26,7 @@ use super::{
     PageRequest, PublishOutcome, RailRecord, ReleaseOutcome, StoreError, TokenRecord, TrackBlock,
 };
 use crate::config::Role;
+use sqlx::query::QueryAs;
 use sqlx::Type;
 use sqlx::{ColumnIndex, Decode, Encode, Executor, FromRow, IntoArguments, Pool, Transaction};
 use std::marker::PhantomData;
@@ -84,6 +88,28 @@ where
         Ok(())
     }
 
+    /// One page of `query`, newest first: its filters are bound, the cursor (`after_seq`) and
+    /// `limit + 1` are bound here as its last two parameters; `cursor` names an item's place
+    /// in the order (its sequence number or id), what the next page starts after.
+    async fn fetch_page<'q, R, T>(
+        pool: &Pool<DB>,
+        query: QueryAs<'q, DB, R, DB::Arguments<'q>>,
+        page: PageRequest,
+        cursor: impl Fn(&T) -> i64,
+    ) -> Result<Page<T>, StoreError>
+    where
+        R: for<'r> FromRow<'r, DB::Row> + Send + Unpin,
+        T: TryFrom<R>,
+        StoreError: From<T::Error>,
+    {
+        let rows = query
+            .bind(page.after_seq)
+            .bind(page.limit + 1)
+            .fetch_all(pool)
+            .await?;
+        Ok(cut_page(records(rows)?, page.limit, cursor))
+    }
+
     pub(crate) async fn ping(pool: &Pool<DB>) -> Result<(), StoreError> {
         sqlx::query("SELECT 1").execute(pool).await?;
         Ok(())
@@ -102,28 +128,17 @@ where
         row.map(JobRecord::try_from).transpose()
     }
 
-    pub(crate) async fn get_job(
-        pool: &Pool<DB>,
-        id: Uuid,
-    ) -> Result<Option<JobRecord>, StoreError> {
-        Self::job_in(&mut *pool.acquire().await?, id).await
-    }
-
     pub(crate) async fn list_jobs(
         pool: &Pool<DB>,
         page: PageRequest,
         filter: JobFilter,
     ) -> Result<Page<JobRecord>, StoreError> {
         let sql = format!("SELECT {JOB_COLUMNS} FROM jobs {}", DB::JOBS_PAGE);
-        let rows: Vec<JobRow> = sqlx::query_as(&sql)
-            .bind(page.after_seq)
+        let query = sqlx::query_as::<_, JobRow>(&sql)
             .bind(filter.status.map(|s| s.as_str().to_string()))
-            .bind(page.limit + 1)
             .bind(filter.parent.map(DbUuid))
-            .bind(filter.top_level)
-            .fetch_all(pool)
-            .await?;
-        fetch_page(rows, page.limit, |j: &JobRecord| j.seq)
+            .bind(filter.top_level);
+        Self::fetch_page(pool, query, page, |j: &JobRecord| j.seq).await
     }
 
     pub(crate) async fn host_leases(
@@ -502,12 +517,8 @@ where
         pool: &Pool<DB>,
         page: PageRequest,
     ) -> Result<Page<RailRecord>, StoreError> {
-        let rows: Vec<RailRecord> = sqlx::query_as(DB::RAILS_PAGE)
-            .bind(page.after_seq)
-            .bind(page.limit + 1)
-            .fetch_all(pool)
-            .await?;
-        Ok(cut_page(rows, page.limit, |r| r.seq))
+        let query = sqlx::query_as::<_, RailRecord>(DB::RAILS_PAGE);
+        Self::fetch_page(pool, query, page, |r: &RailRecord| r.seq).await
     }
 
     pub(crate) async fn measurements(
@@ -515,13 +526,8 @@ where
         serial: String,
         page: PageRequest,
     ) -> Result<Page<MeasurementRecord>, StoreError> {
-        let rows: Vec<MeasurementRow> = sqlx::query_as(DB::MEASUREMENTS_PAGE)
-            .bind(serial)
-            .bind(page.after_seq)
-            .bind(page.limit + 1)
-            .fetch_all(pool)
-            .await?;
-        fetch_page(rows, page.limit, |m: &MeasurementRecord| m.seq)
+        let query = sqlx::query_as::<_, MeasurementRow>(DB::MEASUREMENTS_PAGE).bind(serial);
+        Self::fetch_page(pool, query, page, |m: &MeasurementRecord| m.seq).await
     }
 
     pub(crate) async fn latest_measurement(
@@ -539,7 +545,7 @@ where
     }
 
     /// Curve version `id` read on `conn`.
-    async fn curve_in(
+    pub(crate) async fn curve_in(
         conn: &mut DB::Connection,
         id: i64,
     ) -> Result<Option<CurveRecord>, StoreError> {
@@ -551,7 +557,7 @@ where
     }
 
     /// The published version of `key` read on `conn`.
-    async fn published_in(
+    pub(crate) async fn published_in(
         conn: &mut DB::Connection,
         key: String,
     ) -> Result<Option<CurveRecord>, StoreError> {
@@ -563,33 +569,14 @@ where
         row.map(CurveRecord::try_from).transpose()
     }
 
-    pub(crate) async fn get_curve(
-        pool: &Pool<DB>,
-        id: i64,
-    ) -> Result<Option<CurveRecord>, StoreError> {
-        Self::curve_in(&mut *pool.acquire().await?, id).await
-    }
-
-    pub(crate) async fn published_curve(
-        pool: &Pool<DB>,
-        key: String,
-    ) -> Result<Option<CurveRecord>, StoreError> {
-        Self::published_in(&mut *pool.acquire().await?, key).await
-    }
-
     pub(crate) async fn list_curves(
         pool: &Pool<DB>,
         page: PageRequest,
         filter: CurveFilter,
     ) -> Result<Page<CurveRecord>, StoreError> {
         let sql = format!("{CURVE_SELECT} {}", DB::CURVES_PAGE);
-        let rows: Vec<CurveRow> = sqlx::query_as(&sql)
-            .bind(filter.key)
-            .bind(page.after_seq)
-            .bind(page.limit + 1)
-            .fetch_all(pool)
-            .await?;
-        fetch_page(rows, page.limit, |c: &CurveRecord| c.id)
+        let query = sqlx::query_as::<_, CurveRow>(&sql).bind(filter.key);
+        Self::fetch_page(pool, query, page, |c: &CurveRecord| c.id).await
     }
 
     pub(crate) async fn publish_curve(
@@ -693,12 +680,8 @@ where
             "SELECT {CAMPAIGN_SUMMARY} FROM campaigns {}",
             DB::CAMPAIGNS_PAGE
         );
-        let rows: Vec<CampaignRow> = sqlx::query_as(&sql)
-            .bind(page.after_seq)
-            .bind(page.limit + 1)
-            .fetch_all(pool)
-            .await?;
-        fetch_page(rows, page.limit, |c: &CampaignSummary| c.seq)
+        let query = sqlx::query_as::<_, CampaignRow>(&sql);
+        Self::fetch_page(pool, query, page, |c: &CampaignSummary| c.seq).await
     }
 
     pub(crate) async fn create_token(
@@ -756,268 +739,3 @@ where
         Ok(revoked.is_some())
     }
 }
-
-/// The [`Store`](super::Store) methods whose bodies are the [`Portable`] operations, expanded
-/// inside each engine's `impl Store` (`portable_store_methods!(Portable<Sqlite>);`, on a type
-/// with a `pool` field). The trait's method order is kept in the trait; an impl may list its
-/// methods in any order.
-macro_rules! portable_store_methods {
-    ($shared:ty) => {
-        fn ping(&self) -> $crate::store::StoreFuture<'_, ()> {
-            Box::pin(<$shared>::ping(&self.pool))
-        }
-
-        fn get_job(
-            &self,
-            id: ::uuid::Uuid,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::job_records::JobRecord>> {
-            Box::pin(<$shared>::get_job(&self.pool, id))
-        }
-
-        fn list_jobs(
-            &self,
-            page: $crate::store::PageRequest,
-            filter: $crate::store::JobFilter,
-        ) -> $crate::store::StoreFuture<
-            '_,
-            $crate::store::Page<$crate::store::job_records::JobRecord>,
-        > {
-            Box::pin(<$shared>::list_jobs(&self.pool, page, filter))
-        }
-
-        fn host_leases(
-            &self,
-            host: &str,
-        ) -> $crate::store::StoreFuture<'_, Vec<$crate::store::HostLease>> {
-            Box::pin(<$shared>::host_leases(&self.pool, host.to_string()))
-        }
-
-        fn release_job(
-            &self,
-            id: ::uuid::Uuid,
-            attempt: i64,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::ReleaseOutcome> {
-            Box::pin(<$shared>::release_job(&self.pool, id, attempt, now_ms))
-        }
-
-        fn heartbeat(
-            &self,
-            id: ::uuid::Uuid,
-            attempt: i64,
-            progress: Option<$crate::store::job_records::JobProgress>,
-            now_ms: i64,
-            lease_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::Heartbeat> {
-            Box::pin(<$shared>::heartbeat(
-                &self.pool, id, attempt, progress, now_ms, lease_ms,
-            ))
-        }
-
-        fn finish_job(
-            &self,
-            id: ::uuid::Uuid,
-            attempt: i64,
-            finish: $crate::store::Finish,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, bool> {
-            Box::pin(<$shared>::finish_job(
-                &self.pool, id, attempt, finish, now_ms,
-            ))
-        }
-
-        fn fan_out(
-            &self,
-            parent: ::uuid::Uuid,
-            attempt: i64,
-            fan_out: $crate::store::FanOut,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::FanOutResult> {
-            Box::pin(<$shared>::fan_out(
-                &self.pool, parent, attempt, fan_out, now_ms,
-            ))
-        }
-
-        fn children(
-            &self,
-            parent: ::uuid::Uuid,
-        ) -> $crate::store::StoreFuture<'_, Vec<$crate::store::ChildRecord>> {
-            Box::pin(<$shared>::children(&self.pool, parent))
-        }
-
-        fn attempts(
-            &self,
-            id: ::uuid::Uuid,
-        ) -> $crate::store::StoreFuture<'_, Vec<$crate::store::AttemptRecord>> {
-            Box::pin(<$shared>::attempts(&self.pool, id))
-        }
-
-        fn request_cancel(
-            &self,
-            id: ::uuid::Uuid,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::job_records::JobRecord>> {
-            Box::pin(<$shared>::request_cancel(&self.pool, id, now_ms))
-        }
-
-        fn job_counts(
-            &self,
-        ) -> $crate::store::StoreFuture<'_, Vec<($crate::store::job_records::JobStatus, i64)>> {
-            Box::pin(<$shared>::job_counts(&self.pool))
-        }
-
-        fn track_blocks(
-            &self,
-            id: ::uuid::Uuid,
-        ) -> $crate::store::StoreFuture<'_, Vec<$crate::store::TrackBlock>> {
-            Box::pin(<$shared>::track_blocks(&self.pool, id))
-        }
-
-        fn plot_names(&self, id: ::uuid::Uuid) -> $crate::store::StoreFuture<'_, Vec<String>> {
-            Box::pin(<$shared>::plot_names(&self.pool, id))
-        }
-
-        fn plot(
-            &self,
-            id: ::uuid::Uuid,
-            name: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<String>> {
-            Box::pin(<$shared>::plot(&self.pool, id, name.to_string()))
-        }
-
-        fn active_sweep(
-            &self,
-            curve_key: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::job_records::JobRecord>> {
-            Box::pin(<$shared>::active_sweep(&self.pool, curve_key.to_string()))
-        }
-
-        fn add_measurement(
-            &self,
-            m: $crate::store::NewMeasurement,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::MeasurementRecord> {
-            Box::pin(<$shared>::add_measurement(&self.pool, m))
-        }
-
-        fn get_rail(
-            &self,
-            serial: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::RailRecord>> {
-            Box::pin(<$shared>::get_rail(&self.pool, serial.to_string()))
-        }
-
-        fn list_rails(
-            &self,
-            page: $crate::store::PageRequest,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::Page<$crate::store::RailRecord>> {
-            Box::pin(<$shared>::list_rails(&self.pool, page))
-        }
-
-        fn measurements(
-            &self,
-            serial: &str,
-            page: $crate::store::PageRequest,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::Page<$crate::store::MeasurementRecord>> {
-            Box::pin(<$shared>::measurements(
-                &self.pool,
-                serial.to_string(),
-                page,
-            ))
-        }
-
-        fn latest_measurement(
-            &self,
-            serial: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::MeasurementRecord>> {
-            Box::pin(<$shared>::latest_measurement(
-                &self.pool,
-                serial.to_string(),
-            ))
-        }
-
-        fn get_curve(
-            &self,
-            id: i64,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::CurveRecord>> {
-            Box::pin(<$shared>::get_curve(&self.pool, id))
-        }
-
-        fn published_curve(
-            &self,
-            key: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::CurveRecord>> {
-            Box::pin(<$shared>::published_curve(&self.pool, key.to_string()))
-        }
-
-        fn list_curves(
-            &self,
-            page: $crate::store::PageRequest,
-            filter: $crate::store::CurveFilter,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::Page<$crate::store::CurveRecord>> {
-            Box::pin(<$shared>::list_curves(&self.pool, page, filter))
-        }
-
-        fn publish_curve(
-            &self,
-            id: i64,
-            published_by: &str,
-            force: bool,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::PublishOutcome> {
-            let by = published_by.to_string();
-            Box::pin(<$shared>::publish_curve(&self.pool, id, by, force, now_ms))
-        }
-
-        fn insert_campaign(
-            &self,
-            campaign: $crate::store::NewCampaign,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::CampaignInsert> {
-            Box::pin(<$shared>::insert_campaign(&self.pool, campaign))
-        }
-
-        fn get_campaign(
-            &self,
-            id: ::uuid::Uuid,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::CampaignRecord>> {
-            Box::pin(<$shared>::get_campaign(&self.pool, id))
-        }
-
-        fn list_campaigns(
-            &self,
-            page: $crate::store::PageRequest,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::Page<$crate::store::CampaignSummary>> {
-            Box::pin(<$shared>::list_campaigns(&self.pool, page))
-        }
-
-        fn create_token(
-            &self,
-            name: &str,
-            role: $crate::config::Role,
-            token_sha256: &str,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, $crate::store::TokenRecord> {
-            let (name, sha) = (name.to_string(), token_sha256.to_string());
-            Box::pin(<$shared>::create_token(&self.pool, name, role, sha, now_ms))
-        }
-
-        fn find_token(
-            &self,
-            token_sha256: &str,
-        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::TokenRecord>> {
-            Box::pin(<$shared>::find_token(&self.pool, token_sha256.to_string()))
-        }
-
-        fn list_tokens(&self) -> $crate::store::StoreFuture<'_, Vec<$crate::store::TokenRecord>> {
-            Box::pin(<$shared>::list_tokens(&self.pool))
-        }
-
-        fn revoke_token(
-            &self,
-            id: ::uuid::Uuid,
-            now_ms: i64,
-        ) -> $crate::store::StoreFuture<'_, bool> {
-            Box::pin(<$shared>::revoke_token(&self.pool, id, now_ms))
-        }
-    };
-}
-pub(crate) use portable_store_methods;

@@ -11,9 +11,10 @@
 //! job and its parent locks the parent row first ([`Dialect::LOCK_PARENT`]), then the child.
 
 use super::bookkeeping::Bookkeeping;
+use super::delegate::portable_store_methods;
 use super::dialect::Dialect;
 use super::job_records::JobRecord;
-use super::portable::{portable_store_methods, Portable};
+use super::portable::Portable;
 use super::rows::{corrupt, JobRow, LostRow, JOB_COLUMNS};
 use super::{NewJob, Store, StoreError, StoreFuture, Submitted, WorkerHost};
 use sqlx::postgres::{PgConnectOptions, PgPool, PgPoolOptions};
@@ -42,9 +43,9 @@ impl Dialect for Postgres {
         Some("SELECT 1 FROM jobs WHERE id = (SELECT parent_id FROM jobs WHERE id = $1) FOR UPDATE");
     const LOCK_CURVE_KEY: Option<&'static str> = Some("SELECT pg_advisory_xact_lock(hashtext($1))");
 
-    const JOBS_PAGE: &'static str = "WHERE ($1::BIGINT IS NULL OR seq < $1) \
-        AND ($2::TEXT IS NULL OR status = $2) AND ($4::UUID IS NULL OR parent_id = $4) \
-        AND (NOT $5 OR parent_id IS NULL) ORDER BY seq DESC LIMIT $3";
+    const JOBS_PAGE: &'static str = "WHERE ($4::BIGINT IS NULL OR seq < $4) \
+        AND ($1::TEXT IS NULL OR status = $1) AND ($2::UUID IS NULL OR parent_id = $2) \
+        AND (NOT $3 OR parent_id IS NULL) ORDER BY seq DESC LIMIT $5";
     const HEARTBEAT: &'static str = "UPDATE jobs SET lease_expires_ms = $3 + $4, \
         progress_simulated_s = COALESCE($5, progress_simulated_s), \
         progress_end_s = COALESCE($6, progress_end_s), \
@@ -195,8 +196,7 @@ impl Store for PgStore {
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
-        let worker = worker.to_string();
-        let host = host.cloned();
+        let (worker, host) = (worker.to_string(), host.cloned());
         Box::pin(async move {
             let mut tx = self.pool.begin().await?;
             // The row lock is held to commit; a concurrent claimer skips the locked row and

@@ -102,20 +102,7 @@ impl Encode<'_, Postgres> for DbUuid {
     }
 }
 
-/// Cut a fetched `limit + 1` list of rows into a page of records; `cursor` names an item's
-/// place in the order (its sequence number or id), what the next page starts after.
-pub(crate) fn fetch_page<R, T>(
-    rows: Vec<R>,
-    limit: i64,
-    cursor: impl Fn(&T) -> i64,
-) -> Result<Page<T>, StoreError>
-where
-    T: TryFrom<R, Error = StoreError>,
-{
-    Ok(cut_page(records(rows)?, limit, cursor))
-}
-
-/// Cut a fetched `limit + 1` list into a page (see [`fetch_page`]).
+/// Cut a fetched `limit + 1` list into a page; `cursor` gives the next page's start.
 pub(crate) fn cut_page<T>(mut items: Vec<T>, limit: i64, cursor: impl Fn(&T) -> i64) -> Page<T> {
     let limit = limit.max(0) as usize;
     let next_cursor = if items.len() > limit {
@@ -127,12 +114,15 @@ pub(crate) fn cut_page<T>(mut items: Vec<T>, limit: i64, cursor: impl Fn(&T) -> 
     Page { items, next_cursor }
 }
 
-/// Convert rows one by one (a list without pages).
+/// Convert rows one by one into records.
 pub(crate) fn records<R, T>(rows: Vec<R>) -> Result<Vec<T>, StoreError>
 where
-    T: TryFrom<R, Error = StoreError>,
+    T: TryFrom<R>,
+    StoreError: From<T::Error>,
 {
-    rows.into_iter().map(T::try_from).collect()
+    rows.into_iter()
+        .map(|row| T::try_from(row).map_err(StoreError::from))
+        .collect()
 }
 
 /// The columns of [`JobRow`].
@@ -507,10 +497,8 @@ pub(crate) struct CampaignRow {
     created_ms: i64,
     content_sha256: String,
     content_bytes: i64,
-    tests: i64,
-    specimens: i64,
-    increments: i64,
-    accelerometer_records: i64,
+    #[sqlx(flatten)]
+    counts: CampaignCounts,
 }
 
 impl TryFrom<CampaignRow> for CampaignSummary {
@@ -525,12 +513,7 @@ impl TryFrom<CampaignRow> for CampaignSummary {
             created_ms: row.created_ms,
             content_sha256: row.content_sha256,
             content_bytes: row.content_bytes,
-            counts: CampaignCounts {
-                tests: row.tests,
-                specimens: row.specimens,
-                increments: row.increments,
-                accelerometer_records: row.accelerometer_records,
-            },
+            counts: row.counts,
         })
     }
 }

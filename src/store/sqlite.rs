@@ -5,9 +5,10 @@
 //! the dialect ([`Dialect`]), submission, claims and the lease sweeps.
 
 use super::bookkeeping::Bookkeeping;
+use super::delegate::portable_store_methods;
 use super::dialect::Dialect;
 use super::job_records::JobRecord;
-use super::portable::{portable_store_methods, Portable};
+use super::portable::Portable;
 use super::rows::{corrupt, JobRow, LostRow, StoredUuid, JOB_COLUMNS};
 use super::{NewJob, Store, StoreError, StoreFuture, Submitted, WorkerHost};
 use sqlx::sqlite::{
@@ -38,9 +39,9 @@ impl Dialect for Sqlite {
     const LOCK_PARENT: Option<&'static str> = None;
     const LOCK_CURVE_KEY: Option<&'static str> = None;
 
-    const JOBS_PAGE: &'static str = "WHERE (?1 IS NULL OR seq < ?1) \
-        AND (?2 IS NULL OR status = ?2) AND (?4 IS NULL OR parent_id = ?4) \
-        AND (?5 = 0 OR parent_id IS NULL) ORDER BY seq DESC LIMIT ?3";
+    const JOBS_PAGE: &'static str = "WHERE (?4 IS NULL OR seq < ?4) \
+        AND (?1 IS NULL OR status = ?1) AND (?2 IS NULL OR parent_id = ?2) \
+        AND (?3 = 0 OR parent_id IS NULL) ORDER BY seq DESC LIMIT ?5";
     const HEARTBEAT: &'static str = "UPDATE jobs SET lease_expires_ms = ?3 + ?4, \
         progress_simulated_s = COALESCE(?5, progress_simulated_s), \
         progress_end_s = COALESCE(?6, progress_end_s), \
@@ -104,7 +105,7 @@ impl Store for SqliteStore {
                     let stored_sha: Option<String> = row.try_get("request_sha256")?;
                     tx.rollback().await?;
                     if stored_sha.as_deref() == Some(sha.as_str()) {
-                        let record = Shared::get_job(&self.pool, id)
+                        let record = Shared::job_in(&mut *self.pool.acquire().await?, id)
                             .await?
                             .ok_or_else(|| corrupt("idempotent job vanished"))?;
                         return Ok(Submitted::Replayed(record));
@@ -147,8 +148,7 @@ impl Store for SqliteStore {
         now_ms: i64,
         lease_ms: i64,
     ) -> StoreFuture<'_, Option<JobRecord>> {
-        let worker = worker.to_string();
-        let host = host.cloned();
+        let (worker, host) = (worker.to_string(), host.cloned());
         Box::pin(async move {
             // One statement: the sub-select and the update run under the same write lock, so
             // two workers can never take the same job. A parent queued for its assembly keeps
