@@ -536,3 +536,102 @@ impl TryFrom<CampaignContentRow> for CampaignRecord {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A queued top-level job row as both engines store it.
+    fn job_row() -> JobRow {
+        JobRow {
+            seq: 7,
+            id: StoredUuid(Ok(Uuid::from_u128(7))),
+            kind: "sweep".into(),
+            status: "queued".into(),
+            params: r#"{"points":3}"#.into(),
+            seed: -1,
+            code_version: "test".into(),
+            submitted_by: "planner".into(),
+            attempt: 0,
+            cancel_requested: false,
+            created_ms: 1_000,
+            started_ms: None,
+            finished_ms: None,
+            progress_simulated_s: None,
+            progress_end_s: None,
+            progress_fraction: None,
+            progress_eta_s: None,
+            result: None,
+            error: None,
+            track_samples: 0,
+            curve_key: None,
+            lease_owner: None,
+            parent_id: None,
+            child_index: None,
+            children_total: 0,
+            children_succeeded: 0,
+            children_failed: 0,
+            children_cancelled: 0,
+        }
+    }
+
+    fn corrupt_message(result: Result<JobRecord, StoreError>) -> String {
+        match result {
+            Err(StoreError::Corrupt(what)) => what,
+            other => panic!("expected a corrupt row, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_job_row_reads_back_as_stored() {
+        let mut row = job_row();
+        row.parent_id = Some(StoredUuid(Ok(Uuid::from_u128(1))));
+        row.child_index = Some(2);
+        let job = JobRecord::try_from(row).unwrap();
+        // The seed is stored as its i64 bit pattern: -1 is u64::MAX.
+        assert_eq!(job.seed, u64::MAX);
+        assert_eq!(job.kind, JobKind::Sweep);
+        assert_eq!(job.params, serde_json::json!({ "points": 3 }));
+        assert_eq!(
+            job.parent,
+            Some(ChildOf {
+                parent_id: Uuid::from_u128(1),
+                index: 2
+            })
+        );
+        // No children and no complete progress triple: neither is reported.
+        assert_eq!(job.children, None);
+        assert_eq!(job.progress, None);
+    }
+
+    #[test]
+    fn a_bad_stored_value_is_a_corrupt_row() {
+        let mut row = job_row();
+        row.id = StoredUuid(Err("not-a-uuid".into()));
+        assert_eq!(corrupt_message(row.try_into()), "bad uuid `not-a-uuid`");
+        let mut row = job_row();
+        row.status = "exploded".into();
+        assert_eq!(corrupt_message(row.try_into()), "job status `exploded`");
+        let mut row = job_row();
+        row.kind = "teleport".into();
+        assert_eq!(corrupt_message(row.try_into()), "job kind `teleport`");
+        let mut row = job_row();
+        row.result = Some("{".into());
+        assert!(corrupt_message(row.try_into()).starts_with("job result: "));
+    }
+
+    #[test]
+    fn a_page_ends_where_the_fetch_found_no_extra_item() {
+        // `limit + 1` fetched: the page keeps `limit` and the cursor is the last kept item.
+        let page = cut_page(vec![9, 8, 7, 6], 3, |&seq| seq);
+        assert_eq!(page.items, vec![9, 8, 7]);
+        assert_eq!(page.next_cursor.as_deref(), Some("7"));
+        // Exactly `limit` (or fewer): the last page.
+        let page = cut_page(vec![9, 8, 7], 3, |&seq| seq);
+        assert_eq!(page.items, vec![9, 8, 7]);
+        assert_eq!(page.next_cursor, None);
+        let page = cut_page(vec![9], -1, |&seq| seq);
+        assert!(page.items.is_empty());
+        assert_eq!(page.next_cursor, None);
+    }
+}
