@@ -2,14 +2,21 @@
 //! and a PostgreSQL one (issue 6) serve the same code paths. Every method that writes more than
 //! one row does it in one transaction; every write by a worker is fenced by the job's attempt.
 
+mod bookkeeping;
+mod campaigns;
 pub mod clock;
+mod delegate;
+mod dialect;
+mod portable;
 pub mod postgres;
+mod rows;
 pub mod sqlite;
 pub mod tracks;
 
 use crate::config::Role;
 pub mod job_records;
 use crate::physics::track::TrackSample;
+pub use campaigns::{CampaignCounts, CampaignInsert, CampaignRecord, CampaignSummary, NewCampaign};
 pub use job_records::{ChildCounts, ChildOf};
 use job_records::{JobKind, JobProgress, JobRecord, JobStatus};
 use std::future::Future;
@@ -36,6 +43,13 @@ pub enum StoreError {
     /// The database URL names an engine this build does not support.
     #[error("unsupported database URL `{0}` (expected sqlite://... or postgres://...)")]
     UnsupportedUrl(String),
+}
+
+/// A record read as it is stored (no conversion that could fail).
+impl From<std::convert::Infallible> for StoreError {
+    fn from(never: std::convert::Infallible) -> Self {
+        match never {}
+    }
 }
 
 /// A job to insert.
@@ -286,7 +300,7 @@ pub struct PageRequest {
 }
 
 /// A registered rail.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, sqlx::FromRow)]
 pub struct RailRecord {
     pub serial: String,
     pub seq: i64,
@@ -427,66 +441,6 @@ pub enum PublishOutcome {
 pub struct CurveFilter {
     /// Only this key.
     pub key: Option<String>,
-}
-
-/// How much a campaign holds (what a list shows without reading the content).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct CampaignCounts {
-    pub tests: i64,
-    /// Specimens (repeats) over all tests.
-    pub specimens: i64,
-    /// Increments over all specimens.
-    pub increments: i64,
-    /// Accelerometer records over all specimens.
-    pub accelerometer_records: i64,
-}
-
-/// A validated test campaign to store (issue 14): its canonical JSON text (samples inline),
-/// what `GET /v1/campaigns/{id}` answers with.
-#[derive(Debug, Clone, PartialEq)]
-pub struct NewCampaign {
-    pub id: Uuid,
-    /// The campaign's `name`.
-    pub name: String,
-    /// Token name of the uploader.
-    pub created_by: String,
-    pub created_ms: i64,
-    /// Canonical JSON (`gap::Campaign` as serde_json writes it).
-    pub content: String,
-    /// SHA-256 of `content`, lower-case hex. The same content is stored once.
-    pub content_sha256: String,
-    pub counts: CampaignCounts,
-}
-
-/// A stored campaign without its content.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CampaignSummary {
-    pub id: Uuid,
-    /// Upload order (list cursor).
-    pub seq: i64,
-    pub name: String,
-    pub created_by: String,
-    pub created_ms: i64,
-    pub content_sha256: String,
-    /// Length of the canonical JSON, bytes.
-    pub content_bytes: i64,
-    pub counts: CampaignCounts,
-}
-
-/// A stored campaign with its canonical JSON text.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CampaignRecord {
-    pub summary: CampaignSummary,
-    pub content: String,
-}
-
-/// What [`Store::insert_campaign`] did.
-#[derive(Debug, Clone, PartialEq)]
-pub enum CampaignInsert {
-    /// A new record.
-    Created(CampaignSummary),
-    /// A campaign with the same content (SHA-256) was already stored: that one, unchanged.
-    Existing(CampaignSummary),
 }
 
 /// An API token as stored (the secret itself is only kept as its SHA-256).

@@ -14,9 +14,10 @@ const F64_COLUMNS: usize = 16;
 const BYTES_PER_SAMPLE: usize = F64_COLUMNS * 8 + 2 * 4;
 
 /// One encoded block as stored.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, sqlx::FromRow)]
 pub struct TrackBlock {
     /// Block index within the job, from 0.
+    #[sqlx(rename = "block")]
     pub index: i64,
     /// Samples in the block.
     pub samples: i64,
