@@ -33,6 +33,10 @@ pub enum RunError {
     /// Cancelled through [`RunControl::cancel`].
     #[error("cancelled")]
     Cancelled,
+    /// Stopped with a checkpoint ([`RunControl::request_checkpoint`]): handing its bytes to
+    /// the same computation again resumes it (`models::case::run_case_from`).
+    #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
+    Checkpointed(Box<crate::models::checkpoint::Checkpoint>),
 }
 
 use crate::models::case::{load_case, run_case};
@@ -1077,13 +1081,15 @@ impl SweepPlan {
 /// Point `index` of a planned sweep: the base case with the design dimensions moved by the
 /// point's material-condition offset, run to the end; the rail's wear rate there. The
 /// sequential [`sweep_job`] and a fanned-out sweep's `sweep_point` child jobs both call this, so a
-/// point depends only on the sweep's params and seed.
+/// point depends only on the sweep's params and seed. `resume`: a checkpoint of this point's
+/// run (`RunError::Checkpointed`), as for a simulate job.
 pub fn sweep_point(
     plan: &SweepPlan,
     index: usize,
     replica: usize,
     configs_dir: &Path,
     control: &RunControl,
+    resume: Option<&[u8]>,
 ) -> Result<SweepPoint, RunError> {
     let offset_mm = *plan
         .offsets_mm
@@ -1103,7 +1109,7 @@ pub fn sweep_point(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = run_case(&case, configs_dir, control)?;
+    let (report, _) = crate::models::case::run_case_from(&case, configs_dir, control, resume)?;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()
@@ -1181,17 +1187,18 @@ pub fn run_sweep(
             }
             let done = plan.run_index(i, j) as f64;
             let outer = control.progress.clone();
-            let sub = RunControl {
-                cancel: control.cancel.clone(),
-                progress: Arc::new(move |pr: Progress| {
+            // A sequential sweep keeps no checkpoint: a request stops it as cancelled.
+            let sub = RunControl::new(
+                control.cancel.clone(),
+                Arc::new(move |pr: Progress| {
                     outer(Progress {
                         simulated_time_s: pr.simulated_time_s,
                         end_time_s: pr.end_time_s,
                         fraction: (done + pr.fraction) / total,
                     })
                 }),
-            };
-            runs.push(sweep_point(plan, i, j, configs_dir, &sub)?);
+            );
+            runs.push(sweep_point(plan, i, j, configs_dir, &sub, None)?);
         }
     }
     let outcome = plan.outcome(runs)?;

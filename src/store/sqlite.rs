@@ -10,6 +10,7 @@ use super::{
     NewCurve, NewJob, NewMeasurement, Page, PageRequest, Publication, PublishOutcome, RailRecord,
     ReleaseOutcome, Store, StoreError, StoreFuture, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
+use super::{JobCheckpoint, NewCheckpoint};
 use crate::config::Role;
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteConnection, SqliteJournalMode, SqlitePool, SqlitePoolOptions,
@@ -868,7 +869,7 @@ impl Store for SqliteStore {
     fn attempts(&self, id: Uuid) -> StoreFuture<'_, Vec<AttemptRecord>> {
         Box::pin(async move {
             let rows = sqlx::query(
-                "SELECT attempt, worker, started_ms, ended_ms, outcome FROM job_attempts \
+                "SELECT attempt, worker, started_ms, ended_ms, outcome, checkpoint_s FROM job_attempts \
                  WHERE job_id = ?1 ORDER BY attempt",
             )
             .bind(id.to_string())
@@ -884,6 +885,7 @@ impl Store for SqliteStore {
                         ended_ms: row.try_get("ended_ms")?,
                         outcome: AttemptOutcome::parse(&outcome)
                             .ok_or_else(|| corrupt(format!("attempt outcome `{outcome}`")))?,
+                        checkpoint_s: row.try_get("checkpoint_s")?,
                     })
                 })
                 .collect()
@@ -1417,6 +1419,83 @@ impl Store for SqliteStore {
             .execute(&self.pool)
             .await?;
             Ok(done.rows_affected() == 1)
+        })
+    }
+
+    fn save_checkpoint(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        checkpoint: NewCheckpoint,
+        now_ms: i64,
+    ) -> StoreFuture<'_, bool> {
+        Box::pin(async move {
+            let mut tx = self.pool.begin_with(BEGIN_WRITE).await?;
+            // Fenced by the attempt: only the lease holder writes; progress moves to the
+            // checkpoint's time.
+            let owned = sqlx::query(
+                "UPDATE jobs SET progress_simulated_s = ?3, progress_end_s = ?4, \
+                 progress_fraction = CASE WHEN ?4 > 0 THEN ?3 / ?4 ELSE progress_fraction END \
+                 WHERE id = ?1 AND attempt = ?2 AND status = 'running'",
+            )
+            .bind(id.to_string())
+            .bind(attempt)
+            .bind(checkpoint.simulated_s)
+            .bind(checkpoint.end_s)
+            .execute(&mut *tx)
+            .await?
+            .rows_affected()
+                == 1;
+            if !owned {
+                return Ok(false);
+            }
+            sqlx::query(
+                "INSERT INTO job_checkpoints (job_id, attempt, simulated_s, end_s, created_ms, data) \
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6) \
+                 ON CONFLICT (job_id) DO UPDATE SET attempt = excluded.attempt, \
+                 simulated_s = excluded.simulated_s, end_s = excluded.end_s, \
+                 created_ms = excluded.created_ms, data = excluded.data",
+            )
+            .bind(id.to_string())
+            .bind(attempt)
+            .bind(checkpoint.simulated_s)
+            .bind(checkpoint.end_s)
+            .bind(now_ms)
+            .bind(checkpoint.data)
+            .execute(&mut *tx)
+            .await?;
+            sqlx::query(
+                "UPDATE job_attempts SET checkpoint_s = ?3 WHERE job_id = ?1 AND attempt = ?2",
+            )
+            .bind(id.to_string())
+            .bind(attempt)
+            .bind(checkpoint.simulated_s)
+            .execute(&mut *tx)
+            .await?;
+            tx.commit().await?;
+            Ok(true)
+        })
+    }
+
+    fn load_checkpoint(&self, id: Uuid) -> StoreFuture<'_, Option<JobCheckpoint>> {
+        Box::pin(async move {
+            let row = sqlx::query(
+                "SELECT attempt, simulated_s, end_s, created_ms, data FROM job_checkpoints \
+                 WHERE job_id = ?1",
+            )
+            .bind(id.to_string())
+            .fetch_optional(&self.pool)
+            .await?;
+            row.map(|row| {
+                Ok(JobCheckpoint {
+                    attempt: row.try_get("attempt")?,
+                    simulated_s: row.try_get("simulated_s")?,
+                    end_s: row.try_get("end_s")?,
+                    created_ms: row.try_get("created_ms")?,
+                    data: row.try_get("data")?,
+                })
+            })
+            .transpose()
         })
     }
 }

@@ -96,7 +96,7 @@ impl WearTotals {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 struct Point {
     time_s: f64,
     rate_m3_s: f64,
@@ -106,8 +106,8 @@ struct Point {
     in_contact: bool,
 }
 
-/// Integrates one contact track sample by sample.
-#[derive(Debug, Clone)]
+/// Integrates one contact track sample by sample (serializable: part of a run's checkpoint).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct WearAccumulator {
     law: WearLaw,
     quadrature: Quadrature,
