@@ -152,7 +152,12 @@ impl Jobs {
         let stop = control.clone();
         let runner = Arc::clone(&self.runner);
         let mut computation = tokio::task::spawn_blocking(move || match work {
-            Work::Run => runner.run_from(&kind, &params, &control, resume.as_ref().map(|c| c.data.as_slice())),
+            Work::Run => runner.run_from(
+                &kind,
+                &params,
+                &control,
+                resume.as_ref().map(|c| c.data.as_slice()),
+            ),
             Work::Assemble(Ok(summaries)) => runner.assemble(&kind, &params, &summaries),
             Work::Assemble(Err(e)) | Work::Refused(e) => Err(e),
         });

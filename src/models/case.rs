@@ -1,8 +1,8 @@
 //! From a case file to a finished run: resolves the excitation (profiles by name), builds the
 //! model, maps the run settings, runs it and writes the summary, tracks and plots.
 
-use super::rattle_box;
 use super::checkpoint::{self, RunIdentity};
+use super::rattle_box;
 use super::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
 use super::specs::{CaseSpec, ModelSpecRef, SpecError};
 use crate::analysis::spectra::welch_psd;
@@ -195,10 +195,12 @@ pub fn run_case_from(
             None
         }
     });
+    let mut resumed_from_s = resume.as_ref().map(|cp| cp.time_s());
     let run = match run_model_from(&model, &options, control, resume) {
         Err(ModelRunError::Sim(SimError::BadCheckpoint(reason))) => {
             // Refused before the first step: nothing of it was used.
             tracing::warn!(case = %case.name, %reason, "checkpoint not used: the run restarts from t = 0");
+            resumed_from_s = None;
             run_model_from(&model, &options, control, None)
         }
         other => other,
@@ -216,6 +218,7 @@ pub fn run_case_from(
         }
         Err(e) => return Err(e.into()),
     };
+    report.resumed_from_s = resumed_from_s;
     // The track samples move to the outcome (the report's `tracks` is left empty): a long run
     // holds them once (a 60 s launcher run records ~0.7 million).
     let tracks = std::mem::take(&mut report.tracks);

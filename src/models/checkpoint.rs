@@ -90,11 +90,7 @@ impl RunIdentity {
         hash.update(model.end_time_s.to_le_bytes());
         Self {
             code_version: CODE_VERSION.to_string(),
-            case_sha256: hash
-                .finalize()
-                .iter()
-                .map(|b| format!("{b:02x}"))
-                .collect(),
+            case_sha256: hash.finalize().iter().map(|b| format!("{b:02x}")).collect(),
         }
     }
 }

@@ -7,7 +7,9 @@ use crate::physics::contact::TrackState;
 use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
 use crate::physics::partition::{independent_parts, Part};
-use crate::physics::simulate::{simulate_from, DivergenceLimits, EngineCheckpoint, SimError, StepView};
+use crate::physics::simulate::{
+    simulate_from, DivergenceLimits, EngineCheckpoint, SimError, StepView,
+};
 use crate::physics::system::MultibodySystem;
 use crate::physics::track::TrackSample;
 use crate::pipeline::RunControl;
@@ -126,6 +128,10 @@ pub struct RunReport {
     pub wear_history: Vec<(f64, Vec<f64>)>,
     /// The run's energy account (settle and excitation).
     pub energy: Option<EnergyAudit>,
+    /// Simulated time of the checkpoint the run resumed from, s (None: it ran from t = 0).
+    /// Set by `models::case::run_case_from`; not part of the results.
+    #[serde(default)]
+    pub resumed_from_s: Option<f64>,
 }
 
 /// Why a run failed.
@@ -521,6 +527,7 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
         base_acceleration,
         wear_history,
         energy,
+        resumed_from_s: None,
     }
 }
 
@@ -756,6 +763,7 @@ fn run_whole(
         base_acceleration,
         wear_history,
         energy: stats.energy,
+        resumed_from_s: None,
     })
 }
 

@@ -13,8 +13,8 @@ use super::integrator::{
     Integrator, IntegratorError, IntegratorSettings, IntegratorState, IntegratorStats,
     InteriorStage,
 };
-use serde::{Deserialize, Serialize};
 use super::system::{MultibodySystem, Workspace};
+use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Limits beyond which a run is declared diverged.
