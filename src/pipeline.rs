@@ -1081,9 +1081,20 @@ impl SweepPlan {
 /// Point `index` of a planned sweep: the base case with the design dimensions moved by the
 /// point's material-condition offset, run to the end; the rail's wear rate there. The
 /// sequential [`sweep_job`] and a fanned-out sweep's `sweep_point` child jobs both call this, so a
-/// point depends only on the sweep's params and seed. `resume`: a checkpoint of this point's
-/// run (`RunError::Checkpointed`), as for a simulate job.
+/// point depends only on the sweep's params and seed.
 pub fn sweep_point(
+    plan: &SweepPlan,
+    index: usize,
+    replica: usize,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<SweepPoint, RunError> {
+    sweep_point_from(plan, index, replica, configs_dir, control, None)
+}
+
+/// [`sweep_point`] resuming from `resume`, a checkpoint of this point's run
+/// (`RunError::Checkpointed`), as a simulate job does.
+pub fn sweep_point_from(
     plan: &SweepPlan,
     index: usize,
     replica: usize,
@@ -1198,7 +1209,7 @@ pub fn run_sweep(
                     })
                 }),
             );
-            runs.push(sweep_point(plan, i, j, configs_dir, &sub, None)?);
+            runs.push(sweep_point(plan, i, j, configs_dir, &sub)?);
         }
     }
     let outcome = plan.outcome(runs)?;

@@ -338,7 +338,7 @@ impl CaseRunner for LibraryRunner {
                 sweep_output(&plan, params, &sweep)
             }
             JobPlan::SweepPoint(plan, index, replica) => {
-                let point = crate::pipeline::sweep_point(
+                let point = crate::pipeline::sweep_point_from(
                     &plan,
                     index,
                     replica,
