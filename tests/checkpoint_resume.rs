@@ -67,6 +67,22 @@ fn checkpoint_at(at: usize) -> RunControl {
     control
 }
 
+/// A control that asks for a checkpoint at the first progress report past `fraction` of the
+/// run (for a model run part by part, the fraction counts the finished parts).
+fn checkpoint_past(fraction: f64) -> RunControl {
+    let control = RunControl::silent();
+    let (c, k) = (control.cancel.clone(), control.checkpoint.clone());
+    RunControl {
+        progress: Arc::new(move |p: Progress| {
+            if p.fraction > fraction {
+                k.store(true, Ordering::SeqCst);
+                c.store(true, Ordering::SeqCst);
+            }
+        }),
+        ..control
+    }
+}
+
 /// Runs `case` to the end from `resume`; the results, the energy account's closure and the
 /// time the run resumed from.
 fn finish(case: &CaseSpec, resume: Option<&[u8]>) -> (Results, Option<f64>) {
@@ -108,6 +124,12 @@ fn stop(case: &CaseSpec, resume: Option<&[u8]>, control: &RunControl) -> (Vec<u8
                 (0.0..end).contains(&cp.simulated_time_s),
                 "checkpoint at {} s",
                 cp.simulated_time_s
+            );
+            eprintln!(
+                "{}: checkpoint at {} s, {} bytes",
+                case.name,
+                cp.simulated_time_s,
+                cp.bytes.len()
             );
             (cp.bytes.clone(), cp.simulated_time_s)
         }
@@ -268,4 +290,35 @@ fn the_checkpoint_bytes_round_trip() {
         again.bytes, bytes,
         "decode then encode gives the same bytes"
     );
+}
+
+#[test]
+fn a_launcher_run_part_by_part_resumes_bit_identically_in_either_part() {
+    // Two missiles on their own rails: two independent parts, integrated one after the other.
+    let dir = configs();
+    let case = short_case("launcher-m299-2.toml", 0.05, 0.25);
+    let model = build(&case, &dir).expect("model");
+    assert_eq!(
+        railwear::physics::partition::independent_parts(&model.system).len(),
+        2
+    );
+    let identity = RunIdentity::of(&case, &model, &dir);
+    let (expected, _) = finish(&case, None);
+    // In the first part, then (resumed from it) in the second.
+    let (first, t1) = stop(&case, None, &checkpoint_past(0.2));
+    let cp = checkpoint::decode(&first, &identity).expect("decode");
+    assert_eq!(cp.finished_parts(), 0);
+    let (second, t2) = stop(&case, Some(&first), &checkpoint_past(0.6));
+    let cp = checkpoint::decode(&second, &identity).expect("decode");
+    assert_eq!(
+        cp.finished_parts(),
+        1,
+        "the second checkpoint falls in the second part"
+    );
+    assert!(t1 > 0.0 && t2 > 0.0);
+    for (bytes, t) in [(&first, t1), (&second, t2)] {
+        let (got, resumed) = finish(&case, Some(bytes));
+        assert_eq!(resumed, Some(t));
+        assert_results_equal(&got, &expected, "launcher-m299-2");
+    }
 }
