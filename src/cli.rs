@@ -35,13 +35,13 @@ pub fn run(
     );
     bar.set_message(case.name.clone());
     let b2 = bar.clone();
-    let control = RunControl {
-        cancel: Arc::new(AtomicBool::new(false)),
-        progress: Arc::new(move |p: Progress| {
+    let control = RunControl::new(
+        Arc::new(AtomicBool::new(false)),
+        Arc::new(move |p: Progress| {
             b2.set_position((p.fraction * 1000.0) as u64);
             b2.set_prefix(format!("{:.3}/{:.3} s", p.simulated_time_s, p.end_time_s));
         }),
-    };
+    );
     let (report, outcome) = run_case(&case, configs_dir, &control)?;
     bar.finish_and_clear();
     let dir = out

@@ -357,11 +357,31 @@ fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
     assert_eq!(j["status"], "queued", "{j}");
     assert_eq!(j["worker"], serde_json::Value::Null);
     assert_eq!(attempt_outcomes(&api, &id), ["released"]);
+    // The simulation stopped with a checkpoint, stored before the release.
+    let attempts = curl(
+        "GET",
+        &api.url(&format!("/v1/jobs/{id}/attempts")),
+        Some(ENGINEER),
+        &[],
+        None,
+    )
+    .json();
+    let checkpoint_s = attempts[0]["checkpoint_s"].as_f64();
+    assert!(
+        checkpoint_s.is_some_and(|t| (0.0..602.0).contains(&t)),
+        "{attempts}"
+    );
+    assert_eq!(
+        j["progress"]["simulated_time_s"].as_f64(),
+        checkpoint_s,
+        "{j}"
+    );
 }
 
 /// Issue 17: SIGTERM in the middle of a real sweep (one worker, three points), then a
 /// restart: the points finished before the shutdown are kept (the sweep-level checkpoint), the
-/// point that was running is given back and re-run from its start with its seed, and the
+/// point that was running is given back (with its mid-run checkpoint, from which the next
+/// worker resumes it, or, without one, to be re-run from its start with its seed), and the
 /// sweep's result equals bit for bit the sequential uninterrupted sweep.
 #[test]
 fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {

@@ -2,11 +2,13 @@
 //! workers taking jobs and gives running attempts back to the queue at once (attempt logged
 //! `released`), within the shutdown grace even when the computation does not stop; the next
 //! worker runs the job to a result identical to an uninterrupted run. A sweep keeps the points
-//! that finished (the sweep-level checkpoint) and re-runs only the rest.
+//! that finished (the sweep-level checkpoint) and re-runs only the rest. A real simulation
+//! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
+//! the uninterrupted run's result.
 
 mod service_support;
 
-use railwear::jobs::JobStatus;
+use railwear::jobs::{JobStatus, LibraryRunner};
 use railwear::store::{AttemptOutcome, Store};
 use serde_json::Value;
 use service_support::runner::{start, test_config};
@@ -278,6 +280,143 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     assert_eq!(
         parent_log,
         [AttemptOutcome::FannedOut, AttemptOutcome::Succeeded]
+    );
+    second.stop().await;
+}
+
+/// Start the service in this process with the production runner (the shipped `configs/`).
+async fn start_library(config: railwear::config::ServiceConfig) -> railwear::http::RunningService {
+    let runner = Arc::new(LibraryRunner::new(config.configs_dir.clone()));
+    railwear::http::start(config, runner, true)
+        .await
+        .expect("service starts")
+}
+
+/// Rattle box C, 50 ms settle and 1.2 s excited: a few seconds of computation.
+const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":1.2}},"seed":8}}"#;
+const SIMULATE_END_S: f64 = 1.25;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
+    // Reference: uninterrupted.
+    let ref_dir = TempDir::new("checkpoint-ref");
+    let reference = start_library(test_config(&ref_dir.db_url())).await;
+    let base = format!("http://{}", reference.addr);
+    let expected = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, SIMULATE_BODY);
+        wait_for(Duration::from_secs(300), "succeeded", || {
+            let j = get_job(&base, &id);
+            (j["status"] == "succeeded").then_some(())
+        });
+        results(&base, &id)
+    })
+    .await
+    .unwrap();
+    reference.stop().await;
+    assert!(expected.0.lines().count() > 100, "tracks recorded");
+
+    let dir = TempDir::new("checkpoint");
+    let mut config = test_config(&dir.db_url());
+    config.workers = 1;
+    config.shutdown_grace_s = 5.0;
+    config.lease_s = 60.0; // only the release can hand the job on this fast
+    let first = start_library(config.clone()).await;
+    let store = first.state.store.clone();
+    let first_jobs = first.state.jobs.clone();
+    let base = format!("http://{}", first.addr);
+    let id = tokio::task::spawn_blocking(move || {
+        let id = submit_job(&base, SIMULATE_BODY);
+        wait_for(Duration::from_secs(300), "progress", || {
+            let j = get_job(&base, &id);
+            (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.15).then_some(())
+        });
+        id
+    })
+    .await
+    .unwrap();
+    let asked = Instant::now();
+    first.stop().await;
+    // The engine stops at its next accepted step: far inside the grace.
+    assert!(
+        asked.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        asked.elapsed()
+    );
+    let uuid: uuid::Uuid = id.parse().unwrap();
+    let job = store.get_job(uuid).await.unwrap().unwrap();
+    assert_eq!(job.status, JobStatus::Queued, "given back at once");
+    assert_eq!(job.lease_owner, None);
+    let attempts = store.attempts(uuid).await.unwrap();
+    assert_eq!(attempts.len(), 1);
+    assert_eq!(attempts[0].outcome, AttemptOutcome::Released);
+    let checkpoint_s = attempts[0]
+        .checkpoint_s
+        .expect("the released attempt stored a checkpoint");
+    assert!(
+        checkpoint_s > 0.0 && checkpoint_s < SIMULATE_END_S,
+        "checkpoint at {checkpoint_s} s"
+    );
+    let stored = store.load_checkpoint(uuid).await.unwrap().expect("stored");
+    assert_eq!(stored.simulated_s, checkpoint_s);
+    assert_eq!(stored.end_s, SIMULATE_END_S);
+    assert_eq!(stored.attempt, 1);
+    // The job's progress stands at the checkpoint.
+    let progress = job.progress.expect("progress");
+    assert_eq!(progress.simulated_time_s, checkpoint_s);
+    let metrics = first_jobs.metrics.render(&[]);
+    assert!(
+        metrics.contains("railwear_attempts_released_total{checkpoint=\"true\"} 1"),
+        "{metrics}"
+    );
+
+    // The next worker resumes: its progress starts at the checkpoint's time.
+    let second = start_library(config).await;
+    let base = format!("http://{}", second.addr);
+    let (got, job, first_progress) = tokio::task::spawn_blocking({
+        let id = id.clone();
+        move || {
+            let mut first_progress = None;
+            let job = wait_for(Duration::from_secs(300), "succeeded", || {
+                let j = get_job(&base, &id);
+                if first_progress.is_none() && j["status"] == "running" {
+                    first_progress = j["progress"]["simulated_time_s"].as_f64();
+                }
+                (j["status"] == "succeeded").then_some(j)
+            });
+            let attempts = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
+            (results(&base, &id), (job, attempts), first_progress)
+        }
+    })
+    .await
+    .unwrap();
+    let (job, attempts) = job;
+    assert_eq!(job["attempt"], 2);
+    if let Some(t) = first_progress {
+        assert!(
+            t >= checkpoint_s,
+            "progress of the resumed attempt at {t} s"
+        );
+    }
+    assert_eq!(attempts[0]["outcome"], "released", "{attempts}");
+    assert_eq!(attempts[0]["checkpoint_s"], checkpoint_s, "{attempts}");
+    assert_eq!(attempts[1]["outcome"], "succeeded", "{attempts}");
+    let metrics = second.state.jobs.metrics.render(&[]);
+    assert!(
+        metrics.contains("railwear_attempts_resumed_total 1"),
+        "{metrics}"
+    );
+    assert_eq!(
+        got.0, expected.0,
+        "tracks identical to the uninterrupted run"
+    );
+    assert_eq!(
+        got.1, expected.1,
+        "summary identical to the uninterrupted run"
+    );
+    assert_eq!(
+        store.load_checkpoint(uuid).await.unwrap(),
+        None,
+        "the checkpoint is deleted when the job ends"
     );
     second.stop().await;
 }

@@ -244,3 +244,114 @@ async fn postgres_release_is_fenced_and_yields_to_cancellation() {
     let store = store::open(&db.url).await.expect("postgres");
     release_is_fenced_and_yields_to_cancellation(store).await;
 }
+
+/// Checkpoints (migration 0007): stored only by the attempt holding the lease (recorded on the
+/// attempt, progress moved to its time), replaced by a later save, kept across the release
+/// for the next attempt, and deleted when the job ends, whichever way it ends.
+async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
+    use railwear::store::{Finish, NewCheckpoint, NewJob};
+    let job = |n: u128| NewJob {
+        id: Uuid::from_u128(0xc4ec_0000 + n),
+        kind: JobKind::Simulate,
+        params: serde_json::json!({"n": n as u64}),
+        seed: n as u64,
+        code_version: "test".into(),
+        submitted_by: "tester".into(),
+        idempotency: None,
+        curve_key: None,
+        created_ms: 1_000 + n as i64,
+    };
+    let checkpoint = |t: f64, fill: u8| NewCheckpoint {
+        simulated_s: t,
+        end_s: 2.0,
+        data: vec![fill; 1000],
+    };
+    store.submit_job(job(1)).await.unwrap();
+    store.submit_job(job(2)).await.unwrap();
+    let a = store.claim_job("w", 2_000, 60_000).await.unwrap().unwrap();
+    assert_eq!(a.id, Uuid::from_u128(0xc4ec_0001));
+    // Not the lease holder: nothing stored.
+    assert!(!store
+        .save_checkpoint(a.id, 2, checkpoint(0.5, 1), 2_050)
+        .await
+        .unwrap());
+    assert_eq!(store.load_checkpoint(a.id).await.unwrap(), None);
+    assert!(store
+        .save_checkpoint(a.id, 1, checkpoint(0.5, 1), 2_100)
+        .await
+        .unwrap());
+    assert!(store
+        .save_checkpoint(a.id, 1, checkpoint(0.75, 2), 2_150)
+        .await
+        .unwrap());
+    let stored = store.load_checkpoint(a.id).await.unwrap().expect("stored");
+    assert_eq!(
+        (
+            stored.attempt,
+            stored.simulated_s,
+            stored.end_s,
+            stored.created_ms
+        ),
+        (1, 0.75, 2.0, 2_150)
+    );
+    assert_eq!(
+        stored.data,
+        vec![2u8; 1000],
+        "the later save replaced the first"
+    );
+    let progress = store
+        .get_job(a.id)
+        .await
+        .unwrap()
+        .unwrap()
+        .progress
+        .unwrap();
+    assert_eq!(progress.simulated_time_s, 0.75);
+    assert_eq!(progress.fraction, 0.375);
+    store.release_job(a.id, 1, 2_200).await.unwrap();
+    let log = store.attempts(a.id).await.unwrap();
+    assert_eq!(log[0].outcome, AttemptOutcome::Released);
+    assert_eq!(log[0].checkpoint_s, Some(0.75));
+    // Kept for the next attempt; the old attempt can no longer write one.
+    let again = store.claim_job("w2", 2_300, 60_000).await.unwrap().unwrap();
+    assert_eq!((again.id, again.attempt), (a.id, 2));
+    assert!(store.load_checkpoint(a.id).await.unwrap().is_some());
+    assert!(!store
+        .save_checkpoint(a.id, 1, checkpoint(0.9, 3), 2_350)
+        .await
+        .unwrap());
+    assert_eq!(store.attempts(a.id).await.unwrap()[1].checkpoint_s, None);
+    // The job ends: the checkpoint goes with it.
+    assert!(store
+        .finish_job(a.id, 2, Finish::Failed("x".into()), 2_400)
+        .await
+        .unwrap());
+    assert_eq!(store.load_checkpoint(a.id).await.unwrap(), None);
+    // A queued job with a checkpoint, cancelled: gone too.
+    let b = store.claim_job("w", 2_500, 60_000).await.unwrap().unwrap();
+    assert!(store
+        .save_checkpoint(b.id, 1, checkpoint(0.25, 4), 2_550)
+        .await
+        .unwrap());
+    store.release_job(b.id, 1, 2_600).await.unwrap();
+    store.request_cancel(b.id, 2_700).await.unwrap();
+    assert_eq!(
+        store.get_job(b.id).await.unwrap().unwrap().status,
+        JobStatus::Cancelled
+    );
+    assert_eq!(store.load_checkpoint(b.id).await.unwrap(), None);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sqlite_checkpoints_are_fenced_and_end_with_the_job() {
+    let dir = service_support::TempDir::new("checkpoints");
+    let store = store::open(&dir.db_url()).await.expect("sqlite");
+    checkpoints_are_fenced_and_end_with_the_job(store).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn postgres_checkpoints_are_fenced_and_end_with_the_job() {
+    let db = fresh_db!("checkpoints");
+    let store = store::open(&db.url).await.expect("postgres");
+    checkpoints_are_fenced_and_end_with_the_job(store).await;
+}

@@ -12,7 +12,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use std::f64::consts::PI;
 
 /// Result of a shape pressed into a half-space (world frame).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlaneOverlap {
     /// Penetration, m: how far the deepest point lies below the plane (> 0). ADAMS IMPACT
     /// `w` (thesis eq. 2.1).

@@ -122,6 +122,11 @@ pub struct AttemptView {
     /// a worker starting on the same host) or `released` (given back to the queue when its
     /// worker shut down).
     pub outcome: String,
+    /// Simulated time, s, of the checkpoint a `released` attempt stored before giving its job
+    /// back: the next attempt resumes from it. Absent when the attempt stored none (it did not
+    /// stop within the shutdown grace, or its computation cannot checkpoint).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub checkpoint_s: Option<f64>,
 }
 
 impl From<AttemptRecord> for AttemptView {
@@ -132,6 +137,7 @@ impl From<AttemptRecord> for AttemptView {
             started_at: clock::rfc3339(a.started_ms),
             ended_at: a.ended_ms.map(clock::rfc3339),
             outcome: a.outcome.as_str().to_string(),
+            checkpoint_s: a.checkpoint_s,
         }
     }
 }

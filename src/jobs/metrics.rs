@@ -42,8 +42,15 @@ struct Inner {
     /// HTTP requests by (method, route template, status code).
     http_requests: HashMap<(String, String, u16), u64>,
     simulated_s_total: f64,
-    /// Running attempts in this process: (start, simulated seconds reached).
-    running: HashMap<Uuid, (Instant, f64)>,
+    /// Running attempts in this process: (start, simulated seconds reached, simulated seconds
+    /// it resumed from).
+    running: HashMap<Uuid, (Instant, f64, f64)>,
+    /// Attempts given back at shutdown, without and with a checkpoint.
+    released: [u64; 2],
+    /// Simulated time kept by the checkpoints of released attempts, s.
+    checkpointed_s_total: f64,
+    /// Attempts that resumed from a stored checkpoint.
+    resumed: u64,
 }
 
 impl Inner {
@@ -81,7 +88,21 @@ impl Metrics {
     /// An attempt started in this process.
     pub fn attempt_started(&self, id: Uuid) {
         self.with(|m| {
-            m.running.insert(id, (Instant::now(), 0.0));
+            m.running.insert(id, (Instant::now(), 0.0, 0.0));
+        });
+    }
+
+    /// A running attempt resumes from a checkpoint at `simulated_time_s`: the time before it
+    /// was simulated by an earlier attempt and is not counted again.
+    pub fn attempt_resumed(&self, id: Uuid, simulated_time_s: f64) {
+        self.with(|m| {
+            if let Some(entry) = m.running.get_mut(&id) {
+                if simulated_time_s.is_finite() {
+                    entry.1 = entry.1.max(simulated_time_s);
+                    entry.2 = simulated_time_s;
+                }
+                m.resumed += 1;
+            }
         });
     }
 
@@ -100,16 +121,21 @@ impl Metrics {
     /// An attempt ended with `status`: its wall time goes to the duration histogram.
     pub fn attempt_finished(&self, id: Uuid, kind: JobKind, status: JobStatus) {
         self.with(|m| {
-            if let Some((start, _)) = m.running.remove(&id) {
+            if let Some((start, _, _)) = m.running.remove(&id) {
                 m.observe(kind, status, start.elapsed().as_secs_f64());
             }
         });
     }
 
-    /// An attempt was given back at shutdown: no longer running here, not a finished job.
-    pub fn attempt_released(&self, id: Uuid) {
+    /// An attempt was given back at shutdown (with a checkpoint at `checkpoint_s` simulated
+    /// seconds, if it stored one): no longer running here, not a finished job.
+    pub fn attempt_released(&self, id: Uuid, checkpoint_s: Option<f64>) {
         self.with(|m| {
-            m.running.remove(&id);
+            let resumed_from = m.running.remove(&id).map_or(0.0, |r| r.2);
+            m.released[usize::from(checkpoint_s.is_some())] += 1;
+            if let Some(t) = checkpoint_s.filter(|t| t.is_finite()) {
+                m.checkpointed_s_total += (t - resumed_from).max(0.0);
+            }
         });
     }
 
@@ -218,10 +244,10 @@ impl Metrics {
                 "railwear_simulated_seconds_total {}",
                 num(m.simulated_s_total)
             );
-            let rate = m.running.values().fold(0.0, |acc, (start, sim)| {
+            let rate = m.running.values().fold(0.0, |acc, (start, sim, from)| {
                 let wall = start.elapsed().as_secs_f64();
                 if wall > 0.0 {
-                    acc + sim / wall
+                    acc + (sim - from) / wall
                 } else {
                     acc
                 }
@@ -235,6 +261,34 @@ impl Metrics {
             let _ = writeln!(out, "# HELP railwear_running_attempts Attempts running in this process.");
             let _ = writeln!(out, "# TYPE railwear_running_attempts gauge");
             let _ = writeln!(out, "railwear_running_attempts {}", m.running.len());
+            let _ = writeln!(
+                out,
+                "# HELP railwear_attempts_released_total Attempts this process gave back at shutdown, by whether they stored a checkpoint."
+            );
+            let _ = writeln!(out, "# TYPE railwear_attempts_released_total counter");
+            for (i, label) in ["false", "true"].iter().enumerate() {
+                let _ = writeln!(
+                    out,
+                    "railwear_attempts_released_total{{checkpoint=\"{label}\"}} {}",
+                    m.released[i]
+                );
+            }
+            let _ = writeln!(
+                out,
+                "# HELP railwear_checkpointed_simulated_seconds_total Simulated time the checkpoints of released attempts kept (not simulated again by the next attempt), s."
+            );
+            let _ = writeln!(out, "# TYPE railwear_checkpointed_simulated_seconds_total counter");
+            let _ = writeln!(
+                out,
+                "railwear_checkpointed_simulated_seconds_total {}",
+                num(m.checkpointed_s_total)
+            );
+            let _ = writeln!(
+                out,
+                "# HELP railwear_attempts_resumed_total Attempts this process started from a stored checkpoint."
+            );
+            let _ = writeln!(out, "# TYPE railwear_attempts_resumed_total counter");
+            let _ = writeln!(out, "railwear_attempts_resumed_total {}", m.resumed);
             let _ = writeln!(
                 out,
                 "# HELP railwear_http_requests_total HTTP requests answered by this process, by method, route and status."

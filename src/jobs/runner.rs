@@ -70,6 +70,23 @@ pub trait CaseRunner: Send + Sync {
         control: &RunControl,
     ) -> Result<JobOutput, RunError>;
 
+    /// [`CaseRunner::run`] resuming from `checkpoint`, the bytes of an earlier attempt's
+    /// [`RunError::Checkpointed`] for this job. A computation that can checkpoint returns
+    /// [`RunError::Checkpointed`] at its next step boundary after
+    /// [`RunControl::request_checkpoint`], resumes from a checkpoint to the result of an
+    /// uninterrupted run, and starts over (saying why) from one that does not fit. The default
+    /// cannot checkpoint: it ignores `checkpoint` and runs from the start.
+    fn run_from(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        control: &RunControl,
+        checkpoint: Option<&[u8]>,
+    ) -> Result<JobOutput, RunError> {
+        let _ = checkpoint;
+        self.run(kind, params, control)
+    }
+
     /// Check at submission (on a blocking thread) so a bad request gets a 422 naming the field
     /// instead of a failed job. It should be the same parse [`CaseRunner::run`] does
     /// ([`LibraryRunner::plan`]). The default accepts everything.
@@ -317,9 +334,31 @@ impl CaseRunner for LibraryRunner {
         params: &serde_json::Value,
         control: &RunControl,
     ) -> Result<JobOutput, RunError> {
-        match self.plan(kind, params)? {
+        self.run_from(kind, params, control, None)
+    }
+
+    /// Simulate jobs and sweep points checkpoint and resume (`models::case::run_case_from`);
+    /// the other kinds stop as cancelled on a checkpoint request and start over.
+    fn run_from(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        control: &RunControl,
+        checkpoint: Option<&[u8]>,
+    ) -> Result<JobOutput, RunError> {
+        let plan = self.plan(kind, params)?;
+        let control = &match plan {
+            JobPlan::Simulate(_) | JobPlan::SweepPoint(..) => control.clone(),
+            _ => control.without_checkpoint(),
+        };
+        match plan {
             JobPlan::Simulate(case) => {
-                let (_, out) = crate::models::case::run_case(&case, &self.configs_dir, control)?;
+                let (_, out) = crate::models::case::run_case_from(
+                    &case,
+                    &self.configs_dir,
+                    control,
+                    checkpoint,
+                )?;
                 Ok(JobOutput {
                     summary: out.summary,
                     tracks: out.tracks,
@@ -332,12 +371,13 @@ impl CaseRunner for LibraryRunner {
                 sweep_output(&plan, params, &sweep)
             }
             JobPlan::SweepPoint(plan, index, replica) => {
-                let point = crate::pipeline::sweep_point(
+                let point = crate::pipeline::sweep_point_from(
                     &plan,
                     index,
                     replica,
                     &self.configs_dir,
                     control,
+                    checkpoint,
                 )?;
                 Ok(JobOutput {
                     summary: sweep_point_summary(index, replica, &point),
@@ -434,10 +474,8 @@ pub fn run_diagnosis(
 ) -> Result<JobOutput, RunError> {
     // The window simulations see the cancel flag but not the progress sink: the job's progress
     // counts simulations, not one window's simulated time.
-    let inner = RunControl {
-        cancel: control.cancel.clone(),
-        progress: std::sync::Arc::new(|_| {}),
-    };
+    // Its windows keep no checkpoint: a request stops the diagnosis as cancelled.
+    let inner = RunControl::new(control.cancel.clone(), std::sync::Arc::new(|_| {}));
     let report_progress = |done: usize, total: usize| {
         let total = total.max(1);
         (control.progress)(crate::physics::control::Progress {

@@ -2,6 +2,11 @@
 //! job, run it on a blocking thread while a heartbeat renews the lease and writes progress, then
 //! end the attempt with a fenced write (a stale attempt's result is discarded).
 //!
+//! At shutdown a running attempt is asked for a checkpoint ([`RunControl::request_checkpoint`]):
+//! a simulation stops at its next accepted step with its complete state, which is stored
+//! (fenced by the attempt) before the job is released; the next attempt resumes from it. A
+//! computation that cannot checkpoint stops as cancelled and the job is released without one.
+//!
 //! A job the runner splits ([`super::CaseRunner::fan_out`], a sweep) is not run: the attempt
 //! stores its child jobs and leaves it waiting. When its last child succeeds the store re-queues
 //! it, and the attempt that claims it then assembles its result from the children's results.
@@ -13,6 +18,7 @@ use crate::pipeline::{Progress, RunControl, RunError};
 use crate::store::{
     clock, tracks, CurveFidelity, FanOut, FanOutResult, Finish, NewChild, NewCurve, ReleaseOutcome,
 };
+use crate::store::{JobCheckpoint, NewCheckpoint};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -100,23 +106,58 @@ impl Jobs {
                 }
             }
         };
+        // A checkpoint an earlier attempt stored at its shutdown: this attempt resumes from it.
+        let resume = match work {
+            Work::Run => self.stored_checkpoint(id, attempt).await,
+            _ => None,
+        };
         let cancel = Arc::new(AtomicBool::new(job.cancel_requested));
+        let checkpoint = Arc::new(AtomicBool::new(false));
         self.running_flags().insert(id, Arc::clone(&cancel));
         self.metrics.attempt_started(id);
+        if let Some(cp) = &resume {
+            self.metrics.attempt_resumed(id, cp.simulated_s);
+            // The job's progress starts at the checkpoint's time.
+            let progress = crate::jobs::JobProgress {
+                simulated_time_s: cp.simulated_s,
+                end_time_s: cp.end_s,
+                fraction: if cp.end_s > 0.0 {
+                    (cp.simulated_s / cp.end_s).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+                eta_s: None,
+            };
+            let lease_ms = self.settings.lease.as_millis() as i64;
+            if let Err(e) = self
+                .store
+                .heartbeat(id, attempt, Some(progress), clock::now_ms(), lease_ms)
+                .await
+            {
+                tracing::warn!(job = %id, error = %e, "heartbeat failed");
+            }
+        }
 
         let latest: Arc<Mutex<Option<Progress>>> = Arc::new(Mutex::new(None));
         let sink = Arc::clone(&latest);
         let control = RunControl {
             cancel: Arc::clone(&cancel),
+            checkpoint: Arc::clone(&checkpoint),
             progress: Arc::new(move |p: Progress| {
                 if let Ok(mut slot) = sink.lock() {
                     *slot = Some(p);
                 }
             }),
         };
+        let stop = control.clone();
         let runner = Arc::clone(&self.runner);
         let mut computation = tokio::task::spawn_blocking(move || match work {
-            Work::Run => runner.run(&kind, &params, &control),
+            Work::Run => runner.run_from(
+                &kind,
+                &params,
+                &control,
+                resume.as_ref().map(|c| c.data.as_slice()),
+            ),
             Work::Assemble(Ok(summaries)) => runner.assemble(&kind, &params, &summaries),
             Work::Assemble(Err(e)) | Work::Refused(e) => Err(e),
         });
@@ -126,16 +167,17 @@ impl Jobs {
         let mut ticker = tokio::time::interval(self.settings.heartbeat);
         ticker.tick().await; // the first tick is immediate
         let mut lost = false;
-        // Shutdown: the computation is asked to stop (the cancel flag: at its next step
-        // boundary) and the job is given back by `give_back_by` at the latest.
+        // Shutdown: the computation is asked for a checkpoint (a simulation stops with one at
+        // its next accepted step; any other computation stops as cancelled) and the job is
+        // given back by `give_back_by` at the latest.
         let mut stopping = self.stopping();
         let mut give_back_by: Option<tokio::time::Instant> = None;
         let outcome = loop {
             tokio::select! {
                 result = &mut computation => break Some(result),
                 _ = shutdown_begun(&mut stopping), if give_back_by.is_none() => {
-                    tracing::info!(job = %id, attempt, "shutdown: stopping the attempt to give its job back");
-                    cancel.store(true, Ordering::Relaxed);
+                    tracing::info!(job = %id, attempt, "shutdown: asking the attempt for a checkpoint to give its job back");
+                    stop.request_checkpoint();
                     give_back_by = Some(tokio::time::Instant::now() + self.settings.shutdown_grace);
                 }
                 _ = tokio::time::sleep_until(give_back_by.unwrap_or_else(tokio::time::Instant::now)),
@@ -173,8 +215,14 @@ impl Jobs {
             // The grace ran out: give the job back now; the computation is left to the
             // process's exit (a late result would be fenced out by the next attempt).
             self.running_flags().remove(&id);
-            self.metrics.attempt_released(id);
+            self.metrics.attempt_released(id, None);
+            tracing::warn!(job = %id, attempt, "the shutdown grace ran out: released without a checkpoint");
             return self.give_back(id, attempt).await;
+        };
+        // A checkpoint is a stop like a cancellation, with the state to resume from.
+        let (outcome, saved) = match outcome {
+            Ok(Err(RunError::Checkpointed(cp))) => (Ok(Err(RunError::Cancelled)), Some(*cp)),
+            other => (other, None),
         };
         let released =
             give_back_by.is_some() && matches!(outcome, Ok(Err(RunError::Cancelled))) && !lost;
@@ -227,9 +275,14 @@ impl Jobs {
             }
         };
         if released {
-            // Stopped for the shutdown, not cancelled by anyone: back to the queue.
+            // Stopped for the shutdown, not cancelled by anyone: back to the queue, with the
+            // checkpoint stored first (while this attempt still holds the lease).
             self.running_flags().remove(&id);
-            self.metrics.attempt_released(id);
+            let checkpoint_s = match saved {
+                Some(cp) => self.save_checkpoint(id, attempt, cp).await,
+                None => None,
+            };
+            self.metrics.attempt_released(id, checkpoint_s);
             return self.give_back(id, attempt).await;
         }
         let status = finish.status();
@@ -274,6 +327,64 @@ impl Jobs {
                 (finished - started) as f64 / 1000.0,
             );
         }
+    }
+
+    /// The checkpoint stored for job `id` by an earlier attempt, if any.
+    async fn stored_checkpoint(&self, id: uuid::Uuid, attempt: i64) -> Option<JobCheckpoint> {
+        match self.store.load_checkpoint(id).await {
+            Ok(Some(cp)) => {
+                tracing::info!(
+                    job = %id,
+                    attempt,
+                    from_attempt = cp.attempt,
+                    simulated_s = cp.simulated_s,
+                    "resuming from the stored checkpoint"
+                );
+                Some(cp)
+            }
+            Ok(None) => None,
+            Err(e) => {
+                tracing::warn!(job = %id, attempt, error = %e, "reading the checkpoint failed: running from the start");
+                None
+            }
+        }
+    }
+
+    /// Store the checkpoint attempt `attempt` stopped with (fenced by the attempt; retried on
+    /// transient errors). Its simulated time once stored.
+    async fn save_checkpoint(
+        &self,
+        id: uuid::Uuid,
+        attempt: i64,
+        cp: crate::models::checkpoint::Checkpoint,
+    ) -> Option<f64> {
+        let t = cp.simulated_time_s;
+        let new = NewCheckpoint {
+            simulated_s: t,
+            end_s: cp.end_time_s,
+            data: cp.bytes,
+        };
+        for retry in 0..3u32 {
+            match self
+                .store
+                .save_checkpoint(id, attempt, new.clone(), clock::now_ms())
+                .await
+            {
+                Ok(true) => {
+                    tracing::info!(job = %id, attempt, simulated_s = t, bytes = new.data.len(), "checkpoint stored");
+                    return Some(t);
+                }
+                Ok(false) => {
+                    tracing::warn!(job = %id, attempt, "stale attempt; checkpoint discarded");
+                    return None;
+                }
+                Err(e) => {
+                    tracing::warn!(job = %id, attempt, retry, error = %e, "storing the checkpoint failed");
+                    tokio::time::sleep(Duration::from_millis(100 << retry)).await;
+                }
+            }
+        }
+        None
     }
 
     /// Give attempt `attempt` back to the queue (shutdown). A cancellation requested

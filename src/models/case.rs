@@ -1,8 +1,9 @@
 //! From a case file to a finished run: resolves the excitation (profiles by name), builds the
 //! model, maps the run settings, runs it and writes the summary, tracks and plots.
 
+use super::checkpoint::{self, RunIdentity};
 use super::rattle_box;
-use super::run::{run_model, BuiltModel, ModelRunError, RunOptions, RunReport};
+use super::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
 use super::specs::{CaseSpec, ModelSpecRef, SpecError};
 use crate::analysis::spectra::welch_psd;
 use crate::analysis::svg::{AxisSpec, Plot, Series};
@@ -35,6 +36,11 @@ impl From<ModelRunError> for RunError {
     fn from(e: ModelRunError) -> Self {
         match e {
             ModelRunError::Sim(SimError::Cancelled { .. }) => RunError::Cancelled,
+            // Only `run_case_from` can keep a checkpoint (it knows the case); elsewhere the
+            // request stopped the run like a cancellation.
+            ModelRunError::Sim(SimError::Checkpointed(_)) | ModelRunError::Checkpointed(_) => {
+                RunError::Cancelled
+            }
             ModelRunError::Sim(d) => RunError::Diverged(d.to_string()),
             ModelRunError::Wear(w) => RunError::Diverged(format!("wear post-processing: {w}")),
         }
@@ -163,9 +169,56 @@ pub fn run_case(
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<(RunReport, CaseOutcome), RunError> {
+    run_case_from(case, configs_dir, control, None)
+}
+
+/// [`run_case`], resuming from `resume` (bytes of a [`RunError::Checkpointed`] of the same
+/// case and code) when it fits; a checkpoint that does not is logged and the run restarts
+/// from t = 0. A checkpoint request ([`RunControl::request_checkpoint`]) ends the run with
+/// [`RunError::Checkpointed`] at its next accepted step.
+pub fn run_case_from(
+    case: &CaseSpec,
+    configs_dir: &Path,
+    control: &RunControl,
+    resume: Option<&[u8]>,
+) -> Result<(RunReport, CaseOutcome), RunError> {
     let model = build(case, configs_dir)?;
     let options = run_options(case)?;
-    let mut report = run_model(&model, &options, control)?;
+    let identity = RunIdentity::of(case, &model, configs_dir);
+    let resume = resume.and_then(|bytes| match checkpoint::decode(bytes, &identity) {
+        Ok(cp) => {
+            tracing::info!(case = %case.name, time_s = cp.time_s(), "resuming from checkpoint");
+            Some(cp)
+        }
+        Err(reason) => {
+            tracing::warn!(case = %case.name, %reason, "checkpoint not used: the run restarts from t = 0");
+            None
+        }
+    });
+    let mut resumed_from_s = resume.as_ref().map(|cp| cp.time_s());
+    let run = match run_model_from(&model, &options, control, resume) {
+        Err(ModelRunError::Sim(SimError::BadCheckpoint(reason))) => {
+            // Refused before the first step: nothing of it was used.
+            tracing::warn!(case = %case.name, %reason, "checkpoint not used: the run restarts from t = 0");
+            resumed_from_s = None;
+            run_model_from(&model, &options, control, None)
+        }
+        other => other,
+    };
+    let mut report = match run {
+        Ok(report) => report,
+        Err(ModelRunError::Checkpointed(cp)) => {
+            return Err(match checkpoint::encode(&identity, &cp) {
+                Ok(saved) => RunError::Checkpointed(Box::new(saved)),
+                Err(e) => {
+                    tracing::warn!(case = %case.name, error = %e, "stopped without a checkpoint");
+                    RunError::Cancelled
+                }
+            })
+        }
+        Err(e) => return Err(e.into()),
+    };
+    report.resumed_from_s = resumed_from_s;
     // The track samples move to the outcome (the report's `tracks` is left empty): a long run
     // holds them once (a 60 s launcher run records ~0.7 million).
     let tracks = std::mem::take(&mut report.tracks);

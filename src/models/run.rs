@@ -7,7 +7,9 @@ use crate::physics::contact::TrackState;
 use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
 use crate::physics::partition::{independent_parts, Part};
-use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
+use crate::physics::simulate::{
+    simulate_from, DivergenceLimits, EngineCheckpoint, SimError, StepView,
+};
 use crate::physics::system::MultibodySystem;
 use crate::physics::track::TrackSample;
 use crate::pipeline::RunControl;
@@ -96,8 +98,9 @@ pub struct BodyReport {
     pub mass_rate_mg_per_h: f64,
 }
 
-/// Everything a run produces.
-#[derive(Debug, Clone)]
+/// Everything a run produces (serializable: a partitioned run's checkpoint keeps the reports
+/// of its finished parts).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunReport {
     /// Per contact.
     pub contacts: Vec<ContactReport>,
@@ -125,6 +128,10 @@ pub struct RunReport {
     pub wear_history: Vec<(f64, Vec<f64>)>,
     /// The run's energy account (settle and excitation).
     pub energy: Option<EnergyAudit>,
+    /// Simulated time of the checkpoint the run resumed from, s (None: it ran from t = 0).
+    /// Set by `models::case::run_case_from`; not part of the results.
+    #[serde(default)]
+    pub resumed_from_s: Option<f64>,
 }
 
 /// Why a run failed.
@@ -136,11 +143,112 @@ pub enum ModelRunError {
     /// Wear post-processing rejected a value.
     #[error(transparent)]
     Wear(#[from] WearError),
+    /// Stopped at an accepted step because a checkpoint was requested: resume with
+    /// [`run_model_from`].
+    #[error("checkpointed at t = {:.6} s", .0.time_s())]
+    Checkpointed(Box<ModelCheckpoint>),
 }
 
+/// A model run stopped at an accepted step: everything [`run_model_from`] needs to finish it
+/// with the result of the uninterrupted run, bit for bit. A model integrated part by part
+/// keeps the reports of the parts already finished and the checkpoint of the one running.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ModelCheckpoint {
+    /// Reports of the finished parts, in part order (empty for a model run whole).
+    finished_parts: Vec<RunReport>,
+    /// The run in progress: the engine's state and what the observer accumulated.
+    current: WholeCheckpoint,
+}
+
+impl ModelCheckpoint {
+    /// Simulated time of the run in progress, s.
+    pub fn time_s(&self) -> f64 {
+        self.current.engine.time_s
+    }
+
+    /// End of the run, s.
+    pub fn end_time_s(&self) -> f64 {
+        self.current.engine.end_time_s
+    }
+
+    /// Parts already finished (0 for a model run whole).
+    pub fn finished_parts(&self) -> usize {
+        self.finished_parts.len()
+    }
+}
+
+/// One system's run at a checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct WholeCheckpoint {
+    engine: EngineCheckpoint,
+    observed: Observed,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct TrackAcc {
     acc: WearAccumulator,
     open: bool,
+}
+
+/// What the observer of [`run_whole`] accumulates over the accepted steps: wear per track,
+/// force and power integrals, recorded track samples, the response velocity on its grid and
+/// the wear history, with the instants of their next samples.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Observed {
+    accs: Vec<Vec<Option<TrackAcc>>>,
+    normal_int: Vec<f64>,
+    power_int: Vec<f64>,
+    peak: Vec<f64>,
+    prev_sums: Option<(f64, Vec<f64>, Vec<f64>)>,
+    tracks_out: Vec<TrackSample>,
+    next_record: f64,
+    next_resp: f64,
+    resp_vel: Vec<(f64, [f64; 3])>,
+    prev_vel: Option<(f64, nalgebra::Vector3<f64>)>,
+    wear_history: Vec<(f64, Vec<f64>)>,
+    next_history: f64,
+}
+
+impl Observed {
+    fn new(sys: &MultibodySystem, t0: f64) -> Self {
+        let ncontacts = sys.contacts.len();
+        Self {
+            accs: sys
+                .contacts
+                .iter()
+                .map(|c| {
+                    (0..c.pieces_a.len() * c.faces_b.len())
+                        .map(|_| None)
+                        .collect()
+                })
+                .collect(),
+            normal_int: vec![0.0; ncontacts],
+            power_int: vec![0.0; ncontacts],
+            peak: vec![0.0; ncontacts],
+            prev_sums: None,
+            tracks_out: Vec::new(),
+            next_record: t0,
+            next_resp: t0,
+            resp_vel: Vec::new(),
+            prev_vel: None,
+            wear_history: Vec::new(),
+            next_history: t0,
+        }
+    }
+
+    /// True when the accumulators are shaped for `sys`'s contacts.
+    fn fits(&self, sys: &MultibodySystem) -> bool {
+        let n = sys.contacts.len();
+        self.accs.len() == n
+            && self
+                .accs
+                .iter()
+                .zip(&sys.contacts)
+                .all(|(a, c)| a.len() == c.pieces_a.len() * c.faces_b.len())
+            && self.normal_int.len() == n
+            && self.power_int.len() == n
+            && self.peak.len() == n
+    }
 }
 
 /// Runs the model and post-processes wear.
@@ -154,11 +262,76 @@ pub fn run_model(
     options: &RunOptions,
     control: &RunControl,
 ) -> Result<RunReport, ModelRunError> {
+    run_model_from(model, options, control, None)
+}
+
+/// [`run_model`], or with `resume` its continuation from a checkpoint of the same model and
+/// options ([`ModelRunError::Checkpointed`]): the report equals the uninterrupted run's bit for
+/// bit (wall-clock time aside).
+pub fn run_model_from(
+    model: &BuiltModel,
+    options: &RunOptions,
+    control: &RunControl,
+    resume: Option<ModelCheckpoint>,
+) -> Result<RunReport, ModelRunError> {
     let parts = independent_parts(&model.system);
     if parts.len() > 1 {
-        return run_parts(model, &parts, options, control);
+        return run_parts(model, &parts, options, control, resume);
     }
-    run_whole(model, options, control, &mut |_| {})
+    match resume {
+        Some(cp) if !cp.finished_parts.is_empty() => Err(bad_checkpoint(format!(
+            "{} finished parts, the model runs whole",
+            cp.finished_parts.len()
+        ))),
+        Some(cp) => run_whole(model, options, control, &mut |_| {}, Some(cp.current))
+            .map_err(|e| e.within_parts(Vec::new())),
+        None => run_whole(model, options, control, &mut |_| {}, None)
+            .map_err(|e| e.within_parts(Vec::new())),
+    }
+}
+
+fn bad_checkpoint(reason: String) -> ModelRunError {
+    ModelRunError::Sim(SimError::BadCheckpoint(reason))
+}
+
+/// Why [`run_whole`] stopped: a model run error, or a checkpoint of the one system.
+enum WholeError {
+    Run(ModelRunError),
+    Checkpointed(Box<WholeCheckpoint>),
+}
+
+impl From<ModelRunError> for WholeError {
+    fn from(e: ModelRunError) -> Self {
+        WholeError::Run(e)
+    }
+}
+
+impl From<SimError> for WholeError {
+    fn from(e: SimError) -> Self {
+        WholeError::Run(e.into())
+    }
+}
+
+impl From<WearError> for WholeError {
+    fn from(e: WearError) -> Self {
+        WholeError::Run(e.into())
+    }
+}
+
+impl WholeError {
+    /// The model-level error; a checkpoint is kept with the reports of the parts finished
+    /// before it.
+    fn within_parts(self, finished_parts: Vec<RunReport>) -> ModelRunError {
+        match self {
+            WholeError::Run(e) => e,
+            WholeError::Checkpointed(current) => {
+                ModelRunError::Checkpointed(Box::new(ModelCheckpoint {
+                    finished_parts,
+                    current: *current,
+                }))
+            }
+        }
+    }
 }
 
 /// [`run_model`], also handing every accepted step of the excitation window (`t >=`
@@ -167,25 +340,42 @@ pub fn run_model(
 /// that wear-law variants can be re-integrated exactly as the run integrates wear. The model is
 /// integrated as one system (also when it has independent parts), so the steps come in time
 /// order with the whole model's state.
+///
+/// `extra` keeps state of its own, so this run does not checkpoint: a checkpoint request
+/// stops it as a cancellation.
 pub fn run_model_observed(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
 ) -> Result<RunReport, ModelRunError> {
-    run_whole(model, options, control, extra)
+    run_whole(model, options, &control.without_checkpoint(), extra, None)
+        .map_err(|e| e.within_parts(Vec::new()))
 }
 
-/// Runs each independent part on its own and merges the reports.
+/// Runs each independent part on its own and merges the reports (from a checkpoint: the
+/// finished parts' reports, the part in progress from its checkpoint, then the rest).
 fn run_parts(
     model: &BuiltModel,
     parts: &[Part],
     options: &RunOptions,
     control: &RunControl,
+    resume: Option<ModelCheckpoint>,
 ) -> Result<RunReport, ModelRunError> {
     let count = parts.len() as f64;
-    let mut reports = Vec::with_capacity(parts.len());
-    for (i, part) in parts.iter().enumerate() {
+    let (mut finished, mut current) = match resume {
+        Some(cp) if cp.finished_parts.len() >= parts.len() => {
+            return Err(bad_checkpoint(format!(
+                "{} finished parts of a model with {} parts",
+                cp.finished_parts.len(),
+                parts.len()
+            )))
+        }
+        Some(cp) => (cp.finished_parts, Some(cp.current)),
+        None => (Vec::new(), None),
+    };
+    let first = finished.len();
+    for (i, part) in parts.iter().enumerate().skip(first) {
         let response_body = part
             .bodies
             .iter()
@@ -211,18 +401,24 @@ fn run_parts(
         // Progress of the whole: the parts run one after the other.
         let outer = control.progress.clone();
         let sub_control = RunControl {
-            cancel: control.cancel.clone(),
             progress: std::sync::Arc::new(move |p: crate::physics::control::Progress| {
                 outer(crate::physics::control::Progress {
                     fraction: (i as f64 + p.fraction) / count,
                     ..p
                 })
             }),
+            ..control.clone()
         };
-        let report = run_whole(&sub, options, &sub_control, &mut |_| {})?;
-        let holds_response = part.bodies.contains(&model.response_body);
-        reports.push((report, holds_response));
+        match run_whole(&sub, options, &sub_control, &mut |_| {}, current.take()) {
+            Ok(report) => finished.push(report),
+            Err(e) => return Err(e.within_parts(finished)),
+        }
     }
+    let reports = parts
+        .iter()
+        .zip(finished)
+        .map(|(part, report)| (report, part.bodies.contains(&model.response_body)))
+        .collect();
     Ok(merge_reports(model, parts, reports))
 }
 
@@ -331,48 +527,42 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
         base_acceleration,
         wear_history,
         energy,
+        resumed_from_s: None,
     }
 }
 
-/// The run of a model integrated as one system.
+/// The run of a model integrated as one system (from `resume`, its checkpoint, if given).
 fn run_whole(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
-) -> Result<RunReport, ModelRunError> {
+    resume: Option<WholeCheckpoint>,
+) -> Result<RunReport, WholeError> {
     let sys = &model.system;
     let t0 = model.excitation_start_s;
     let ncontacts = sys.contacts.len();
-    let mut accs: Vec<Vec<Option<TrackAcc>>> = sys
-        .contacts
-        .iter()
-        .map(|c| {
-            (0..c.pieces_a.len() * c.faces_b.len())
-                .map(|_| None)
-                .collect()
-        })
-        .collect();
-    let mut normal_int = vec![0.0; ncontacts];
-    let mut power_int = vec![0.0; ncontacts];
-    let mut peak = vec![0.0f64; ncontacts];
-    let mut prev_sums: Option<(f64, Vec<f64>, Vec<f64>)> = None;
-    let mut tracks_out: Vec<TrackSample> = Vec::new();
-    let mut next_record = t0;
+    let (mut st, engine) = match resume {
+        Some(cp) => {
+            if !cp.observed.fits(sys) {
+                return Err(bad_checkpoint(
+                    "the observer's accumulators do not fit the model's contacts".into(),
+                )
+                .into());
+            }
+            (cp.observed, Some(cp.engine))
+        }
+        None => (Observed::new(sys, t0), None),
+    };
     let mut wear_error: Option<WearError> = None;
     // Response acceleration from velocity differences on a uniform grid.
     let dt_resp = 1.0 / options.response_rate_hz;
-    let mut next_resp = t0;
-    let mut resp_vel: Vec<(f64, [f64; 3])> = Vec::new();
-    let mut prev_vel: Option<(f64, nalgebra::Vector3<f64>)> = None;
     let resp_offset = match sys.bodies[model.response_body].kind {
         BodyKind::Dynamic { offset } => Some(offset),
         BodyKind::Kinematic(_) => None,
     };
     let law = options.wear_law;
-    let mut wear_history: Vec<(f64, Vec<f64>)> = Vec::new();
     let history_dt = (model.end_time_s - t0) / 200.0;
-    let mut next_history = t0;
     let mut observer = |v: &StepView| {
         if v.t < t0 {
             return;
@@ -385,24 +575,24 @@ fn run_whole(
             let c = tr.contact as usize;
             n_sum[c] += tr.normal_force;
             p_sum[c] += tr.normal_force * tr.slip_speed;
-            peak[c] = peak[c].max(tr.normal_force);
+            st.peak[c] = st.peak[c].max(tr.normal_force);
         }
-        if let Some((tp, np, pp)) = &prev_sums {
+        if let Some((tp, np, pp)) = &st.prev_sums {
             let dt = v.t - tp;
             for c in 0..ncontacts {
-                normal_int[c] += 0.5 * dt * (np[c] + n_sum[c]);
-                power_int[c] += 0.5 * dt * (pp[c] + p_sum[c]);
+                st.normal_int[c] += 0.5 * dt * (np[c] + n_sum[c]);
+                st.power_int[c] += 0.5 * dt * (pp[c] + p_sum[c]);
             }
         }
-        prev_sums = Some((v.t, n_sum, p_sum));
+        st.prev_sums = Some((v.t, n_sum, p_sum));
         // Wear per track; a track that vanished is closed with a zero-force sample.
-        for list in accs.iter_mut() {
+        for list in st.accs.iter_mut() {
             for a in list.iter_mut().flatten() {
                 a.open = false;
             }
         }
         for tr in v.tracks {
-            let slot = &mut accs[tr.contact as usize][tr.track as usize];
+            let slot = &mut st.accs[tr.contact as usize][tr.track as usize];
             let entry = match slot {
                 Some(e) => e,
                 None => match WearAccumulator::new(law) {
@@ -418,7 +608,7 @@ fn run_whole(
                 wear_error.get_or_insert(e);
             }
         }
-        for list in accs.iter_mut() {
+        for list in st.accs.iter_mut() {
             for a in list.iter_mut().flatten() {
                 if !a.open {
                     if let Err(e) = a.acc.push(v.t, 0.0, 0.0, 0.0) {
@@ -428,35 +618,36 @@ fn run_whole(
                 }
             }
         }
-        if v.t >= next_history {
-            next_history = v.t + history_dt;
-            let vols = accs
+        if v.t >= st.next_history {
+            st.next_history = v.t + history_dt;
+            let vols = st
+                .accs
                 .iter()
                 .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
                 .collect();
-            wear_history.push((v.t, vols));
+            st.wear_history.push((v.t, vols));
         }
         // Track samples for export.
-        if options.record_interval_s >= 0.0 && v.t >= next_record {
-            next_record = v.t + options.record_interval_s;
-            record_tracks(v, &mut tracks_out);
+        if options.record_interval_s >= 0.0 && v.t >= st.next_record {
+            st.next_record = v.t + options.record_interval_s;
+            record_tracks(v, &mut st.tracks_out);
         }
         // Response velocity, linearly interpolated onto the uniform grid.
         if let Some(off) = resp_offset {
             let vel = nalgebra::Vector3::new(v.state[off + 7], v.state[off + 8], v.state[off + 9]);
-            if let Some((tp, vp)) = prev_vel {
-                while next_resp <= v.t && v.t > tp {
-                    let s = (next_resp - tp) / (v.t - tp);
+            if let Some((tp, vp)) = st.prev_vel {
+                while st.next_resp <= v.t && v.t > tp {
+                    let s = (st.next_resp - tp) / (v.t - tp);
                     let vi = vp + (vel - vp) * s.clamp(0.0, 1.0);
-                    resp_vel.push((next_resp, [vi.x, vi.y, vi.z]));
-                    next_resp += dt_resp;
+                    st.resp_vel.push((st.next_resp, [vi.x, vi.y, vi.z]));
+                    st.next_resp += dt_resp;
                 }
             }
-            prev_vel = Some((v.t, vel));
+            st.prev_vel = Some((v.t, vel));
         }
     };
     let mut y = model.initial_state.clone();
-    let stats = simulate(
+    let result = simulate_from(
         sys,
         &mut y,
         0.0,
@@ -465,10 +656,31 @@ fn run_whole(
         options.limits,
         control,
         &mut observer,
-    )?;
+        engine,
+    );
     if let Some(e) = wear_error {
-        return Err(e.into());
+        return Err(ModelRunError::from(e).into());
     }
+    let stats = match result {
+        Ok(stats) => stats,
+        Err(SimError::Checkpointed(engine)) => {
+            return Err(WholeError::Checkpointed(Box::new(WholeCheckpoint {
+                engine: *engine,
+                observed: st,
+            })))
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let Observed {
+        mut accs,
+        normal_int,
+        power_int,
+        peak,
+        tracks_out,
+        resp_vel,
+        wear_history,
+        ..
+    } = st;
     if let Some(e) = stats.energy.as_ref().filter(|e| !e.balanced) {
         tracing::warn!(
             case = %model.name,
@@ -551,6 +763,7 @@ fn run_whole(
         base_acceleration,
         wear_history,
         energy: stats.energy,
+        resumed_from_s: None,
     })
 }
 

@@ -203,7 +203,7 @@ impl TrackLinearization {
 /// every pose unchanged, and a pose column of one body leaves the contacts of the other bodies
 /// unchanged; those contacts replay the overlaps (85 % of a right-hand side) recorded at the
 /// unperturbed state, which gives bit-identical forces at a fraction of the cost.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum GeometryMode {
     /// Compute every overlap (normal evaluation).
     #[default]
@@ -275,8 +275,10 @@ impl PlaneCull {
     }
 }
 
-/// Overlaps remembered between a `Record` pass and replays over the same poses.
-#[derive(Debug, Clone, Default)]
+/// Overlaps remembered between a `Record` pass and replays over the same poses. Part of a
+/// run's checkpoint: `Refresh` keeps an overlap while its plane barely moved, so what the
+/// next step sees depends on when each overlap was last computed.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct GeometryCache {
     /// Current mode.
     pub mode: GeometryMode,

@@ -1,6 +1,6 @@
-//! The engine's run hooks: a cancellation flag and a progress sink the caller hands to
-//! [`simulate`](super::simulate::simulate) (the engine owns its hooks, as rapier's pipeline
-//! does; the service passes them in through `pipeline`).
+//! The engine's run hooks: a cancellation flag, a checkpoint request and a progress sink the
+//! caller hands to [`simulate`](super::simulate::simulate) (the engine owns its hooks, as
+//! rapier's pipeline does; the service passes them in through `pipeline`).
 
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,26 +17,56 @@ pub struct Progress {
     pub fraction: f64,
 }
 
-/// Cancellation flag and progress sink handed to a run.
+/// Cancellation flag, checkpoint request and progress sink handed to a run.
 #[derive(Clone)]
 pub struct RunControl {
     /// Set to true to stop the run; it returns a cancellation error within a second.
     pub cancel: Arc<AtomicBool>,
+    /// Set together with `cancel` ([`RunControl::request_checkpoint`]) to stop the run with a
+    /// checkpoint of its state instead of a cancellation: a simulation returns it at its next
+    /// accepted step. A computation that cannot checkpoint sees only `cancel`.
+    pub checkpoint: Arc<AtomicBool>,
     /// Called from the simulation thread, at most a few times per second.
     pub progress: Arc<dyn Fn(Progress) + Send + Sync>,
 }
 
 impl RunControl {
-    /// A control that is never cancelled and drops progress.
-    pub fn silent() -> Self {
+    /// A control with this cancel flag and progress sink and no checkpoint request.
+    pub fn new(cancel: Arc<AtomicBool>, progress: Arc<dyn Fn(Progress) + Send + Sync>) -> Self {
         Self {
-            cancel: Arc::new(AtomicBool::new(false)),
-            progress: Arc::new(|_| {}),
+            cancel,
+            checkpoint: Arc::new(AtomicBool::new(false)),
+            progress,
         }
     }
 
-    /// True once cancellation was requested.
+    /// A control that is never cancelled and drops progress.
+    pub fn silent() -> Self {
+        Self::new(Arc::new(AtomicBool::new(false)), Arc::new(|_| {}))
+    }
+
+    /// True once cancellation (or a checkpoint) was requested.
     pub fn is_cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
+        self.cancel.load(Ordering::SeqCst)
+    }
+
+    /// True once a checkpoint was requested. Read it after [`Self::is_cancelled`] returned
+    /// true: the request sets this flag first, so a run that sees the cancellation also sees
+    /// the request.
+    pub fn checkpoint_requested(&self) -> bool {
+        self.checkpoint.load(Ordering::SeqCst)
+    }
+
+    /// Asks the run to stop with a checkpoint (a computation that cannot checkpoint stops as
+    /// cancelled).
+    pub fn request_checkpoint(&self) {
+        self.checkpoint.store(true, Ordering::SeqCst);
+        self.cancel.store(true, Ordering::SeqCst);
+    }
+
+    /// The same cancel flag and progress sink without the checkpoint request: for runs whose
+    /// caller cannot keep a checkpoint (a request then stops them as a cancellation).
+    pub fn without_checkpoint(&self) -> Self {
+        Self::new(self.cancel.clone(), self.progress.clone())
     }
 }

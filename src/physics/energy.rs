@@ -123,8 +123,8 @@ impl EnergyAudit {
     }
 }
 
-/// Accumulates the account over accepted states.
-#[derive(Debug, Clone)]
+/// Accumulates the account over accepted states (part of a run's checkpoint).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EnergyMeter {
     names: Vec<String>,
     last: Option<Sample>,
@@ -139,7 +139,7 @@ pub struct EnergyMeter {
     max_rise: f64,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct Sample {
     t: f64,
     power: PowerBalance,

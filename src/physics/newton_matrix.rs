@@ -25,7 +25,7 @@ const POSE: usize = 7;
 const VEL: usize = 6;
 
 /// Factorisation of `I - a J` for `bodies` dynamic bodies (state laid out body after body).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct NewtonLu {
     bodies: usize,
     /// `a` of the factored matrix.
@@ -59,6 +59,11 @@ impl NewtonLu {
             pose_tmp: vec![0.0; POSE * bodies],
             vel_tmp: vec![0.0; VEL * bodies],
         }
+    }
+
+    /// Number of dynamic bodies the solver is sized for.
+    pub fn bodies(&self) -> usize {
+        self.bodies
     }
 
     /// Factors `I - scale * jac` (`jac` column-major, `13 bodies` square). False when singular.
@@ -207,7 +212,7 @@ fn invert4(m: &[f64; 16]) -> Option<[f64; 16]> {
 
 /// Dense LU with partial pivoting (row-major, factored in place, allocated once): the Schur
 /// complements are small (6 per body) and refactored often.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct DenseLu {
     n: usize,
     a: Vec<f64>,

@@ -1,15 +1,20 @@
 //! The run loop: advances a system with an integrator, hands every accepted step to an
 //! observer, reports progress, honours cancellation and turns any breakdown into a
-//! [`SimError::Diverged`] diagnostic naming time, body, contact and energy.
+//! [`SimError::Diverged`] diagnostic naming time, body, contact and energy. Asked for a
+//! checkpoint ([`RunControl::request_checkpoint`]) it stops at the next accepted step with
+//! the run's state ([`EngineCheckpoint`]); [`simulate_from`] continues from it to the same
+//! result bit for bit.
 
 use super::body::BodyKind;
-use super::contact::TrackState;
+use super::contact::{GeometryCache, TrackState};
 use super::control::{Progress, RunControl};
 use super::energy::{EnergyAudit, EnergyMeter};
 use super::integrator::{
-    Integrator, IntegratorError, IntegratorSettings, IntegratorStats, InteriorStage,
+    Integrator, IntegratorError, IntegratorSettings, IntegratorState, IntegratorStats,
+    InteriorStage,
 };
 use super::system::{MultibodySystem, Workspace};
+use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Limits beyond which a run is declared diverged.
@@ -68,6 +73,37 @@ pub enum SimError {
         /// Simulated time reached, s.
         time_s: f64,
     },
+    /// Stopped at an accepted step because a checkpoint was requested: the state to resume
+    /// from with [`simulate_from`].
+    #[error("checkpointed at t = {:.6} s", .0.time_s)]
+    Checkpointed(Box<EngineCheckpoint>),
+    /// The checkpoint given to [`simulate_from`] does not belong to this system or span.
+    #[error("checkpoint does not fit the run: {0}")]
+    BadCheckpoint(String),
+}
+
+/// The run loop's state at an accepted-step boundary: time, state vector, the integrator's
+/// carried state ([`IntegratorState`]), the contact overlaps kept for the next step (their
+/// reuse depends on when each was computed) and the energy account so far. The system itself
+/// is rebuilt from the case.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EngineCheckpoint {
+    /// Simulated time of the boundary, s.
+    pub time_s: f64,
+    /// Start of the run, s.
+    pub start_time_s: f64,
+    /// End of the run, s.
+    pub end_time_s: f64,
+    /// State at `time_s`.
+    pub state: Vec<f64>,
+    /// Integrator state.
+    pub integrator: IntegratorState,
+    /// Contact overlaps kept on their pieces for the next step.
+    pub geometry: GeometryCache,
+    /// Energy account so far.
+    pub energy: EnergyMeter,
+    /// Wall-clock time spent before the checkpoint, s.
+    pub wall_s: f64,
 }
 
 /// Summary of a finished run.
@@ -93,6 +129,26 @@ pub fn simulate(
     control: &RunControl,
     observer: &mut dyn FnMut(&StepView),
 ) -> Result<RunStats, SimError> {
+    simulate_from(
+        system, y, t0, t_end, settings, limits, control, observer, None,
+    )
+}
+
+/// [`simulate`], or with `resume` its continuation from a checkpoint of the same system,
+/// span and settings: the observer then sees the steps after the checkpoint, and the result
+/// (states, steps, counters, energy account) is that of the uninterrupted run bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_from(
+    system: &MultibodySystem,
+    y: &mut [f64],
+    t0: f64,
+    t_end: f64,
+    settings: IntegratorSettings,
+    limits: DivergenceLimits,
+    control: &RunControl,
+    observer: &mut dyn FnMut(&StepView),
+    resume: Option<EngineCheckpoint>,
+) -> Result<RunStats, SimError> {
     let start = Instant::now();
     let mut integ = Integrator::new(system, settings);
     let mut ws = system.workspace();
@@ -100,24 +156,68 @@ pub fn simulate(
     // tracks are those of the step, with no second overlap computation.
     ws.keep_tracks = true;
     let mut tracks: Vec<TrackState> = Vec::with_capacity(16);
-    let mut last_good = y.to_vec();
     let mut t = t0;
     let mut last_progress = Instant::now();
     let mut meter = EnergyMeter::new(system.contacts.iter().map(|c| c.name.clone()).collect());
-    // One evaluation at the start: its tracks, stored energy and powers open the account.
-    let mut dy = vec![0.0; y.len()];
-    system.derivative(t, y, &mut dy, &mut ws);
-    std::mem::swap(&mut tracks, &mut ws.tracks);
-    record_energy(system, &mut meter, t, y, &mut ws, &tracks, None);
-    observer(&StepView {
-        t_prev: t,
-        t,
-        state: y,
-        tracks: &tracks,
-        system,
-    });
+    let mut wall_before = 0.0;
+    if let Some(cp) = resume {
+        if cp.state.len() != y.len() || cp.start_time_s != t0 || cp.end_time_s != t_end {
+            return Err(SimError::BadCheckpoint(format!(
+                "{} state entries over [{}, {}] s, the run has {} over [{t0}, {t_end}] s",
+                cp.state.len(),
+                cp.start_time_s,
+                cp.end_time_s,
+                y.len()
+            )));
+        }
+        if !(t0..=t_end).contains(&cp.time_s) {
+            return Err(SimError::BadCheckpoint(format!(
+                "time {} s outside the run",
+                cp.time_s
+            )));
+        }
+        integ
+            .restore_state(cp.integrator)
+            .map_err(|e| SimError::BadCheckpoint(e.to_string()))?;
+        y.copy_from_slice(&cp.state);
+        t = cp.time_s;
+        ws.geometry = cp.geometry;
+        meter = cp.energy;
+        wall_before = cp.wall_s;
+        (control.progress)(Progress {
+            simulated_time_s: t,
+            end_time_s: t_end,
+            fraction: ((t - t0) / (t_end - t0)).clamp(0.0, 1.0),
+        });
+    } else {
+        // One evaluation at the start: its tracks, stored energy and powers open the account.
+        let mut dy = vec![0.0; y.len()];
+        system.derivative(t, y, &mut dy, &mut ws);
+        std::mem::swap(&mut tracks, &mut ws.tracks);
+        record_energy(system, &mut meter, t, y, &mut ws, &tracks, None);
+        observer(&StepView {
+            t_prev: t,
+            t,
+            state: y,
+            tracks: &tracks,
+            system,
+        });
+    }
+    let mut last_good = y.to_vec();
     while t < t_end {
         if control.is_cancelled() {
+            if control.checkpoint_requested() {
+                return Err(SimError::Checkpointed(Box::new(EngineCheckpoint {
+                    time_s: t,
+                    start_time_s: t0,
+                    end_time_s: t_end,
+                    state: y.to_vec(),
+                    integrator: integ.save_state(),
+                    geometry: ws.geometry.clone(),
+                    energy: meter,
+                    wall_s: wall_before + start.elapsed().as_secs_f64(),
+                })));
+            }
             return Err(SimError::Cancelled { time_s: t });
         }
         let t_prev = t;
@@ -198,7 +298,7 @@ pub fn simulate(
     });
     Ok(RunStats {
         integrator: integ.stats,
-        wall_s: start.elapsed().as_secs_f64(),
+        wall_s: wall_before + start.elapsed().as_secs_f64(),
         energy: Some(meter.audit()),
     })
 }

@@ -52,7 +52,7 @@ pub struct Workspace {
 
 /// The stored elastic energy and the power terms of one derivative evaluation, for the energy
 /// account `E_mech + W_dissipated - W_drive - W_applied = E_mech(0)` (SPEC §2).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PowerBalance {
     /// Elastic energy stored in contacts and force elements, J.
     pub elastic_energy: f64,

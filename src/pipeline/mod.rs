@@ -48,6 +48,10 @@ pub enum RunError {
     /// Cancelled through [`RunControl::cancel`].
     #[error("cancelled")]
     Cancelled,
+    /// Stopped with a checkpoint ([`RunControl::request_checkpoint`]): handing its bytes to
+    /// the same computation again resumes it (`models::case::run_case_from`).
+    #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
+    Checkpointed(Box<crate::models::checkpoint::Checkpoint>),
 }
 
 fn invalid(field: &str, rule: impl Into<String>) -> RunError {

@@ -5,7 +5,6 @@ use super::{
     check_keys, design_rattle_space, invalid, merge_json, replica_seed, resolve_case, Progress,
     RunControl, RunError, SweepRange, SWEEP_KEYS,
 };
-use crate::models::case::run_case;
 use crate::models::specs::CaseSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -360,6 +359,19 @@ pub fn sweep_point(
     configs_dir: &Path,
     control: &RunControl,
 ) -> Result<SweepPoint, RunError> {
+    sweep_point_from(plan, index, replica, configs_dir, control, None)
+}
+
+/// [`sweep_point`] resuming from `resume`, a checkpoint of this point's run
+/// (`RunError::Checkpointed`), as a simulate job does.
+pub fn sweep_point_from(
+    plan: &SweepPlan,
+    index: usize,
+    replica: usize,
+    configs_dir: &Path,
+    control: &RunControl,
+    resume: Option<&[u8]>,
+) -> Result<SweepPoint, RunError> {
     let offset_mm = *plan
         .offsets_mm
         .get(index)
@@ -378,7 +390,7 @@ pub fn sweep_point(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = run_case(&case, configs_dir, control)?;
+    let (report, _) = crate::models::case::run_case_from(&case, configs_dir, control, resume)?;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()
@@ -456,16 +468,17 @@ pub fn run_sweep(
             }
             let done = plan.run_index(i, j) as f64;
             let outer = control.progress.clone();
-            let sub = RunControl {
-                cancel: control.cancel.clone(),
-                progress: Arc::new(move |pr: Progress| {
+            // A sequential sweep keeps no checkpoint: a request stops it as cancelled.
+            let sub = RunControl::new(
+                control.cancel.clone(),
+                Arc::new(move |pr: Progress| {
                     outer(Progress {
                         simulated_time_s: pr.simulated_time_s,
                         end_time_s: pr.end_time_s,
                         fraction: (done + pr.fraction) / total,
                     })
                 }),
-            };
+            );
             runs.push(sweep_point(plan, i, j, configs_dir, &sub)?);
         }
     }

@@ -268,6 +268,25 @@ macro_rules! portable_store_methods {
         ) -> $crate::store::StoreFuture<'_, bool> {
             Box::pin(<$shared>::revoke_token(&self.pool, id, now_ms))
         }
+
+        fn save_checkpoint(
+            &self,
+            id: ::uuid::Uuid,
+            attempt: i64,
+            checkpoint: $crate::store::NewCheckpoint,
+            now_ms: i64,
+        ) -> $crate::store::StoreFuture<'_, bool> {
+            Box::pin(<$shared>::save_checkpoint(
+                &self.pool, id, attempt, checkpoint, now_ms,
+            ))
+        }
+
+        fn load_checkpoint(
+            &self,
+            id: ::uuid::Uuid,
+        ) -> $crate::store::StoreFuture<'_, Option<$crate::store::JobCheckpoint>> {
+            Box::pin(<$shared>::load_checkpoint(&self.pool, id))
+        }
     };
 }
 pub(crate) use portable_store_methods;

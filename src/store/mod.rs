@@ -218,7 +218,7 @@ pub fn child_failure_message(
 
 /// One attempt of a job: written at the claim and at the attempt's end, in the same
 /// transactions as the job row, so it shows every write that took effect.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AttemptRecord {
     pub attempt: i64,
     /// Lease owner: `<host>-<pid>-<n>` for `railwear worker`.
@@ -226,6 +226,55 @@ pub struct AttemptRecord {
     pub started_ms: i64,
     pub ended_ms: Option<i64>,
     pub outcome: AttemptOutcome,
+    /// Simulated time of the checkpoint the attempt stored before it was released, s.
+    pub checkpoint_s: Option<f64>,
+}
+
+/// A checkpoint to store ([`Store::save_checkpoint`]).
+#[derive(Clone, PartialEq)]
+pub struct NewCheckpoint {
+    /// Simulated time of the checkpoint, s.
+    pub simulated_s: f64,
+    /// End of the run it belongs to, s.
+    pub end_s: f64,
+    /// The encoded checkpoint (`models::checkpoint`).
+    pub data: Vec<u8>,
+}
+
+/// A job's stored checkpoint ([`Store::load_checkpoint`]), read as the row it is.
+#[derive(Clone, PartialEq, sqlx::FromRow)]
+pub struct JobCheckpoint {
+    /// The attempt that stored it.
+    pub attempt: i64,
+    /// Simulated time of the checkpoint, s.
+    pub simulated_s: f64,
+    /// End of the run it belongs to, s.
+    pub end_s: f64,
+    pub created_ms: i64,
+    /// The encoded checkpoint.
+    pub data: Vec<u8>,
+}
+
+impl std::fmt::Debug for NewCheckpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NewCheckpoint")
+            .field("simulated_s", &self.simulated_s)
+            .field("end_s", &self.end_s)
+            .field("bytes", &self.data.len())
+            .finish()
+    }
+}
+
+impl std::fmt::Debug for JobCheckpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JobCheckpoint")
+            .field("attempt", &self.attempt)
+            .field("simulated_s", &self.simulated_s)
+            .field("end_s", &self.end_s)
+            .field("created_ms", &self.created_ms)
+            .field("bytes", &self.data.len())
+            .finish()
+    }
 }
 
 /// Where a worker process runs, recorded with each claim so that a worker starting on the same
@@ -597,6 +646,21 @@ pub trait Store: Send + Sync {
     fn find_token(&self, token_sha256: &str) -> StoreFuture<'_, Option<TokenRecord>>;
     fn list_tokens(&self) -> StoreFuture<'_, Vec<TokenRecord>>;
     fn revoke_token(&self, id: Uuid, now_ms: i64) -> StoreFuture<'_, bool>;
+
+    // Checkpoints (issue 17, migration 0007).
+    /// Store `checkpoint` for job `id` (replacing an older one) only while attempt `attempt`
+    /// holds the running lease; in the same transaction the attempt records the checkpoint's
+    /// time and the job's progress moves to it. False when the attempt is stale (nothing
+    /// written). The checkpoint is deleted when the job ends.
+    fn save_checkpoint(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        checkpoint: NewCheckpoint,
+        now_ms: i64,
+    ) -> StoreFuture<'_, bool>;
+    /// The job's stored checkpoint, if any.
+    fn load_checkpoint(&self, id: Uuid) -> StoreFuture<'_, Option<JobCheckpoint>>;
 }
 
 /// Open the store named by `database_url` and apply migrations.

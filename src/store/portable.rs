@@ -22,8 +22,9 @@ use super::rows::{
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, CampaignInsert, CampaignRecord,
     CampaignSummary, ChildRecord, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish,
-    Heartbeat, HostLease, JobFilter, MeasurementRecord, NewCampaign, NewMeasurement, Page,
-    PageRequest, PublishOutcome, RailRecord, ReleaseOutcome, StoreError, TokenRecord, TrackBlock,
+    Heartbeat, HostLease, JobCheckpoint, JobFilter, MeasurementRecord, NewCampaign, NewCheckpoint,
+    NewMeasurement, Page, PageRequest, PublishOutcome, RailRecord, ReleaseOutcome, StoreError,
+    TokenRecord, TrackBlock,
 };
 use crate::config::Role;
 use sqlx::query::QueryAs;
@@ -50,6 +51,7 @@ where
     TokenRow: for<'r> FromRow<'r, DB::Row>,
     CampaignRow: for<'r> FromRow<'r, DB::Row>,
     CampaignContentRow: for<'r> FromRow<'r, DB::Row>,
+    JobCheckpoint: for<'r> FromRow<'r, DB::Row>,
     for<'c> &'c mut DB::Connection: Executor<'c, Database = DB>,
     for<'q> DB::Arguments<'q>: IntoArguments<'q, DB>,
     for<'q> bool: Encode<'q, DB> + Decode<'q, DB> + Type<DB>,
@@ -347,8 +349,8 @@ where
         id: Uuid,
     ) -> Result<Vec<AttemptRecord>, StoreError> {
         let rows: Vec<AttemptRow> = sqlx::query_as(
-            "SELECT attempt, worker, started_ms, ended_ms, outcome FROM job_attempts \
-             WHERE job_id = $1 ORDER BY attempt",
+            "SELECT attempt, worker, started_ms, ended_ms, outcome, checkpoint_s \
+             FROM job_attempts WHERE job_id = $1 ORDER BY attempt",
         )
         .bind(DbUuid(id))
         .fetch_all(pool)
@@ -737,5 +739,70 @@ where
         .fetch_optional(pool)
         .await?;
         Ok(revoked.is_some())
+    }
+
+    /// Stores `checkpoint` while `attempt` holds the running lease (fenced by the attempt, as
+    /// every worker write); in the same transaction progress moves to its time and the attempt
+    /// records it. False, with nothing written, for a stale attempt.
+    pub(crate) async fn save_checkpoint(
+        pool: &Pool<DB>,
+        id: Uuid,
+        attempt: i64,
+        checkpoint: NewCheckpoint,
+        now_ms: i64,
+    ) -> Result<bool, StoreError> {
+        let mut tx = Self::begin_write(pool).await?;
+        let owned: Option<(i64,)> = sqlx::query_as(
+            "UPDATE jobs SET progress_simulated_s = $3, progress_end_s = $4, \
+             progress_fraction = CASE WHEN $4 > 0 THEN $3 / $4 ELSE progress_fraction END \
+             WHERE id = $1 AND attempt = $2 AND status = 'running' RETURNING seq",
+        )
+        .bind(DbUuid(id))
+        .bind(attempt)
+        .bind(checkpoint.simulated_s)
+        .bind(checkpoint.end_s)
+        .fetch_optional(&mut *tx)
+        .await?;
+        if owned.is_none() {
+            tx.rollback().await?;
+            return Ok(false);
+        }
+        sqlx::query(
+            "INSERT INTO job_checkpoints (job_id, attempt, simulated_s, end_s, created_ms, data) \
+             VALUES ($1, $2, $3, $4, $5, $6) \
+             ON CONFLICT (job_id) DO UPDATE SET attempt = excluded.attempt, \
+             simulated_s = excluded.simulated_s, end_s = excluded.end_s, \
+             created_ms = excluded.created_ms, data = excluded.data",
+        )
+        .bind(DbUuid(id))
+        .bind(attempt)
+        .bind(checkpoint.simulated_s)
+        .bind(checkpoint.end_s)
+        .bind(now_ms)
+        .bind(checkpoint.data)
+        .execute(&mut *tx)
+        .await?;
+        sqlx::query("UPDATE job_attempts SET checkpoint_s = $3 WHERE job_id = $1 AND attempt = $2")
+            .bind(DbUuid(id))
+            .bind(attempt)
+            .bind(checkpoint.simulated_s)
+            .execute(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok(true)
+    }
+
+    /// The job's stored checkpoint, if any.
+    pub(crate) async fn load_checkpoint(
+        pool: &Pool<DB>,
+        id: Uuid,
+    ) -> Result<Option<JobCheckpoint>, StoreError> {
+        Ok(sqlx::query_as(
+            "SELECT attempt, simulated_s, end_s, created_ms, data FROM job_checkpoints \
+             WHERE job_id = $1",
+        )
+        .bind(DbUuid(id))
+        .fetch_optional(pool)
+        .await?)
     }
 }

@@ -327,6 +327,7 @@ pub(crate) struct AttemptRow {
     started_ms: i64,
     ended_ms: Option<i64>,
     outcome: String,
+    checkpoint_s: Option<f64>,
 }
 
 impl TryFrom<AttemptRow> for AttemptRecord {
@@ -341,6 +342,7 @@ impl TryFrom<AttemptRow> for AttemptRecord {
             ended_ms: row.ended_ms,
             outcome: AttemptOutcome::parse(outcome)
                 .ok_or_else(|| corrupt(format!("attempt outcome `{outcome}`")))?,
+            checkpoint_s: row.checkpoint_s,
         })
     }
 }

@@ -96,7 +96,7 @@ impl WearTotals {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 struct Point {
     time_s: f64,
     rate_m3_s: f64,
@@ -106,14 +106,31 @@ struct Point {
     in_contact: bool,
 }
 
-/// Integrates one contact track sample by sample.
-#[derive(Debug, Clone)]
+/// Integrates one contact track sample by sample (serializable: part of a run's checkpoint).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct WearAccumulator {
+    #[serde(with = "law_as_json")]
     law: WearLaw,
     quadrature: Quadrature,
     cutoff_pressure_pa: f64,
     prev: Option<Point>,
     totals: WearTotals,
+}
+
+/// The law as its JSON text inside a checkpoint: [`WearLaw`] is an internally tagged enum,
+/// which only self-describing formats read back (the checkpoint's bincode is not).
+mod law_as_json {
+    use super::WearLaw;
+    use serde::{de::Error as _, ser::Error as _, Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(law: &WearLaw, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(law).map_err(S::Error::custom)?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WearLaw, D::Error> {
+        let text = String::deserialize(d)?;
+        serde_json::from_str(&text).map_err(D::Error::custom)
+    }
 }
 
 impl WearAccumulator {

@@ -16,12 +16,12 @@ pub(crate) fn budget_control(
     let cancel = Arc::new(AtomicBool::new(false));
     let reached = Arc::new(AtomicU64::new(0f64.to_bits()));
     let r2 = reached.clone();
-    let control = RunControl {
-        cancel: cancel.clone(),
-        progress: Arc::new(move |p: Progress| {
+    let control = RunControl::new(
+        cancel.clone(),
+        Arc::new(move |p: Progress| {
             r2.store(p.simulated_time_s.to_bits(), Ordering::Relaxed);
         }),
-    };
+    );
     let (tx, rx) = mpsc::channel::<()>();
     let c2 = cancel.clone();
     let watchdog = std::thread::spawn(move || {

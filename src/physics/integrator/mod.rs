@@ -30,18 +30,21 @@
 //! Files: `settings.rs` (method, tolerances, Newton and patch choices, counters, errors),
 //! `methods.rs` (the tableaus and one attempt of each method), `newton.rs` (the stage
 //! equations' Newton iteration), `jacobian.rs` (Newton matrix: finite-difference and
-//! contact-aware parts, factorisation), `diagnostics.rs` (where the steps go); this file holds
+//! contact-aware parts, factorisation), `diagnostics.rs` (where the steps go), `checkpoint.rs`
+//! (what carries over between steps, for a run's checkpoint); this file holds
 //! the integrator's state and the step control.
 
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
 
+mod checkpoint;
 mod diagnostics;
 mod jacobian;
 mod methods;
 mod newton;
 mod settings;
 
+pub use checkpoint::{IntegratorState, RestoreError};
 pub use diagnostics::{StepDiagnostics, STEP_DECADES};
 pub use settings::{
     ContactPatches, ErrorControl, IntegratorError, IntegratorKind, IntegratorSettings,
@@ -160,7 +163,7 @@ pub struct Integrator {
 /// energy account integrates each power as `h (w0 P(t) + w1 P(stage) + w2 P(t + h))`, the
 /// weights with which the method advanced the state itself (TR-BDF2: `(√2/4, √2/4, 1 − √2/2)`),
 /// so the works follow the same quadrature as the momenta.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct InteriorStage {
     /// Weights of the start, the stage and the end (sum 1).
     pub weights: [f64; 3],

@@ -1,0 +1,183 @@
+//! A case's run stopped mid-way and stored as bytes, to be finished later, possibly by another
+//! process (issue 17: graceful shutdown).
+//!
+//! The bytes are a zlib stream of bincode values: first the format version alone, then the
+//! header (code version, the case's identity, simulated time), then the
+//! [`ModelCheckpoint`]. A reader checks the format and the header before it reads the body,
+//! so a checkpoint from another format, code version or case is refused with a reason and the
+//! run restarts from t = 0; it is never resumed into a different run. Bincode rather than
+//! JSON: serde_json writes non-finite numbers as `null` and cannot read them back, and a run
+//! carries some (the infinite pressure of a zero-area track sample, Archard's infinite
+//! cutoff); bincode writes every `f64` as its eight bytes, so the round trip is exact by
+//! construction. zlib (flate2, already used for the stored tracks) shrinks the recorded track
+//! samples the checkpoint carries.
+//!
+//! What is rebuilt rather than stored: the model (geometry, bodies, contacts, the excitation
+//! signal from its seed) and the run options, all from the case.
+
+use super::case::{resolve_excitation, CODE_VERSION};
+use super::run::{BuiltModel, ModelCheckpoint};
+use super::specs::CaseSpec;
+use bincode::Options;
+use flate2::read::ZlibDecoder;
+use flate2::write::ZlibEncoder;
+use flate2::Compression;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::io::Write;
+use std::path::Path;
+
+/// Version of the checkpoint layout; bump it whenever a checkpointed type changes shape.
+pub const CHECKPOINT_FORMAT: u32 = 1;
+
+/// Largest checkpoint decoded, bytes (after decompression): a guard against a corrupt length.
+const MAX_DECODED_BYTES: u64 = 4 << 30;
+
+fn codec() -> impl Options {
+    bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .with_little_endian()
+        .with_limit(MAX_DECODED_BYTES)
+}
+
+/// A stored checkpoint: its bytes and where it stands.
+#[derive(Clone, PartialEq)]
+pub struct Checkpoint {
+    /// Simulated time of the run in progress, s.
+    pub simulated_time_s: f64,
+    /// End of that run, s.
+    pub end_time_s: f64,
+    /// The encoded checkpoint.
+    pub bytes: Vec<u8>,
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("simulated_time_s", &self.simulated_time_s)
+            .field("end_time_s", &self.end_time_s)
+            .field("bytes", &self.bytes.len())
+            .finish()
+    }
+}
+
+/// What a checkpoint must match to be resumed: the code version and the SHA-256 of the case
+/// (its canonical JSON, the resolved excitation, which may come from a named profile file,
+/// and the model's initial state).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunIdentity {
+    /// [`CODE_VERSION`] of the writer.
+    pub code_version: String,
+    /// Hex SHA-256 of the case.
+    pub case_sha256: String,
+}
+
+impl RunIdentity {
+    /// The identity of `case` built as `model` by this code.
+    pub fn of(case: &CaseSpec, model: &BuiltModel, configs_dir: &Path) -> Self {
+        let mut hash = Sha256::new();
+        hash.update(serde_json::to_string(case).unwrap_or_default().as_bytes());
+        hash.update([0]);
+        let excitation = resolve_excitation(case, configs_dir)
+            .ok()
+            .and_then(|e| serde_json::to_string(&e).ok())
+            .unwrap_or_default();
+        hash.update(excitation.as_bytes());
+        hash.update([0]);
+        for x in &model.initial_state {
+            hash.update(x.to_le_bytes());
+        }
+        hash.update(model.end_time_s.to_le_bytes());
+        Self {
+            code_version: CODE_VERSION.to_string(),
+            case_sha256: hash.finalize().iter().map(|b| format!("{b:02x}")).collect(),
+        }
+    }
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+struct Header {
+    identity: RunIdentity,
+    simulated_time_s: f64,
+    end_time_s: f64,
+    finished_parts: u64,
+}
+
+/// Why a checkpoint was not resumed (the run restarts from t = 0).
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    /// Written in another layout.
+    #[error("checkpoint format {found}, this code reads format {CHECKPOINT_FORMAT}")]
+    Format { found: u32 },
+    /// Written by another code version.
+    #[error("checkpoint of code version {found}, this is {CODE_VERSION}")]
+    CodeVersion { found: String },
+    /// Written for another case.
+    #[error("checkpoint of another case (SHA-256 {found}, this case {expected})")]
+    Case { found: String, expected: String },
+    /// Unreadable.
+    #[error("unreadable checkpoint: {0}")]
+    Decode(String),
+    /// Could not be written.
+    #[error("checkpoint could not be encoded: {0}")]
+    Encode(String),
+}
+
+/// Encodes the checkpoint of the run identified by `identity`.
+pub fn encode(identity: &RunIdentity, cp: &ModelCheckpoint) -> Result<Checkpoint, CheckpointError> {
+    let header = Header {
+        identity: identity.clone(),
+        simulated_time_s: cp.time_s(),
+        end_time_s: cp.end_time_s(),
+        finished_parts: cp.finished_parts() as u64,
+    };
+    let enc = |e: bincode::Error| CheckpointError::Encode(e.to_string());
+    let mut z = ZlibEncoder::new(Vec::new(), Compression::fast());
+    codec()
+        .serialize_into(&mut z, &CHECKPOINT_FORMAT)
+        .map_err(enc)?;
+    codec().serialize_into(&mut z, &header).map_err(enc)?;
+    codec().serialize_into(&mut z, cp).map_err(enc)?;
+    z.flush()
+        .map_err(|e| CheckpointError::Encode(e.to_string()))?;
+    let bytes = z
+        .finish()
+        .map_err(|e| CheckpointError::Encode(e.to_string()))?;
+    Ok(Checkpoint {
+        simulated_time_s: header.simulated_time_s,
+        end_time_s: header.end_time_s,
+        bytes,
+    })
+}
+
+/// Decodes a checkpoint for the run identified by `expected`: the format, code version and
+/// case are checked before the body is read.
+pub fn decode(bytes: &[u8], expected: &RunIdentity) -> Result<ModelCheckpoint, CheckpointError> {
+    let dec = |e: bincode::Error| CheckpointError::Decode(e.to_string());
+    let mut z = ZlibDecoder::new(bytes);
+    let format: u32 = codec().deserialize_from(&mut z).map_err(dec)?;
+    if format != CHECKPOINT_FORMAT {
+        return Err(CheckpointError::Format { found: format });
+    }
+    let header: Header = codec().deserialize_from(&mut z).map_err(dec)?;
+    if header.identity.code_version != expected.code_version {
+        return Err(CheckpointError::CodeVersion {
+            found: header.identity.code_version,
+        });
+    }
+    if header.identity.case_sha256 != expected.case_sha256 {
+        return Err(CheckpointError::Case {
+            found: header.identity.case_sha256,
+            expected: expected.case_sha256.clone(),
+        });
+    }
+    let cp: ModelCheckpoint = codec().deserialize_from(&mut z).map_err(dec)?;
+    if cp.time_s().to_bits() != header.simulated_time_s.to_bits()
+        || cp.finished_parts() as u64 != header.finished_parts
+    {
+        return Err(CheckpointError::Decode(
+            "the header does not match the body".into(),
+        ));
+    }
+    Ok(cp)
+}
