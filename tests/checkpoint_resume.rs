@@ -12,8 +12,9 @@ use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
 use railwear::physics::track::TrackSample;
 use railwear::pipeline::{Progress, RunControl, RunError};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
+use std::time::Duration;
 
 fn configs() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs")
@@ -44,31 +45,30 @@ fn csv(tracks: &[TrackSample]) -> String {
     out
 }
 
-/// A control that asks for a checkpoint at its `at`-th progress report (0: before the first
-/// step). The engine reports progress every 200 ms of wall time, and on resuming at once.
-fn checkpoint_at(at: usize) -> RunControl {
-    let cancel = Arc::new(AtomicBool::new(false));
-    let checkpoint = Arc::new(AtomicBool::new(false));
-    let calls = Arc::new(AtomicUsize::new(0));
-    let (c, k) = (cancel.clone(), checkpoint.clone());
+/// A control that asks for a checkpoint at the first accepted step at or past simulated time
+/// `at_s` (0: before the first step). Progress is reported after every accepted step, so the
+/// checkpoint falls on the same step in every run, whatever the machine's speed.
+fn checkpoint_at(at_s: f64) -> RunControl {
+    let control = RunControl::silent();
+    let (c, k) = (control.cancel.clone(), control.checkpoint.clone());
     let control = RunControl {
-        cancel,
-        checkpoint,
-        progress: Arc::new(move |_: Progress| {
-            if calls.fetch_add(1, Ordering::SeqCst) + 1 == at {
+        progress: Arc::new(move |p: Progress| {
+            if p.simulated_time_s >= at_s {
                 k.store(true, Ordering::SeqCst);
                 c.store(true, Ordering::SeqCst);
             }
         }),
+        progress_interval: Duration::ZERO,
+        ..control
     };
-    if at == 0 {
+    if at_s <= 0.0 {
         control.request_checkpoint();
     }
     control
 }
 
-/// A control that asks for a checkpoint at the first progress report past `fraction` of the
-/// run (for a model run part by part, the fraction counts the finished parts).
+/// A control that asks for a checkpoint at the first accepted step past `fraction` of the run
+/// (for a model run part by part, the fraction counts the finished parts).
 fn checkpoint_past(fraction: f64) -> RunControl {
     let control = RunControl::silent();
     let (c, k) = (control.cancel.clone(), control.checkpoint.clone());
@@ -79,6 +79,7 @@ fn checkpoint_past(fraction: f64) -> RunControl {
                 c.store(true, Ordering::SeqCst);
             }
         }),
+        progress_interval: Duration::ZERO,
         ..control
     }
 }
@@ -141,10 +142,10 @@ fn stop(case: &CaseSpec, resume: Option<&[u8]>, control: &RunControl) -> (Vec<u8
     }
 }
 
-/// Interrupts `case` at the given progress reports, one after the other (each resumed from
+/// Interrupts `case` at the given simulated times, one after the other (each resumed from
 /// the previous checkpoint's bytes), then resumes to the end; also resumes each checkpoint
 /// directly to the end. Every result must equal the uninterrupted one.
-fn check_case(case: &CaseSpec, stops: &[usize]) -> Vec<f64> {
+fn check_case(case: &CaseSpec, stops: &[f64]) -> Vec<f64> {
     let (expected, resumed) = finish(case, None);
     assert_eq!(resumed, None);
     let mut resume: Option<Vec<u8>> = None;
@@ -196,7 +197,7 @@ fn rattle_box_c_resumes_bit_identically_from_checkpoints_at_several_steps() {
     // Settle 0.05 s, excited 0.25 s: the checkpoints fall before the first step, in the settle
     // or the excited window as the wall clock has it, and twice more later on.
     let case = short_case("rattle-box-c.toml", 0.05, 0.25);
-    let times = check_case(&case, &[0, 2, 2, 3]);
+    let times = check_case(&case, &[0.0, 0.04, 0.12, 0.27]);
     assert_eq!(times[0], 0.0, "asked before the first step");
     assert!(times[1] > 0.0);
 }
@@ -204,7 +205,7 @@ fn rattle_box_c_resumes_bit_identically_from_checkpoints_at_several_steps() {
 #[test]
 fn the_launcher_resumes_bit_identically_from_checkpoints() {
     let case = short_case("launcher-design.toml", 0.05, 0.4);
-    let times = check_case(&case, &[2, 3]);
+    let times = check_case(&case, &[0.1, 0.3]);
     assert!(times[0] > 0.0);
 }
 
@@ -212,7 +213,7 @@ fn the_launcher_resumes_bit_identically_from_checkpoints() {
 fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     let dir = configs();
     let case = short_case("rattle-box-c.toml", 0.02, 0.4);
-    let (bytes, t) = stop(&case, None, &checkpoint_at(2));
+    let (bytes, t) = stop(&case, None, &checkpoint_at(0.1));
     assert!(t > 0.0);
     let model = build(&case, &dir).expect("model");
     let identity = RunIdentity::of(&case, &model, &dir);
@@ -281,7 +282,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
 fn the_checkpoint_bytes_round_trip() {
     let dir = configs();
     let case = short_case("rattle-box-c.toml", 0.02, 0.4);
-    let (bytes, _) = stop(&case, None, &checkpoint_at(2));
+    let (bytes, _) = stop(&case, None, &checkpoint_at(0.1));
     let model = build(&case, Path::new(&dir)).expect("model");
     let identity = RunIdentity::of(&case, &model, &dir);
     let decoded = checkpoint::decode(&bytes, &identity).expect("decode");

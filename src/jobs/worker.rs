@@ -141,6 +141,7 @@ impl Jobs {
         let latest: Arc<Mutex<Option<Progress>>> = Arc::new(Mutex::new(None));
         let sink = Arc::clone(&latest);
         let control = RunControl {
+            progress_interval: crate::physics::control::DEFAULT_PROGRESS_INTERVAL,
             cancel: Arc::clone(&cancel),
             checkpoint: Arc::clone(&checkpoint),
             progress: Arc::new(move |p: Progress| {

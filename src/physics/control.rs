@@ -26,9 +26,18 @@ pub struct RunControl {
     /// checkpoint of its state instead of a cancellation: a simulation returns it at its next
     /// accepted step. A computation that cannot checkpoint sees only `cancel`.
     pub checkpoint: Arc<AtomicBool>,
-    /// Called from the simulation thread, at most a few times per second.
+    /// Called from the simulation thread: at the start, after an accepted step once
+    /// `progress_interval` of wall time has passed since the last call, and at the end.
     pub progress: Arc<dyn Fn(Progress) + Send + Sync>,
+    /// Least wall time between two progress calls ([`DEFAULT_PROGRESS_INTERVAL`]). Zero calls
+    /// the sink after every accepted step, so a sink that acts on the simulated time acts at
+    /// the same step in every run (deterministic tests of checkpoints).
+    pub progress_interval: std::time::Duration,
 }
+
+/// Wall time between progress calls of a [`RunControl::new`] control: 200 ms, a few
+/// heartbeats per second without measurable cost.
+pub const DEFAULT_PROGRESS_INTERVAL: std::time::Duration = std::time::Duration::from_millis(200);
 
 impl RunControl {
     /// A control with this cancel flag and progress sink and no checkpoint request.
@@ -37,6 +46,7 @@ impl RunControl {
             cancel,
             checkpoint: Arc::new(AtomicBool::new(false)),
             progress,
+            progress_interval: DEFAULT_PROGRESS_INTERVAL,
         }
     }
 
@@ -67,6 +77,9 @@ impl RunControl {
     /// The same cancel flag and progress sink without the checkpoint request: for runs whose
     /// caller cannot keep a checkpoint (a request then stops them as a cancellation).
     pub fn without_checkpoint(&self) -> Self {
-        Self::new(self.cancel.clone(), self.progress.clone())
+        Self {
+            progress_interval: self.progress_interval,
+            ..Self::new(self.cancel.clone(), self.progress.clone())
+        }
     }
 }

@@ -15,7 +15,7 @@ use super::integrator::{
 };
 use super::system::{MultibodySystem, Workspace};
 use serde::{Deserialize, Serialize};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Limits beyond which a run is declared diverged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -282,7 +282,7 @@ pub fn simulate_from(
             system,
         });
         last_good.copy_from_slice(y);
-        if last_progress.elapsed() > Duration::from_millis(200) {
+        if last_progress.elapsed() >= control.progress_interval {
             last_progress = Instant::now();
             (control.progress)(Progress {
                 simulated_time_s: t,
