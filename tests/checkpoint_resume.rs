@@ -5,7 +5,7 @@
 //! excited window, twice in a row). A checkpoint of another case, code version or format is
 //! not resumed: the run restarts from t = 0 (and gives that case's own result).
 
-use railwear::models::case::{build, load_case, run_case_from, CODE_VERSION};
+use railwear::models::case::{build, code_version, load_case, run_case_from};
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
 use railwear::models::specs::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
@@ -217,7 +217,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     assert!(t > 0.0);
     let model = build(&case, &dir).expect("model");
     let identity = RunIdentity::of(&case, &model, &dir);
-    assert_eq!(identity.code_version, CODE_VERSION);
+    assert_eq!(identity.code_version, code_version());
     let decoded = checkpoint::decode(&bytes, &identity).expect("its own checkpoint decodes");
     assert_eq!(decoded.time_s(), t);
 
@@ -239,7 +239,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     // Another code version.
     let foreign = checkpoint::encode(
         &RunIdentity {
-            code_version: format!("{CODE_VERSION}-other"),
+            code_version: format!("{}-other", code_version()),
             ..identity.clone()
         },
         &decoded,

@@ -135,12 +135,13 @@ async fn dashboard_shows_a_job_reach_success() {
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
-        // 40 steps of 100 ms: long enough to be seen queued/running before it succeeds.
-        let body = r#"{"kind":"simulate","params":{"steps":40,"step_ms":100,"samples":50}}"#;
-        let id = submit_job(&base, body);
-
+        // The page is open before the job is submitted (a browser can take seconds to start on
+        // a loaded machine), and the job runs 40 steps of 100 ms: several of the page's 1 s
+        // polls see it queued or running before it succeeds.
         let driver = Driver::start(&chromium, &chromedriver);
         driver.goto(&format!("{base}/#token={ENGINEER}"));
+        let body = r#"{"kind":"simulate","params":{"steps":40,"step_ms":100,"samples":50}}"#;
+        let id = submit_job(&base, body);
         let row_status = format!(
             "const r = document.getElementById('job-{id}'); return r ? r.dataset.status : null;"
         );

@@ -369,7 +369,7 @@ pub fn run_cached(
         accelerometer_rate_hz: options.accelerometer_rate_hz,
         sensor_noise_m_s2: options.sensor_noise_m_s2,
         tests: truth_tests,
-        code_version: crate::models::case::CODE_VERSION.to_string(),
+        code_version: crate::models::case::code_version().to_string(),
     };
     Ok((out, truth))
 }

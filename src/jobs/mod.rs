@@ -22,15 +22,7 @@ use std::time::Duration;
 use tokio::sync::Notify;
 use uuid::Uuid;
 
-/// Version of the code that accepts and runs jobs: `CARGO_PKG_VERSION`, plus `+<git hash>` when
-/// `RAILWEAR_GIT_HASH` was set at build time (`.ci/run` and the Dockerfile set it).
-pub fn code_version() -> String {
-    let version = env!("CARGO_PKG_VERSION");
-    match option_env!("RAILWEAR_GIT_HASH") {
-        Some(hash) if !hash.is_empty() => format!("{version}+{hash}"),
-        _ => version.to_string(),
-    }
-}
+pub use crate::models::case::code_version;
 
 /// Key of a penalization curve: vehicle profile, environment and wear law.
 pub fn curve_key(vehicle_profile: &str, environment: &str, wear_law: &str) -> String {
@@ -349,7 +341,7 @@ impl Jobs {
                 kind,
                 params,
                 seed,
-                code_version: code_version(),
+                code_version: code_version().to_string(),
                 submitted_by: submitted_by.to_string(),
                 idempotency,
                 curve_key,

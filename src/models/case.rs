@@ -16,8 +16,20 @@ use crate::pipeline::{CaseOutcome, RunControl, RunError};
 use serde_json::{json, Value};
 use std::path::Path;
 
-/// Code version recorded with every result.
-pub const CODE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// Version of the code, the one stamp recorded with every result, job, diagnosis and
+/// checkpoint: `CARGO_PKG_VERSION`, plus `+<git hash>` when `RAILWEAR_GIT_HASH` was set at
+/// build time (`.ci/run` and the Dockerfile set it). A checkpoint resumes only in the code
+/// version that wrote it.
+pub fn code_version() -> &'static str {
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION.get_or_init(|| {
+        let version = env!("CARGO_PKG_VERSION");
+        match option_env!("RAILWEAR_GIT_HASH") {
+            Some(hash) if !hash.is_empty() => format!("{version}+{hash}"),
+            _ => version.to_string(),
+        }
+    })
+}
 
 fn invalid(field: impl Into<String>, rule: impl Into<String>) -> RunError {
     RunError::InvalidConfig {
@@ -269,7 +281,7 @@ fn package_parts(
     let summary = json!({
         "name": case.name,
         "model": case.model,
-        "code_version": CODE_VERSION,
+        "code_version": code_version(),
         "seed": case.simulation.seed,
         "config": case,
         "rattle_space": rattle_space,

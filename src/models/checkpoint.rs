@@ -15,7 +15,7 @@
 //! What is rebuilt rather than stored: the model (geometry, bodies, contacts, the excitation
 //! signal from its seed) and the run options, all from the case.
 
-use super::case::{resolve_excitation, CODE_VERSION};
+use super::case::{code_version, resolve_excitation};
 use super::run::{BuiltModel, ModelCheckpoint};
 use super::specs::CaseSpec;
 use bincode::Options;
@@ -66,7 +66,7 @@ impl std::fmt::Debug for Checkpoint {
 /// and the model's initial state).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct RunIdentity {
-    /// [`CODE_VERSION`] of the writer.
+    /// [`code_version`] of the writer.
     pub code_version: String,
     /// Hex SHA-256 of the case.
     pub case_sha256: String,
@@ -89,7 +89,7 @@ impl RunIdentity {
         }
         hash.update(model.end_time_s.to_le_bytes());
         Self {
-            code_version: CODE_VERSION.to_string(),
+            code_version: code_version().to_string(),
             case_sha256: hash.finalize().iter().map(|b| format!("{b:02x}")).collect(),
         }
     }
@@ -110,7 +110,7 @@ pub enum CheckpointError {
     #[error("checkpoint format {found}, this code reads format {CHECKPOINT_FORMAT}")]
     Format { found: u32 },
     /// Written by another code version.
-    #[error("checkpoint of code version {found}, this is {CODE_VERSION}")]
+    #[error("checkpoint of code version {found}, this is {}", code_version())]
     CodeVersion { found: String },
     /// Written for another case.
     #[error("checkpoint of another case (SHA-256 {found}, this case {expected})")]

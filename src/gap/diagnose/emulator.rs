@@ -776,7 +776,7 @@ impl Emulator {
         let text = serde_json::json!({
             "tests": tests,
             "options": options,
-            "code": crate::models::case::CODE_VERSION,
+            "code": crate::models::case::code_version(),
         })
         .to_string();
         format!("{:x}", Sha256::digest(text.as_bytes()))

@@ -753,7 +753,7 @@ pub fn diagnose_with(
                 "specimen scatter is common to a specimen's increments; that correlation is not modelled".into(),
             ],
         },
-        code_version: crate::models::case::CODE_VERSION.to_string(),
+        code_version: crate::models::case::code_version().to_string(),
     })
 }
 

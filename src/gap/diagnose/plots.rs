@@ -16,6 +16,9 @@ struct Bar {
     highlight: bool,
 }
 
+/// Estimated width of one label character, px (0.55 em of the 12 px sans-serif labels).
+const LABEL_CHAR_PX: f64 = 6.6;
+
 fn bar_chart(
     title: &str,
     axis: &str,
@@ -24,9 +27,16 @@ fn bar_chart(
     legend: Option<(&str, &str)>,
 ) -> String {
     let row = 22.0;
-    let left = 330.0;
-    let width = 900.0;
-    let plot_w = width - left - 140.0;
+    // Labels are right-aligned against the bars: the margin holds the longest one at about
+    // 0.55 em a character (12 px sans-serif), so none is cut off at the left edge.
+    let longest = bars
+        .iter()
+        .map(|b| b.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    let left = (16.0 + LABEL_CHAR_PX * longest as f64).max(120.0);
+    let plot_w = 430.0;
+    let width = left + plot_w + 140.0;
     let top = 50.0;
     let height = top + row * bars.len().max(1) as f64 + 60.0;
     let values = bars
@@ -233,4 +243,53 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
         ("ranking.svg".into(), ranking),
         ("before_after.svg".into(), before_after),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bar(label: &str) -> Bar {
+        Bar {
+            label: label.into(),
+            value: 1.0,
+            second: None,
+            note: String::new(),
+            highlight: false,
+        }
+    }
+
+    /// The x of every label's right end, and the SVG's width.
+    fn label_ends(svg: &str) -> (Vec<f64>, f64) {
+        let number = |s: &str, key: &str| -> Option<f64> {
+            let at = s.find(key)? + key.len();
+            s[at..].split('"').next()?.parse().ok()
+        };
+        let ends = svg
+            .split("<text ")
+            .filter(|t| t.contains(r#"text-anchor="end""#))
+            .filter_map(|t| number(t, "x=\""))
+            .collect();
+        (ends, number(svg, "width=\"").unwrap_or(f64::NAN))
+    }
+
+    #[test]
+    fn the_longest_label_fits_left_of_the_bars() {
+        let long = "pressure_band: 0.1-0.5 Sy and below the cutoff, case A, increment 3";
+        let svg = bar_chart("t", "x", &[bar("short"), bar(long)], &[], None);
+        let (ends, width) = label_ends(&svg);
+        assert_eq!(ends.len(), 2, "{svg}");
+        // 0.55 em a character at 12 px: the label's start stays inside the picture.
+        for end in ends {
+            assert!(
+                end - 0.55 * 12.0 * long.chars().count() as f64 >= 0.0,
+                "{end}"
+            );
+        }
+        // The plot keeps its width whatever the labels: 430 px of bars, 140 px of notes.
+        let short = bar_chart("t", "x", &[bar("a")], &[], None);
+        let (_, short_width) = label_ends(&short);
+        assert!(width > short_width);
+        assert_eq!(short_width, 120.0 + 430.0 + 140.0);
+    }
 }
