@@ -281,28 +281,7 @@ fn a_pattern_no_effect_makes_is_not_explained() {
 /// tables (not on the verdict, which needs longer windows to mean anything).
 #[test]
 fn simulated_tables_follow_the_physics_and_the_report_is_written() {
-    let text = r#"
-format_version = 1
-name = "small-diagnosis"
-[[tests]]
-id = "C"
-config = "rattle-box-c"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "C-1"
-increments = [{ mass_loss_mg = { cube = 0.004 } }, { mass_loss_mg = { cube = 0.005 } }]
-[[tests]]
-id = "D"
-config = "rattle-box-d"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "D-1"
-increments = [{ mass_loss_mg = { cube = 0.002 } }, { mass_loss_mg = { cube = 0.003 } }]
-"#;
+    let text = include_str!("fixtures/small-campaign.toml");
     let c = Campaign::from_toml_str(text, Path::new(".")).unwrap();
     let mut o = DiagnoseOptions::default();
     o.emulator.window_s = 0.25;

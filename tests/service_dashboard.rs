@@ -179,30 +179,8 @@ async fn dashboard_shows_a_job_reach_success() {
     service.stop().await;
 }
 
-/// The smallest campaign that runs a real diagnosis (as tests/service_diagnose.rs): two rattle
-/// box tests, one specimen of two increments each, cube mass only.
-const CAMPAIGN: &str = r#"
-format_version = 1
-name = "dashboard-diagnosis"
-[[tests]]
-id = "C"
-config = "rattle-box-c"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "C-1"
-increments = [{ mass_loss_mg = { cube = 0.004 } }, { mass_loss_mg = { cube = 0.005 } }]
-[[tests]]
-id = "D"
-config = "rattle-box-d"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "D-1"
-increments = [{ mass_loss_mg = { cube = 0.002 } }, { mass_loss_mg = { cube = 0.003 } }]
-"#;
+/// The smallest campaign that runs a real diagnosis (shared with tests/service_diagnose.rs).
+const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
 
 /// Sets an input's value through the page (as typing would).
 fn fill(driver: &Driver, id: &str, value: &str) {

@@ -13,28 +13,8 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-const CAMPAIGN: &str = r#"
-format_version = 1
-name = "small-diagnosis-http"
-[[tests]]
-id = "C"
-config = "rattle-box-c"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "C-1"
-increments = [{ mass_loss_mg = { cube = 0.004 } }, { mass_loss_mg = { cube = 0.005 } }]
-[[tests]]
-id = "D"
-config = "rattle-box-d"
-increment_duration_s = 5400.0
-scale_resolution_mg = 0.0001
-components = ["cube"]
-[[tests.specimens]]
-id = "D-1"
-increments = [{ mass_loss_mg = { cube = 0.002 } }, { mass_loss_mg = { cube = 0.003 } }]
-"#;
+/// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
+const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_test_engineer_diagnoses_a_campaign_over_http() {
@@ -179,7 +159,7 @@ async fn a_diagnosis_reads_its_campaign_when_it_runs() {
     let (gone, changed) = tokio::task::spawn_blocking(move || {
         let mut jobs = Vec::new();
         for name in ["to-be-deleted", "to-be-changed"] {
-            let text = CAMPAIGN.replace("small-diagnosis-http", name);
+            let text = CAMPAIGN.replace("\"small-diagnosis\"", &format!("\"{name}\""));
             let campaign = Campaign::from_toml_str(&text, Path::new(".")).expect("campaign");
             let body = serde_json::to_string(&campaign).unwrap();
             let r = curl(
