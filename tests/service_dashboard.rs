@@ -6,14 +6,12 @@
 
 mod service_support;
 
-use railwear::gap::Campaign;
-use railwear::jobs::LibraryRunner;
 use serde_json::{json, Value};
-use service_support::runner::{start, test_config};
-use service_support::{curl, submit_job, wait_for, TempDir, ENGINEER, PLANNER, TEST_ENGINEER};
-use std::path::Path;
+use service_support::runner::{start, start_library, test_config};
+use service_support::{
+    curl, submit_job, upload_campaign, wait_for, TempDir, ENGINEER, PLANNER, TEST_ENGINEER,
+};
 use std::process::{Child, Command, Stdio};
-use std::sync::Arc;
 use std::time::Duration;
 
 fn find(program: &str) -> Option<String> {
@@ -197,27 +195,10 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         return;
     };
     let dir = TempDir::new("dash-diagnose");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let service = railwear::http::start(
-        test_config(&dir.db_url()),
-        Arc::new(LibraryRunner::new(root.join("configs"))),
-        true,
-    )
-    .await
-    .expect("service starts");
+    let service = start_library(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
-        let campaign = Campaign::from_toml_str(CAMPAIGN, Path::new(".")).expect("campaign");
-        let body = serde_json::to_string(&campaign).unwrap();
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/campaigns"),
-            Some(TEST_ENGINEER),
-            &[],
-            Some(&body),
-        );
-        assert_eq!(r.status, 201, "{}", r.body);
-        let campaign_id = r.json()["id"].as_str().unwrap().to_string();
+        let campaign_id = upload_campaign(&base, CAMPAIGN);
         let driver = Driver::start(&chromium, &chromedriver);
         let row = format!("document.getElementById('campaign-{campaign_id}')");
         let buttons = format!("{row}.querySelectorAll('button.start-diagnosis').length");

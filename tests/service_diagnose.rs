@@ -5,12 +5,10 @@
 mod service_support;
 
 use railwear::gap::Campaign;
-use railwear::jobs::LibraryRunner;
 use serde_json::{json, Value};
-use service_support::runner::test_config;
-use service_support::{curl, TempDir, PLANNER, TEST_ENGINEER};
+use service_support::runner::{start_library, test_config};
+use service_support::{curl, upload_campaign, TempDir, PLANNER, TEST_ENGINEER};
 use std::path::Path;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
@@ -19,27 +17,10 @@ const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_test_engineer_diagnoses_a_campaign_over_http() {
     let dir = TempDir::new("diagnose");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let service = railwear::http::start(
-        test_config(&dir.db_url()),
-        Arc::new(LibraryRunner::new(root.join("configs"))),
-        true,
-    )
-    .await
-    .expect("service starts");
+    let service = start_library(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
-        let campaign = Campaign::from_toml_str(CAMPAIGN, Path::new(".")).expect("campaign");
-        let body = serde_json::to_string(&campaign).unwrap();
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/campaigns"),
-            Some(TEST_ENGINEER),
-            &[],
-            Some(&body),
-        );
-        assert_eq!(r.status, 201, "{}", r.body);
-        let id = r.json()["id"].as_str().unwrap().to_string();
+        let id = upload_campaign(&base, CAMPAIGN);
         let url = format!("{base}/v1/campaigns/{id}/diagnoses");
         let post = |token: &str, body: &Value| {
             curl("POST", &url, Some(token), &[], Some(&body.to_string()))
@@ -145,16 +126,9 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_diagnosis_reads_its_campaign_when_it_runs() {
     let dir = TempDir::new("diagnose-gone");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let db_url = dir.db_url();
     // No workers yet: the jobs wait in the queue while their campaigns change.
-    let service = railwear::http::start(
-        test_config(&db_url),
-        Arc::new(LibraryRunner::new(root.join("configs"))),
-        false,
-    )
-    .await
-    .expect("service starts");
+    let service = start_library(test_config(&db_url), false).await;
     let base = format!("http://{}", service.addr);
     let (gone, changed) = tokio::task::spawn_blocking(move || {
         let mut jobs = Vec::new();

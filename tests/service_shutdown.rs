@@ -8,10 +8,10 @@
 
 mod service_support;
 
-use railwear::jobs::{JobStatus, LibraryRunner};
+use railwear::jobs::JobStatus;
 use railwear::store::{AttemptOutcome, Store};
 use serde_json::Value;
-use service_support::runner::{start, test_config};
+use service_support::runner::{start, start_library, test_config};
 use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -284,14 +284,6 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     second.stop().await;
 }
 
-/// Start the service in this process with the production runner (the shipped `configs/`).
-async fn start_library(config: railwear::config::ServiceConfig) -> railwear::http::RunningService {
-    let runner = Arc::new(LibraryRunner::new(config.configs_dir.clone()));
-    railwear::http::start(config, runner, true)
-        .await
-        .expect("service starts")
-}
-
 /// Rattle box C, 50 ms settle and 1.2 s excited: a few seconds of computation.
 const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":1.2}},"seed":8}}"#;
 const SIMULATE_END_S: f64 = 1.25;
@@ -300,7 +292,7 @@ const SIMULATE_END_S: f64 = 1.25;
 async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
     // Reference: uninterrupted.
     let ref_dir = TempDir::new("checkpoint-ref");
-    let reference = start_library(test_config(&ref_dir.db_url())).await;
+    let reference = start_library(test_config(&ref_dir.db_url()), true).await;
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
         let id = submit_job(&base, SIMULATE_BODY);
@@ -320,7 +312,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     config.workers = 1;
     config.shutdown_grace_s = 5.0;
     config.lease_s = 60.0; // only the release can hand the job on this fast
-    let first = start_library(config.clone()).await;
+    let first = start_library(config.clone(), true).await;
     let store = first.state.store.clone();
     let first_jobs = first.state.jobs.clone();
     let base = format!("http://{}", first.addr);
@@ -370,7 +362,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     );
 
     // The next worker resumes: its progress starts at the checkpoint's time.
-    let second = start_library(config).await;
+    let second = start_library(config, true).await;
     let base = format!("http://{}", second.addr);
     let (got, job, first_progress) = tokio::task::spawn_blocking({
         let id = id.clone();

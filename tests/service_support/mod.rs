@@ -217,6 +217,22 @@ impl Drop for Binary {
 }
 
 /// `GET {base}{path}` as the engineer; asserts 200 and returns the JSON body.
+/// Uploads the campaign manifest `toml` (no CSV records) as a test engineer; the stored
+/// campaign's id.
+pub fn upload_campaign(base: &str, toml: &str) -> String {
+    let campaign = railwear::gap::Campaign::from_toml_str(toml, Path::new(".")).expect("campaign");
+    let body = serde_json::to_string(&campaign).expect("campaign JSON");
+    let r = curl(
+        "POST",
+        &format!("{base}/v1/campaigns"),
+        Some(TEST_ENGINEER),
+        &[],
+        Some(&body),
+    );
+    assert_eq!(r.status, 201, "{}", r.body);
+    r.json()["id"].as_str().expect("campaign id").to_string()
+}
+
 pub fn get_json(base: &str, path: &str) -> serde_json::Value {
     let r = curl("GET", &format!("{base}{path}"), Some(ENGINEER), &[], None);
     assert_eq!(r.status, 200, "{path}: {}", r.body);

@@ -274,6 +274,16 @@ pub fn test_config(db_url: &str) -> ServiceConfig {
     config
 }
 
+/// Start the service in this process with the production runner (the shipped `configs/`).
+pub async fn start_library(config: ServiceConfig, workers: bool) -> RunningService {
+    let runner = Arc::new(railwear::jobs::LibraryRunner::new(
+        config.configs_dir.clone(),
+    ));
+    railwear::http::start(config, runner, workers)
+        .await
+        .expect("service starts")
+}
+
 /// Start the service in this process with the counting runner.
 pub async fn start(config: ServiceConfig, workers: bool) -> RunningService {
     railwear::http::start(config, Arc::new(CountingRunner), workers)
