@@ -167,13 +167,10 @@ async fn postgres_releases_the_leases_of_dead_workers_of_this_host() {
     dead_leases_of_this_host_are_released_at_start_up(store).await;
 }
 
-/// `release_job` (shutdown): the job goes back to the queue with its attempt logged
-/// `released`; a stale attempt releases nothing; a job whose cancellation was requested is not
-/// released (the worker ends it as cancelled).
-async fn release_is_fenced_and_yields_to_cancellation(store: Arc<dyn Store>) {
-    use railwear::store::{Finish, NewJob, ReleaseOutcome};
-    let job = |n: u128| NewJob {
-        id: Uuid::from_u128(0xfee1_0000 + n),
+/// Simulate job number `n` of a test, its id `base + n`.
+fn numbered_job(base: u128, n: u128) -> railwear::store::NewJob {
+    railwear::store::NewJob {
+        id: Uuid::from_u128(base + n),
         kind: JobKind::Simulate,
         params: serde_json::json!({"n": n as u64}),
         seed: n as u64,
@@ -182,7 +179,15 @@ async fn release_is_fenced_and_yields_to_cancellation(store: Arc<dyn Store>) {
         idempotency: None,
         curve_key: None,
         created_ms: 1_000 + n as i64,
-    };
+    }
+}
+
+/// `release_job` (shutdown): the job goes back to the queue with its attempt logged
+/// `released`; a stale attempt releases nothing; a job whose cancellation was requested is not
+/// released (the worker ends it as cancelled).
+async fn release_is_fenced_and_yields_to_cancellation(store: Arc<dyn Store>) {
+    use railwear::store::{Finish, ReleaseOutcome};
+    let job = |n: u128| numbered_job(0xfee1_0000, n);
     store.submit_job(job(1)).await.unwrap();
     store.submit_job(job(2)).await.unwrap();
     let a = store.claim_job("w", 2_000, 60_000).await.unwrap().unwrap();
@@ -249,18 +254,8 @@ async fn postgres_release_is_fenced_and_yields_to_cancellation() {
 /// attempt, progress moved to its time), replaced by a later save, kept across the release
 /// for the next attempt, and deleted when the job ends, whichever way it ends.
 async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
-    use railwear::store::{Finish, NewCheckpoint, NewJob};
-    let job = |n: u128| NewJob {
-        id: Uuid::from_u128(0xc4ec_0000 + n),
-        kind: JobKind::Simulate,
-        params: serde_json::json!({"n": n as u64}),
-        seed: n as u64,
-        code_version: "test".into(),
-        submitted_by: "tester".into(),
-        idempotency: None,
-        curve_key: None,
-        created_ms: 1_000 + n as i64,
-    };
+    use railwear::store::{Finish, NewCheckpoint};
+    let job = |n: u128| numbered_job(0xc4ec_0000, n);
     let checkpoint = |t: f64, fill: u8| NewCheckpoint {
         simulated_s: t,
         end_s: 2.0,
