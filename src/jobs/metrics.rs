@@ -30,6 +30,13 @@ struct HttpHistogram {
 }
 
 /// A number as Prometheus text, never `-0` (an empty float sum is -0.0 in Rust).
+/// One unlabelled metric: its HELP and TYPE lines and its value.
+fn scalar(out: &mut String, name: &str, kind: &str, help: &str, value: impl std::fmt::Display) {
+    let _ = writeln!(out, "# HELP {name} {help}");
+    let _ = writeln!(out, "# TYPE {name} {kind}");
+    let _ = writeln!(out, "{name} {value}");
+}
+
 fn num(x: f64) -> f64 {
     x + 0.0
 }
@@ -234,15 +241,12 @@ impl Metrics {
                 );
                 let _ = writeln!(out, "railwear_job_duration_seconds_count{{{labels}}} {}", h.count);
             }
-            let _ = writeln!(
-                out,
-                "# HELP railwear_simulated_seconds_total Simulated time advanced by this process, s."
-            );
-            let _ = writeln!(out, "# TYPE railwear_simulated_seconds_total counter");
-            let _ = writeln!(
-                out,
-                "railwear_simulated_seconds_total {}",
-                num(m.simulated_s_total)
+            scalar(
+                &mut out,
+                "railwear_simulated_seconds_total",
+                "counter",
+                "Simulated time advanced by this process, s.",
+                num(m.simulated_s_total),
             );
             let rate = m.running.values().fold(0.0, |acc, (start, sim, from)| {
                 let wall = start.elapsed().as_secs_f64();
@@ -252,15 +256,20 @@ impl Metrics {
                     acc
                 }
             });
-            let _ = writeln!(
-                out,
-                "# HELP railwear_simulated_seconds_per_second Simulated seconds per wall second, summed over running attempts."
+            scalar(
+                &mut out,
+                "railwear_simulated_seconds_per_second",
+                "gauge",
+                "Simulated seconds per wall second, summed over running attempts.",
+                num(rate),
             );
-            let _ = writeln!(out, "# TYPE railwear_simulated_seconds_per_second gauge");
-            let _ = writeln!(out, "railwear_simulated_seconds_per_second {}", num(rate));
-            let _ = writeln!(out, "# HELP railwear_running_attempts Attempts running in this process.");
-            let _ = writeln!(out, "# TYPE railwear_running_attempts gauge");
-            let _ = writeln!(out, "railwear_running_attempts {}", m.running.len());
+            scalar(
+                &mut out,
+                "railwear_running_attempts",
+                "gauge",
+                "Attempts running in this process.",
+                m.running.len(),
+            );
             let _ = writeln!(
                 out,
                 "# HELP railwear_attempts_released_total Attempts this process gave back at shutdown, by whether they stored a checkpoint."
@@ -273,22 +282,20 @@ impl Metrics {
                     m.released[i]
                 );
             }
-            let _ = writeln!(
-                out,
-                "# HELP railwear_checkpointed_simulated_seconds_total Simulated time the checkpoints of released attempts kept (not simulated again by the next attempt), s."
+            scalar(
+                &mut out,
+                "railwear_checkpointed_simulated_seconds_total",
+                "counter",
+                "Simulated time the checkpoints of released attempts kept (not simulated again by the next attempt), s.",
+                num(m.checkpointed_s_total),
             );
-            let _ = writeln!(out, "# TYPE railwear_checkpointed_simulated_seconds_total counter");
-            let _ = writeln!(
-                out,
-                "railwear_checkpointed_simulated_seconds_total {}",
-                num(m.checkpointed_s_total)
+            scalar(
+                &mut out,
+                "railwear_attempts_resumed_total",
+                "counter",
+                "Attempts this process started from a stored checkpoint.",
+                m.resumed,
             );
-            let _ = writeln!(
-                out,
-                "# HELP railwear_attempts_resumed_total Attempts this process started from a stored checkpoint."
-            );
-            let _ = writeln!(out, "# TYPE railwear_attempts_resumed_total counter");
-            let _ = writeln!(out, "railwear_attempts_resumed_total {}", m.resumed);
             let _ = writeln!(
                 out,
                 "# HELP railwear_http_requests_total HTTP requests answered by this process, by method, route and status."
