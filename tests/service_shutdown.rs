@@ -43,8 +43,22 @@ fn results(base: &str, id: &str) -> (String, Value) {
     )
 }
 
-fn wait_status(base: &str, id: &str, status: &str) -> Value {
-    wait_for(Duration::from_secs(30), status, || {
+/// Submits `body` and waits until the job's progress passes `fraction`; the job's id.
+fn submit_until_progress(base: &str, body: &str, fraction: f64, timeout: Duration) -> String {
+    let id = submit_job(base, body);
+    wait_for(timeout, "progress", || {
+        let j = get_job(base, &id);
+        (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > fraction).then_some(())
+    });
+    id
+}
+
+/// How long the counting runner's jobs may take to reach a state, and a real simulation.
+const SHORT: Duration = Duration::from_secs(30);
+const LONG: Duration = Duration::from_secs(300);
+
+fn wait_status(base: &str, id: &str, status: &str, timeout: Duration) -> Value {
+    wait_for(timeout, status, || {
         let j = get_job(base, id);
         (j["status"] == status).then_some(j)
     })
@@ -61,7 +75,7 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
         let id = submit_job(&base, BODY);
-        wait_status(&base, &id, "succeeded");
+        wait_status(&base, &id, "succeeded", SHORT);
         results(&base, &id)
     })
     .await
@@ -76,16 +90,9 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     let first = start(config.clone(), true).await;
     let store = first.state.store.clone();
     let base = format!("http://{}", first.addr);
-    let id = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, BODY);
-        wait_for(Duration::from_secs(30), "progress", || {
-            let j = get_job(&base, &id);
-            (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.2).then_some(())
-        });
-        id
-    })
-    .await
-    .unwrap();
+    let id = tokio::task::spawn_blocking(move || submit_until_progress(&base, BODY, 0.2, SHORT))
+        .await
+        .unwrap();
     let asked = Instant::now();
     first.stop().await;
     // The runner stops at its next 50 ms step: far inside the grace.
@@ -105,7 +112,7 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     let (got, job) = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            let job = wait_status(&base, &id, "succeeded");
+            let job = wait_status(&base, &id, "succeeded", SHORT);
             (results(&base, &id), job)
         }
     })
@@ -140,7 +147,7 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
             &base,
             r#"{"kind":"simulate","params":{"steps":2,"step_ms":4000,"seed":1}}"#,
         );
-        wait_status(&base, &id, "running");
+        wait_status(&base, &id, "running", SHORT);
         id
     })
     .await
@@ -173,7 +180,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
         let id = submit_job(&base, body);
-        wait_status(&base, &id, "succeeded");
+        wait_status(&base, &id, "succeeded", SHORT);
         get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
     })
     .await
@@ -191,7 +198,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let id = tokio::task::spawn_blocking(move || {
         let id = submit_job(&base, body);
         // Stop once some points are done and others run.
-        wait_for(Duration::from_secs(30), "a point done", || {
+        wait_for(SHORT, "a point done", || {
             let j = get_job(&base, &id);
             (j["children"]["succeeded"].as_i64().unwrap_or(0) >= 2).then_some(())
         });
@@ -221,13 +228,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     );
     let mut released = 0;
     for c in &children {
-        let log: Vec<_> = store
-            .attempts(c.id)
-            .await
-            .unwrap()
-            .iter()
-            .map(|a| a.outcome)
-            .collect();
+        let log = outcomes(&store, &c.id.to_string()).await;
         released += log
             .iter()
             .filter(|o| **o == AttemptOutcome::Released)
@@ -240,7 +241,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let summary = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            wait_status(&base, &id, "succeeded");
+            wait_status(&base, &id, "succeeded", SHORT);
             get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
         }
     })
@@ -252,13 +253,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     );
     // The points finished before the shutdown were not run again; every point succeeded once.
     for c in store.children(sweep).await.unwrap() {
-        let log: Vec<_> = store
-            .attempts(c.id)
-            .await
-            .unwrap()
-            .iter()
-            .map(|a| a.outcome)
-            .collect();
+        let log = outcomes(&store, &c.id.to_string()).await;
         assert_eq!(
             log.iter()
                 .filter(|o| **o == AttemptOutcome::Succeeded)
@@ -296,10 +291,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
         let id = submit_job(&base, SIMULATE_BODY);
-        wait_for(Duration::from_secs(300), "succeeded", || {
-            let j = get_job(&base, &id);
-            (j["status"] == "succeeded").then_some(())
-        });
+        wait_status(&base, &id, "succeeded", LONG);
         results(&base, &id)
     })
     .await
@@ -317,12 +309,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     let first_jobs = first.state.jobs.clone();
     let base = format!("http://{}", first.addr);
     let id = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, SIMULATE_BODY);
-        wait_for(Duration::from_secs(300), "progress", || {
-            let j = get_job(&base, &id);
-            (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.15).then_some(())
-        });
-        id
+        submit_until_progress(&base, SIMULATE_BODY, 0.15, LONG)
     })
     .await
     .unwrap();
@@ -368,7 +355,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
         let id = id.clone();
         move || {
             let mut first_progress = None;
-            let job = wait_for(Duration::from_secs(300), "succeeded", || {
+            let job = wait_for(LONG, "succeeded", || {
                 let j = get_job(&base, &id);
                 if first_progress.is_none() && j["status"] == "running" {
                     first_progress = j["progress"]["simulated_time_s"].as_f64();
