@@ -8,6 +8,7 @@ use railwear::gap::tracks::{SlipHistory, TrackPoint, TrackRecord, WearTerm};
 use railwear::models::case::load_case;
 use railwear::models::specs::CaseSpec;
 use railwear::wear::law::WearLaw;
+use railwear::wear::Material;
 use std::path::{Path, PathBuf};
 
 fn configs() -> PathBuf {
@@ -116,7 +117,9 @@ fn wear(record: &TrackRecord, terms: &[&dyn WearTerm], history: SlipHistory) -> 
 
 fn term(text: &str) -> Box<dyn WearTerm> {
     match Effect::parse(text) {
-        Ok(e) => e.wear_term(effects::brinell_to_pa(135.0)).unwrap(),
+        Ok(e) => e
+            .wear_term(Material::aluminium_7075_t73().hardness_pa())
+            .unwrap(),
         Err(_) => HiddenEffect::parse(text).unwrap().wear_term(),
     }
 }
@@ -173,7 +176,7 @@ fn wear_above_cutoff_adds_ratio_times_k_at_the_cutoff() {
 
 #[test]
 fn third_body_raises_k_only_where_pressure_and_slip_allow() {
-    let h_pa = effects::brinell_to_pa(135.0);
+    let h_pa = Material::aluminium_7075_t73().hardness_pa();
     assert!((h_pa - 1.3239e9).abs() < 1e6, "135 HB = 1.32 GPa");
     let t = term("third_body=2e-3");
     let pressed = track_at(1.0e7);

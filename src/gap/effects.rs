@@ -15,7 +15,6 @@ use super::tracks::{WearSample, WearTerm};
 use super::GapError;
 use crate::excitation::{Axis, ExcitationSpec, Tone};
 use crate::models::specs::{CaseSpec, ModelKind};
-use crate::units::STANDARD_GRAVITY;
 use crate::wear::law::WearLaw;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -527,11 +526,6 @@ impl WearTerm for ThirdBody {
             k
         }
     }
-}
-
-/// Brinell hardness (kgf/mm²) to indentation hardness, Pa.
-pub fn brinell_to_pa(hb: f64) -> f64 {
-    hb * STANDARD_GRAVITY * 1e6
 }
 
 fn resolved_excitation(

@@ -160,7 +160,7 @@ pub fn simulate_window(
         record,
         window_s: model.end_time_s - model.excitation_start_s,
         law: case.wear.law,
-        hardness_pa: super::effects::brinell_to_pa(material.brinell_hardness),
+        hardness_pa: material.hardness_pa(),
         yield_strength_pa: material.yield_strength_pa,
         input: report.base_acceleration,
         response: report.response_acceleration,
