@@ -79,6 +79,15 @@ impl GapError {
         }
     }
 
+    /// `Ok` when `ok` holds, otherwise a field error naming `field` and `rule`.
+    pub fn require(field: &str, ok: bool, rule: &str) -> Result<(), Self> {
+        if ok {
+            Ok(())
+        } else {
+            Err(Self::field(field, rule))
+        }
+    }
+
     /// The field at fault (for problem+json `field`), if any.
     pub fn field_path(&self) -> Option<&str> {
         match self {

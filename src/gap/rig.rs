@@ -185,13 +185,7 @@ fn normal(rng: &mut ChaCha20Rng) -> f64 {
 }
 
 fn check_options(o: &RigOptions) -> Result<(), GapError> {
-    let rule = |field: &str, ok: bool, text: &str| {
-        if ok {
-            Ok(())
-        } else {
-            Err(GapError::field(field, text.to_string()))
-        }
-    };
+    let rule = GapError::require;
     rule(
         "noise",
         o.noise_rel.is_finite() && (0.0..=1.0).contains(&o.noise_rel),

@@ -505,13 +505,7 @@ pub fn diagnose(
 }
 
 fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
-    let rule = |field: &str, ok: bool, text: &str| {
-        if ok {
-            Ok(())
-        } else {
-            Err(GapError::field(field, text.to_string()))
-        }
-    };
+    let rule = GapError::require;
     rule(
         "alpha",
         o.alpha > 0.0 && o.alpha < 0.5,
