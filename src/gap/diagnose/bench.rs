@@ -16,7 +16,7 @@
 
 use super::emulator::{Emulator, EmulatorOptions};
 use super::noise::{observations, NoiseModel, Observation};
-use super::{diagnose_with, stats, DiagnoseOptions, Report, Verdict};
+use super::{diagnose_refining, stats, DiagnoseOptions, Report, Verdict};
 use crate::gap::effects::{Effect, LIBRARY};
 use crate::gap::rig::{run_cached, RigOptions, Truth};
 use crate::gap::rig_effects::{HiddenEffect, RIG_ONLY};
@@ -342,7 +342,18 @@ pub fn run(
             let noise = NoiseModel::estimate(&noisy, &mut noisy_obs, &emulator, &o.diagnose);
             detectability(&observations(&clean), &control_obs, &noise, &noisy_obs)
         };
-        let report: Report = diagnose_with(&noisy, &emulator, &o.diagnose)?;
+        // Each campaign refines its own copy, so its diagnosis is the one it would get alone.
+        let mut refined = emulator.clone();
+        let report: Report = diagnose_refining(
+            &noisy,
+            &mut refined,
+            &o.diagnose,
+            configs_dir,
+            control,
+            &cache,
+            &|_, _| {},
+        )?;
+        let refinements = refined.simulations - emulator.simulations;
         let chosen = report.best_effect.as_ref().map(|b| b.name.clone());
         outcomes.push(Outcome {
             scenario: s.clone(),
@@ -367,7 +378,7 @@ pub fn run(
         });
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
         progress(format!(
-            "  -> {:?} {:?} (detectability {det:.1})",
+            "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows)",
             last.as_ref().map(|l| l.0),
             last.and_then(|l| l.1)
         ));

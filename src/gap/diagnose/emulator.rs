@@ -438,6 +438,119 @@ struct Task {
     settle_shift_s: f64,
 }
 
+/// One simulation slot: the effects on, the tolerance scale, the friction step and the settle
+/// shift of its run of every test.
+type Slot = (Vec<Effect>, f64, f64, f64);
+
+/// Every test's case and the number of increments simulated for it.
+fn plan(campaign: &Campaign, configs_dir: &Path) -> Result<(Vec<CaseSpec>, Vec<usize>), GapError> {
+    let cases: Vec<CaseSpec> = campaign
+        .tests
+        .iter()
+        .enumerate()
+        .map(|(ti, t)| t.case(ti, configs_dir))
+        .collect::<Result<_, _>>()?;
+    let increments: Vec<usize> = campaign
+        .tests
+        .iter()
+        .map(|t| {
+            t.specimens
+                .iter()
+                .map(|s| s.increments.len())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    Ok((cases, increments))
+}
+
+/// Simulates every test under every slot on `options.threads` threads; returns the increments
+/// `[slot][test]`. `progress(done, total)` is called after every test simulated, counting from
+/// `done_before` of `total`.
+#[allow(clippy::too_many_arguments)]
+fn simulate_slots(
+    slots: &[Slot],
+    campaign: &Campaign,
+    (cases, increments): (&[CaseSpec], &[usize]),
+    configs_dir: &Path,
+    options: &EmulatorOptions,
+    control: &RunControl,
+    cache: &WindowCache,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    (done_before, total): (usize, usize),
+) -> Result<Vec<Vec<Vec<ModelIncrement>>>, GapError> {
+    let tasks: Vec<Task> = slots
+        .iter()
+        .enumerate()
+        .flat_map(|(slot, (effects, tol, fr, settle))| {
+            (0..campaign.tests.len()).map(move |test| Task {
+                slot,
+                test,
+                effects: effects.clone(),
+                tolerance_scale: *tol,
+                friction_step: *fr,
+                settle_shift_s: *settle,
+            })
+        })
+        .collect();
+    let results: Mutex<Vec<Option<TaskResult>>> =
+        Mutex::new((0..tasks.len()).map(|_| None).collect());
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(done_before);
+    std::thread::scope(|scope| {
+        for _ in 0..options.threads.max(1) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(task) = tasks.get(i) else { break };
+                if control.is_cancelled() {
+                    break;
+                }
+                let r = run_task(
+                    task,
+                    campaign,
+                    cases,
+                    configs_dir,
+                    options,
+                    increments,
+                    control,
+                    cache,
+                );
+                if let Ok(mut v) = results.lock() {
+                    v[i] = Some(r);
+                }
+                progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
+            });
+        }
+    });
+    if control.is_cancelled() {
+        return Err(GapError::Simulation {
+            what: "diagnosis".into(),
+            message: "cancelled".into(),
+        });
+    }
+    let mut results = results.into_inner().map_err(|_| GapError::Simulation {
+        what: "diagnosis".into(),
+        message: "a simulation thread panicked".into(),
+    })?;
+    let mut by_slot: Vec<Vec<Vec<ModelIncrement>>> = (0..slots.len()).map(|_| Vec::new()).collect();
+    for (i, task) in tasks.iter().enumerate() {
+        let r = results[i].take().ok_or_else(|| GapError::Simulation {
+            what: format!("test {}", campaign.tests[task.test].id),
+            message: "not simulated".into(),
+        })??;
+        debug_assert_eq!(by_slot[task.slot].len(), task.test);
+        by_slot[task.slot].push(r);
+    }
+    Ok(by_slot)
+}
+
+/// Predictions `[test][increment]` of one slot's simulated increments.
+fn predictions_of(slot: &[Vec<ModelIncrement>]) -> TestPredictions {
+    slot.iter()
+        .map(|t| t.iter().map(Prediction::from_increment).collect())
+        .collect()
+}
+
 impl Emulator {
     /// Simulates and tabulates. `progress(done, total)` is called after every test simulated.
     pub fn build(
@@ -448,27 +561,11 @@ impl Emulator {
         cache: &WindowCache,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Self, GapError> {
-        let cases: Vec<CaseSpec> = campaign
-            .tests
-            .iter()
-            .enumerate()
-            .map(|(ti, t)| t.case(ti, configs_dir))
-            .collect::<Result<_, _>>()?;
+        let (cases, increments) = plan(campaign, configs_dir)?;
         let infos = applicable(&cases, options.effects.as_deref())?;
-        let increments: Vec<usize> = campaign
-            .tests
-            .iter()
-            .map(|t| {
-                t.specimens
-                    .iter()
-                    .map(|s| s.increments.len())
-                    .max()
-                    .unwrap_or(0)
-            })
-            .collect();
         // Slots: 0 nominal, 1 halving, 2 friction step, 3 initial state, then (dynamics
         // effect, magnitude).
-        let mut slots: Vec<(Vec<Effect>, f64, f64, f64)> = vec![
+        let mut slots: Vec<Slot> = vec![
             (vec![], 1.0, 0.0, 0.0),
             (vec![], 0.5, 0.0, 0.0),
             (vec![], 1.0, FRICTION_STEP, 0.0),
@@ -490,77 +587,21 @@ impl Emulator {
             }
             dyn_slots.push((ei, ids));
         }
-        let tasks: Vec<Task> = slots
-            .iter()
-            .enumerate()
-            .flat_map(|(slot, (effects, tol, fr, settle))| {
-                (0..campaign.tests.len()).map(move |test| Task {
-                    slot,
-                    test,
-                    effects: effects.clone(),
-                    tolerance_scale: *tol,
-                    friction_step: *fr,
-                    settle_shift_s: *settle,
-                })
-            })
-            .collect();
-        let total = tasks.len();
-        let results: Mutex<Vec<Option<TaskResult>>> =
-            Mutex::new((0..total).map(|_| None).collect());
-        let next = AtomicUsize::new(0);
-        let done = AtomicUsize::new(0);
         let before = cache.len();
-        std::thread::scope(|scope| {
-            for _ in 0..options.threads.max(1) {
-                scope.spawn(|| loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(task) = tasks.get(i) else { break };
-                    if control.is_cancelled() {
-                        break;
-                    }
-                    let r = run_task(
-                        task,
-                        campaign,
-                        &cases,
-                        configs_dir,
-                        options,
-                        &increments,
-                        control,
-                        cache,
-                    );
-                    if let Ok(mut v) = results.lock() {
-                        v[i] = Some(r);
-                    }
-                    progress(done.fetch_add(1, Ordering::SeqCst) + 1, total);
-                });
-            }
-        });
-        if control.is_cancelled() {
-            return Err(GapError::Simulation {
-                what: "diagnosis".into(),
-                message: "cancelled".into(),
-            });
-        }
-        let mut results = results.into_inner().map_err(|_| GapError::Simulation {
-            what: "diagnosis".into(),
-            message: "a simulation thread panicked".into(),
-        })?;
+        let total = slots.len() * campaign.tests.len();
+        let by_slot = simulate_slots(
+            &slots,
+            campaign,
+            (&cases, &increments),
+            configs_dir,
+            options,
+            control,
+            cache,
+            progress,
+            (0, total),
+        )?;
         let ntests = campaign.tests.len();
-        let mut by_slot: Vec<Vec<Vec<ModelIncrement>>> =
-            (0..slots.len()).map(|_| Vec::new()).collect();
-        for (i, task) in tasks.iter().enumerate() {
-            let r = results[i].take().ok_or_else(|| GapError::Simulation {
-                what: format!("test {}", campaign.tests[task.test].id),
-                message: "not simulated".into(),
-            })??;
-            debug_assert_eq!(by_slot[task.slot].len(), task.test);
-            by_slot[task.slot].push(r);
-        }
-        let preds = |slot: &Vec<Vec<ModelIncrement>>| -> TestPredictions {
-            slot.iter()
-                .map(|t| t.iter().map(Prediction::from_increment).collect())
-                .collect()
-        };
+        let preds = |slot: &Vec<Vec<ModelIncrement>>| predictions_of(slot);
         let nominal = preds(&by_slot[0]);
         let mut effects = Vec::new();
         let mut dyn_iter = dyn_slots.iter();
@@ -690,6 +731,72 @@ impl Emulator {
                 out
             }
         }
+    }
+}
+
+impl Emulator {
+    /// Adds simulated points to dynamics-effect tables: each request `(table index, magnitude)`
+    /// whose magnitude the table does not hold yet is simulated for every test (the same
+    /// segment path, tolerance and initial state as the grid) and inserted in order. Wear-law
+    /// tables are exact at every magnitude already and are left alone. Returns how many points
+    /// were added; `progress(done, total)` counts this refinement's test simulations.
+    ///
+    /// This is the adaptive refinement of the diagnosis: where a fit lands between grid points
+    /// of a rough table, the simulator itself replaces the interpolation there.
+    pub fn refine(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        requests: &[(usize, f64)],
+        control: &RunControl,
+        cache: &WindowCache,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<usize, GapError> {
+        let mut targets: Vec<(usize, f64)> = Vec::new();
+        for &(e, m) in requests {
+            let Some(t) = self.effects.get(e) else {
+                continue;
+            };
+            let inside = m >= t.magnitudes[0] && m <= t.magnitudes[t.magnitudes.len() - 1];
+            if !t.simulated
+                || !m.is_finite()
+                || !inside
+                || t.magnitudes.contains(&m)
+                || targets.contains(&(e, m))
+            {
+                continue;
+            }
+            targets.push((e, m));
+        }
+        if targets.is_empty() {
+            return Ok(0);
+        }
+        let (cases, increments) = plan(campaign, configs_dir)?;
+        let slots: Vec<Slot> = targets
+            .iter()
+            .map(|&(e, m)| (vec![effect_at(self.effects[e].info, m)], 1.0, 0.0, 0.0))
+            .collect();
+        let before = cache.len();
+        let total = slots.len() * campaign.tests.len();
+        let by_slot = simulate_slots(
+            &slots,
+            campaign,
+            (&cases, &increments),
+            configs_dir,
+            &self.options,
+            control,
+            cache,
+            progress,
+            (0, total),
+        )?;
+        for (&(e, m), slot) in targets.iter().zip(&by_slot) {
+            let t = &mut self.effects[e];
+            let at = t.magnitudes.partition_point(|x| *x < m);
+            t.magnitudes.insert(at, m);
+            t.predictions.insert(at, predictions_of(slot));
+        }
+        self.simulations += cache.len() - before;
+        Ok(targets.len())
     }
 }
 

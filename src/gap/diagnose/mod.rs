@@ -52,6 +52,13 @@ pub const MIN_HELD_OUT_GAIN: f64 = 2.0;
 /// little of it, does not explain it.
 pub const MIN_EXPLAINED_SHARE: f64 = 0.5;
 
+/// Default rounds of adaptive refinement ([`DiagnoseOptions::refine_rounds`]).
+pub const REFINE_ROUNDS: usize = 3;
+
+/// Dynamics effects refined per round: those with the best held-out log-likelihood among the
+/// ones that improve on the nominal.
+pub const REFINE_CONTENDERS: usize = 3;
+
 /// Profile-likelihood drop of a 95 % interval for one parameter (chi-square 1 dof: 3.84 / 2).
 pub const PROFILE_95: f64 = 1.920_729_410_347_062;
 
@@ -71,6 +78,11 @@ pub struct DiagnoseOptions {
     /// Relative calibration uncertainty of an accelerometer's sensitivity (a mean square
     /// carries twice it).
     pub accelerometer_calibration_rel: f64,
+    /// Rounds of adaptive refinement: each round simulates the dynamics effects that improve
+    /// the held-out fit at the magnitudes their fits land on (on all tests and on every
+    /// training fold) where the table holds no simulation yet, then fits again. 0 keeps the
+    /// grid alone.
+    pub refine_rounds: usize,
 }
 
 impl Default for DiagnoseOptions {
@@ -82,6 +94,7 @@ impl Default for DiagnoseOptions {
             assumed_scatter_rel: 0.3,
             k_rel_uncertainty: 0.1,
             accelerometer_calibration_rel: 0.02,
+            refine_rounds: REFINE_ROUNDS,
         }
     }
 }
@@ -397,8 +410,10 @@ impl<'a> Problem<'a> {
         let mut held_nll = Vec::with_capacity(self.groups);
         let mut held_r2 = Vec::with_capacity(self.groups);
         let mut held_w = Vec::with_capacity(self.groups);
+        let mut fold_magnitudes = Vec::with_capacity(self.groups);
         for g in 0..self.groups {
             let (mags, _) = self.fit(effects, &|h| h != g);
+            fold_magnitudes.push(mags.clone());
             let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags).collect();
             let s = self.score(&spec);
             held_nll.push(s.nll[g]);
@@ -415,6 +430,7 @@ impl<'a> Problem<'a> {
         Candidate {
             effects: effects.to_vec(),
             magnitudes: mags,
+            fold_magnitudes,
             held_nll,
             held_r2,
             held_w,
@@ -444,6 +460,8 @@ impl<'a> Problem<'a> {
 struct Candidate {
     effects: Vec<usize>,
     magnitudes: Vec<f64>,
+    /// Magnitudes fitted on each training fold (the held-out predictions use them).
+    fold_magnitudes: Vec<Vec<f64>>,
     held_nll: Vec<f64>,
     held_r2: Vec<f64>,
     held_w: Vec<f64>,
@@ -500,8 +518,80 @@ pub fn diagnose(
         cache,
         progress,
     )?;
-    let report = diagnose_with(campaign, &emulator, options)?;
+    let mut emulator = emulator;
+    let report = diagnose_refining(
+        campaign,
+        &mut emulator,
+        options,
+        configs_dir,
+        control,
+        cache,
+        progress,
+    )?;
     Ok((report, emulator))
+}
+
+/// The diagnosis after up to `options.refine_rounds` rounds of adaptive refinement of the
+/// emulator's dynamics tables ([`Emulator::refine`]): while the contending effects' fits land
+/// between simulated magnitudes, those magnitudes are simulated and the fits repeated, so the
+/// verdict rests on the simulator at the fitted magnitudes rather than on interpolation.
+/// Nothing is refined when the nominal model shows no gap.
+pub fn diagnose_refining(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Report, GapError> {
+    for _ in 0..options.refine_rounds {
+        let requests = refinement_requests(campaign, emulator, options);
+        if requests.is_empty() {
+            break;
+        }
+        let added = emulator.refine(campaign, configs_dir, &requests, control, cache, progress)?;
+        if added == 0 {
+            break;
+        }
+    }
+    diagnose_with(campaign, emulator, options)
+}
+
+/// Magnitudes the next refinement round simulates: for the [`REFINE_CONTENDERS`] simulated
+/// effects whose held-out fit beats the nominal, the full-data and every training fold's
+/// fitted magnitude. Empty when the nominal model shows no gap.
+fn refinement_requests(
+    campaign: &Campaign,
+    emulator: &Emulator,
+    options: &DiagnoseOptions,
+) -> Vec<(usize, f64)> {
+    let problem = Problem::new(campaign, emulator, options);
+    if problem.obs.is_empty() {
+        return Vec::new();
+    }
+    let nominal = problem.evaluate(&[], options.alpha);
+    let nominal_p = stats::chi2_sf(nominal.chi2, nominal.dof.round().max(1.0) as usize);
+    if nominal_p >= options.alpha && !location::locate(campaign, &problem).any_flagged() {
+        return Vec::new();
+    }
+    let mut contenders: Vec<Candidate> = (0..emulator.effects.len())
+        .filter(|&e| emulator.effects[e].simulated)
+        .map(|e| problem.evaluate(&[e], options.alpha))
+        .filter(|c| c.held_ll() > nominal.held_ll())
+        .collect();
+    contenders.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
+    contenders
+        .iter()
+        .take(REFINE_CONTENDERS)
+        .flat_map(|c| {
+            let e = c.effects[0];
+            std::iter::once(c.magnitudes[0])
+                .chain(c.fold_magnitudes.iter().map(|m| m[0]))
+                .map(move |m| (e, m))
+        })
+        .filter(|(_, m)| *m != 0.0)
+        .collect()
 }
 
 fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
