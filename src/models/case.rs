@@ -2,6 +2,7 @@
 //! model, maps the run settings, runs it and writes the summary, tracks and plots.
 
 use super::checkpoint::{self, RunIdentity};
+use super::outcome::{CaseOutcome, RunError};
 use super::rattle_box;
 use super::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
 use super::specs::{CaseSpec, ModelSpecRef, SpecError};
@@ -10,9 +11,9 @@ use crate::analysis::svg::{AxisSpec, Plot, Series};
 use crate::analysis::vdv::vibration_dose_value_uniform;
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
+use crate::physics::control::RunControl;
 use crate::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
 use crate::physics::simulate::{DivergenceLimits, SimError};
-use crate::pipeline::{CaseOutcome, RunControl, RunError};
 use serde_json::{json, Value};
 use std::path::Path;
 

@@ -4,6 +4,7 @@
 
 use crate::physics::body::BodyKind;
 use crate::physics::contact::TrackState;
+use crate::physics::control::RunControl;
 use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
 use crate::physics::partition::{independent_parts, Part};
@@ -12,7 +13,6 @@ use crate::physics::simulate::{
 };
 use crate::physics::system::MultibodySystem;
 use crate::physics::track::TrackSample;
-use crate::pipeline::RunControl;
 use crate::units::{MG_PER_KG, S_PER_H};
 use crate::wear::allocation::VolumeSplit;
 use crate::wear::integrate::{WearAccumulator, WearTotals};

@@ -115,7 +115,7 @@ pub fn resolve_case(
 ) -> Result<CaseSpec, RunError> {
     let mut value = match params.get("config") {
         Some(serde_json::Value::String(name)) => {
-            let path = crate::config::reference_config_path(configs_dir, name)
+            let path = crate::models::reference::reference_config_path(configs_dir, name)
                 .map_err(|e| invalid("config", e.to_string()))?;
             let case = load_case(&path)?;
             serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?

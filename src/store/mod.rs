@@ -9,16 +9,17 @@ mod delegate;
 mod dialect;
 mod portable;
 pub mod postgres;
+mod role;
 mod rows;
 pub mod sqlite;
 pub mod tracks;
 
-use crate::config::Role;
 pub mod job_records;
 use crate::physics::track::TrackSample;
 pub use campaigns::{CampaignCounts, CampaignInsert, CampaignRecord, CampaignSummary, NewCampaign};
 pub use job_records::{ChildCounts, ChildOf};
 use job_records::{JobKind, JobProgress, JobRecord, JobStatus};
+pub use role::Role;
 use std::future::Future;
 use std::pin::Pin;
 use std::sync::Arc;

@@ -2,7 +2,7 @@
 
 use super::Anchor;
 use crate::models::case::{load_case, run_case};
-use crate::pipeline::RunControl;
+use crate::physics::control::RunControl;
 use std::path::Path;
 
 /// Thesis Table 5.4 (ADAMS) rattle-box wear rates, mg/h.
