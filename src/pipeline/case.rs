@@ -4,8 +4,9 @@ use super::{
     check_keys, invalid, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError,
     SIMULATE_KEYS,
 };
-use crate::models::case::{load_case, run_case};
+use crate::models::case::load_case;
 use crate::models::specs::CaseSpec;
+use crate::report::run_case;
 use std::path::Path;
 
 /// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
