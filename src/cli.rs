@@ -1,8 +1,9 @@
 //! Command-line front ends of the library: `railwear run` and `railwear validate`.
 //! (anyhow is allowed here: this is the binary edge.)
 
-use crate::models::case::{load_case, run_case};
+use crate::models::case::load_case;
 use crate::pipeline::{Progress, RunControl};
+use crate::report::run_case;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;

@@ -1,8 +1,8 @@
 //! railwear: wear of missile-launcher rails and missile shoes in captive carry.
 //!
-//! The pipeline follows the data (see ARCHITECTURE.md):
-//! config -> geometry and bodies -> time integration with contacts -> contact tracks
-//! -> wear -> reports (service life) -> storage -> HTTP.
+//! The modules are floors that follow the data (see ARCHITECTURE.md, "Floors"): geometry ->
+//! physics -> wear -> models -> report -> pipeline -> jobs -> http, each importing only the
+//! floors below it.
 //!
 //! Units: SI inside the engine (m, kg, s, N, Pa). See [`units`] for the
 //! conversions from the thesis' ADAMS units (mm, kg, s, N).
@@ -26,6 +26,8 @@ pub mod jobs;
 pub mod models;
 pub mod physics;
 pub mod pipeline;
+pub mod report;
+pub mod service_life;
 pub mod store;
 pub mod units;
 pub mod validation;

@@ -285,7 +285,7 @@ async fn shutdown_signal() {
 /// repository without `RAILWEAR_CONFIGS_DIR`).
 fn log_start_up(config: &mut ServiceConfig) {
     config.configs_dir = config.resolved_configs_dir();
-    let models = railwear::config::reference_config_names(&config.configs_dir);
+    let models = railwear::models::reference::reference_config_names(&config.configs_dir);
     tracing::info!(
         database = %config.redacted_database_url(),
         configs_dir = %config.configs_dir.display(),

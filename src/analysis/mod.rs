@@ -1,9 +1,8 @@
 //! Analysis: spectra, vibration dose value, calibration fits, rattle space, service-life
-//! penalization, SVG plots.
+//! penalization. Plots are drawn by [`crate::report`].
 
 pub mod calibration;
 pub mod penalization;
 pub mod rattle_space;
 pub mod spectra;
-pub mod svg;
 pub mod vdv;

@@ -13,8 +13,8 @@
 
 use super::accel::{self, AccelRecord, ACCEL_COLUMNS};
 use super::GapError;
+use crate::models::outcome::RunError;
 use crate::models::specs::{CaseSpec, ModelSpecRef};
-use crate::pipeline::RunError;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Component, Path};
@@ -344,8 +344,8 @@ impl CampaignTest {
     /// built once to check it.
     pub fn case(&self, ti: usize, configs_dir: &Path) -> Result<CaseSpec, GapError> {
         let f = |rest: &str| format!("tests[{ti}].{rest}");
-        if crate::config::reference_config_path(configs_dir, &self.config).is_err() {
-            let known = crate::config::reference_config_names(configs_dir);
+        if crate::models::reference::reference_config_path(configs_dir, &self.config).is_err() {
+            let known = crate::models::reference::reference_config_names(configs_dir);
             return Err(GapError::field(
                 f("config"),
                 format!(

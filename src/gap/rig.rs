@@ -29,7 +29,7 @@ use super::tracks::{SlipHistory, WearTerm};
 use super::window::{WindowCache, WindowOptions, WindowRun};
 use super::GapError;
 use crate::models::specs::CaseSpec;
-use crate::pipeline::RunControl;
+use crate::physics::control::RunControl;
 use crate::units::S_PER_H;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha20Rng;

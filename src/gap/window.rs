@@ -11,7 +11,7 @@
 use super::tracks::{SlipHistory, TrackRecord, WearTerm};
 use super::GapError;
 use crate::models::specs::{CaseSpec, ModelSpecRef};
-use crate::pipeline::RunControl;
+use crate::physics::control::RunControl;
 use crate::units::MG_PER_KG;
 use crate::wear::allocation::VolumeSplit;
 use crate::wear::law::WearLaw;

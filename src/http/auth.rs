@@ -3,7 +3,7 @@
 
 use super::problem::Problem;
 use super::AppState;
-use crate::config::Role;
+use crate::store::Role;
 use axum::extract::FromRequestParts;
 use axum::http::request::Parts;
 use axum::http::{header, Method};

@@ -281,7 +281,7 @@ mod tests {
         pagination::PageView<campaigns::CampaignView>,
         tokens::TokenRequest, tokens::TokenView, tokens::CreatedToken, tokens::WhoAmI,
         tokens::Permissions,
-        crate::config::Role,
+        crate::store::Role,
     )),
     modifiers(&BearerAuth, &CommonErrors, &Links),
     tags(

@@ -3,7 +3,7 @@
 use super::auth::{generate_token, token_sha256, Area, Caller};
 use super::problem::{read_json, Problem};
 use super::AppState;
-use crate::config::Role;
+use crate::store::Role;
 use crate::store::{clock, TokenRecord};
 use axum::extract::{Path, State};
 use axum::http::{Method, StatusCode};

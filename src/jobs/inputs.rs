@@ -5,7 +5,7 @@
 //! Runners run on tokio's blocking threads; the store is async, so a read here blocks the
 //! calling thread on the runtime the worker runs in.
 
-use crate::pipeline::RunError;
+use crate::models::outcome::RunError;
 use crate::store::Store;
 use sha2::{Digest, Sha256};
 use std::sync::{Arc, OnceLock};

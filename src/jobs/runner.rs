@@ -353,12 +353,8 @@ impl CaseRunner for LibraryRunner {
         };
         match plan {
             JobPlan::Simulate(case) => {
-                let (_, out) = crate::models::case::run_case_from(
-                    &case,
-                    &self.configs_dir,
-                    control,
-                    checkpoint,
-                )?;
+                let (_, out) =
+                    crate::report::run_case_from(&case, &self.configs_dir, control, checkpoint)?;
                 Ok(JobOutput {
                     summary: out.summary,
                     tracks: out.tracks,
@@ -577,7 +573,7 @@ pub fn sweep_output(
             "design_base": plan.range.design_base,
         }),
     };
-    let plot = curve_plot(&curve);
+    let plot = crate::report::curve_plot(&curve);
     let summary = serde_json::to_value(sweep).map_err(|e| RunError::InvalidConfig {
         field: "sweep".into(),
         rule: e.to_string(),
@@ -589,31 +585,4 @@ pub fn sweep_output(
         penalization: Some(curve),
         curve_info: Some(curve_info),
     })
-}
-
-/// K_SL versus rattle space with the 0.9 and 0.8 bands (thesis Figure 6.68).
-pub fn curve_plot(curve: &PenalizationCurve) -> String {
-    use crate::analysis::svg::{AxisSpec, Plot, Series};
-    let (lo, hi) = curve.range();
-    let n = 60;
-    let mut k_sl = Vec::new();
-    let mut b90 = Vec::new();
-    let mut b80 = Vec::new();
-    for i in 0..=n {
-        let k = lo + (hi - lo) * i as f64 / n as f64;
-        if let Ok(f) = curve.factors(k) {
-            k_sl.push((k, f.k_sl));
-            b90.push((k, f.k_sl_conservative_90));
-            b80.push((k, f.k_sl_conservative_80));
-        }
-    }
-    Plot::new(
-        "Service-life penalization (eq. 6.4)",
-        AxisSpec::linear("rattle space k_rs"),
-        AxisSpec::linear("K_SL"),
-    )
-    .with_series(Series::line("K_SL", k_sl))
-    .with_series(Series::line("0.9 K_SL", b90))
-    .with_series(Series::line("0.8 K_SL", b80))
-    .to_svg()
 }

@@ -16,6 +16,7 @@
 //! - the latch tooth against the floor, roof and chamber walls;
 //! - the mid shoe's front protrusion against the tooth's rear face (a latch half-space).
 
+use super::outcome::RunError;
 use super::run::BuiltModel;
 use super::specs::{CaseSpec, LatchJoint, LauncherSpec, PlanarFace, RoundedBoxSpec};
 use crate::excitation::BaseMotion;
@@ -28,7 +29,6 @@ use crate::physics::forces::{
 };
 use crate::physics::partition::remap_force;
 use crate::physics::system::MultibodySystem;
-use crate::pipeline::RunError;
 use crate::units::STANDARD_GRAVITY;
 use nalgebra::{Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::f64::consts::PI;

@@ -5,6 +5,10 @@ pub mod case;
 pub mod checkpoint;
 pub mod launcher;
 pub mod motion;
+pub mod outcome;
 pub mod rattle_box;
+pub mod reference;
 pub mod run;
 pub mod specs;
+#[cfg(test)]
+mod system_tests;

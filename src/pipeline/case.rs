@@ -4,8 +4,9 @@ use super::{
     check_keys, invalid, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError,
     SIMULATE_KEYS,
 };
-use crate::models::case::{load_case, run_case};
+use crate::models::case::load_case;
 use crate::models::specs::CaseSpec;
+use crate::report::run_case;
 use std::path::Path;
 
 /// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
@@ -115,7 +116,7 @@ pub fn resolve_case(
 ) -> Result<CaseSpec, RunError> {
     let mut value = match params.get("config") {
         Some(serde_json::Value::String(name)) => {
-            let path = crate::config::reference_config_path(configs_dir, name)
+            let path = crate::models::reference::reference_config_path(configs_dir, name)
                 .map_err(|e| invalid("config", e.to_string()))?;
             let case = load_case(&path)?;
             serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?

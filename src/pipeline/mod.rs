@@ -20,39 +20,8 @@ pub use case::*;
 pub use sweep::*;
 pub use sweep_range::*;
 
-use crate::physics::track::TrackSample;
-
+pub use crate::models::outcome::{CaseOutcome, RunError};
 pub use crate::physics::control::{Progress, RunControl};
-
-/// What a finished case produces.
-#[derive(Debug, Clone)]
-pub struct CaseOutcome {
-    /// Summary: wear per contact and body (mg, mg/h), above-cutoff work share, pressure PDFs,
-    /// spectra, settings used. JSON object.
-    pub summary: serde_json::Value,
-    /// Recorded contact-track samples (may be many).
-    pub tracks: Vec<TrackSample>,
-    /// Named SVG plots: (file name, SVG text).
-    pub plots: Vec<(String, String)>,
-}
-
-/// Why a run did not produce an outcome.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The configuration broke a rule; `field` is a dotted path into the config.
-    #[error("invalid configuration: field `{field}` {rule}")]
-    InvalidConfig { field: String, rule: String },
-    /// The simulation diverged; the message names time, body, contact and energy.
-    #[error("simulation diverged: {0}")]
-    Diverged(String),
-    /// Cancelled through [`RunControl::cancel`].
-    #[error("cancelled")]
-    Cancelled,
-    /// Stopped with a checkpoint ([`RunControl::request_checkpoint`]): handing its bytes to
-    /// the same computation again resumes it (`models::case::run_case_from`).
-    #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
-    Checkpointed(Box<crate::models::checkpoint::Checkpoint>),
-}
 
 fn invalid(field: &str, rule: impl Into<String>) -> RunError {
     RunError::InvalidConfig {

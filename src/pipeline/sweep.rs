@@ -76,7 +76,7 @@ pub fn vehicle_profile_names(configs_dir: &Path) -> Vec<String> {
         .iter()
         .map(|(alias, _)| alias.to_string())
         .collect();
-    names.extend(crate::config::reference_config_names(
+    names.extend(crate::models::reference::reference_config_names(
         &configs_dir.join("profiles"),
     ));
     names.sort();
@@ -91,7 +91,7 @@ pub fn vehicle_profile_file(configs_dir: &Path, name: &str) -> Result<String, Ru
         .find(|(alias, _)| *alias == name)
         .map_or(name, |(_, stem)| stem);
     let dir = configs_dir.join("profiles");
-    match crate::config::reference_config_path(&dir, stem) {
+    match crate::models::reference::reference_config_path(&dir, stem) {
         Ok(_) => Ok(stem.to_string()),
         Err(_) => Err(invalid(
             "vehicle_profile",
@@ -390,7 +390,7 @@ pub fn sweep_point_from(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = crate::models::case::run_case_from(&case, configs_dir, control, resume)?;
+    let (report, _) = crate::report::run_case_from(&case, configs_dir, control, resume)?;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()

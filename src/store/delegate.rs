@@ -242,7 +242,7 @@ macro_rules! portable_store_methods {
         fn create_token(
             &self,
             name: &str,
-            role: $crate::config::Role,
+            role: $crate::store::Role,
             token_sha256: &str,
             now_ms: i64,
         ) -> $crate::store::StoreFuture<'_, $crate::store::TokenRecord> {

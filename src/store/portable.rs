@@ -19,6 +19,7 @@ use super::rows::{
     CurveRow, DbUuid, HostLeaseRow, JobRow, MeasurementRow, ParentLinkRow, TokenRow,
     CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
 };
+use super::Role;
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, CampaignInsert, CampaignRecord,
     CampaignSummary, ChildRecord, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish,
@@ -26,7 +27,6 @@ use super::{
     NewMeasurement, Page, PageRequest, PublishOutcome, RailRecord, ReleaseOutcome, StoreError,
     TokenRecord, TrackBlock,
 };
-use crate::config::Role;
 use sqlx::query::QueryAs;
 use sqlx::Type;
 use sqlx::{ColumnIndex, Decode, Encode, Executor, FromRow, IntoArguments, Pool, Transaction};

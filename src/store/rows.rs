@@ -7,12 +7,12 @@
 //! (INTEGER 0/1 on SQLite), which sqlx decodes into `bool` on both.
 
 use super::job_records::{ChildCounts, ChildOf, JobKind, JobProgress, JobRecord, JobStatus};
+use super::Role;
 use super::{
     AttemptOutcome, AttemptRecord, CampaignCounts, CampaignRecord, CampaignSummary, ChildRecord,
     CurveFidelity, CurveRecord, HostLease, MeasurementRecord, Page, Publication, StoreError,
     TokenRecord,
 };
-use crate::config::Role;
 use sqlx::encode::IsNull;
 use sqlx::error::BoxDynError;
 use sqlx::postgres::{PgArgumentBuffer, PgTypeInfo, PgValueRef};

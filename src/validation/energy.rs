@@ -9,11 +9,12 @@
 
 use super::{anchor, Anchor};
 use crate::models::case::{build, integrator_settings, load_case};
+use crate::models::outcome::RunError;
+use crate::physics::control::RunControl;
 use crate::physics::energy::EnergyAudit;
 use crate::physics::integrator::IntegratorSettings;
 use crate::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use crate::physics::system::MultibodySystem;
-use crate::pipeline::{RunControl, RunError};
 use crate::units::STANDARD_GRAVITY;
 use nalgebra::{UnitQuaternion, Vector3};
 use std::path::Path;

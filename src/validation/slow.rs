@@ -1,8 +1,9 @@
 //! Slow anchors of `railwear validate --slow`: whole-model runs.
 
 use super::Anchor;
-use crate::models::case::{load_case, run_case};
-use crate::pipeline::RunControl;
+use crate::models::case::load_case;
+use crate::physics::control::RunControl;
+use crate::report::run_case;
 use std::path::Path;
 
 /// Thesis Table 5.4 (ADAMS) rattle-box wear rates, mg/h.

@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 use nalgebra::{Isometry3, Vector3};
 use railwear::analysis::rattle_space::LauncherDimensions;
 use railwear::analysis::vdv::vibration_dose_value_uniform;
-use railwear::models::case::{build, load_case, run_case, run_options};
+use railwear::models::case::{build, load_case, run_options};
 use railwear::models::run::{run_model, BuiltModel, ModelRunError, RunOptions, RunReport};
 use railwear::models::specs::CaseSpec;
 use railwear::physics::body::write_state;
@@ -18,6 +18,7 @@ use railwear::physics::integrator::{
 };
 use railwear::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
 use railwear::pipeline::{Progress, RunControl, RunError};
+use railwear::report::run_case;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};

@@ -3,7 +3,7 @@
 //! Horizontal labelled bars, drawn without dependencies (the report's numbers are in its JSON).
 
 use super::Report;
-use crate::analysis::svg::escape;
+use crate::report::svg::escape;
 use std::fmt::Write;
 
 /// One bar.

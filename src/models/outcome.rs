@@ -1,0 +1,38 @@
+//! What a case run gives its caller: the packaged [`CaseOutcome`] (summary JSON, track samples,
+//! SVG plots) or why there is none, [`RunError`] (the one error of a model run, from a bad
+//! configuration to a checkpointed stop). `pipeline` re-exports both for the jobs.
+
+use crate::physics::track::TrackSample;
+
+/// What a finished case produces.
+#[derive(Debug, Clone)]
+pub struct CaseOutcome {
+    /// Summary: wear per contact and body (mg, mg/h), above-cutoff work share, pressure PDFs,
+    /// spectra, settings used. JSON object.
+    pub summary: serde_json::Value,
+    /// Recorded contact-track samples (may be many).
+    pub tracks: Vec<TrackSample>,
+    /// Named SVG plots: (file name, SVG text).
+    pub plots: Vec<(String, String)>,
+}
+
+/// Why a run did not produce an outcome.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The configuration broke a rule; `field` is a dotted path into the config.
+    #[error("invalid configuration: field `{field}` {rule}")]
+    InvalidConfig { field: String, rule: String },
+    /// The simulation diverged; the message names time, body, contact and energy.
+    #[error("simulation diverged: {0}")]
+    Diverged(String),
+    /// Cancelled through
+    /// [`RunControl::cancel`](crate::physics::control::RunControl::cancel).
+    #[error("cancelled")]
+    Cancelled,
+    /// Stopped with a checkpoint
+    /// ([`RunControl::request_checkpoint`](crate::physics::control::RunControl::request_checkpoint)):
+    /// handing its bytes to the same computation again resumes it
+    /// (`models::case::run_case_from`).
+    #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
+    Checkpointed(Box<super::checkpoint::Checkpoint>),
+}

@@ -1,0 +1,343 @@
+//! Tests of the multibody system's contact evaluation (geometry modes, patch reuse, contact
+//! Jacobian, the tracks the integrator leaves) on the reference models: they build rattle box C
+//! and the launcher from `configs/`, so they live above the physics floor.
+
+use crate::physics::body::BodyKind;
+use crate::physics::contact::{GeometryMode, TrackState};
+use crate::physics::system::{MultibodySystem, Workspace};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use std::path::Path;
+
+/// The reference model `configs/<name>.toml`.
+fn reference_model(name: &str) -> super::run::BuiltModel {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let case = super::case::load_case(&dir.join(format!("{name}.toml"))).expect("case");
+    super::case::build(&case, &dir).expect("model")
+}
+
+/// Rattle box C with the cube tilted and pressed into the floor, spinning and sliding.
+fn pressed_cube() -> (MultibodySystem, Vec<f64>) {
+    let model = reference_model("rattle-box-c");
+    let mut y = model.initial_state.clone();
+    y[1] -= 3e-5; // 30 µm further into the floor
+    let tilt = nalgebra::UnitQuaternion::from_euler_angles(2e-3, 1e-3, -4e-3);
+    let q = tilt.into_inner();
+    y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+    y[7..13].copy_from_slice(&[0.3, -0.05, 0.1, 2.0, -1.0, 0.5]);
+    (model.system, y)
+}
+
+/// The tracks of one derivative evaluation at `y` in geometry mode `mode`.
+fn tracks_in_mode(
+    sys: &MultibodySystem,
+    ws: &mut Workspace,
+    y: &[f64],
+    mode: GeometryMode,
+) -> Vec<TrackState> {
+    let mut f = vec![0.0; sys.state_len()];
+    ws.keep_tracks = true;
+    ws.geometry.set_mode(mode);
+    sys.derivative(0.0, y, &mut f, ws);
+    ws.geometry.set_mode(GeometryMode::Compute);
+    std::mem::take(&mut ws.tracks)
+}
+
+#[test]
+fn frozen_patches_keep_the_normal_force_exact_and_move_with_the_piece() {
+    let (sys, y) = pressed_cube();
+    let mut ws = sys.workspace();
+    let recorded = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Record);
+    assert!(!recorded.is_empty(), "the cube must touch the floor");
+    // Pressed 0.2 µm deeper, moving faster: penetration, its rate and the normal force
+    // come from the support function, bit for bit as a full evaluation.
+    let mut deeper = y.clone();
+    deeper[1] -= 2e-7;
+    deeper[8] -= 0.05;
+    let full = tracks_in_mode(&sys, &mut ws, &deeper, GeometryMode::Compute);
+    let frozen = tracks_in_mode(&sys, &mut ws, &deeper, GeometryMode::Frozen);
+    assert_eq!(full.len(), frozen.len());
+    for (a, b) in full.iter().zip(&frozen) {
+        assert_eq!((a.contact, a.track), (b.contact, b.track));
+        assert_eq!(a.penetration, b.penetration);
+        assert_eq!(a.penetration_rate, b.penetration_rate);
+        assert_eq!(a.normal_force, b.normal_force);
+        assert_ne!(a.area, b.area, "the area is the recorded one");
+    }
+    // Slid 0.1 mm along the floor and turned 0.01 rad about its normal: the overlap moves
+    // rigidly with the cube, so the held centroid is the true one (to round-off).
+    let mut slid = y.clone();
+    slid[0] += 1e-4;
+    slid[2] -= 5e-5;
+    let q = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
+    let turned = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.01) * q;
+    slid[3..7].copy_from_slice(&[turned.w, turned.i, turned.j, turned.k]);
+    let _ = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Record);
+    let full = tracks_in_mode(&sys, &mut ws, &slid, GeometryMode::Compute);
+    let frozen = tracks_in_mode(&sys, &mut ws, &slid, GeometryMode::Frozen);
+    assert_eq!(full.len(), frozen.len());
+    for (a, b) in full.iter().zip(&frozen) {
+        assert!(
+            (a.point - b.point).norm() < 1e-12,
+            "{:?} vs {:?}",
+            a.point,
+            b.point
+        );
+        assert!((a.area - b.area).abs() < 1e-9 * a.area);
+        assert!((a.slip_velocity - b.slip_velocity).norm() < 1e-12);
+    }
+    // Recorded clear of the floor, evaluated touching it: the new patch is computed in full.
+    let mut above = y.clone();
+    above[1] += 1e-3;
+    let none = tracks_in_mode(&sys, &mut ws, &above, GeometryMode::Record);
+    assert!(none.is_empty());
+    let full = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Compute);
+    let frozen = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Frozen);
+    assert_eq!(full.len(), frozen.len());
+    for (a, b) in full.iter().zip(&frozen) {
+        assert_eq!(
+            (a.point, a.area, a.normal_force),
+            (b.point, b.area, b.normal_force)
+        );
+    }
+}
+
+#[test]
+fn refreshed_patches_are_reused_within_their_bound_and_recomputed_beyond_it() {
+    use crate::physics::contact::PATCH_REUSE;
+    let (sys, y) = pressed_cube();
+    let mut ws = sys.workspace();
+    let recorded = tracks_in_mode(&sys, &mut ws, &y, GeometryMode::Refresh);
+    assert_eq!(recorded.len(), 1, "the cube rests on the floor only");
+    let (w, area) = (recorded[0].penetration, recorded[0].area);
+    let half: f64 = 0.0254 / 2.0;
+    let radius = (3.0 * half * half).sqrt();
+    // Pressed deeper by half the reuse bound: the patch is kept (area as recorded), within
+    // the bound's error of a full computation; the penetration is exact.
+    let mut near = y.clone();
+    near[1] -= 0.5 * PATCH_REUSE * w;
+    let full = tracks_in_mode(&sys, &mut ws, &near, GeometryMode::Compute);
+    let kept = tracks_in_mode(&sys, &mut ws, &near, GeometryMode::Refresh);
+    assert_eq!(kept[0].area, area);
+    assert_ne!(full[0].area, area);
+    assert_eq!(kept[0].penetration, full[0].penetration);
+    assert_eq!(kept[0].normal_force, full[0].normal_force);
+    assert!((kept[0].area - full[0].area).abs() <= 7.0 * PATCH_REUSE * full[0].area);
+    assert!((kept[0].point - full[0].point).norm() <= 12.0 * PATCH_REUSE * radius);
+    // Twice the bound further: recomputed, bit for bit a full computation.
+    let mut far = y.clone();
+    far[1] -= 2.0 * PATCH_REUSE * w;
+    let full = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Compute);
+    let redone = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Refresh);
+    assert_eq!(
+        (redone[0].area, redone[0].point),
+        (full[0].area, full[0].point)
+    );
+    // A tilt of the same size is caught through the bounding radius.
+    let q = UnitQuaternion::from_quaternion(Quaternion::new(far[3], far[4], far[5], far[6]));
+    let tilt = 2.0 * PATCH_REUSE * w / radius;
+    let tilted = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), tilt) * q;
+    far[3..7].copy_from_slice(&[tilted.w, tilted.i, tilted.j, tilted.k]);
+    let full = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Compute);
+    let redone = tracks_in_mode(&sys, &mut ws, &far, GeometryMode::Refresh);
+    assert_eq!(
+        (redone[0].area, redone[0].point),
+        (full[0].area, full[0].point)
+    );
+}
+
+#[test]
+fn replayed_geometry_gives_the_same_derivative_for_velocity_changes() {
+    let (sys, y) = pressed_cube();
+    let mut ws = sys.workspace();
+    let n = sys.state_len();
+    let (mut computed, mut replayed) = (vec![0.0; n], vec![0.0; n]);
+    let mut tracks = 0;
+    sys.tracks(0.0, &y, &mut ws, &mut |_| tracks += 1);
+    assert!(tracks >= 1, "the cube must touch the floor");
+    ws.geometry.set_mode(GeometryMode::Record);
+    sys.derivative(0.0, &y, &mut computed, &mut ws);
+    for j in 7..13 {
+        let mut yv = y.clone();
+        yv[j] += 1e-3 * (j as f64);
+        ws.geometry.set_mode(GeometryMode::Compute);
+        sys.derivative(0.0, &yv, &mut computed, &mut ws);
+        ws.geometry.set_mode(GeometryMode::Replay);
+        sys.derivative(0.0, &yv, &mut replayed, &mut ws);
+        assert_eq!(computed, replayed, "velocity column {j}");
+    }
+    // A pose change: the forces come from the contact points, computed exactly in every
+    // mode; only the tracks' area (the overlap) is the replayed one.
+    let mut yp = y.clone();
+    yp[1] -= 1e-6;
+    ws.keep_tracks = true;
+    ws.geometry.set_mode(GeometryMode::Compute);
+    sys.derivative(0.0, &yp, &mut computed, &mut ws);
+    let area_computed = ws.tracks[0].area;
+    ws.geometry.set_mode(GeometryMode::Replay);
+    sys.derivative(0.0, &yp, &mut replayed, &mut ws);
+    assert_eq!(computed, replayed);
+    assert_ne!(area_computed, ws.tracks[0].area);
+}
+
+#[test]
+fn pose_columns_replay_only_contacts_of_other_bodies() {
+    let model = reference_model("launcher-design");
+    let (sys, y) = (model.system, model.initial_state);
+    let mut ws = sys.workspace();
+    let n = sys.state_len();
+    let (mut computed, mut replayed) = (vec![0.0; n], vec![0.0; n]);
+    ws.geometry.set_mode(GeometryMode::Record);
+    sys.derivative(0.0, &y, &mut computed, &mut ws);
+    for (i, b) in sys.bodies.iter().enumerate() {
+        let BodyKind::Dynamic { offset } = b.kind else {
+            continue;
+        };
+        for j in offset..offset + 7 {
+            let mut yp = y.clone();
+            yp[j] += 2e-6;
+            ws.geometry.set_mode(GeometryMode::Compute);
+            sys.derivative(0.0, &yp, &mut computed, &mut ws);
+            ws.geometry.set_mode(GeometryMode::ReplayExcept(i));
+            sys.derivative(0.0, &yp, &mut replayed, &mut ws);
+            assert_eq!(computed, replayed, "body {} column {j}", b.name);
+        }
+    }
+}
+
+/// Forward-difference Jacobian of the derivative, column-major, with or without contacts.
+fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64> {
+    let n = sys.state_len();
+    let mut ws = sys.workspace();
+    ws.skip_contacts = !with_contacts;
+    let (mut f0, mut f1) = (vec![0.0; n], vec![0.0; n]);
+    sys.derivative(0.0, y, &mut f0, &mut ws);
+    let mut jac = vec![0.0; n * n];
+    for j in 0..n {
+        // Central differences: the contact force is smooth away from the clamp.
+        let delta = 1e-7 * y[j].abs().max(1e-3);
+        let mut yp = y.to_vec();
+        yp[j] += delta;
+        sys.derivative(0.0, &yp, &mut f1, &mut ws);
+        yp[j] = y[j] - delta;
+        sys.derivative(0.0, &yp, &mut f0, &mut ws);
+        for i in 0..n {
+            jac[j * n + i] = (f1[i] - f0[i]) / (2.0 * delta);
+        }
+    }
+    jac
+}
+
+fn analytic_contact_jacobian(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, usize) {
+    let n = sys.state_len();
+    let mut ws = sys.workspace();
+    ws.linearize = true;
+    let mut f = vec![0.0; n];
+    sys.derivative(0.0, y, &mut f, &mut ws);
+    let mut jac = vec![0.0; n * n];
+    sys.contact_jacobian(y, &ws, &mut jac);
+    (jac, ws.linearizations.len())
+}
+
+#[test]
+fn contact_jacobian_velocity_columns_equal_finite_differences() {
+    // A velocity change moves no pose, so the contact force's velocity derivatives are
+    // exactly those of the IMPACT damping and the friction law at fixed geometry.
+    let (sys, y) = pressed_cube();
+    let n = sys.state_len();
+    let (analytic, tracks) = analytic_contact_jacobian(&sys, &y);
+    assert!(tracks >= 1);
+    let full = fd_jacobian(&sys, &y, true);
+    let free = fd_jacobian(&sys, &y, false);
+    for j in 7..13 {
+        let col = |m: &[f64], i: usize| m[j * n + i];
+        let scale = (0..n).map(|i| col(&full, i).abs()).fold(0.0_f64, f64::max);
+        assert!(scale > 1e3, "column {j} must feel the contact damping");
+        for i in 0..n {
+            let contact_fd = col(&full, i) - col(&free, i);
+            let err = (contact_fd - col(&analytic, i)).abs();
+            assert!(
+                err <= 1e-6 * scale,
+                "d f[{i}] / d y[{j}]: finite differences {contact_fd:e}, analytic {:e}",
+                col(&analytic, i)
+            );
+        }
+    }
+}
+
+#[test]
+fn contact_jacobian_pose_columns_equal_finite_differences() {
+    // Each contact point's force, the rates it uses and its point of application belong to
+    // the same material point: translating the cube moves them together, so every row of
+    // the translation columns is exact. The rotation columns leave out the second-order
+    // geometric terms (the lever of the point in the torque, the turn of the slip's lever):
+    // relative size F / (k_eff r), bounded here by 1e-3 of the column.
+    let (sys, y) = pressed_cube();
+    let n = sys.state_len();
+    let (analytic, _) = analytic_contact_jacobian(&sys, &y);
+    let full = fd_jacobian(&sys, &y, true);
+    let free = fd_jacobian(&sys, &y, false);
+    for (cols, tol) in [(0..3, 1e-5), (3..7, 1e-5)] {
+        let scale = cols
+            .clone()
+            .flat_map(|j| (7..13).map(move |i| (j, i)))
+            .map(|(j, i)| (full[j * n + i] - free[j * n + i]).abs())
+            .fold(0.0_f64, f64::max);
+        assert!(scale > 1e3, "columns {cols:?} must feel the contact");
+        for j in cols {
+            for i in 7..13 {
+                let contact_fd = full[j * n + i] - free[j * n + i];
+                let err = (contact_fd - analytic[j * n + i]).abs();
+                assert!(
+                    err <= tol * scale,
+                    "d f[{i}] / d y[{j}]: finite differences {contact_fd:e}, analytic {:e}",
+                    analytic[j * n + i]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn integrator_leaves_the_tracks_of_the_accepted_state() {
+    // simulate() records each step's tracks from the integrator's last derivative
+    // evaluation instead of recomputing the overlaps: that evaluation must be at the
+    // accepted state, for every method and Newton matrix.
+    use crate::physics::integrator::{Integrator, IntegratorKind, NewtonJacobian};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let case = super::case::load_case(&dir.join("rattle-box-c.toml")).expect("case");
+    let base_settings = super::case::integrator_settings(&case).expect("settings");
+    // Pressed in, spinning and sliding: the tracks change on every step.
+    let (sys, y0) = pressed_cube();
+    for (kind, newton) in [
+        (IntegratorKind::Trbdf2, NewtonJacobian::ContactAware),
+        (IntegratorKind::Trbdf2, NewtonJacobian::FiniteDifference),
+        (IntegratorKind::Sdirk2, NewtonJacobian::ContactAware),
+        (IntegratorKind::Dopri5, NewtonJacobian::ContactAware),
+    ] {
+        let mut settings = base_settings;
+        settings.kind = kind;
+        settings.newton = newton;
+        let mut integ = Integrator::new(&sys, settings);
+        let mut ws = sys.workspace();
+        ws.keep_tracks = true;
+        let mut check = sys.workspace();
+        let mut y = y0.clone();
+        let (mut t, mut steps_in_contact) = (0.0, 0);
+        while t < 2e-4 {
+            t = integ
+                .advance(&sys, &mut ws, t, &mut y, 2e-4)
+                .expect("advances");
+            let mut fresh = Vec::new();
+            sys.tracks(t, &y, &mut check, &mut |tr| fresh.push(*tr));
+            assert_eq!(fresh.len(), ws.tracks.len(), "{kind:?} {newton:?} t = {t}");
+            for (a, b) in fresh.iter().zip(&ws.tracks) {
+                assert_eq!((a.contact, a.track), (b.contact, b.track));
+                let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
+                assert!(close(a.penetration, b.penetration), "{kind:?} t = {t}");
+                assert!(close(a.normal_force, b.normal_force), "{kind:?} t = {t}");
+            }
+            steps_in_contact += usize::from(!fresh.is_empty());
+        }
+        assert!(steps_in_contact > 10, "the cube must touch the floor");
+    }
+}
