@@ -27,6 +27,8 @@ pub mod models;
 pub mod physics;
 pub mod pipeline;
 pub mod store;
+#[doc(hidden)]
+pub mod testkit;
 pub mod units;
 pub mod validation;
 pub mod wear;

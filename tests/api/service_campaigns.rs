@@ -3,12 +3,11 @@
 //! broken campaign is a 422 naming the field (down to the sample row) and stores nothing;
 //! only test engineers and admins upload, every role reads.
 
-mod service_support;
-
+use crate::helpers::{curl, Reply};
+use crate::support::runner::{start, test_config};
+use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
 use serde_json::{json, Value};
-use service_support::runner::{start, test_config};
-use service_support::{curl, Reply, TempDir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use std::path::Path;
 
 fn thesis_json() -> Value {
@@ -86,7 +85,7 @@ impl Api {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn campaigns_round_trip_and_list() {
-    let dir = TempDir::new("campaigns");
+    let dir = temp_dir("campaigns");
     let service = start(test_config(&dir.db_url()), false).await;
     let api = Api {
         base: format!("http://{}", service.addr),
@@ -242,7 +241,7 @@ fn bad_campaigns() -> Vec<(&'static str, Value, String)> {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn bad_campaigns_name_field_and_row_and_store_nothing() {
-    let dir = TempDir::new("campaigns-bad");
+    let dir = temp_dir("campaigns-bad");
     let mut config = test_config(&dir.db_url());
     config.campaign_body_limit_bytes = 1024 * 1024;
     let service = start(config, false).await;
@@ -314,7 +313,7 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn only_test_engineers_and_admins_upload() {
-    let dir = TempDir::new("campaigns-roles");
+    let dir = temp_dir("campaigns-roles");
     let service = start(test_config(&dir.db_url()), false).await;
     let api = Api {
         base: format!("http://{}", service.addr),

@@ -2,11 +2,10 @@
 //! counting test runner: idempotency, cancellation, results and track export, recovery of a job
 //! whose worker died, rejected inputs leaving stored data unchanged.
 
-mod service_support;
-
+use crate::helpers::{curl, get_job, submit_job, wait_for};
+use crate::support::runner::{sample, start, test_config};
+use crate::support::{temp_dir, ENGINEER, PLANNER};
 use serde_json::json;
-use service_support::runner::{sample, start, test_config};
-use service_support::{curl, get_job, submit_job, wait_for, TempDir, ENGINEER, PLANNER};
 use std::time::{Duration, Instant};
 
 fn job_count(base: &str) -> usize {
@@ -22,7 +21,7 @@ fn job_count(base: &str) -> usize {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn idempotency_key_gives_one_job() {
-    let dir = TempDir::new("idem");
+    let dir = temp_dir("idem");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -88,7 +87,7 @@ async fn idempotency_key_gives_one_job() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancel_stops_a_running_job_within_a_second() {
-    let dir = TempDir::new("cancel");
+    let dir = temp_dir("cancel");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -145,7 +144,7 @@ async fn cancel_stops_a_running_job_within_a_second() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn results_and_tracks_export_with_downsampling() {
-    let dir = TempDir::new("tracks");
+    let dir = temp_dir("tracks");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -257,7 +256,7 @@ async fn results_and_tracks_export_with_downsampling() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
-    let dir = TempDir::new("lease");
+    let dir = temp_dir("lease");
     let config = test_config(&dir.db_url());
     // Reference: an uninterrupted run of seed 5.
     let reference = start(config.clone(), true).await;
@@ -362,7 +361,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn rejected_inputs_are_problems_and_change_nothing() {
-    let dir = TempDir::new("reject");
+    let dir = temp_dir("reject");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -544,7 +543,7 @@ async fn rejected_inputs_are_problems_and_change_nothing() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn pagination_walks_every_job_once() {
-    let dir = TempDir::new("page");
+    let dir = temp_dir("page");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {

@@ -1,14 +1,13 @@
 //! The real `railwear` binary on a free port with a fresh SQLite database, driven with curl.
 
-mod service_support;
-
-use service_support::{curl, submit_job, wait_for, Binary, TempDir, ADMIN, ENGINEER, PLANNER};
+use crate::helpers::{curl, submit_job, wait_for, Binary};
+use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER};
 use std::process::Command;
 use std::time::Duration;
 
 #[test]
 fn serves_health_metrics_docs_and_enforces_tokens() {
-    let dir = TempDir::new("bin");
+    let dir = temp_dir("bin");
     let server = Binary::start(&dir.db_url(), &[]);
     assert_eq!(
         curl("GET", &server.url("/healthz"), None, &[], None).body,
@@ -70,7 +69,7 @@ fn serves_health_metrics_docs_and_enforces_tokens() {
 
 #[test]
 fn unknown_or_unsafe_config_names_are_422_and_store_nothing() {
-    let dir = TempDir::new("names");
+    let dir = temp_dir("names");
     let server = Binary::start(&dir.db_url(), &[]);
     for name in ["../../etc/passwd", "no-such-model", ""] {
         let body = serde_json::json!({"kind": "simulate", "params": {"config": name}}).to_string();
@@ -99,7 +98,7 @@ fn unknown_or_unsafe_config_names_are_422_and_store_nothing() {
 
 #[test]
 fn token_create_command_makes_a_working_token() {
-    let dir = TempDir::new("cli");
+    let dir = temp_dir("cli");
     let out = Command::new(env!("CARGO_BIN_EXE_railwear"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(["token", "create", "--role", "engineer", "--name", "ci"])
@@ -145,7 +144,7 @@ fn wait_succeeded(server: &Binary, id: &str, timeout: Duration) -> serde_json::V
 
 #[test]
 fn simulate_job_succeeds_with_results_and_tracks_csv() {
-    let dir = TempDir::new("sim");
+    let dir = temp_dir("sim");
     let server = Binary::start(&dir.db_url(), &[]);
     let id = submit_job(&server.url(""), SHORT_SIMULATE);
     let job = wait_succeeded(&server, &id, Duration::from_secs(300));
@@ -177,7 +176,7 @@ fn simulate_job_succeeds_with_results_and_tracks_csv() {
 #[test]
 fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     // Reference: uninterrupted run of the same seed.
-    let ref_dir = TempDir::new("ref");
+    let ref_dir = temp_dir("ref");
     let reference = Binary::start(&ref_dir.db_url(), &[]);
     let ref_id = submit_job(&reference.url(""), SHORT_SIMULATE);
     wait_succeeded(&reference, &ref_id, Duration::from_secs(300));
@@ -199,7 +198,7 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     .json();
     drop(reference);
 
-    let dir = TempDir::new("crash");
+    let dir = temp_dir("crash");
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
     let server = Binary::start(&dir.db_url(), &env);
     let id = submit_job(&server.url(""), SHORT_SIMULATE);
@@ -243,7 +242,7 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
 
 #[test]
 fn cancel_a_running_simulation() {
-    let dir = TempDir::new("bincancel");
+    let dir = temp_dir("bincancel");
     let server = Binary::start(&dir.db_url(), &[]);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = submit_job(&server.url(""), long);
@@ -284,12 +283,12 @@ fn cancel_a_running_simulation() {
 fn sigterm(server: &mut Binary) -> Duration {
     let asked = std::time::Instant::now();
     let status = Command::new("kill")
-        .args(["-TERM", &server.child.id().to_string()])
+        .args(["-TERM", &server.process.id().to_string()])
         .status()
         .expect("run kill");
     assert!(status.success());
     loop {
-        if let Some(exit) = server.child.try_wait().expect("try_wait") {
+        if let Some(exit) = server.process.child_mut().try_wait().expect("try_wait") {
             assert!(exit.success(), "exit status {exit}");
             eprintln!("exited {:?} after SIGTERM", asked.elapsed());
             return asked.elapsed();
@@ -335,7 +334,7 @@ fn job(server: &Binary, id: &str) -> serde_json::Value {
 /// logged `released`.
 #[test]
 fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
-    let dir = TempDir::new("sigterm");
+    let dir = temp_dir("sigterm");
     let env = [
         ("RAILWEAR_SHUTDOWN_GRACE_S", "2"),
         ("RAILWEAR_LEASE_S", "60"),
@@ -405,7 +404,7 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
             .0
         })
     };
-    let dir = TempDir::new("sigterm-sweep");
+    let dir = temp_dir("sigterm-sweep");
     let env = [
         ("RAILWEAR_SHUTDOWN_GRACE_S", "5"),
         ("RAILWEAR_LEASE_S", "60"),
@@ -475,7 +474,7 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
 /// dead process's running job at once instead of after the 60 s lease.
 #[test]
 fn a_restarted_service_releases_its_dead_predecessors_job_at_once() {
-    let dir = TempDir::new("restart");
+    let dir = temp_dir("restart");
     let env = [("RAILWEAR_LEASE_S", "60"), ("RAILWEAR_WORKERS", "1")];
     let server = Binary::start(&dir.db_url(), &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":4,"overrides":{"simulation":{"duration_s":600}}}}"#;

@@ -4,12 +4,11 @@
 //! assembled once from the children's results in index order; a failing child fails the sweep
 //! naming it and cancels the rest; cancelling the sweep cancels its children.
 
-mod service_support;
-
+use crate::helpers::{curl, get_job, get_json, submit_job, wait_for};
+use crate::support::runner::{sample, start, test_config};
+use crate::support::{temp_dir, ENGINEER};
 use railwear::store::AttemptOutcome;
 use serde_json::{json, Value};
-use service_support::runner::{sample, start, test_config};
-use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::time::Duration;
 
 fn children(base: &str, id: &str) -> Vec<Value> {
@@ -25,7 +24,7 @@ fn count(items: &[Value], status: &str) -> usize {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
-    let dir = TempDir::new("fanout");
+    let dir = temp_dir("fanout");
     let mut config = test_config(&dir.db_url());
     config.workers = 3;
     let service = start(config, true).await;
@@ -147,7 +146,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
-    let dir = TempDir::new("fanout-fail");
+    let dir = temp_dir("fanout-fail");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -207,7 +206,7 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
-    let dir = TempDir::new("fanout-cancel");
+    let dir = temp_dir("fanout-cancel");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -248,7 +247,7 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sweep_points_cannot_be_submitted_and_bad_filters_are_refused() {
-    let dir = TempDir::new("fanout-refuse");
+    let dir = temp_dir("fanout-refuse");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -292,7 +291,7 @@ fn sample_value(text: &str, series: &str) -> Option<f64> {
 /// failure ends the sweep; each sweep once.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_sweep_duration_histogram_counts_whole_sweeps() {
-    let dir = TempDir::new("fanout-metrics");
+    let dir = temp_dir("fanout-metrics");
     let mut config = test_config(&dir.db_url());
     config.workers = 2;
     let service = start(config, true).await;

@@ -2,21 +2,20 @@
 //! diagnosis, follows the job to the end and reads the report and its SVG figures; planners
 //! may not diagnose; bad params are 422s naming the field; an unknown campaign is a 404.
 
-mod service_support;
-
+use crate::helpers::{curl, upload_campaign};
+use crate::support::runner::{start_library, test_config};
+use crate::support::{temp_dir, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
 use serde_json::{json, Value};
-use service_support::runner::{start_library, test_config};
-use service_support::{curl, upload_campaign, TempDir, PLANNER, TEST_ENGINEER};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
-const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
+const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_test_engineer_diagnoses_a_campaign_over_http() {
-    let dir = TempDir::new("diagnose");
+    let dir = temp_dir("diagnose");
     let service = start_library(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -125,7 +124,7 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
 /// that SHA-256, fails the job saying which.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_diagnosis_reads_its_campaign_when_it_runs() {
-    let dir = TempDir::new("diagnose-gone");
+    let dir = temp_dir("diagnose-gone");
     let db_url = dir.db_url();
     // No workers yet: the jobs wait in the queue while their campaigns change.
     let service = start_library(test_config(&db_url), false).await;
@@ -189,7 +188,7 @@ async fn a_diagnosis_reads_its_campaign_when_it_runs() {
     let errors = tokio::task::spawn_blocking(move || {
         [gone.1, changed.1].map(|job| {
             let url = format!("{base}/v1/jobs/{job}");
-            service_support::wait_for(Duration::from_secs(60), "the job to end", || {
+            crate::helpers::wait_for(Duration::from_secs(60), "the job to end", || {
                 let j = curl("GET", &url, Some(TEST_ENGINEER), &[], None).json();
                 match j["status"].as_str() {
                     Some("failed") => Some(j["error"].as_str().unwrap_or_default().to_string()),

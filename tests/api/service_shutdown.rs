@@ -6,13 +6,12 @@
 //! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
 //! the uninterrupted run's result.
 
-mod service_support;
-
+use crate::helpers::{curl, get_job, get_json, submit_job, wait_for};
+use crate::support::runner::{start, start_library, test_config};
+use crate::support::{temp_dir, ENGINEER};
 use railwear::jobs::JobStatus;
 use railwear::store::{AttemptOutcome, Store};
 use serde_json::Value;
-use service_support::runner::{start, start_library, test_config};
-use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -70,7 +69,7 @@ const BODY: &str =
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identically() {
     // Reference: uninterrupted.
-    let ref_dir = TempDir::new("shutdown-ref");
+    let ref_dir = temp_dir("shutdown-ref");
     let reference = start(test_config(&ref_dir.db_url()), true).await;
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
@@ -82,7 +81,7 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     .unwrap();
     reference.stop().await;
 
-    let dir = TempDir::new("shutdown");
+    let dir = temp_dir("shutdown");
     let mut config = test_config(&dir.db_url());
     config.workers = 1;
     config.shutdown_grace_s = 1.0;
@@ -133,7 +132,7 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
-    let dir = TempDir::new("shutdown-grace");
+    let dir = temp_dir("shutdown-grace");
     let mut config = test_config(&dir.db_url());
     config.workers = 1;
     config.shutdown_grace_s = 0.5;
@@ -175,7 +174,7 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_result() {
     let body = r#"{"kind":"sweep","params":{"children":6,"steps":8,"step_ms":50,"seed":77}}"#;
-    let ref_dir = TempDir::new("shutdown-sweep-ref");
+    let ref_dir = temp_dir("shutdown-sweep-ref");
     let reference = start(test_config(&ref_dir.db_url()), true).await;
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
@@ -187,7 +186,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     .unwrap();
     reference.stop().await;
 
-    let dir = TempDir::new("shutdown-sweep");
+    let dir = temp_dir("shutdown-sweep");
     let mut config = test_config(&dir.db_url());
     config.workers = 2;
     config.shutdown_grace_s = 1.0;
@@ -286,7 +285,7 @@ const SIMULATE_END_S: f64 = 1.25;
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
     // Reference: uninterrupted.
-    let ref_dir = TempDir::new("checkpoint-ref");
+    let ref_dir = temp_dir("checkpoint-ref");
     let reference = start_library(test_config(&ref_dir.db_url()), true).await;
     let base = format!("http://{}", reference.addr);
     let expected = tokio::task::spawn_blocking(move || {
@@ -299,7 +298,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     reference.stop().await;
     assert!(expected.0.lines().count() > 100, "tracks recorded");
 
-    let dir = TempDir::new("checkpoint");
+    let dir = temp_dir("checkpoint");
     let mut config = test_config(&dir.db_url());
     config.workers = 1;
     config.shutdown_grace_s = 5.0;

@@ -3,10 +3,8 @@
 //! HTTP is run by a worker process; a worker killed with SIGKILL mid-job loses its lease and
 //! another worker process finishes the job.
 
-mod postgres_support;
-mod service_support;
-
-use service_support::{curl, get_job, get_json, submit_job, tokens_env, wait_for, ENGINEER};
+use crate::helpers::{curl, get_job, get_json, submit_job, wait_for};
+use crate::support::{tokens_env, ENGINEER};
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -91,7 +89,7 @@ const SHORT: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","see
 #[test]
 fn api_without_workers_and_a_worker_process_complete_a_job() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("bin").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("bin").await }) else {
         return;
     };
     let (_api, base) = api(&db.url, &[]);
@@ -134,7 +132,7 @@ fn api_without_workers_and_a_worker_process_complete_a_job() {
 #[test]
 fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("kill").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("kill").await }) else {
         return;
     };
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
@@ -191,7 +189,7 @@ fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
 fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     use railwear::store::AttemptOutcome;
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("fanout").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("fanout").await }) else {
         return;
     };
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
@@ -222,8 +220,8 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
     let id = submit_job(&base, &body);
     // The same sweep in one process on SQLite.
-    let sqlite_dir = service_support::TempDir::new("fanout-sqlite");
-    let single = service_support::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
+    let sqlite_dir = crate::support::temp_dir("fanout-sqlite");
+    let single = crate::helpers::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
     let single_id = submit_job(&single.base, &body);
 
     // SIGKILL the worker process that holds a running child.
@@ -373,7 +371,7 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
 #[test]
 fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("sigterm").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("sigterm").await }) else {
         return;
     };
     let env = [

@@ -4,12 +4,11 @@
 //! Sweeps here are the counting test runner's fixed curve: rail wear 2.0, 1.5, 1.0 mg/h at
 //! k_rs 0.7684 (loose), 0.7990 (design), 0.8317 (tight).
 
-mod service_support;
-
+use crate::helpers::{curl, wait_for};
+use crate::support::runner::{start, test_config};
+use crate::support::{temp_dir, ENGINEER, PLANNER};
 use railwear::analysis::rattle_space::LauncherDimensions;
 use serde_json::json;
-use service_support::runner::{start, test_config};
-use service_support::{curl, wait_for, TempDir, ENGINEER, PLANNER};
 use std::time::Duration;
 
 fn measurement(dims: LauncherDimensions) -> String {
@@ -24,7 +23,7 @@ fn measurement(dims: LauncherDimensions) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn measurement_report_and_penalized_life() {
-    let dir = TempDir::new("rails");
+    let dir = temp_dir("rails");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -170,7 +169,7 @@ async fn measurement_report_and_penalized_life() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
-    let dir = TempDir::new("badrail");
+    let dir = temp_dir("badrail");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -333,7 +332,7 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
-    let dir = TempDir::new("latest");
+    let dir = temp_dir("latest");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -410,7 +409,7 @@ fn run_sweep(base: &str, body: &str) -> String {
     id
 }
 
-fn publish(base: &str, id: i64, body: Option<&str>) -> service_support::Reply {
+fn publish(base: &str, id: i64, body: Option<&str>) -> crate::helpers::Reply {
     curl(
         "POST",
         &format!("{base}/v1/curves/{id}/publish"),
@@ -425,7 +424,7 @@ fn publish(base: &str, id: i64, body: Option<&str>) -> service_support::Reply {
 /// default sweep forever); running and publishing it gives them a service life.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
-    let dir = TempDir::new("rails-range");
+    let dir = temp_dir("rails-range");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -526,7 +525,7 @@ async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
 /// the report names the curve, its fidelity, and carries K_SL's interval over seeds.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
-    let dir = TempDir::new("rails-publish");
+    let dir = temp_dir("rails-publish");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -637,7 +636,7 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
 /// life or an unknown or repeated parameter is a 400 naming it.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn report_labels_must_name_what_a_sweep_runs() {
-    let dir = TempDir::new("report-labels");
+    let dir = temp_dir("report-labels");
     let service = start(test_config(&dir.db_url()), false).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {

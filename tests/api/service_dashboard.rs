@@ -4,13 +4,10 @@
 //! (verdict, ranking, figures) as the API gives it. Skipped with a message when Chromium is
 //! absent, unless RAILWEAR_REQUIRE_BROWSER is set (`.ci/run` sets it and installs the browser).
 
-mod service_support;
-
+use crate::helpers::{curl, submit_job, upload_campaign, wait_for};
+use crate::support::runner::{start, start_library, test_config};
+use crate::support::{temp_dir, ENGINEER, PLANNER, TEST_ENGINEER};
 use serde_json::{json, Value};
-use service_support::runner::{start, start_library, test_config};
-use service_support::{
-    curl, submit_job, upload_campaign, wait_for, TempDir, ENGINEER, PLANNER, TEST_ENGINEER,
-};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
@@ -129,7 +126,7 @@ async fn dashboard_shows_a_job_reach_success() {
     let Some((chromium, chromedriver)) = browser() else {
         return;
     };
-    let dir = TempDir::new("dash");
+    let dir = temp_dir("dash");
     let service = start(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -178,7 +175,7 @@ async fn dashboard_shows_a_job_reach_success() {
 }
 
 /// The smallest campaign that runs a real diagnosis (shared with tests/service_diagnose.rs).
-const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
+const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
 
 /// Sets an input's value through the page (as typing would).
 fn fill(driver: &Driver, id: &str, value: &str) {
@@ -194,7 +191,7 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
     let Some((chromium, chromedriver)) = browser() else {
         return;
     };
-    let dir = TempDir::new("dash-diagnose");
+    let dir = temp_dir("dash-diagnose");
     let service = start_library(test_config(&dir.db_url()), true).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {

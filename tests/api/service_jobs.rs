@@ -4,12 +4,11 @@
 //! authorization comes before body parsing, every error is problem+json, drawn seeds are
 //! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
 
-mod service_support;
-
+use crate::helpers::curl;
+use crate::support::runner::test_config;
+use crate::support::{temp_dir, TempDir, ENGINEER, PLANNER};
 use railwear::jobs::LibraryRunner;
 use serde_json::json;
-use service_support::runner::test_config;
-use service_support::{curl, TempDir, ENGINEER, PLANNER};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -50,7 +49,7 @@ fn simulate_with(simulation: serde_json::Value) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
-    let dir = TempDir::new("jobs-validate");
+    let dir = temp_dir("jobs-validate");
     let service = start_library(&dir).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
@@ -227,7 +226,7 @@ async fn drawn_seeds_are_below_two_to_the_53() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
-    let dir = TempDir::new("jobs-errors");
+    let dir = temp_dir("jobs-errors");
     let service = start_library(&dir).await;
     let base = format!("http://{}", service.addr);
     tokio::task::spawn_blocking(move || {
