@@ -11,7 +11,7 @@ use crate::support::runner::{start, start_library, test_config};
 use crate::support::{temp_dir, tokens_env, TempDir, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::config::ServiceConfig;
 use railwear::http::RunningService;
-use railwear::testkit::{self, Client, Request, ServerProcess};
+use railwear::testkit::{self, Client, ClientError, Request, ServerProcess};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -94,6 +94,20 @@ impl Api {
         headers: &[(&str, &str)],
         body: Option<&str>,
     ) -> Reply {
+        self.try_request(method, path, token, headers, body)
+            .unwrap_or_else(|e| panic!("{method} {} failed: {e}", self.url(path)))
+    }
+
+    /// [`Api::request`] that returns a connection failure instead of panicking (a server
+    /// that may not listen yet).
+    pub fn try_request(
+        &self,
+        method: &str,
+        path: &str,
+        token: Option<&str>,
+        headers: &[(&str, &str)],
+        body: Option<&str>,
+    ) -> Result<Reply, ClientError> {
         let mut request = Request::new(method, path);
         if let Some(token) = token {
             request = request.bearer(token);
@@ -105,7 +119,6 @@ impl Api {
             request = request.json(body);
         }
         let client = self.client.clone();
-        let what = format!("{method} {}", self.url(path));
         // A thread of its own with a one-request runtime: callable from any thread.
         let response = std::thread::spawn(move || {
             let rt = tokio::runtime::Builder::new_current_thread()
@@ -115,13 +128,12 @@ impl Api {
             rt.block_on(client.send(&request))
         })
         .join()
-        .expect("client thread")
-        .unwrap_or_else(|e| panic!("{what} failed: {e}"));
-        Reply {
+        .expect("client thread")?;
+        Ok(Reply {
             status: response.status,
             body: response.text(),
             headers: response.headers,
-        }
+        })
     }
 
     pub fn get(&self, path: &str, token: Option<&str>) -> Reply {
@@ -226,7 +238,7 @@ pub struct TestApp {
     pub api: Api,
     pub service: RunningService,
     /// Holds the SQLite file; removed when the app drops.
-    pub dir: TempDir,
+    _dir: TempDir,
 }
 
 impl std::ops::Deref for TestApp {
@@ -264,7 +276,7 @@ impl TestApp {
         TestApp {
             api: Api::new(&format!("http://{}", service.addr)),
             service,
-            dir,
+            _dir: dir,
         }
     }
 
@@ -319,34 +331,4 @@ impl Binary {
     pub fn kill9(self) {
         self.process.kill();
     }
-}
-
-/// Transitional: the old curl-shaped call on the testkit client (`url` = base + path).
-pub fn curl(
-    method: &str,
-    url: &str,
-    token: Option<&str>,
-    headers: &[(&str, &str)],
-    body: Option<&str>,
-) -> Reply {
-    let rest = url.strip_prefix("http://").unwrap_or(url);
-    let (host, path) = rest.split_at(rest.find('/').unwrap_or(rest.len()));
-    let path = if path.is_empty() { "/" } else { path };
-    Api::new(&format!("http://{host}")).request(method, path, token, headers, body)
-}
-
-pub fn get_json(base: &str, path: &str) -> serde_json::Value {
-    Api::new(base).get_json(path)
-}
-
-pub fn get_job(base: &str, id: &str) -> serde_json::Value {
-    Api::new(base).get_job(id)
-}
-
-pub fn submit_job(base: &str, body: &str) -> String {
-    Api::new(base).submit_job(body)
-}
-
-pub fn upload_campaign(base: &str, toml: &str) -> String {
-    Api::new(base).upload_campaign(toml)
 }

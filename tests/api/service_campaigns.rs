@@ -1,9 +1,9 @@
-//! Test-engineer journey over HTTP (curl), issue 14 item 5: a campaign uploaded as JSON is
+//! Test-engineer journey over HTTP, issue 14 item 5: a campaign uploaded as JSON is
 //! validated against the service's configs, stored, listed and served back unchanged; a
 //! broken campaign is a 422 naming the field (down to the sample row) and stores nothing;
 //! only test engineers and admins upload, every role reads.
 
-use crate::helpers::{curl, Reply};
+use crate::helpers::{Api, Reply};
 use crate::support::runner::{start, test_config};
 use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
@@ -43,23 +43,16 @@ fn with_records() -> Value {
     c
 }
 
-struct Api {
-    base: String,
-}
+/// The campaign routes of one service.
+struct Campaigns(Api);
 
-impl Api {
+impl Campaigns {
     fn post(&self, token: Option<&str>, body: &str) -> Reply {
-        curl(
-            "POST",
-            &format!("{}/v1/campaigns", self.base),
-            token,
-            &[],
-            Some(body),
-        )
+        self.0.post("/v1/campaigns", token, body)
     }
 
     fn get(&self, token: Option<&str>, path: &str) -> Reply {
-        curl("GET", &format!("{}{path}", self.base), token, &[], None)
+        self.0.get(path, token)
     }
 
     /// Every stored campaign (all pages), as the planner sees them.
@@ -87,9 +80,7 @@ impl Api {
 async fn campaigns_round_trip_and_list() {
     let dir = temp_dir("campaigns");
     let service = start(test_config(&dir.db_url()), false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
     tokio::task::spawn_blocking(move || {
         // The thesis campaign goes in and comes back unchanged.
         let thesis = thesis_json();
@@ -245,9 +236,7 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
     let mut config = test_config(&dir.db_url());
     config.campaign_body_limit_bytes = 1024 * 1024;
     let service = start(config, false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
     tokio::task::spawn_blocking(move || {
         let r = api.post(Some(TEST_ENGINEER), &thesis_json().to_string());
         assert_eq!(r.status, 201, "{}", r.body);
@@ -288,9 +277,9 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
         // Malformed JSON, a non-JSON body, an empty object, a body over the campaign limit.
         let p = api.post(Some(TEST_ENGINEER), "{\"name\": ").problem(400);
         assert_eq!(p["type"], "urn:railwear:problem:malformed-json");
-        let r = curl(
+        let r = api.0.request(
             "POST",
-            &format!("{}/v1/campaigns", api.base),
+            "/v1/campaigns",
             Some(TEST_ENGINEER),
             &[("Content-Type", "text/csv")],
             Some("time_s,a_x_m_s2\n"),
@@ -315,9 +304,7 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
 async fn only_test_engineers_and_admins_upload() {
     let dir = temp_dir("campaigns-roles");
     let service = start(test_config(&dir.db_url()), false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
     tokio::task::spawn_blocking(move || {
         let good = thesis_json().to_string();
         // The role is checked before the body is read: a planner gets 403 whatever it sends.

@@ -4,7 +4,7 @@
 //! authorization comes before body parsing, every error is problem+json, drawn seeds are
 //! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
 
-use crate::helpers::curl;
+use crate::helpers::Api;
 use crate::support::runner::test_config;
 use crate::support::{temp_dir, TempDir, ENGINEER, PLANNER};
 use railwear::jobs::LibraryRunner;
@@ -22,14 +22,8 @@ async fn start_library(dir: &TempDir) -> railwear::http::RunningService {
         .expect("service starts")
 }
 
-fn stored_jobs(base: &str) -> usize {
-    let r = curl(
-        "GET",
-        &format!("{base}/v1/jobs?limit=100"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+fn stored_jobs(api: &Api) -> usize {
+    let r = api.get("/v1/jobs?limit=100", Some(ENGINEER));
     assert_eq!(r.status, 200, "{}", r.body);
     r.json()["items"].as_array().map_or(0, Vec::len)
 }
@@ -51,11 +45,11 @@ fn simulate_with(simulation: serde_json::Value) -> String {
 async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
     let dir = temp_dir("jobs-validate");
     let service = start_library(&dir).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
-        let jobs = format!("{base}/v1/jobs");
+        let jobs = "/v1/jobs";
         let rejected = |body: &str, field: &str| -> serde_json::Value {
-            let r = curl("POST", &jobs, Some(ENGINEER), &[], Some(body));
+            let r = api.post(&jobs, Some(ENGINEER), body);
             let p = r.problem(422);
             assert_eq!(p["field"], field, "{body}: {p}");
             p
@@ -122,14 +116,13 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
             r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#,
             "params.config",
         );
-        let p = curl(
-            "POST",
-            &jobs,
-            Some(ENGINEER),
-            &[],
-            Some(r#"{"kind":"simulate","params":{"config":{"garbage":true}}}"#),
-        )
-        .problem(422);
+        let p = api
+            .post(
+                &jobs,
+                Some(ENGINEER),
+                r#"{"kind":"simulate","params":{"config":{"garbage":true}}}"#,
+            )
+            .problem(422);
         assert!(
             p["field"].as_str().unwrap().starts_with("params.config"),
             "{p}"
@@ -185,23 +178,15 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
             "params.wear_law.density_kg_m3",
         );
 
-        assert_eq!(stored_jobs(&base), 0, "a rejected job stores nothing");
+        assert_eq!(stored_jobs(&api), 0, "a rejected job stores nothing");
 
         // What is valid is accepted: the sweep's curve selectors are stored with it.
-        let r = curl(
-            "POST",
-            &jobs,
-            Some(ENGINEER),
-            &[],
-            Some(&simulate_with(json!({}))),
-        );
+        let r = api.post(&jobs, Some(ENGINEER), &simulate_with(json!({})));
         assert_eq!(r.status, 201, "{}", r.body);
-        let r = curl(
-            "POST",
+        let r = api.post(
             &jobs,
             Some(ENGINEER),
-            &[],
-            Some(r#"{"kind":"sweep","params":{"points":3}}"#),
+            r#"{"kind":"sweep","params":{"points":3}}"#,
         );
         assert_eq!(r.status, 201, "{}", r.body);
         let sweep = r.json();
@@ -210,7 +195,7 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
         // Drawn seeds are below 2^53: JSON readers that use doubles read them exactly.
         let seed = sweep["seed"].as_u64().expect("seed");
         assert!(seed < 1 << 53, "{seed}");
-        assert_eq!(stored_jobs(&base), 2);
+        assert_eq!(stored_jobs(&api), 2);
     })
     .await
     .unwrap();
@@ -228,12 +213,12 @@ async fn drawn_seeds_are_below_two_to_the_53() {
 async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
     let dir = temp_dir("jobs-errors");
     let service = start_library(&dir).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
-        let jobs = format!("{base}/v1/jobs");
+        let jobs = "/v1/jobs";
         // A planner may not submit jobs, whatever the body holds.
-        curl("POST", &jobs, Some(PLANNER), &[], Some("{not json")).problem(403);
-        curl(
+        api.post(&jobs, Some(PLANNER), "{not json").problem(403);
+        api.request(
             "POST",
             &jobs,
             Some(PLANNER),
@@ -242,43 +227,18 @@ async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
         )
         .problem(403);
         // An engineer may not record measurements, whatever the body holds.
-        curl(
-            "POST",
-            &format!("{base}/v1/rails/R-1/measurements"),
-            Some(ENGINEER),
-            &[],
-            Some("[1,2"),
-        )
-        .problem(403);
+        api.post("/v1/rails/R-1/measurements", Some(ENGINEER), "[1,2")
+            .problem(403);
         // A repeated query key and invalid percent-encoding answer problem+json.
-        let p = curl(
-            "GET",
-            &format!("{jobs}?limit=1&limit=2"),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .problem(400);
+        let p = api
+            .get(&format!("{jobs}?limit=1&limit=2"), Some(ENGINEER))
+            .problem(400);
         assert_eq!(p["field"], "limit", "{p}");
-        curl(
-            "GET",
-            &format!("{base}/v1/rails/%FF%FE/report"),
-            Some(PLANNER),
-            &[],
-            None,
-        )
-        .problem(400);
-        curl(
-            "GET",
-            &format!("{base}/v1/jobs/%FF"),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .problem(400);
+        api.get_problem("/v1/rails/%FF%FE/report", Some(PLANNER), 400);
+        api.get_problem("/v1/jobs/%FF", Some(ENGINEER), 400);
 
         // /metrics: never -0, and HTTP requests per route with a latency histogram.
-        let r = curl("GET", &format!("{base}/metrics"), None, &[], None);
+        let r = api.get("/metrics", None);
         assert_eq!(r.status, 200);
         assert!(!r.body.contains(" -0"), "{}", r.body);
         assert!(
