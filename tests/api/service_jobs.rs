@@ -49,7 +49,7 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
     tokio::task::spawn_blocking(move || {
         let jobs = "/v1/jobs";
         let rejected = |body: &str, field: &str| -> serde_json::Value {
-            let r = api.post(&jobs, Some(ENGINEER), body);
+            let r = api.post(jobs, Some(ENGINEER), body);
             let p = r.problem(422);
             assert_eq!(p["field"], field, "{body}: {p}");
             p
@@ -118,7 +118,7 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
         );
         let p = api
             .post(
-                &jobs,
+                jobs,
                 Some(ENGINEER),
                 r#"{"kind":"simulate","params":{"config":{"garbage":true}}}"#,
             )
@@ -181,10 +181,10 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
         assert_eq!(stored_jobs(&api), 0, "a rejected job stores nothing");
 
         // What is valid is accepted: the sweep's curve selectors are stored with it.
-        let r = api.post(&jobs, Some(ENGINEER), &simulate_with(json!({})));
+        let r = api.post(jobs, Some(ENGINEER), &simulate_with(json!({})));
         assert_eq!(r.status, 201, "{}", r.body);
         let r = api.post(
-            &jobs,
+            jobs,
             Some(ENGINEER),
             r#"{"kind":"sweep","params":{"points":3}}"#,
         );
@@ -217,10 +217,10 @@ async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
     tokio::task::spawn_blocking(move || {
         let jobs = "/v1/jobs";
         // A planner may not submit jobs, whatever the body holds.
-        api.post(&jobs, Some(PLANNER), "{not json").problem(403);
+        api.post(jobs, Some(PLANNER), "{not json").problem(403);
         api.request(
             "POST",
-            &jobs,
+            jobs,
             Some(PLANNER),
             &[("Content-Type", "text/plain")],
             Some("x"),

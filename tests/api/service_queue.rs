@@ -274,16 +274,7 @@ async fn rejected_inputs_are_problems_and_change_nothing() {
         let wrong = Some("wrong-token-0000000000000");
         let (eng, plain) = (Some(ENGINEER), &[("Content-Type", "text/plain")][..]);
         // (case, method, path, token, headers, body, status, what the problem names)
-        let cases: [(
-            &str,
-            &str,
-            &str,
-            Option<&str>,
-            &[(&str, &str)],
-            Option<&str>,
-            u16,
-            Names,
-        ); 22] = [
+        let cases: [Rejected; 22] = [
             (
                 "no token",
                 "POST",
@@ -561,6 +552,19 @@ async fn pagination_walks_every_job_once() {
     .unwrap();
     app.stop().await;
 }
+
+/// A rejected request: (case, method, path, token, headers, body, status, what the problem
+/// names).
+type Rejected<'a> = (
+    &'a str,
+    &'a str,
+    &'a str,
+    Option<&'a str>,
+    &'a [(&'a str, &'a str)],
+    Option<&'a str>,
+    u16,
+    Names,
+);
 
 /// What a rejected request's problem must name besides its status.
 #[derive(Clone, Copy)]

@@ -26,9 +26,9 @@ async fn measurement_report_and_penalized_life() {
     let app = TestApp::spawn().await;
     let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let post = |serial: &str, body: &str| api.post_rail(&serial, body);
+        let post = |serial: &str, body: &str| api.post_rail(serial, body);
         let report = |serial: &str| {
-            let r = api.rail_report(&serial);
+            let r = api.rail_report(serial);
             assert_eq!(r.status, 200, "{}", r.body);
             r.json()
         };
@@ -126,14 +126,14 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
         let url = "/v1/rails/R-1/measurements";
         assert_eq!(
             api.post(
-                &url,
+                url,
                 Some(PLANNER),
                 &measurement(LauncherDimensions::design())
             )
             .status,
             201
         );
-        let history = || api.get(&url, Some(PLANNER)).body;
+        let history = || api.get(url, Some(PLANNER)).body;
         let before = history();
 
         let with = |f: &dyn Fn(&mut serde_json::Value)| {
@@ -218,7 +218,7 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
             ),
         ];
         for (body, field) in cases {
-            let p = api.post(&url, Some(PLANNER), &body).problem(422);
+            let p = api.post(url, Some(PLANNER), &body).problem(422);
             assert!(
                 p["field"].as_str().unwrap().starts_with(field),
                 "expected field {field}, got {p}"
@@ -241,14 +241,14 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
         }
         let p = api
             .post(
-                &url,
+                url,
                 Some(PLANNER),
                 &with(&|v| v["dimensions_mm"] = json!([38.1, 16.23])),
             )
             .problem(422);
         assert!(p["detail"].as_str().unwrap().contains("positional"), "{p}");
-        api.post(&url, Some(ENGINEER), &body).problem(403);
-        api.post(&url, None, &body).problem(401);
+        api.post(url, Some(ENGINEER), &body).problem(403);
+        api.post(url, None, &body).problem(401);
         api.rail_report("R-404").problem(404);
         assert_eq!(
             before,
@@ -273,7 +273,7 @@ async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
         let post = |dims: LauncherDimensions, measured_at: &str| {
             let mut v: serde_json::Value = serde_json::from_str(&measurement(dims)).unwrap();
             v["measured_at"] = json!(measured_at);
-            let r = api.post(&url, Some(PLANNER), &v.to_string());
+            let r = api.post(url, Some(PLANNER), &v.to_string());
             assert_eq!(r.status, 201, "{}", r.body);
             r.json()
         };
@@ -286,7 +286,7 @@ async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
         assert_eq!(report["measurement"]["id"], current["id"], "{report}");
         assert_eq!(report["rattle_space"], current["rattle_space"]);
         // History shows both times for each measurement.
-        let history = api.get(&url, Some(PLANNER)).json();
+        let history = api.get(url, Some(PLANNER)).json();
         let items = history["items"].as_array().unwrap();
         assert_eq!(items.len(), 2);
         for item in items {
@@ -300,7 +300,7 @@ async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
 }
 
 fn report_of(api: &Api, serial: &str) -> serde_json::Value {
-    let r = api.rail_report(&serial);
+    let r = api.rail_report(serial);
     assert_eq!(r.status, 200, "{}", r.body);
     r.json()
 }
@@ -337,7 +337,7 @@ async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
     let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
         let post = |serial: &str, dims: LauncherDimensions| {
-            let r = api.post_rail(&serial, &measurement(dims));
+            let r = api.post_rail(serial, &measurement(dims));
             assert_eq!(r.status, 201, "{}", r.body);
             r.json()["rattle_space"].as_f64().unwrap()
         };
