@@ -1,4 +1,4 @@
-//! The real `railwear` binary on a free port with a fresh SQLite database, driven with curl.
+//! The real `railwear` binary on a free port with a fresh SQLite database, driven with the test client.
 
 use crate::helpers::{wait_for, Binary};
 use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER};

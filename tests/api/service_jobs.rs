@@ -1,26 +1,12 @@
-//! Issue 17 over HTTP (curl) against an in-process service with the production runner
+//! Issue 17 over HTTP against an in-process service with the production runner
 //! (`LibraryRunner`, the shipped `configs/`) and no workers, so nothing runs: job parameters
 //! are checked completely at submission (422 problem+json naming the field, nothing stored),
 //! authorization comes before body parsing, every error is problem+json, drawn seeds are
 //! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
 
-use crate::helpers::Api;
-use crate::support::runner::test_config;
-use crate::support::{temp_dir, TempDir, ENGINEER, PLANNER};
-use railwear::jobs::LibraryRunner;
+use crate::helpers::{Api, Runner, TestApp};
+use crate::support::{ENGINEER, PLANNER};
 use serde_json::json;
-use std::path::Path;
-use std::sync::Arc;
-
-async fn start_library(dir: &TempDir) -> railwear::http::RunningService {
-    let config = test_config(&dir.db_url());
-    let runner = Arc::new(LibraryRunner::new(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs"),
-    ));
-    railwear::http::start(config, runner, false)
-        .await
-        .expect("service starts")
-}
 
 fn stored_jobs(api: &Api) -> usize {
     let r = api.get("/v1/jobs?limit=100", Some(ENGINEER));
@@ -43,79 +29,66 @@ fn simulate_with(simulation: serde_json::Value) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
-    let dir = temp_dir("jobs-validate");
-    let service = start_library(&dir).await;
-    let api = Api::new(&format!("http://{}", service.addr));
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         let jobs = "/v1/jobs";
-        let rejected = |body: &str, field: &str| -> serde_json::Value {
-            let r = api.post(jobs, Some(ENGINEER), body);
-            let p = r.problem(422);
-            assert_eq!(p["field"], field, "{body}: {p}");
-            p
-        };
         let sim = |s: serde_json::Value| simulate_with(s);
-
-        // Durations: not positive, absurd (1e308 once ran with eta 1.8e307 s).
-        for d in [json!(-1.0), json!(0.0), json!(1e308), json!(86_401.0)] {
-            rejected(
-                &sim(json!({"duration_s": d})),
-                "params.overrides.simulation.duration_s",
-            );
+        let raw = |s: &str| s.to_string();
+        let duration = "params.overrides.simulation.duration_s";
+        // (case, body, field the 422 names, a word its detail must contain)
+        let cases: Vec<(&str, String, &str, Option<&str>)> = vec![
+            // Durations: not positive, absurd (1e308 once ran with eta 1.8e307 s).
+            ("negative duration", sim(json!({"duration_s": -1.0})), duration, None),
+            ("zero duration", sim(json!({"duration_s": 0.0})), duration, None),
+            ("absurd duration", sim(json!({"duration_s": 1e308})), duration, None),
+            ("duration over a day", sim(json!({"duration_s": 86_401.0})), duration, None),
+            ("settle over a day", sim(json!({"settle_s": 1e6})), "params.overrides.simulation.settle_s", None),
+            ("loose tolerance", sim(json!({"rel_tolerance": 0.5})), "params.overrides.simulation.rel_tolerance", None),
+            ("metre tolerance", sim(json!({"abs_tolerance_m": 1.0})), "params.overrides.simulation.abs_tolerance_m", None),
+            ("nanosecond records", sim(json!({"record_interval_s": 1e-9})), "params.overrides.simulation.record_interval_s", None),
+            // 24 h at the default 0.1 ms interval records far more than memory holds.
+            (
+                "24 h of default records",
+                json!({"kind": "simulate", "params": {"config": "rattle-box-c",
+                    "overrides": {"simulation": {"duration_s": 86_400.0}}}})
+                .to_string(),
+                "params.overrides.simulation.record_interval_s",
+                None,
+            ),
+            // A typo in an override key, overrides that are not an object, unknown params.
+            ("override typo", sim(json!({"durationn_s": 1.0})), "params.overrides.simulation.durationn_s", Some("durationn_s")),
+            ("overrides an array", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":[1,2]}}"#), "params.overrides", None),
+            ("params typo", raw(r#"{"kind":"simulate","params":{"confg":"rattle-box-c"}}"#), "params.confg", None),
+            ("no config", raw(r#"{"kind":"simulate","params":{"seed":3}}"#), "params.config", None),
+            // Names the directory searched.
+            ("config not a model", raw(r#"{"kind":"simulate","params":{"config":"service"}}"#), "params.config", Some("configs")),
+            ("unknown config", raw(r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#), "params.config", None),
+            ("seed 2^53", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9007199254740992}}"#), "params.seed", None),
+            // Sweeps: point counts, launcher-only, labels that must select something real.
+            ("one point", raw(r#"{"kind":"sweep","params":{"points":1}}"#), "params.points", None),
+            ("500 points", raw(r#"{"kind":"sweep","params":{"points":500}}"#), "params.points", None),
+            ("sweep of a rattle box", raw(r#"{"kind":"sweep","params":{"config":"rattle-box-c"}}"#), "params.config", None),
+            ("unknown vehicle", raw(r#"{"kind":"sweep","params":{"vehicle_profile":"uh60"}}"#), "params.vehicle_profile", Some("ah64")),
+            ("unknown wear law", raw(r#"{"kind":"sweep","params":{"wear_law":"totally-made-up"}}"#), "params.wear_law", None),
+            // `archard` is a real law but needs its coefficient: the default config has none.
+            ("archard without coefficient", raw(r#"{"kind":"sweep","params":{"wear_law":"archard"}}"#), "params.wear_law", None),
+            ("unknown environment", raw(r#"{"kind":"sweep","params":{"environment":"desert-sand"}}"#), "params.environment", None),
+            ("point on a sweep", raw(r#"{"kind":"sweep","params":{"point":0}}"#), "params.point", None),
+            ("sweep negative duration", raw(r#"{"kind":"sweep","params":{"overrides":{"simulation":{"duration_s":-2}}}}"#), duration, None),
+            // Calibration data: required, typed, no unknown keys.
+            ("no calibration data", raw(r#"{"kind":"calibrate","params":{}}"#), "params", None),
+            ("calibration typo", raw(r#"{"kind":"calibrate","params":{"wear_law":{"records":[],"densty":1}}}"#), "params.wear_law.densty", None),
+            ("absurd density", raw(r#"{"kind":"calibrate","params":{"wear_law":{"density_kg_m3":1e9,"records":[]}}}"#), "params.wear_law.density_kg_m3", None),
+        ];
+        for (case, body, field, word) in &cases {
+            let p = api.post(jobs, Some(ENGINEER), body).problem(422);
+            assert_eq!(p["field"], *field, "{case}: {body}: {p}");
+            if let Some(word) = word {
+                assert!(p["detail"].as_str().unwrap().contains(word), "{case}: {p}");
+            }
         }
-        rejected(
-            &sim(json!({"settle_s": 1e6})),
-            "params.overrides.simulation.settle_s",
-        );
-        rejected(
-            &sim(json!({"rel_tolerance": 0.5})),
-            "params.overrides.simulation.rel_tolerance",
-        );
-        rejected(
-            &sim(json!({"abs_tolerance_m": 1.0})),
-            "params.overrides.simulation.abs_tolerance_m",
-        );
-        rejected(
-            &sim(json!({"record_interval_s": 1e-9})),
-            "params.overrides.simulation.record_interval_s",
-        );
-        // 24 h at the default 0.1 ms interval records far more than memory holds.
-        rejected(
-            &json!({"kind": "simulate", "params": {"config": "rattle-box-c",
-                "overrides": {"simulation": {"duration_s": 86_400.0}}}})
-            .to_string(),
-            "params.overrides.simulation.record_interval_s",
-        );
-        // A typo in an override key, overrides that are not an object, unknown params.
-        let p = rejected(
-            &sim(json!({"durationn_s": 1.0})),
-            "params.overrides.simulation.durationn_s",
-        );
-        assert!(p["detail"].as_str().unwrap().contains("durationn_s"), "{p}");
-        rejected(
-            r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":[1,2]}}"#,
-            "params.overrides",
-        );
-        rejected(
-            r#"{"kind":"simulate","params":{"confg":"rattle-box-c"}}"#,
-            "params.confg",
-        );
-        rejected(
-            r#"{"kind":"simulate","params":{"seed":3}}"#,
-            "params.config",
-        );
-        let p = rejected(
-            r#"{"kind":"simulate","params":{"config":"service"}}"#,
-            "params.config",
-        );
-        assert!(
-            p["detail"].as_str().unwrap().contains("configs"),
-            "names the directory searched: {p}"
-        );
-        rejected(
-            r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#,
-            "params.config",
-        );
+        // A config that is an object: the field is under params.config.
         let p = api
             .post(
                 jobs,
@@ -126,56 +99,6 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
         assert!(
             p["field"].as_str().unwrap().starts_with("params.config"),
             "{p}"
-        );
-        rejected(
-            r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9007199254740992}}"#,
-            "params.seed",
-        );
-
-        // Sweeps: point counts, launcher-only, labels that must select something real.
-        for points in [1, 500] {
-            rejected(
-                &json!({"kind": "sweep", "params": {"points": points}}).to_string(),
-                "params.points",
-            );
-        }
-        rejected(
-            r#"{"kind":"sweep","params":{"config":"rattle-box-c"}}"#,
-            "params.config",
-        );
-        let p = rejected(
-            r#"{"kind":"sweep","params":{"vehicle_profile":"uh60"}}"#,
-            "params.vehicle_profile",
-        );
-        assert!(p["detail"].as_str().unwrap().contains("ah64"), "{p}");
-        rejected(
-            r#"{"kind":"sweep","params":{"wear_law":"totally-made-up"}}"#,
-            "params.wear_law",
-        );
-        // `archard` is a real law but needs its coefficient: the default config has none.
-        rejected(
-            r#"{"kind":"sweep","params":{"wear_law":"archard"}}"#,
-            "params.wear_law",
-        );
-        rejected(
-            r#"{"kind":"sweep","params":{"environment":"desert-sand"}}"#,
-            "params.environment",
-        );
-        rejected(r#"{"kind":"sweep","params":{"point":0}}"#, "params.point");
-        rejected(
-            r#"{"kind":"sweep","params":{"overrides":{"simulation":{"duration_s":-2}}}}"#,
-            "params.overrides.simulation.duration_s",
-        );
-
-        // Calibration data: required, typed, no unknown keys.
-        rejected(r#"{"kind":"calibrate","params":{}}"#, "params");
-        rejected(
-            r#"{"kind":"calibrate","params":{"wear_law":{"records":[],"densty":1}}}"#,
-            "params.wear_law.densty",
-        );
-        rejected(
-            r#"{"kind":"calibrate","params":{"wear_law":{"density_kg_m3":1e9,"records":[]}}}"#,
-            "params.wear_law.density_kg_m3",
         );
 
         assert_eq!(stored_jobs(&api), 0, "a rejected job stores nothing");
@@ -199,7 +122,7 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -211,9 +134,8 @@ async fn drawn_seeds_are_below_two_to_the_53() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
-    let dir = temp_dir("jobs-errors");
-    let service = start_library(&dir).await;
-    let api = Api::new(&format!("http://{}", service.addr));
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         let jobs = "/v1/jobs";
         // A planner may not submit jobs, whatever the body holds.
@@ -258,5 +180,5 @@ async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }

@@ -1,4 +1,4 @@
-//! Planner journey over HTTP (curl): measured dimensions -> rattle space at once (eq. 6.1-6.3),
+//! Planner journey over HTTP: measured dimensions -> rattle space at once (eq. 6.1-6.3),
 //! a report that says which sweep to run, then K_SL and penalized life once the sweep's curve
 //! exists (eq. 6.4); rejected measurements are 4xx problems that store nothing.
 //! Sweeps here are the counting test runner's fixed curve: rail wear 2.0, 1.5, 1.0 mg/h at
