@@ -3,7 +3,7 @@
 //! broken campaign is a 422 naming the field (down to the sample row) and stores nothing;
 //! only test engineers and admins upload, every role reads.
 
-use crate::helpers::{Api, Reply};
+use crate::helpers::{Api, Reply, TestApp};
 use crate::support::runner::{start, test_config};
 use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
@@ -302,9 +302,8 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn only_test_engineers_and_admins_upload() {
-    let dir = temp_dir("campaigns-roles");
-    let service = start(test_config(&dir.db_url()), false).await;
-    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
+    let app = TestApp::spawn_idle().await;
+    let api = Campaigns(app.api.clone());
     tokio::task::spawn_blocking(move || {
         let good = thesis_json().to_string();
         // The role is checked before the body is read: a planner gets 403 whatever it sends.
@@ -327,5 +326,5 @@ async fn only_test_engineers_and_admins_upload() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }

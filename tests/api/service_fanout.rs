@@ -4,9 +4,9 @@
 //! assembled once from the children's results in index order; a failing child fails the sweep
 //! naming it and cancels the rest; cancelling the sweep cancels its children.
 
-use crate::helpers::{wait_for, Api, TestApp};
-use crate::support::runner::{sample, start, test_config};
-use crate::support::{temp_dir, ENGINEER};
+use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::support::runner::sample;
+use crate::support::ENGINEER;
 use railwear::store::AttemptOutcome;
 use serde_json::{json, Value};
 use std::time::Duration;
@@ -24,12 +24,12 @@ fn count(items: &[Value], status: &str) -> usize {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
-    let dir = temp_dir("fanout");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 3;
-    let service = start(config, true).await;
-    let store = service.state.store.clone();
-    let api = Api::new(&format!("http://{}", service.addr));
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 3;
+    })
+    .await;
+    let store = app.service.state.store.clone();
+    let api = app.api.clone();
     let (id, child_ids) = tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":3,"step_ms":20,"seed":42}}"#;
         let id = api.submit_job(body);
@@ -132,7 +132,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         .unwrap()
         .unwrap();
     assert_eq!(curve.job_id, id);
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -259,11 +259,11 @@ fn sample_value(text: &str, series: &str) -> Option<f64> {
 /// failure ends the sweep; each sweep once.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_sweep_duration_histogram_counts_whole_sweeps() {
-    let dir = temp_dir("fanout-metrics");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 2;
-    let service = start(config, true).await;
-    let api = Api::new(&format!("http://{}", service.addr));
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 2;
+    })
+    .await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         // 4 children of 5 x 60 ms on 2 workers: at least 0.6 s of wall time.
         let body = r#"{"kind":"sweep","params":{"children":4,"steps":5,"step_ms":60,"seed":3}}"#;
@@ -314,7 +314,7 @@ async fn the_sweep_duration_histogram_counts_whole_sweeps() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 /// Unix ms of an RFC 3339 time as the API writes it (`2024-05-01T08:30:00.123Z`).

@@ -6,7 +6,7 @@
 //! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
 //! the uninterrupted run's result.
 
-use crate::helpers::{wait_for, Api};
+use crate::helpers::{wait_for, Api, Runner, TestApp};
 use crate::support::runner::{start, start_library, test_config};
 use crate::support::{temp_dir, ENGINEER};
 use railwear::jobs::JobStatus;
@@ -126,14 +126,14 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
-    let dir = temp_dir("shutdown-grace");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 1;
-    config.shutdown_grace_s = 0.5;
-    config.lease_s = 60.0;
-    let service = start(config, true).await;
-    let store = service.state.store.clone();
-    let api = Api::new(&format!("http://{}", service.addr));
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 1;
+        config.shutdown_grace_s = 0.5;
+        config.lease_s = 60.0;
+    })
+    .await;
+    let store = app.service.state.store.clone();
+    let api = app.api.clone();
     // One step of 4 s: the runner looks at its cancel flag only between steps.
     let id = tokio::task::spawn_blocking(move || {
         let id =
@@ -144,7 +144,7 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
     .await
     .unwrap();
     let asked = Instant::now();
-    service.stop().await;
+    app.stop().await;
     let took = asked.elapsed();
     assert!(
         took >= Duration::from_millis(450) && took < Duration::from_millis(1500),
