@@ -29,6 +29,8 @@ pub mod pipeline;
 pub mod report;
 pub mod service_life;
 pub mod store;
+#[doc(hidden)]
+pub mod testkit;
 pub mod units;
 pub mod validation;
 pub mod wear;

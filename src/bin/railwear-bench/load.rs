@@ -2,137 +2,22 @@
 
 use super::*;
 
-pub(crate) mod http1 {
-    use tokio::io::{AsyncBufReadExt, AsyncReadExt, AsyncWriteExt, BufReader};
-    use tokio::net::TcpStream;
+use railwear::testkit::{ClientError, Conn, Request, ServerProcess, TempDir};
 
-    pub struct Conn {
-        addr: String,
-        stream: Option<BufReader<TcpStream>>,
+/// One request as `token` on a kept connection (the testkit's HTTP/1.1 client): status and body.
+async fn call(
+    conn: &mut Conn,
+    method: &str,
+    path: &str,
+    token: &str,
+    body: Option<&str>,
+) -> std::result::Result<(u16, Vec<u8>), ClientError> {
+    let mut request = Request::new(method, path).bearer(token);
+    if let Some(body) = body {
+        request = request.json(body);
     }
-
-    pub(crate) fn bad(msg: impl Into<String>) -> std::io::Error {
-        std::io::Error::new(std::io::ErrorKind::InvalidData, msg.into())
-    }
-
-    impl Conn {
-        pub fn new(addr: &str) -> Self {
-            Self {
-                addr: addr.to_string(),
-                stream: None,
-            }
-        }
-
-        /// One request; reconnects when the server closed the connection.
-        pub async fn request(
-            &mut self,
-            method: &str,
-            path: &str,
-            token: &str,
-            body: Option<&str>,
-        ) -> std::io::Result<(u16, Vec<u8>)> {
-            for attempt in 0..2 {
-                match self.try_request(method, path, token, body).await {
-                    Ok(r) => return Ok(r),
-                    Err(e) if attempt == 0 => {
-                        self.stream = None;
-                        let _ = e;
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-            Err(bad("unreachable"))
-        }
-
-        async fn try_request(
-            &mut self,
-            method: &str,
-            path: &str,
-            token: &str,
-            body: Option<&str>,
-        ) -> std::io::Result<(u16, Vec<u8>)> {
-            if self.stream.is_none() {
-                let s = TcpStream::connect(&self.addr).await?;
-                s.set_nodelay(true)?;
-                self.stream = Some(BufReader::new(s));
-            }
-            let Some(stream) = self.stream.as_mut() else {
-                return Err(bad("no connection"));
-            };
-            let mut req = format!(
-                "{method} {path} HTTP/1.1\r\nHost: {}\r\nAuthorization: Bearer {token}\r\n",
-                self.addr
-            );
-            if let Some(b) = body {
-                req.push_str(&format!(
-                    "Content-Type: application/json\r\nContent-Length: {}\r\n",
-                    b.len()
-                ));
-            }
-            req.push_str("\r\n");
-            if let Some(b) = body {
-                req.push_str(b);
-            }
-            stream.get_mut().write_all(req.as_bytes()).await?;
-            let mut line = String::new();
-            if stream.read_line(&mut line).await? == 0 {
-                return Err(bad("connection closed"));
-            }
-            let status: u16 = line
-                .split_whitespace()
-                .nth(1)
-                .and_then(|s| s.parse().ok())
-                .ok_or_else(|| bad(format!("bad status line {line:?}")))?;
-            let mut content_length: Option<usize> = None;
-            let mut chunked = false;
-            let mut close = false;
-            loop {
-                line.clear();
-                if stream.read_line(&mut line).await? == 0 {
-                    return Err(bad("connection closed in headers"));
-                }
-                let h = line.trim_end();
-                if h.is_empty() {
-                    break;
-                }
-                if let Some((k, v)) = h.split_once(':') {
-                    let k = k.trim().to_ascii_lowercase();
-                    let v = v.trim();
-                    match k.as_str() {
-                        "content-length" => content_length = v.parse().ok(),
-                        "transfer-encoding" => chunked = v.eq_ignore_ascii_case("chunked"),
-                        "connection" => close = v.eq_ignore_ascii_case("close"),
-                        _ => {}
-                    }
-                }
-            }
-            let mut body = Vec::new();
-            if chunked {
-                loop {
-                    line.clear();
-                    stream.read_line(&mut line).await?;
-                    let n = usize::from_str_radix(line.trim().split(';').next().unwrap_or(""), 16)
-                        .map_err(|_| bad("bad chunk size"))?;
-                    let mut chunk = vec![0u8; n + 2];
-                    stream.read_exact(&mut chunk).await?;
-                    if n == 0 {
-                        break;
-                    }
-                    body.extend_from_slice(&chunk[..n]);
-                }
-            } else if let Some(n) = content_length {
-                body.resize(n, 0);
-                stream.read_exact(&mut body).await?;
-            } else {
-                stream.read_to_end(&mut body).await?;
-                close = true;
-            }
-            if close {
-                self.stream = None;
-            }
-            Ok((status, body))
-        }
-    }
+    let response = conn.send(&request).await?;
+    Ok((response.status, response.body))
 }
 
 pub(crate) fn percentile(sorted: &[u64], p: f64) -> f64 {
@@ -143,69 +28,25 @@ pub(crate) fn percentile(sorted: &[u64], p: f64) -> f64 {
     sorted[i.min(sorted.len() - 1)] as f64
 }
 
+/// The server process and its database directory (the process is killed first on drop).
 pub(crate) struct Server {
-    pub(crate) child: std::process::Child,
-    pub(crate) addr: String,
-    pub(crate) dir: PathBuf,
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        let _ = std::fs::remove_dir_all(&self.dir);
-    }
+    pub(crate) process: ServerProcess,
+    pub(crate) _dir: TempDir,
 }
 
 pub(crate) fn start_server(bin: &Path, configs_dir: &Path, tokens: &str) -> Result<Server> {
-    use std::io::BufRead;
     if !bin.exists() {
         bail!(
             "{} not found: build it first (cargo build --release)",
             bin.display()
         );
     }
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_nanos())
-        .unwrap_or(0);
-    let dir = std::env::temp_dir().join(format!("railwear-bench-{}-{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let db = format!("sqlite://{}?mode=rwc", dir.join("bench.db").display());
-    let mut child = std::process::Command::new(bin)
-        .args(["serve", "--listen", "127.0.0.1:0", "--workers", "2"])
-        .env("DATABASE_URL", &db)
-        .env("RAILWEAR_TOKENS", tokens)
-        .env("RAILWEAR_CONFIGS_DIR", configs_dir)
-        .env("RUST_LOG", "warn")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::inherit())
-        .spawn()
+    let dir = TempDir::new("bench")?;
+    let mut cmd = railwear::testkit::serve_command(bin, &dir.db_url(), tokens, configs_dir);
+    cmd.args(["--workers", "2"]);
+    let process = ServerProcess::spawn(cmd, Duration::from_secs(60))
         .with_context(|| format!("starting {}", bin.display()))?;
-    let Some(stdout) = child.stdout.take() else {
-        let _ = child.kill();
-        bail!("no stdout from the server");
-    };
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in std::io::BufReader::new(stdout)
-            .lines()
-            .map_while(Result::ok)
-        {
-            if let Some(a) = line.strip_prefix("listening on http://") {
-                let _ = tx.send(a.trim().to_string());
-            }
-        }
-    });
-    let mut server = Server {
-        child,
-        addr: String::new(),
-        dir,
-    };
-    server.addr = rx
-        .recv_timeout(Duration::from_secs(60))
-        .context("the server did not print `listening on http://ADDR` within 60 s")?;
-    Ok(server)
+    Ok(Server { process, _dir: dir })
 }
 
 pub(crate) fn json_body(b: &[u8]) -> Value {
@@ -238,12 +79,12 @@ pub(crate) fn load(
     let tokens = format!("bench-p:planner:{planner},bench-e:engineer:{engineer}");
     let configs_abs = std::fs::canonicalize(configs_dir).unwrap_or(configs_dir.to_path_buf());
     let server = start_server(bin, &configs_abs, &tokens)?;
-    eprintln!("load: server at {}", server.addr);
+    eprintln!("load: server at {}", server.process.addr());
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(client_threads)
         .enable_all()
         .build()?;
-    let addr = server.addr.clone();
+    let addr = server.process.addr().to_string();
     let result = rt.block_on(load_async(
         addr,
         planner,
@@ -266,7 +107,6 @@ async fn load_async(
     seconds: f64,
     curve: bool,
 ) -> Result<Vec<Table>> {
-    use http1::Conn;
     let mut notes = Vec::new();
     let mut conn = Conn::new(&addr);
     // Optional short sweep so that reports compute K_SL from a stored curve.
@@ -277,9 +117,7 @@ async fn load_async(
             "config": "launcher-design", "points": 3,
             "overrides": {"simulation": {"settle_s": 0.1, "duration_s": 0.1, "record_interval_s": 0.01}}}})
         .to_string();
-        let (st, b) = conn
-            .request("POST", "/v1/jobs", &engineer, Some(&body))
-            .await?;
+        let (st, b) = call(&mut conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
         let id = json_body(&b)
             .get("id")
             .and_then(Value::as_str)
@@ -289,9 +127,8 @@ async fn load_async(
                 let t0 = Instant::now();
                 loop {
                     tokio::time::sleep(Duration::from_millis(500)).await;
-                    let (_, b) = conn
-                        .request("GET", &format!("/v1/jobs/{id}"), &engineer, None)
-                        .await?;
+                    let (_, b) =
+                        call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
                     let status = json_body(&b)
                         .get("status")
                         .and_then(Value::as_str)
@@ -346,14 +183,14 @@ async fn load_async(
                     "location": "loopback",
                 })
                 .to_string();
-                match c
-                    .request(
-                        "POST",
-                        &format!("/v1/rails/R-{i:05}/measurements"),
-                        &planner,
-                        Some(&body),
-                    )
-                    .await
+                match call(
+                    &mut c,
+                    "POST",
+                    &format!("/v1/rails/R-{i:05}/measurements"),
+                    &planner,
+                    Some(&body),
+                )
+                .await
                 {
                     Ok((st, _)) if st < 300 => {}
                     _ => failures += 1,
@@ -376,9 +213,7 @@ async fn load_async(
         let body = json!({"kind": "simulate", "params": {"config": "rattle-box-c", "seed": seed,
             "overrides": {"simulation": {"settle_s": 1.0, "duration_s": 3600.0}}}})
         .to_string();
-        let (st, b) = conn
-            .request("POST", "/v1/jobs", &engineer, Some(&body))
-            .await?;
+        let (st, b) = call(&mut conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
         match json_body(&b).get("id").and_then(Value::as_str) {
             Some(id) if st < 300 => job_ids.push(id.to_string()),
             _ => notes.push(format!(
@@ -393,9 +228,7 @@ async fn load_async(
     while t_wait.elapsed() < Duration::from_secs(30) {
         running = 0;
         for id in &job_ids {
-            let (_, b) = conn
-                .request("GET", &format!("/v1/jobs/{id}"), &engineer, None)
-                .await?;
+            let (_, b) = call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
             if json_body(&b).get("status").and_then(Value::as_str) == Some("running") {
                 running += 1;
             }
@@ -406,9 +239,7 @@ async fn load_async(
         tokio::time::sleep(Duration::from_millis(200)).await;
     }
     // A sample report.
-    let (st, b) = conn
-        .request("GET", "/v1/rails/R-00000/report", &planner, None)
-        .await?;
+    let (st, b) = call(&mut conn, "GET", "/v1/rails/R-00000/report", &planner, None).await?;
     let sample = json_body(&b);
     let report_kind = if st != 200 {
         format!("status {st}")
@@ -437,9 +268,14 @@ async fn load_async(
                 x ^= x << 17;
                 let i = (x % rails as u64) as usize;
                 let t = Instant::now();
-                match c
-                    .request("GET", &format!("/v1/rails/R-{i:05}/report"), &planner, None)
-                    .await
+                match call(
+                    &mut c,
+                    "GET",
+                    &format!("/v1/rails/R-{i:05}/report"),
+                    &planner,
+                    None,
+                )
+                .await
                 {
                     Ok((200, _)) => lat_us.push(t.elapsed().as_micros() as u64),
                     Ok(_) => {
@@ -467,15 +303,18 @@ async fn load_async(
     // Still running? Then cancel.
     let mut still = 0;
     for id in &job_ids {
-        let (_, b) = conn
-            .request("GET", &format!("/v1/jobs/{id}"), &engineer, None)
-            .await?;
+        let (_, b) = call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
         if json_body(&b).get("status").and_then(Value::as_str) == Some("running") {
             still += 1;
         }
-        let _ = conn
-            .request("POST", &format!("/v1/jobs/{id}/cancel"), &engineer, None)
-            .await;
+        let _ = call(
+            &mut conn,
+            "POST",
+            &format!("/v1/jobs/{id}/cancel"),
+            &engineer,
+            None,
+        )
+        .await;
     }
     let mut t = Table::new(
         "Service load: GET /v1/rails/{serial}/report on loopback",

@@ -2,76 +2,6 @@
 
 use super::*;
 
-/// A database created for the benchmark, dropped on drop.
-pub(crate) struct BenchDb {
-    pub(crate) admin_url: String,
-    pub(crate) name: String,
-    pub(crate) url: String,
-}
-
-impl BenchDb {
-    async fn create(admin_url: &str) -> Result<Self> {
-        use sqlx::Connection;
-        let mut conn = sqlx::postgres::PgConnection::connect(admin_url)
-            .await
-            .with_context(|| format!("connecting to {admin_url}"))?;
-        let stamp = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos())
-            .unwrap_or(0);
-        let name = format!("railwear_bench_{}_{stamp}", std::process::id());
-        sqlx::query(&format!("CREATE DATABASE \"{name}\""))
-            .execute(&mut conn)
-            .await
-            .with_context(|| format!("CREATE DATABASE {name}"))?;
-        let _ = conn.close().await;
-        // Same server and credentials, other database: replace the URL's path.
-        let (base, query) = admin_url.split_once('?').unwrap_or((admin_url, ""));
-        let host_start = base.find("://").map_or(0, |i| i + 3);
-        let host_end = base[host_start..]
-            .find('/')
-            .map_or(base.len(), |i| host_start + i);
-        let mut url = format!("{}/{name}", &base[..host_end]);
-        if !query.is_empty() {
-            url.push('?');
-            url.push_str(query);
-        }
-        Ok(Self {
-            admin_url: admin_url.to_string(),
-            name,
-            url,
-        })
-    }
-}
-
-impl Drop for BenchDb {
-    fn drop(&mut self) {
-        let (admin_url, name) = (self.admin_url.clone(), self.name.clone());
-        // Drop may run inside a runtime: use one of our own on a plain thread.
-        let dropped = std::thread::spawn(move || -> Option<()> {
-            use sqlx::Connection;
-            let rt = tokio::runtime::Builder::new_current_thread()
-                .enable_all()
-                .build()
-                .ok()?;
-            rt.block_on(async {
-                let mut conn = sqlx::postgres::PgConnection::connect(&admin_url)
-                    .await
-                    .ok()?;
-                sqlx::query(&format!("DROP DATABASE IF EXISTS \"{name}\" WITH (FORCE)"))
-                    .execute(&mut conn)
-                    .await
-                    .ok()?;
-                conn.close().await.ok()
-            })
-        })
-        .join();
-        if !matches!(dropped, Ok(Some(()))) {
-            eprintln!("warning: could not drop benchmark database {}", self.name);
-        }
-    }
-}
-
 /// CPU time of this process's reaped children (user + system), s, from /proc/self/stat
 /// (`cutime`, `cstime` in USER_HZ ticks, 100 per second on Linux).
 pub(crate) fn reaped_children_cpu_s() -> Option<f64> {
@@ -127,7 +57,13 @@ pub(crate) fn sweep_procs(
         .worker_threads(1)
         .enable_all()
         .build()?;
-    let db = rt.block_on(BenchDb::create(admin_url))?;
+    // A database created beside the admin connection's, dropped at the end (testkit).
+    let db = rt
+        .block_on(railwear::testkit::ThrowawayDb::create(
+            admin_url,
+            "railwear_bench",
+        ))
+        .with_context(|| format!("creating a database through {admin_url}"))?;
     let store = rt.block_on(railwear::store::open(&db.url))?;
     // Submissions go through the job system as an API process would (no workers here).
     let jobs = railwear::jobs::Jobs::new(

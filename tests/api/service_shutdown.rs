@@ -6,13 +6,12 @@
 //! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
 //! the uninterrupted run's result.
 
-mod service_support;
-
+use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::support::runner::{start, start_library, test_config};
+use crate::support::{temp_dir, ENGINEER};
 use railwear::jobs::JobStatus;
 use railwear::store::{AttemptOutcome, Store};
 use serde_json::Value;
-use service_support::runner::{start, start_library, test_config};
-use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -28,26 +27,20 @@ async fn outcomes(store: &Arc<dyn Store>, id: &str) -> Vec<AttemptOutcome> {
 }
 
 /// Tracks CSV and result summary of a succeeded job.
-fn results(base: &str, id: &str) -> (String, Value) {
-    let csv = curl(
-        "GET",
-        &format!("{base}/v1/jobs/{id}/tracks"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+fn results(api: &Api, id: &str) -> (String, Value) {
+    let csv = api.get(&format!("/v1/jobs/{id}/tracks"), Some(ENGINEER));
     assert_eq!(csv.status, 200, "{}", csv.body);
     (
         csv.body,
-        get_json(base, &format!("/v1/jobs/{id}/result"))["summary"].clone(),
+        api.get_json(&format!("/v1/jobs/{id}/result"))["summary"].clone(),
     )
 }
 
 /// Submits `body` and waits until the job's progress passes `fraction`; the job's id.
-fn submit_until_progress(base: &str, body: &str, fraction: f64, timeout: Duration) -> String {
-    let id = submit_job(base, body);
+fn submit_until_progress(api: &Api, body: &str, fraction: f64, timeout: Duration) -> String {
+    let id = api.submit_job(body);
     wait_for(timeout, "progress", || {
-        let j = get_job(base, &id);
+        let j = api.get_job(&id);
         (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > fraction).then_some(())
     });
     id
@@ -57,9 +50,9 @@ fn submit_until_progress(base: &str, body: &str, fraction: f64, timeout: Duratio
 const SHORT: Duration = Duration::from_secs(30);
 const LONG: Duration = Duration::from_secs(300);
 
-fn wait_status(base: &str, id: &str, status: &str, timeout: Duration) -> Value {
+fn wait_status(api: &Api, id: &str, status: &str, timeout: Duration) -> Value {
     wait_for(timeout, status, || {
-        let j = get_job(base, id);
+        let j = api.get_job(id);
         (j["status"] == status).then_some(j)
     })
 }
@@ -70,27 +63,27 @@ const BODY: &str =
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identically() {
     // Reference: uninterrupted.
-    let ref_dir = TempDir::new("shutdown-ref");
+    let ref_dir = temp_dir("shutdown-ref");
     let reference = start(test_config(&ref_dir.db_url()), true).await;
-    let base = format!("http://{}", reference.addr);
+    let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, BODY);
-        wait_status(&base, &id, "succeeded", SHORT);
-        results(&base, &id)
+        let id = api.submit_job(BODY);
+        wait_status(&api, &id, "succeeded", SHORT);
+        results(&api, &id)
     })
     .await
     .unwrap();
     reference.stop().await;
 
-    let dir = TempDir::new("shutdown");
+    let dir = temp_dir("shutdown");
     let mut config = test_config(&dir.db_url());
     config.workers = 1;
     config.shutdown_grace_s = 1.0;
     config.lease_s = 60.0; // only the release can hand the job on this fast
     let first = start(config.clone(), true).await;
     let store = first.state.store.clone();
-    let base = format!("http://{}", first.addr);
-    let id = tokio::task::spawn_blocking(move || submit_until_progress(&base, BODY, 0.2, SHORT))
+    let api = Api::new(&format!("http://{}", first.addr));
+    let id = tokio::task::spawn_blocking(move || submit_until_progress(&api, BODY, 0.2, SHORT))
         .await
         .unwrap();
     let asked = Instant::now();
@@ -108,12 +101,12 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     assert_eq!(outcomes(&store, &id).await, [AttemptOutcome::Released]);
 
     let second = start(config, true).await;
-    let base = format!("http://{}", second.addr);
+    let api = Api::new(&format!("http://{}", second.addr));
     let (got, job) = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            let job = wait_status(&base, &id, "succeeded", SHORT);
-            (results(&base, &id), job)
+            let job = wait_status(&api, &id, "succeeded", SHORT);
+            (results(&api, &id), job)
         }
     })
     .await
@@ -133,27 +126,25 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
-    let dir = TempDir::new("shutdown-grace");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 1;
-    config.shutdown_grace_s = 0.5;
-    config.lease_s = 60.0;
-    let service = start(config, true).await;
-    let store = service.state.store.clone();
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 1;
+        config.shutdown_grace_s = 0.5;
+        config.lease_s = 60.0;
+    })
+    .await;
+    let store = app.service.state.store.clone();
+    let api = app.api.clone();
     // One step of 4 s: the runner looks at its cancel flag only between steps.
     let id = tokio::task::spawn_blocking(move || {
-        let id = submit_job(
-            &base,
-            r#"{"kind":"simulate","params":{"steps":2,"step_ms":4000,"seed":1}}"#,
-        );
-        wait_status(&base, &id, "running", SHORT);
+        let id =
+            api.submit_job(r#"{"kind":"simulate","params":{"steps":2,"step_ms":4000,"seed":1}}"#);
+        wait_status(&api, &id, "running", SHORT);
         id
     })
     .await
     .unwrap();
     let asked = Instant::now();
-    service.stop().await;
+    app.stop().await;
     let took = asked.elapsed();
     assert!(
         took >= Duration::from_millis(450) && took < Duration::from_millis(1500),
@@ -175,31 +166,31 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_result() {
     let body = r#"{"kind":"sweep","params":{"children":6,"steps":8,"step_ms":50,"seed":77}}"#;
-    let ref_dir = TempDir::new("shutdown-sweep-ref");
+    let ref_dir = temp_dir("shutdown-sweep-ref");
     let reference = start(test_config(&ref_dir.db_url()), true).await;
-    let base = format!("http://{}", reference.addr);
+    let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, body);
-        wait_status(&base, &id, "succeeded", SHORT);
-        get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
+        let id = api.submit_job(body);
+        wait_status(&api, &id, "succeeded", SHORT);
+        api.get_json(&format!("/v1/jobs/{id}/result"))["summary"].clone()
     })
     .await
     .unwrap();
     reference.stop().await;
 
-    let dir = TempDir::new("shutdown-sweep");
+    let dir = temp_dir("shutdown-sweep");
     let mut config = test_config(&dir.db_url());
     config.workers = 2;
     config.shutdown_grace_s = 1.0;
     config.lease_s = 60.0;
     let first = start(config.clone(), true).await;
     let store = first.state.store.clone();
-    let base = format!("http://{}", first.addr);
+    let api = Api::new(&format!("http://{}", first.addr));
     let id = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         // Stop once some points are done and others run.
         wait_for(SHORT, "a point done", || {
-            let j = get_job(&base, &id);
+            let j = api.get_job(&id);
             (j["children"]["succeeded"].as_i64().unwrap_or(0) >= 2).then_some(())
         });
         id
@@ -237,12 +228,12 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     assert!(released >= 1, "a running point was given back");
 
     let second = start(config, true).await;
-    let base = format!("http://{}", second.addr);
+    let api = Api::new(&format!("http://{}", second.addr));
     let summary = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            wait_status(&base, &id, "succeeded", SHORT);
-            get_json(&base, &format!("/v1/jobs/{id}/result"))["summary"].clone()
+            wait_status(&api, &id, "succeeded", SHORT);
+            api.get_json(&format!("/v1/jobs/{id}/result"))["summary"].clone()
         }
     })
     .await
@@ -286,20 +277,20 @@ const SIMULATE_END_S: f64 = 1.25;
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
     // Reference: uninterrupted.
-    let ref_dir = TempDir::new("checkpoint-ref");
+    let ref_dir = temp_dir("checkpoint-ref");
     let reference = start_library(test_config(&ref_dir.db_url()), true).await;
-    let base = format!("http://{}", reference.addr);
+    let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
-        let id = submit_job(&base, SIMULATE_BODY);
-        wait_status(&base, &id, "succeeded", LONG);
-        results(&base, &id)
+        let id = api.submit_job(SIMULATE_BODY);
+        wait_status(&api, &id, "succeeded", LONG);
+        results(&api, &id)
     })
     .await
     .unwrap();
     reference.stop().await;
     assert!(expected.0.lines().count() > 100, "tracks recorded");
 
-    let dir = TempDir::new("checkpoint");
+    let dir = temp_dir("checkpoint");
     let mut config = test_config(&dir.db_url());
     config.workers = 1;
     config.shutdown_grace_s = 5.0;
@@ -307,12 +298,11 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     let first = start_library(config.clone(), true).await;
     let store = first.state.store.clone();
     let first_jobs = first.state.jobs.clone();
-    let base = format!("http://{}", first.addr);
-    let id = tokio::task::spawn_blocking(move || {
-        submit_until_progress(&base, SIMULATE_BODY, 0.15, LONG)
-    })
-    .await
-    .unwrap();
+    let api = Api::new(&format!("http://{}", first.addr));
+    let id =
+        tokio::task::spawn_blocking(move || submit_until_progress(&api, SIMULATE_BODY, 0.15, LONG))
+            .await
+            .unwrap();
     let asked = Instant::now();
     first.stop().await;
     // The engine stops at its next accepted step: far inside the grace.
@@ -350,20 +340,20 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
 
     // The next worker resumes: its progress starts at the checkpoint's time.
     let second = start_library(config, true).await;
-    let base = format!("http://{}", second.addr);
+    let api = Api::new(&format!("http://{}", second.addr));
     let (got, job, first_progress) = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
             let mut first_progress = None;
             let job = wait_for(LONG, "succeeded", || {
-                let j = get_job(&base, &id);
+                let j = api.get_job(&id);
                 if first_progress.is_none() && j["status"] == "running" {
                     first_progress = j["progress"]["simulated_time_s"].as_f64();
                 }
                 (j["status"] == "succeeded").then_some(j)
             });
-            let attempts = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
-            (results(&base, &id), (job, attempts), first_progress)
+            let attempts = api.get_json(&format!("/v1/jobs/{id}/attempts"));
+            (results(&api, &id), (job, attempts), first_progress)
         }
     })
     .await

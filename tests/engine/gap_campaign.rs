@@ -3,6 +3,7 @@
 
 use railwear::gap::campaign::Campaign;
 use railwear::gap::GapError;
+use railwear::testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -14,12 +15,10 @@ fn thesis_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("campaigns/thesis-rattle-box.toml")
 }
 
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("railwear-gap-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh scratch directory for one test, unique among the tests of this process and
+/// removed when the test ends.
+fn scratch(name: &str) -> TempDir {
+    TempDir::new(&format!("gap-{name}")).expect("scratch dir")
 }
 
 /// Thesis Table 5.3, mg/hr per increment as printed.
@@ -99,7 +98,8 @@ fn with_records() -> Campaign {
 fn toml_with_csv_and_json_round_trip() {
     let c = with_records();
     c.validate(&configs()).unwrap();
-    let dir = scratch("roundtrip");
+    let scratch = scratch("roundtrip");
+    let dir = scratch.path().to_path_buf();
     c.write_dir(&dir).unwrap();
     let back = Campaign::load(&dir.join("campaign.toml")).unwrap();
     // The manifest names the CSV file; the samples come back bit for bit.
@@ -124,7 +124,8 @@ fn field_of(e: &GapError) -> String {
 #[test]
 fn bad_campaigns_name_the_field() {
     let base = std::fs::read_to_string(thesis_path()).unwrap();
-    let dir = scratch("bad");
+    let scratch = scratch("bad");
+    let dir = scratch.path().to_path_buf();
     let check = |text: &str| -> GapError {
         match Campaign::from_toml_str(text, &dir) {
             Err(e) => e,
@@ -209,7 +210,8 @@ fn csv_error(dir: &Path, csv_text: Option<&str>) -> (String, usize, String) {
 
 #[test]
 fn bad_accelerometer_files_name_field_and_row() {
-    let dir = scratch("csv");
+    let scratch = scratch("csv");
+    let dir = scratch.path().to_path_buf();
     let field = "tests[0].specimens[0].accelerometers[0].csv";
     let good = "time_s,a_x_m_s2,a_y_m_s2,a_z_m_s2\n0.00,1,0,0\n0.01,2,0,0\n0.02,3,0,0\n";
     let c = Campaign::from_toml_str(&record_campaign(&dir, Some(good)), &dir).unwrap();
@@ -286,7 +288,8 @@ fn cli_check_prints_a_summary_or_the_error() {
     );
     let out = String::from_utf8_lossy(&ok.stdout);
     assert!(out.contains("4 tests, 4 specimens, 8 increments"), "{out}");
-    let dir = scratch("cli");
+    let scratch = scratch("cli");
+    let dir = scratch.path().to_path_buf();
     let bad =
         std::fs::read_to_string(thesis_path())
             .unwrap()

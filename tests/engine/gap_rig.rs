@@ -87,8 +87,8 @@ fn same_seed_same_campaign_other_seed_differs_and_zero_effect_is_the_control() {
     assert_eq!(tz.tests, ta.tests);
     assert_eq!(tz.effects.len(), zero.len());
     // The written campaign validates and reads back as written.
-    let dir = std::env::temp_dir().join(format!("railwear-gap-rig-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let scratch = railwear::testkit::TempDir::new("gap-rig").expect("scratch dir");
+    let dir = scratch.path().to_path_buf();
     a.write_dir(&dir).unwrap();
     let back = Campaign::load(&dir.join("campaign.toml")).unwrap();
     back.validate(&configs()).unwrap();

@@ -15,9 +15,8 @@
 //! (default 25 per operation) and `RAILWEAR_SCHEMATHESIS_SEED` (default 1, reproducible) tune
 //! the run.
 
-mod service_support;
-
-use service_support::{Binary, TempDir, ADMIN};
+use crate::helpers::Binary;
+use crate::support::{temp_dir, ADMIN};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -50,11 +49,11 @@ fn the_api_conforms_to_its_openapi_document_under_generated_requests() {
     };
     let examples = std::env::var("RAILWEAR_SCHEMATHESIS_EXAMPLES").unwrap_or_else(|_| "25".into());
     let seed = std::env::var("RAILWEAR_SCHEMATHESIS_SEED").unwrap_or_else(|_| "1".into());
-    let dir = TempDir::new("schemathesis");
+    let dir = temp_dir("schemathesis");
     let server = Binary::start_with_args(&dir.db_url(), &[], &["--no-workers"]);
     let document = Path::new(env!("CARGO_MANIFEST_DIR")).join("api/openapi.json");
     let out = Command::new(&st)
-        .current_dir(&dir.0)
+        .current_dir(dir.path())
         .arg("run")
         .arg(&document)
         .args(["--url", &server.base])

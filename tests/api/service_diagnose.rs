@@ -2,29 +2,26 @@
 //! diagnosis, follows the job to the end and reads the report and its SVG figures; planners
 //! may not diagnose; bad params are 422s naming the field; an unknown campaign is a 404.
 
-mod service_support;
-
+use crate::helpers::Api;
+use crate::support::runner::{start_library, test_config};
+use crate::support::{temp_dir, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
 use serde_json::{json, Value};
-use service_support::runner::{start_library, test_config};
-use service_support::{curl, upload_campaign, TempDir, PLANNER, TEST_ENGINEER};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
-const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
+const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_test_engineer_diagnoses_a_campaign_over_http() {
-    let dir = TempDir::new("diagnose");
+    let dir = temp_dir("diagnose");
     let service = start_library(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
-        let id = upload_campaign(&base, CAMPAIGN);
-        let url = format!("{base}/v1/campaigns/{id}/diagnoses");
-        let post = |token: &str, body: &Value| {
-            curl("POST", &url, Some(token), &[], Some(&body.to_string()))
-        };
+        let id = api.upload_campaign(CAMPAIGN);
+        let url = format!("/v1/campaigns/{id}/diagnoses");
+        let post = |token: &str, body: &Value| api.post(&url, Some(token), &body.to_string());
 
         // Who and what is refused.
         let good =
@@ -33,7 +30,7 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         // What `GET /v1/whoami` tells a client (the dashboard shows the button by it) is what
         // the service does.
         for (token, may) in [(PLANNER, false), (TEST_ENGINEER, true)] {
-            let me = curl("GET", &format!("{base}/v1/whoami"), Some(token), &[], None).json();
+            let me = api.get("/v1/whoami", Some(token)).json();
             assert_eq!(me["may"]["diagnose"], may, "{me}");
             assert_eq!(me["may"]["upload_campaigns"], may, "{me}");
         }
@@ -47,15 +44,9 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
             let p = post(TEST_ENGINEER, &bad).problem(422);
             assert_eq!(p["field"], field, "{p}");
         }
-        let unknown = format!("{base}/v1/campaigns/{}/diagnoses", uuid::Uuid::new_v4());
-        curl(
-            "POST",
-            &unknown,
-            Some(TEST_ENGINEER),
-            &[],
-            Some(&good.to_string()),
-        )
-        .problem(404);
+        let unknown = format!("/v1/campaigns/{}/diagnoses", uuid::Uuid::new_v4());
+        api.post(&unknown, Some(TEST_ENGINEER), &good.to_string())
+            .problem(404);
 
         // The diagnosis runs as a job.
         let r = post(TEST_ENGINEER, &good);
@@ -67,10 +58,10 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
             job["params"].get("campaign").is_none(),
             "the view leaves the content out"
         );
-        let job_url = format!("{base}/v1/jobs/{}", job["id"].as_str().unwrap());
+        let job_url = format!("/v1/jobs/{}", job["id"].as_str().unwrap());
         let deadline = Instant::now() + Duration::from_secs(300);
         let done = loop {
-            let j = curl("GET", &job_url, Some(PLANNER), &[], None).json();
+            let j = api.get(&job_url, Some(PLANNER)).json();
             match j["status"].as_str().unwrap() {
                 "succeeded" => break j,
                 "failed" | "cancelled" => panic!("diagnosis ended: {j}"),
@@ -81,13 +72,7 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         };
         assert_eq!(done["progress"]["fraction"], 1.0, "{done}");
 
-        let r = curl(
-            "GET",
-            &format!("{job_url}/result"),
-            Some(TEST_ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.get(&format!("{job_url}/result"), Some(TEST_ENGINEER));
         assert_eq!(r.status, 200, "{}", r.body);
         let result = r.json();
         let report = &result["summary"];
@@ -104,13 +89,7 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         assert!(!report["where"]["groups"].as_array().unwrap().is_empty());
         let plots = result["plots"].as_array().unwrap();
         assert!(!plots.is_empty(), "{result}");
-        let r = curl(
-            "GET",
-            &format!("{base}{}", plots[0]["url"].as_str().unwrap()),
-            Some(TEST_ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.get(plots[0]["url"].as_str().unwrap(), Some(TEST_ENGINEER));
         assert_eq!(r.status, 200);
         assert_eq!(r.header("content-type"), Some("image/svg+xml"));
         assert!(r.body.contains("<svg"));
@@ -125,33 +104,25 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
 /// that SHA-256, fails the job saying which.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_diagnosis_reads_its_campaign_when_it_runs() {
-    let dir = TempDir::new("diagnose-gone");
+    let dir = temp_dir("diagnose-gone");
     let db_url = dir.db_url();
     // No workers yet: the jobs wait in the queue while their campaigns change.
     let service = start_library(test_config(&db_url), false).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     let (gone, changed) = tokio::task::spawn_blocking(move || {
         let mut jobs = Vec::new();
         for name in ["to-be-deleted", "to-be-changed"] {
             let text = CAMPAIGN.replace("\"small-diagnosis\"", &format!("\"{name}\""));
             let campaign = Campaign::from_toml_str(&text, Path::new(".")).expect("campaign");
             let body = serde_json::to_string(&campaign).unwrap();
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/campaigns"),
-                Some(TEST_ENGINEER),
-                &[],
-                Some(&body),
-            );
+            let r = api.post("/v1/campaigns", Some(TEST_ENGINEER), &body);
             assert_eq!(r.status, 201, "{}", r.body);
             let stored = r.json();
             let id = stored["id"].as_str().unwrap().to_string();
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/campaigns/{id}/diagnoses"),
+            let r = api.post(
+                &format!("/v1/campaigns/{id}/diagnoses"),
                 Some(TEST_ENGINEER),
-                &[],
-                Some(r#"{"window_s": 0.1, "effects": ["third_body"]}"#),
+                r#"{"window_s": 0.1, "effects": ["third_body"]}"#,
             );
             assert_eq!(r.status, 201, "{}", r.body);
             let job = r.json();
@@ -185,12 +156,12 @@ async fn a_diagnosis_reads_its_campaign_when_it_runs() {
     pool.close().await;
 
     let workers = service.state.jobs.spawn_workers(1, "diagnose-gone");
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     let errors = tokio::task::spawn_blocking(move || {
         [gone.1, changed.1].map(|job| {
-            let url = format!("{base}/v1/jobs/{job}");
-            service_support::wait_for(Duration::from_secs(60), "the job to end", || {
-                let j = curl("GET", &url, Some(TEST_ENGINEER), &[], None).json();
+            let url = format!("/v1/jobs/{job}");
+            crate::helpers::wait_for(Duration::from_secs(60), "the job to end", || {
+                let j = api.get(&url, Some(TEST_ENGINEER)).json();
                 match j["status"].as_str() {
                     Some("failed") => Some(j["error"].as_str().unwrap_or_default().to_string()),
                     Some("succeeded" | "cancelled") => panic!("should fail: {j}"),

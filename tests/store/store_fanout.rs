@@ -8,9 +8,7 @@
 //! fan-out keeps its data through the fan-out migration, and its curve through the curve
 //! versions migration (published version 1).
 
-mod postgres_support;
-mod service_support;
-
+use crate::fresh_db;
 use railwear::jobs::{ChildCounts, ChildOf, JobKind, JobProgress, JobStatus};
 use railwear::store::{
     self, AttemptOutcome, CurveFidelity, FanOut, FanOutResult, Finish, JobFilter, NewChild,
@@ -421,7 +419,7 @@ async fn script(store: &dyn Store) -> Vec<String> {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn fan_out_lifecycle_is_the_same_on_sqlite_and_postgres() {
-    let dir = service_support::TempDir::new("fanout-script");
+    let dir = crate::support::temp_dir("fanout-script");
     let sqlite = store::open(&dir.db_url()).await.expect("open sqlite store");
     let sqlite_trace = script(sqlite.as_ref()).await;
 
@@ -541,7 +539,7 @@ async fn race(stores: Vec<Arc<dyn Store>>, rounds: u128, n: usize) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn racing_child_finishes_on_sqlite_assemble_the_parent_once() {
-    let dir = service_support::TempDir::new("fanout-race");
+    let dir = crate::support::temp_dir("fanout-race");
     let mut stores = Vec::new();
     for _ in 0..4 {
         stores.push(store::open(&dir.db_url()).await.expect("open sqlite store"));
@@ -561,13 +559,13 @@ async fn racing_child_finishes_on_postgres_assemble_the_parent_once() {
 
 /// The migrator of the first migration only (the schema before fan-out), from the repository's
 /// file, so its checksum is the one `store::open` expects.
-async fn first_migration(engine: &str, dir: &service_support::TempDir) -> sqlx::migrate::Migrator {
+async fn first_migration(engine: &str, dir: &crate::support::TempDir) -> sqlx::migrate::Migrator {
     let source = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("migrations")
         .join(engine)
         .join("0001_init.sql");
-    std::fs::copy(&source, dir.0.join("0001_init.sql")).expect("copy migration 0001");
-    sqlx::migrate::Migrator::new(dir.0.as_path())
+    std::fs::copy(&source, dir.path().join("0001_init.sql")).expect("copy migration 0001");
+    sqlx::migrate::Migrator::new(dir.path())
         .await
         .expect("migrator")
 }
@@ -629,7 +627,7 @@ async fn check_migrated(store: &dyn Store) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_fan_out_migration_keeps_sqlite_data() {
-    let dir = service_support::TempDir::new("migrate-sqlite");
+    let dir = crate::support::temp_dir("migrate-sqlite");
     let url = dir.db_url();
     let old = store::sqlite::SqliteStore::connect(&url).await.unwrap();
     first_migration("sqlite", &dir)
@@ -674,7 +672,7 @@ async fn the_fan_out_migration_keeps_sqlite_data() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_fan_out_migration_keeps_postgres_data() {
     let db = fresh_db!("migrate");
-    let dir = service_support::TempDir::new("migrate-pg");
+    let dir = crate::support::temp_dir("migrate-pg");
     let old = store::postgres::PgStore::connect(&db.url).await.unwrap();
     first_migration("postgres", &dir)
         .await

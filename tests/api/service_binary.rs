@@ -1,105 +1,75 @@
-//! The real `railwear` binary on a free port with a fresh SQLite database, driven with curl.
+//! The real `railwear` binary on a free port with a fresh SQLite database, driven with the test client.
 
-mod service_support;
-
-use service_support::{curl, submit_job, wait_for, Binary, TempDir, ADMIN, ENGINEER, PLANNER};
+use crate::helpers::{wait_for, Binary};
+use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER};
 use std::process::Command;
 use std::time::Duration;
 
 #[test]
 fn serves_health_metrics_docs_and_enforces_tokens() {
-    let dir = TempDir::new("bin");
+    let dir = temp_dir("bin");
     let server = Binary::start(&dir.db_url(), &[]);
-    assert_eq!(
-        curl("GET", &server.url("/healthz"), None, &[], None).body,
-        "ok"
-    );
-    assert_eq!(
-        curl("GET", &server.url("/readyz"), None, &[], None).body,
-        "ready"
-    );
-    let metrics = curl("GET", &server.url("/metrics"), None, &[], None);
+    assert_eq!(server.get("/healthz", None).body, "ok");
+    assert_eq!(server.get("/readyz", None).body, "ready");
+    let metrics = server.get("/metrics", None);
     assert!(metrics.body.contains("railwear_queue_depth 0"));
     assert!(metrics
         .body
         .contains("railwear_simulated_seconds_per_second"));
-    let docs = curl("GET", &server.url("/docs"), None, &[], None);
+    let docs = server.get("/docs", None);
     assert!(docs.body.contains("/v1/openapi.json"));
-    let doc = curl("GET", &server.url("/v1/openapi.json"), None, &[], None);
+    let doc = server.get("/v1/openapi.json", None);
     assert_eq!(doc.body, railwear::http::openapi::openapi_json());
 
-    curl("GET", &server.url("/v1/jobs"), None, &[], None).problem(401);
-    curl("GET", &server.url("/v1/tokens"), Some(PLANNER), &[], None).problem(403);
+    server.get_problem("/v1/jobs", None, 401);
+    server.get_problem("/v1/tokens", Some(PLANNER), 403);
     // An admin creates a planner token over HTTP; it works, and is refused once revoked.
-    let created = curl(
-        "POST",
-        &server.url("/v1/tokens"),
+    let created = server.post(
+        "/v1/tokens",
         Some(ADMIN),
-        &[],
-        Some(r#"{"name":"depot-7","role":"planner"}"#),
+        r#"{"name":"depot-7","role":"planner"}"#,
     );
     assert_eq!(created.status, 201, "{}", created.body);
     let created = created.json();
     let token = created["token"].as_str().unwrap().to_string();
-    assert_eq!(
-        curl("GET", &server.url("/v1/rails"), Some(&token), &[], None).status,
-        200
-    );
-    curl(
-        "POST",
-        &server.url("/v1/jobs"),
-        Some(&token),
-        &[],
-        Some(r#"{"kind":"sweep","params":{}}"#),
-    )
-    .problem(403);
+    assert_eq!(server.get("/v1/rails", Some(&token)).status, 200);
+    server
+        .post("/v1/jobs", Some(&token), r#"{"kind":"sweep","params":{}}"#)
+        .problem(403);
     let id = created["id"].as_str().unwrap();
     assert_eq!(
-        curl(
-            "DELETE",
-            &server.url(&format!("/v1/tokens/{id}")),
-            Some(ADMIN),
-            &[],
-            None
-        )
-        .status,
+        server
+            .delete(&format!("/v1/tokens/{id}"), Some(ADMIN))
+            .status,
         204
     );
-    curl("GET", &server.url("/v1/rails"), Some(&token), &[], None).problem(401);
+    server.get_problem("/v1/rails", Some(&token), 401);
 }
 
 #[test]
 fn unknown_or_unsafe_config_names_are_422_and_store_nothing() {
-    let dir = TempDir::new("names");
+    let dir = temp_dir("names");
     let server = Binary::start(&dir.db_url(), &[]);
     for name in ["../../etc/passwd", "no-such-model", ""] {
         let body = serde_json::json!({"kind": "simulate", "params": {"config": name}}).to_string();
-        let p = curl(
-            "POST",
-            &server.url("/v1/jobs"),
-            Some(ENGINEER),
-            &[],
-            Some(&body),
-        )
-        .problem(422);
+        let p = server.post("/v1/jobs", Some(ENGINEER), &body).problem(422);
         assert_eq!(p["field"], "params.config");
     }
-    let p = curl(
-        "POST",
-        &server.url("/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(r#"{"kind":"simulate","params":{"config":7}}"#),
-    )
-    .problem(422);
+    let p = server
+        .post(
+            "/v1/jobs",
+            Some(ENGINEER),
+            r#"{"kind":"simulate","params":{"config":7}}"#,
+        )
+        .problem(422);
     assert_eq!(p["field"], "params.config");
-    let list = curl("GET", &server.url("/v1/jobs"), Some(ENGINEER), &[], None).json();
+    let list = server.get("/v1/jobs", Some(ENGINEER)).json();
     assert_eq!(list["items"].as_array().unwrap().len(), 0);
 }
 
 #[test]
 fn token_create_command_makes_a_working_token() {
-    let dir = TempDir::new("cli");
+    let dir = temp_dir("cli");
     let out = Command::new(env!("CARGO_BIN_EXE_railwear"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(["token", "create", "--role", "engineer", "--name", "ci"])
@@ -121,51 +91,24 @@ fn token_create_command_makes_a_working_token() {
     assert!(!bad.status.success());
 
     let server = Binary::start(&dir.db_url(), &[]);
-    let r = curl("GET", &server.url("/v1/jobs"), Some(&token), &[], None);
+    let r = server.get("/v1/jobs", Some(&token));
     assert_eq!(r.status, 200, "{}", r.body);
 }
 
 /// Request body of a short simulate job of rattle-box case C.
 const SHORT_SIMULATE: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":11,"overrides":{"simulation":{"settle_s":0.5,"duration_s":0.5}}}}"#;
 
-fn wait_succeeded(server: &Binary, id: &str, timeout: Duration) -> serde_json::Value {
-    wait_for(timeout, "job success", || {
-        let j = curl(
-            "GET",
-            &server.url(&format!("/v1/jobs/{id}")),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
-        assert_ne!(j["status"], "failed", "job failed: {j}");
-        (j["status"] == "succeeded").then_some(j)
-    })
-}
-
 #[test]
 fn simulate_job_succeeds_with_results_and_tracks_csv() {
-    let dir = TempDir::new("sim");
+    let dir = temp_dir("sim");
     let server = Binary::start(&dir.db_url(), &[]);
-    let id = submit_job(&server.url(""), SHORT_SIMULATE);
-    let job = wait_succeeded(&server, &id, Duration::from_secs(300));
+    let id = server.submit_job(SHORT_SIMULATE);
+    let job = server.wait_job(&id, "succeeded", Duration::from_secs(300));
     assert!(job["track_samples"].as_i64().unwrap() > 0);
-    let result = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/result")),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let result = server.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
     assert_eq!(result.status, 200);
     assert!(result.json()["summary"].is_object());
-    let csv = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/tracks?format=csv")),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let csv = server.get(&format!("/v1/jobs/{id}/tracks?format=csv"), Some(ENGINEER));
     let lines: Vec<&str> = csv.body.lines().collect();
     assert_eq!(lines[0], railwear::physics::track::TrackSample::CSV_HEADER);
     assert_eq!(
@@ -177,104 +120,57 @@ fn simulate_job_succeeds_with_results_and_tracks_csv() {
 #[test]
 fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     // Reference: uninterrupted run of the same seed.
-    let ref_dir = TempDir::new("ref");
+    let ref_dir = temp_dir("ref");
     let reference = Binary::start(&ref_dir.db_url(), &[]);
-    let ref_id = submit_job(&reference.url(""), SHORT_SIMULATE);
-    wait_succeeded(&reference, &ref_id, Duration::from_secs(300));
-    let ref_csv = curl(
-        "GET",
-        &reference.url(&format!("/v1/jobs/{ref_id}/tracks")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .body;
-    let ref_result = curl(
-        "GET",
-        &reference.url(&format!("/v1/jobs/{ref_id}/result")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .json();
+    let ref_id = reference.submit_job(SHORT_SIMULATE);
+    reference.wait_job(&ref_id, "succeeded", Duration::from_secs(300));
+    let ref_csv = reference
+        .get(&format!("/v1/jobs/{ref_id}/tracks"), Some(ENGINEER))
+        .body;
+    let ref_result = reference
+        .get(&format!("/v1/jobs/{ref_id}/result"), Some(ENGINEER))
+        .json();
     drop(reference);
 
-    let dir = TempDir::new("crash");
+    let dir = temp_dir("crash");
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
     let server = Binary::start(&dir.db_url(), &env);
-    let id = submit_job(&server.url(""), SHORT_SIMULATE);
+    let id = server.submit_job(SHORT_SIMULATE);
     wait_for(Duration::from_secs(60), "running", || {
-        let j = curl(
-            "GET",
-            &server.url(&format!("/v1/jobs/{id}")),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
+        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
         (j["status"] == "running").then_some(())
     });
     server.kill9();
 
     let server = Binary::start(&dir.db_url(), &env);
-    let job = wait_succeeded(&server, &id, Duration::from_secs(300));
+    let job = server.wait_job(&id, "succeeded", Duration::from_secs(300));
     assert_eq!(job["attempt"], 2, "exactly one re-run");
-    let csv = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/tracks")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .body;
-    let result = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/result")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .json();
+    let csv = server
+        .get(&format!("/v1/jobs/{id}/tracks"), Some(ENGINEER))
+        .body;
+    let result = server
+        .get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER))
+        .json();
     assert_eq!(csv, ref_csv);
     assert_eq!(result["summary"], ref_result["summary"]);
-    let list = curl("GET", &server.url("/v1/jobs"), Some(ENGINEER), &[], None).json();
+    let list = server.get("/v1/jobs", Some(ENGINEER)).json();
     assert_eq!(list["items"].as_array().unwrap().len(), 1);
 }
 
 #[test]
 fn cancel_a_running_simulation() {
-    let dir = TempDir::new("bincancel");
+    let dir = temp_dir("bincancel");
     let server = Binary::start(&dir.db_url(), &[]);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit_job(&server.url(""), long);
+    let id = server.submit_job(long);
     wait_for(Duration::from_secs(60), "running", || {
-        let j = curl(
-            "GET",
-            &server.url(&format!("/v1/jobs/{id}")),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
+        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
         (j["status"] == "running").then_some(())
     });
     let asked = std::time::Instant::now();
-    curl(
-        "POST",
-        &server.url(&format!("/v1/jobs/{id}/cancel")),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    server.cancel_job(&id);
     wait_for(Duration::from_secs(5), "cancelled", || {
-        let j = curl(
-            "GET",
-            &server.url(&format!("/v1/jobs/{id}")),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
+        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
         (j["status"] == "cancelled").then_some(())
     });
     assert!(asked.elapsed() < Duration::from_millis(1500));
@@ -284,12 +180,12 @@ fn cancel_a_running_simulation() {
 fn sigterm(server: &mut Binary) -> Duration {
     let asked = std::time::Instant::now();
     let status = Command::new("kill")
-        .args(["-TERM", &server.child.id().to_string()])
+        .args(["-TERM", &server.process.id().to_string()])
         .status()
         .expect("run kill");
     assert!(status.success());
     loop {
-        if let Some(exit) = server.child.try_wait().expect("try_wait") {
+        if let Some(exit) = server.process.child_mut().try_wait().expect("try_wait") {
             assert!(exit.success(), "exit status {exit}");
             eprintln!("exited {:?} after SIGTERM", asked.elapsed());
             return asked.elapsed();
@@ -303,13 +199,7 @@ fn sigterm(server: &mut Binary) -> Duration {
 }
 
 fn attempt_outcomes(server: &Binary, id: &str) -> Vec<String> {
-    let r = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/attempts")),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let r = server.get(&format!("/v1/jobs/{id}/attempts"), Some(ENGINEER));
     assert_eq!(r.status, 200, "{}", r.body);
     r.json()
         .as_array()
@@ -320,14 +210,7 @@ fn attempt_outcomes(server: &Binary, id: &str) -> Vec<String> {
 }
 
 fn job(server: &Binary, id: &str) -> serde_json::Value {
-    curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .json()
+    server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json()
 }
 
 /// Issue 17: SIGTERM with a 600 s simulation running: the process exits within the grace, the
@@ -335,7 +218,7 @@ fn job(server: &Binary, id: &str) -> serde_json::Value {
 /// logged `released`.
 #[test]
 fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
-    let dir = TempDir::new("sigterm");
+    let dir = temp_dir("sigterm");
     let env = [
         ("RAILWEAR_SHUTDOWN_GRACE_S", "2"),
         ("RAILWEAR_LEASE_S", "60"),
@@ -343,7 +226,7 @@ fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
     ];
     let mut server = Binary::start(&dir.db_url(), &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit_job(&server.url(""), long);
+    let id = server.submit_job(long);
     wait_for(Duration::from_secs(60), "running", || {
         (job(&server, &id)["status"] == "running").then_some(())
     });
@@ -358,14 +241,9 @@ fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
     assert_eq!(j["worker"], serde_json::Value::Null);
     assert_eq!(attempt_outcomes(&api, &id), ["released"]);
     // The simulation stopped with a checkpoint, stored before the release.
-    let attempts = curl(
-        "GET",
-        &api.url(&format!("/v1/jobs/{id}/attempts")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .json();
+    let attempts = api
+        .get(&format!("/v1/jobs/{id}/attempts"), Some(ENGINEER))
+        .json();
     let checkpoint_s = attempts[0]["checkpoint_s"].as_f64();
     assert!(
         checkpoint_s.is_some_and(|t| (0.0..602.0).contains(&t)),
@@ -405,7 +283,7 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
             .0
         })
     };
-    let dir = TempDir::new("sigterm-sweep");
+    let dir = temp_dir("sigterm-sweep");
     let env = [
         ("RAILWEAR_SHUTDOWN_GRACE_S", "5"),
         ("RAILWEAR_LEASE_S", "60"),
@@ -413,16 +291,11 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
     ];
     let mut server = Binary::start(&dir.db_url(), &env);
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
-    let id = submit_job(&server.url(""), &body);
+    let id = server.submit_job(&body);
     let children = |server: &Binary| -> Vec<serde_json::Value> {
-        curl(
-            "GET",
-            &server.url(&format!("/v1/jobs?parent={id}&limit=100")),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json()["items"]
+        server
+            .get(&format!("/v1/jobs?parent={id}&limit=100"), Some(ENGINEER))
+            .json()["items"]
             .as_array()
             .cloned()
             .unwrap_or_default()
@@ -443,16 +316,11 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
     drop(server);
 
     let server = Binary::start(&dir.db_url(), &env);
-    let done = wait_succeeded(&server, &id, Duration::from_secs(300));
+    let done = server.wait_job(&id, "succeeded", Duration::from_secs(300));
     assert_eq!(done["children"]["succeeded"], 3);
-    let result = curl(
-        "GET",
-        &server.url(&format!("/v1/jobs/{id}/result")),
-        Some(ENGINEER),
-        &[],
-        None,
-    )
-    .json();
+    let result = server
+        .get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER))
+        .json();
     assert_eq!(
         result["summary"],
         reference.join().expect("reference"),
@@ -475,11 +343,11 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
 /// dead process's running job at once instead of after the 60 s lease.
 #[test]
 fn a_restarted_service_releases_its_dead_predecessors_job_at_once() {
-    let dir = TempDir::new("restart");
+    let dir = temp_dir("restart");
     let env = [("RAILWEAR_LEASE_S", "60"), ("RAILWEAR_WORKERS", "1")];
     let server = Binary::start(&dir.db_url(), &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":4,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit_job(&server.url(""), long);
+    let id = server.submit_job(long);
     wait_for(Duration::from_secs(60), "running", || {
         (job(&server, &id)["status"] == "running").then_some(())
     });
@@ -493,11 +361,5 @@ fn a_restarted_service_releases_its_dead_predecessors_job_at_once() {
     });
     assert!(restarted.elapsed() < Duration::from_secs(15));
     assert_eq!(attempt_outcomes(&server, &id), ["lost", "running"], "{j}");
-    curl(
-        "POST",
-        &server.url(&format!("/v1/jobs/{id}/cancel")),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    server.cancel_job(&id);
 }

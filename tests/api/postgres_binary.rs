@@ -3,29 +3,18 @@
 //! HTTP is run by a worker process; a worker killed with SIGKILL mid-job loses its lease and
 //! another worker process finishes the job.
 
-mod postgres_support;
-mod service_support;
-
-use service_support::{curl, get_job, get_json, submit_job, tokens_env, wait_for, ENGINEER};
-use std::io::{BufRead, BufReader};
+use crate::helpers::{wait_for, Api};
+use crate::support::{tokens_env, ENGINEER};
+use railwear::testkit::ServerProcess;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::process::Command;
 use std::time::Duration;
 
-/// A child process killed (SIGKILL) and reaped on drop.
-struct Proc(Child);
+/// A `railwear` process (testkit), killed (SIGKILL) and reaped on drop.
+type Proc = ServerProcess;
 
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// Start `railwear <args>` and wait for a stdout line starting with `ready_prefix`; returns the
-/// process and the rest of that line.
-fn spawn(args: &[&str], db_url: &str, env: &[(&str, &str)], ready_prefix: &str) -> (Proc, String) {
+/// Start `railwear <args>` and wait for a stdout line starting with `ready_prefix`.
+fn spawn(args: &[&str], db_url: &str, env: &[(&str, &str)], ready_prefix: &str) -> Proc {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_railwear"));
     cmd.current_dir(root)
@@ -34,55 +23,31 @@ fn spawn(args: &[&str], db_url: &str, env: &[(&str, &str)], ready_prefix: &str) 
         .env("RAILWEAR_TOKENS", tokens_env())
         .env("RAILWEAR_CONFIGS_DIR", root.join("configs"))
         .env("RUST_LOG", "warn")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit());
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    let mut child = cmd.spawn().expect("start railwear");
-    let stdout = child.stdout.take().expect("stdout");
-    let (tx, rx) = mpsc::channel();
-    let prefix = ready_prefix.to_string();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if let Some(rest) = line.strip_prefix(&prefix) {
-                let _ = tx.send(rest.to_string());
-            }
-        }
-    });
-    let proc = Proc(child);
-    let rest = rx
-        .recv_timeout(Duration::from_secs(60))
-        .unwrap_or_else(|_| panic!("railwear {args:?} did not print `{ready_prefix}`"));
-    (proc, rest)
+        .envs(env.iter().copied());
+    ServerProcess::spawn_ready(cmd, ready_prefix, Duration::from_secs(60))
+        .unwrap_or_else(|e| panic!("railwear {args:?}: {e}"))
 }
 
-fn api(db_url: &str, env: &[(&str, &str)]) -> (Proc, String) {
-    spawn(
+/// `railwear serve --no-workers` and a client of it.
+fn serve(db_url: &str, env: &[(&str, &str)]) -> (Proc, Api) {
+    let server = spawn(
         &["serve", "--no-workers", "--listen", "127.0.0.1:0"],
         db_url,
         env,
         "listening on ",
-    )
+    );
+    let api = Api::new(&server.base_url());
+    (server, api)
 }
 
 fn worker(db_url: &str, env: &[(&str, &str)]) -> Proc {
     // The URL comes from the flag: DATABASE_URL is pointed elsewhere to prove the flag wins.
-    let (proc, _) = spawn(
+    spawn(
         &["worker", "--database-url", db_url, "--workers", "1"],
         "sqlite://not-used-by-the-worker.db?mode=ro",
         env,
         "workers started: ",
-    );
-    proc
-}
-
-fn wait_status(base: &str, id: &str, status: &str, timeout: Duration) -> serde_json::Value {
-    wait_for(timeout, status, || {
-        let j = get_job(base, id);
-        assert_ne!(j["status"], "failed", "job failed: {j}");
-        (j["status"] == status).then_some(j)
-    })
+    )
 }
 
 /// A very short simulate job of rattle-box case C.
@@ -91,36 +56,24 @@ const SHORT: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","see
 #[test]
 fn api_without_workers_and_a_worker_process_complete_a_job() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("bin").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("bin").await }) else {
         return;
     };
-    let (_api, base) = api(&db.url, &[]);
-    let id = submit_job(&base, SHORT);
+    let (_server, api) = serve(&db.url, &[]);
+    let id = api.submit_job(SHORT);
     // The API runs no workers: the job stays queued.
     std::thread::sleep(Duration::from_millis(1500));
-    assert_eq!(get_job(&base, &id)["status"], "queued");
+    assert_eq!(api.get_job(&id)["status"], "queued");
 
     let _worker = worker(&db.url, &[]);
-    let done = wait_status(&base, &id, "succeeded", Duration::from_secs(300));
+    let done = api.wait_job(&id, "succeeded", Duration::from_secs(300));
     assert_eq!(done["attempt"], 1);
     assert!(done["track_samples"].as_i64().unwrap() > 0);
-    let result = curl(
-        "GET",
-        &format!("{base}/v1/jobs/{id}/result"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
     assert_eq!(result.status, 200, "{}", result.body);
     assert!(result.json()["summary"].is_object());
     // Tracks written by the worker process are served by the API process, one CSV row each.
-    let csv = curl(
-        "GET",
-        &format!("{base}/v1/jobs/{id}/tracks?format=csv"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let csv = api.get(&format!("/v1/jobs/{id}/tracks?format=csv"), Some(ENGINEER));
     assert_eq!(csv.status, 200);
     let lines: Vec<&str> = csv.body.lines().collect();
     assert_eq!(lines[0], railwear::physics::track::TrackSample::CSV_HEADER);
@@ -134,22 +87,22 @@ fn api_without_workers_and_a_worker_process_complete_a_job() {
 #[test]
 fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("kill").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("kill").await }) else {
         return;
     };
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
-    let (_api, base) = api(&db.url, &env);
+    let (_server, api) = serve(&db.url, &env);
     // Long enough to be caught running (cancelled at the end, so its length costs nothing).
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit_job(&base, long);
+    let id = api.submit_job(long);
     let first = worker(&db.url, &env);
-    let running = wait_status(&base, &id, "running", Duration::from_secs(60));
+    let running = api.wait_job(&id, "running", Duration::from_secs(60));
     assert_eq!(running["attempt"], 1);
     drop(first); // SIGKILL: no shutdown code runs, the lease is left to expire
 
     let _second = worker(&db.url, &env);
     let retaken = wait_for(Duration::from_secs(60), "attempt 2", || {
-        let j = get_job(&base, &id);
+        let j = api.get_job(&id);
         (j["status"] == "running" && j["attempt"] == 2).then_some(j)
     });
     assert_eq!(
@@ -157,26 +110,14 @@ fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
         "{retaken}"
     );
     // The new owner heartbeats: its cancel request reaches it through the database.
-    curl(
-        "POST",
-        &format!("{base}/v1/jobs/{id}/cancel"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
-    let cancelled = wait_status(&base, &id, "cancelled", Duration::from_secs(30));
+    api.cancel_job(&id);
+    let cancelled = api.wait_job(&id, "cancelled", Duration::from_secs(30));
     assert_eq!(cancelled["attempt"], 2);
     drop(rt);
 }
 
-fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
-    let r = curl(
-        "GET",
-        &format!("{base}/v1/jobs?parent={id}&limit=100"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+fn children(api: &Api, id: &str) -> Vec<serde_json::Value> {
+    let r = api.get(&format!("/v1/jobs?parent={id}&limit=100"), Some(ENGINEER));
     assert_eq!(r.status, 200, "{}", r.body);
     r.json()["items"].as_array().cloned().unwrap_or_default()
 }
@@ -191,11 +132,11 @@ fn children(base: &str, id: &str) -> Vec<serde_json::Value> {
 fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     use railwear::store::AttemptOutcome;
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("fanout").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("fanout").await }) else {
         return;
     };
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
-    let (_api, base) = api(&db.url, &env);
+    let (_server, api) = serve(&db.url, &env);
     let mut workers: Vec<Option<Proc>> = (0..3).map(|_| Some(worker(&db.url, &env))).collect();
 
     // Short points (under a second each in the test profile).
@@ -220,15 +161,15 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         })
     };
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
-    let id = submit_job(&base, &body);
+    let id = api.submit_job(&body);
     // The same sweep in one process on SQLite.
-    let sqlite_dir = service_support::TempDir::new("fanout-sqlite");
-    let single = service_support::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
-    let single_id = submit_job(&single.base, &body);
+    let sqlite_dir = crate::support::temp_dir("fanout-sqlite");
+    let single = crate::helpers::Binary::start(&sqlite_dir.db_url(), &[("RAILWEAR_WORKERS", "2")]);
+    let single_id = single.submit_job(&body);
 
     // SIGKILL the worker process that holds a running child.
     let victim_worker = wait_for(Duration::from_secs(120), "a running child", || {
-        children(&base, &id).iter().find_map(|c| {
+        children(&api, &id).iter().find_map(|c| {
             let worker = c["worker"].as_str()?;
             (c["status"] == "running").then(|| worker.to_string())
         })
@@ -241,16 +182,16 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         .unwrap_or_else(|| panic!("no pid in worker name {victim_worker}"));
     let slot = workers
         .iter()
-        .position(|w| w.as_ref().is_some_and(|p| p.0.id() == pid))
+        .position(|w| w.as_ref().is_some_and(|p| p.id() == pid))
         .unwrap_or_else(|| panic!("worker {victim_worker} is not one of ours"));
     drop(workers[slot].take());
 
-    let done = wait_status(&base, &id, "succeeded", Duration::from_secs(300));
+    let done = api.wait_job(&id, "succeeded", Duration::from_secs(300));
     assert_eq!(
         done["children"],
         serde_json::json!({"total": 12, "succeeded": 12, "failed": 0, "cancelled": 0})
     );
-    let kids = children(&base, &id);
+    let kids = children(&api, &id);
     assert_eq!(kids.len(), 12);
     assert!(kids.iter().all(|c| c["status"] == "succeeded"), "{kids:?}");
 
@@ -285,7 +226,7 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     assert_eq!(lost[0].1, victim_worker);
     // The same log over HTTP: the re-run child shows the killed worker's lost attempt, then
     // the success by another worker.
-    let rerun = get_json(&base, &format!("/v1/jobs/{}/attempts", lost[0].0));
+    let rerun = api.get_json(&format!("/v1/jobs/{}/attempts", lost[0].0));
     let rows = rerun.as_array().expect("an array of attempts");
     let outcomes: Vec<&str> = rows.iter().filter_map(|a| a["outcome"].as_str()).collect();
     assert_eq!(outcomes, ["lost", "succeeded"], "{rerun}");
@@ -308,20 +249,9 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     // the single-process SQLite service's result.
     let (summary, outcome) = reference.join().expect("reference sweep");
     let job = rt.block_on(store.get_job(id)).expect("job").expect("job");
-    let single_done = wait_status(
-        &single.base,
-        &single_id,
-        "succeeded",
-        Duration::from_secs(300),
-    );
+    let single_done = single.wait_job(&single_id, "succeeded", Duration::from_secs(300));
     assert_eq!(single_done["children"]["succeeded"], 12);
-    let single_result = curl(
-        "GET",
-        &format!("{}/v1/jobs/{single_id}/result", single.base),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
+    let single_result = single.get(&format!("/v1/jobs/{single_id}/result"), Some(ENGINEER));
     assert_eq!(single_result.status, 200, "{}", single_result.body);
     assert_eq!(job.result, Some(single_result.json()["summary"].clone()));
     single.kill9();
@@ -373,26 +303,26 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
 #[test]
 fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
     let rt = tokio::runtime::Runtime::new().expect("runtime");
-    let Some(db) = rt.block_on(async { postgres_support::TestDb::create("sigterm").await }) else {
+    let Some(db) = rt.block_on(async { crate::support::postgres::create("sigterm").await }) else {
         return;
     };
     let env = [
         ("RAILWEAR_LEASE_S", "60"),
         ("RAILWEAR_SHUTDOWN_GRACE_S", "2"),
     ];
-    let (_api, base) = api(&db.url, &env);
+    let (_server, api) = serve(&db.url, &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
-    let id = submit_job(&base, long);
+    let id = api.submit_job(long);
     let mut first = worker(&db.url, &env);
-    wait_status(&base, &id, "running", Duration::from_secs(60));
+    api.wait_job(&id, "running", Duration::from_secs(60));
     let asked = std::time::Instant::now();
     let status = std::process::Command::new("kill")
-        .args(["-TERM", &first.0.id().to_string()])
+        .args(["-TERM", &first.id().to_string()])
         .status()
         .expect("kill");
     assert!(status.success());
     let exit = loop {
-        if let Some(exit) = first.0.try_wait().expect("try_wait") {
+        if let Some(exit) = first.child_mut().try_wait().expect("try_wait") {
             break exit;
         }
         assert!(asked.elapsed() < Duration::from_secs(20), "no exit");
@@ -404,21 +334,15 @@ fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
         "{:?}",
         asked.elapsed()
     );
-    let j = get_job(&base, &id);
+    let j = api.get_job(&id);
     assert_eq!(j["status"], "queued", "{j}");
-    let log = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
+    let log = api.get_json(&format!("/v1/jobs/{id}/attempts"));
     assert_eq!(log[0]["outcome"], "released", "{log}");
 
     let _second = worker(&db.url, &env);
-    let retaken = wait_status(&base, &id, "running", Duration::from_secs(10));
+    let retaken = api.wait_job(&id, "running", Duration::from_secs(10));
     assert_eq!(retaken["attempt"], 2);
-    curl(
-        "POST",
-        &format!("{base}/v1/jobs/{id}/cancel"),
-        Some(ENGINEER),
-        &[],
-        None,
-    );
-    wait_status(&base, &id, "cancelled", Duration::from_secs(30));
+    api.cancel_job(&id);
+    api.wait_job(&id, "cancelled", Duration::from_secs(30));
     drop(rt);
 }

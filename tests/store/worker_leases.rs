@@ -3,12 +3,10 @@
 //! for the whole lease; live processes, and other hosts, keep theirs. Same behaviour on SQLite
 //! and PostgreSQL.
 
-mod postgres_support;
-mod service_support;
-
+use crate::fresh_db;
+use crate::support::runner::{test_config, CountingRunner};
 use railwear::jobs::{JobKind, JobStatus, Jobs};
 use railwear::store::{self, AttemptOutcome, Store, Submitted, WorkerHost};
-use service_support::runner::{test_config, CountingRunner};
 use std::process::Command;
 use std::sync::Arc;
 use uuid::Uuid;
@@ -38,7 +36,7 @@ async fn submit(jobs: &Jobs, n: u64) -> Uuid {
 }
 
 async fn dead_leases_of_this_host_are_released_at_start_up(store: Arc<dyn Store>) {
-    let dir = service_support::TempDir::new("leases-cfg");
+    let dir = crate::support::temp_dir("leases-cfg");
     let config = test_config(&dir.db_url());
     let jobs = Jobs::new(
         Arc::clone(&store),
@@ -155,7 +153,7 @@ async fn dead_leases_of_this_host_are_released_at_start_up(store: Arc<dyn Store>
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sqlite_releases_the_leases_of_dead_workers_of_this_host() {
-    let dir = service_support::TempDir::new("leases");
+    let dir = crate::support::temp_dir("leases");
     let store = store::open(&dir.db_url()).await.expect("sqlite");
     dead_leases_of_this_host_are_released_at_start_up(store).await;
 }
@@ -238,7 +236,7 @@ async fn release_is_fenced_and_yields_to_cancellation(store: Arc<dyn Store>) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sqlite_release_is_fenced_and_yields_to_cancellation() {
-    let dir = service_support::TempDir::new("release");
+    let dir = crate::support::temp_dir("release");
     let store = store::open(&dir.db_url()).await.expect("sqlite");
     release_is_fenced_and_yields_to_cancellation(store).await;
 }
@@ -339,7 +337,7 @@ async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sqlite_checkpoints_are_fenced_and_end_with_the_job() {
-    let dir = service_support::TempDir::new("checkpoints");
+    let dir = crate::support::temp_dir("checkpoints");
     let store = store::open(&dir.db_url()).await.expect("sqlite");
     checkpoints_are_fenced_and_end_with_the_job(store).await;
 }

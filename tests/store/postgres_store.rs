@@ -3,9 +3,7 @@
 //! the last error kept, and one scripted use of every `Store` method gives the same records on
 //! PostgreSQL as on SQLite.
 
-mod postgres_support;
-mod service_support;
-
+use crate::fresh_db;
 use railwear::config::Role;
 use railwear::jobs::{JobKind, JobProgress, JobStatus};
 use railwear::store::{
@@ -896,7 +894,7 @@ async fn every_store_method_behaves_as_on_sqlite() {
     let pg = store::open(&db.url).await.expect("open postgres store");
     let pg_trace = script(pg.as_ref()).await;
 
-    let dir = service_support::TempDir::new("pg-script");
+    let dir = crate::support::temp_dir("pg-script");
     let sqlite = store::open(&dir.db_url()).await.expect("open sqlite store");
     let sqlite_trace = script(sqlite.as_ref()).await;
     assert_eq!(pg_trace.len(), sqlite_trace.len());

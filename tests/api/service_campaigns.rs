@@ -1,14 +1,13 @@
-//! Test-engineer journey over HTTP (curl), issue 14 item 5: a campaign uploaded as JSON is
+//! Test-engineer journey over HTTP, issue 14 item 5: a campaign uploaded as JSON is
 //! validated against the service's configs, stored, listed and served back unchanged; a
 //! broken campaign is a 422 naming the field (down to the sample row) and stores nothing;
 //! only test engineers and admins upload, every role reads.
 
-mod service_support;
-
+use crate::helpers::{Api, Reply, TestApp};
+use crate::support::runner::{start, test_config};
+use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
 use serde_json::{json, Value};
-use service_support::runner::{start, test_config};
-use service_support::{curl, Reply, TempDir, ADMIN, ENGINEER, PLANNER, TEST_ENGINEER};
 use std::path::Path;
 
 fn thesis_json() -> Value {
@@ -44,23 +43,16 @@ fn with_records() -> Value {
     c
 }
 
-struct Api {
-    base: String,
-}
+/// The campaign routes of one service.
+struct Campaigns(Api);
 
-impl Api {
+impl Campaigns {
     fn post(&self, token: Option<&str>, body: &str) -> Reply {
-        curl(
-            "POST",
-            &format!("{}/v1/campaigns", self.base),
-            token,
-            &[],
-            Some(body),
-        )
+        self.0.post("/v1/campaigns", token, body)
     }
 
     fn get(&self, token: Option<&str>, path: &str) -> Reply {
-        curl("GET", &format!("{}{path}", self.base), token, &[], None)
+        self.0.get(path, token)
     }
 
     /// Every stored campaign (all pages), as the planner sees them.
@@ -86,11 +78,9 @@ impl Api {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn campaigns_round_trip_and_list() {
-    let dir = TempDir::new("campaigns");
+    let dir = temp_dir("campaigns");
     let service = start(test_config(&dir.db_url()), false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
     tokio::task::spawn_blocking(move || {
         // The thesis campaign goes in and comes back unchanged.
         let thesis = thesis_json();
@@ -242,13 +232,11 @@ fn bad_campaigns() -> Vec<(&'static str, Value, String)> {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn bad_campaigns_name_field_and_row_and_store_nothing() {
-    let dir = TempDir::new("campaigns-bad");
+    let dir = temp_dir("campaigns-bad");
     let mut config = test_config(&dir.db_url());
     config.campaign_body_limit_bytes = 1024 * 1024;
     let service = start(config, false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let api = Campaigns(Api::new(&format!("http://{}", service.addr)));
     tokio::task::spawn_blocking(move || {
         let r = api.post(Some(TEST_ENGINEER), &thesis_json().to_string());
         assert_eq!(r.status, 201, "{}", r.body);
@@ -289,9 +277,9 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
         // Malformed JSON, a non-JSON body, an empty object, a body over the campaign limit.
         let p = api.post(Some(TEST_ENGINEER), "{\"name\": ").problem(400);
         assert_eq!(p["type"], "urn:railwear:problem:malformed-json");
-        let r = curl(
+        let r = api.0.request(
             "POST",
-            &format!("{}/v1/campaigns", api.base),
+            "/v1/campaigns",
             Some(TEST_ENGINEER),
             &[("Content-Type", "text/csv")],
             Some("time_s,a_x_m_s2\n"),
@@ -314,11 +302,8 @@ async fn bad_campaigns_name_field_and_row_and_store_nothing() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn only_test_engineers_and_admins_upload() {
-    let dir = TempDir::new("campaigns-roles");
-    let service = start(test_config(&dir.db_url()), false).await;
-    let api = Api {
-        base: format!("http://{}", service.addr),
-    };
+    let app = TestApp::spawn_idle().await;
+    let api = Campaigns(app.api.clone());
     tokio::task::spawn_blocking(move || {
         let good = thesis_json().to_string();
         // The role is checked before the body is read: a planner gets 403 whatever it sends.
@@ -341,5 +326,5 @@ async fn only_test_engineers_and_admins_upload() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }

@@ -281,7 +281,7 @@ fn a_pattern_no_effect_makes_is_not_explained() {
 /// tables (not on the verdict, which needs longer windows to mean anything).
 #[test]
 fn simulated_tables_follow_the_physics_and_the_report_is_written() {
-    let text = include_str!("fixtures/small-campaign.toml");
+    let text = include_str!("../fixtures/small-campaign.toml");
     let c = Campaign::from_toml_str(text, Path::new(".")).unwrap();
     let mut o = DiagnoseOptions::default();
     o.emulator.window_s = 0.25;

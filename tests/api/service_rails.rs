@@ -1,15 +1,14 @@
-//! Planner journey over HTTP (curl): measured dimensions -> rattle space at once (eq. 6.1-6.3),
+//! Planner journey over HTTP: measured dimensions -> rattle space at once (eq. 6.1-6.3),
 //! a report that says which sweep to run, then K_SL and penalized life once the sweep's curve
 //! exists (eq. 6.4); rejected measurements are 4xx problems that store nothing.
 //! Sweeps here are the counting test runner's fixed curve: rail wear 2.0, 1.5, 1.0 mg/h at
 //! k_rs 0.7684 (loose), 0.7990 (design), 0.8317 (tight).
 
-mod service_support;
-
+use crate::helpers::{wait_for, Api, TestApp};
+use crate::support::runner::{start, test_config};
+use crate::support::{temp_dir, ENGINEER, PLANNER};
 use railwear::analysis::rattle_space::LauncherDimensions;
 use serde_json::json;
-use service_support::runner::{start, test_config};
-use service_support::{curl, wait_for, TempDir, ENGINEER, PLANNER};
 use std::time::Duration;
 
 fn measurement(dims: LauncherDimensions) -> String {
@@ -24,27 +23,12 @@ fn measurement(dims: LauncherDimensions) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn measurement_report_and_penalized_life() {
-    let dir = TempDir::new("rails");
-    let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let post = |serial: &str, body: &str| {
-            curl(
-                "POST",
-                &format!("{base}/v1/rails/{serial}/measurements"),
-                Some(PLANNER),
-                &[],
-                Some(body),
-            )
-        };
+        let post = |serial: &str, body: &str| api.post_rail(serial, body);
         let report = |serial: &str| {
-            let r = curl(
-                "GET",
-                &format!("{base}/v1/rails/{serial}/report"),
-                Some(PLANNER),
-                &[],
-                None,
-            );
+            let r = api.rail_report(serial);
             assert_eq!(r.status, 200, "{}", r.body);
             r.json()
         };
@@ -66,13 +50,7 @@ async fn measurement_report_and_penalized_life() {
 
         // An engineer queues that sweep: the report says it is under way.
         let sweep = r#"{"kind":"sweep","params":{"steps":20,"step_ms":100}}"#;
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs"),
-            Some(ENGINEER),
-            &[],
-            Some(sweep),
-        );
+        let r = api.post("/v1/jobs", Some(ENGINEER), sweep);
         assert_eq!(r.status, 201, "{}", r.body);
         let sweep_id = r.json()["id"].as_str().unwrap().to_string();
         let rep = report("R-100");
@@ -80,14 +58,9 @@ async fn measurement_report_and_penalized_life() {
         assert!(rep["missing_curve"]["suggested_job"].is_null());
 
         wait_for(Duration::from_secs(30), "sweep success", || {
-            let j = curl(
-                "GET",
-                &format!("{base}/v1/jobs/{sweep_id}"),
-                Some(ENGINEER),
-                &[],
-                None,
-            )
-            .json();
+            let j = api
+                .get(&format!("/v1/jobs/{sweep_id}"), Some(ENGINEER))
+                .json();
             (j["status"] == "succeeded").then_some(())
         });
 
@@ -98,21 +71,9 @@ async fn measurement_report_and_penalized_life() {
         let curve_id = rep["missing_curve"]["unpublished_curve_id"]
             .as_i64()
             .expect("the unpublished version is named");
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/curves/{curve_id}/publish"),
-            Some(PLANNER),
-            &[],
-            None,
-        );
+        let r = api.post_empty(&format!("/v1/curves/{curve_id}/publish"), Some(PLANNER));
         r.problem(403);
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/curves/{curve_id}/publish"),
-            Some(ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.post_empty(&format!("/v1/curves/{curve_id}/publish"), Some(ENGINEER));
         assert_eq!(r.status, 200, "{}", r.body);
 
         // At the design point K_SL = 1 (eq. 6.4), so the penalized life is the design life.
@@ -130,13 +91,7 @@ async fn measurement_report_and_penalized_life() {
         // bands 0.675 and 0.6; with 400 h design life, 300 h.
         let r = post("R-100", &measurement(LauncherDimensions::loose()));
         assert_eq!(r.status, 201);
-        let r = curl(
-            "GET",
-            &format!("{base}/v1/rails/R-100/report?design_life_h=400"),
-            Some(PLANNER),
-            &[],
-            None,
-        );
+        let r = api.get("/v1/rails/R-100/report?design_life_h=400", Some(PLANNER));
         let life = r.json()["service_life"].clone();
         let close = |v: &serde_json::Value, x: f64| (v.as_f64().unwrap() - x).abs() < 1e-9;
         assert!(close(&life["k_sl"], 0.75), "{life}");
@@ -148,14 +103,9 @@ async fn measurement_report_and_penalized_life() {
         assert_eq!(report("R-200")["service_life"]["k_sl"], 1.0);
 
         // History, newest first.
-        let h = curl(
-            "GET",
-            &format!("{base}/v1/rails/R-100/measurements"),
-            Some(PLANNER),
-            &[],
-            None,
-        )
-        .json();
+        let h = api
+            .get("/v1/rails/R-100/measurements", Some(PLANNER))
+            .json();
         let items = h["items"].as_array().unwrap();
         assert_eq!(items.len(), 2);
         assert!(
@@ -165,28 +115,25 @@ async fn measurement_report_and_penalized_life() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
-    let dir = TempDir::new("badrail");
-    let service = start(test_config(&dir.db_url()), false).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_idle().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let url = format!("{base}/v1/rails/R-1/measurements");
+        let url = "/v1/rails/R-1/measurements";
         assert_eq!(
-            curl(
-                "POST",
-                &url,
+            api.post(
+                url,
                 Some(PLANNER),
-                &[],
-                Some(&measurement(LauncherDimensions::design()))
+                &measurement(LauncherDimensions::design())
             )
             .status,
             201
         );
-        let history = || curl("GET", &url, Some(PLANNER), &[], None).body;
+        let history = || api.get(url, Some(PLANNER)).body;
         let before = history();
 
         let with = |f: &dyn Fn(&mut serde_json::Value)| {
@@ -271,96 +218,75 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
             ),
         ];
         for (body, field) in cases {
-            let p = curl("POST", &url, Some(PLANNER), &[], Some(&body)).problem(422);
+            let p = api.post(url, Some(PLANNER), &body).problem(422);
             assert!(
                 p["field"].as_str().unwrap().starts_with(field),
                 "expected field {field}, got {p}"
             );
         }
         let body = measurement(LauncherDimensions::design());
-        curl(
-            "POST",
-            &format!("{base}/v1/rails/bad%20serial/measurements"),
-            Some(PLANNER),
-            &[],
-            Some(&body),
-        )
-        .problem(400);
+        api.post("/v1/rails/bad%20serial/measurements", Some(PLANNER), &body)
+            .problem(400);
         // Issue 17: "." and ".." (and anything not starting with a letter or digit) are not
         // serials: a URL path resolves them away, so their report URL was unreachable.
         for serial in ["%2E", "%2E%2E", ".hidden", "-R1"] {
-            let p = curl(
-                "POST",
-                &format!("{base}/v1/rails/{serial}/measurements"),
-                Some(PLANNER),
-                &[],
-                Some(&body),
-            )
-            .problem(400);
+            let p = api
+                .post(
+                    &format!("/v1/rails/{serial}/measurements"),
+                    Some(PLANNER),
+                    &body,
+                )
+                .problem(400);
             assert_eq!(p["field"], "serial", "{serial}: {p}");
         }
-        let p = curl(
-            "POST",
-            &url,
-            Some(PLANNER),
-            &[],
-            Some(&with(&|v| v["dimensions_mm"] = json!([38.1, 16.23]))),
-        )
-        .problem(422);
+        let p = api
+            .post(
+                url,
+                Some(PLANNER),
+                &with(&|v| v["dimensions_mm"] = json!([38.1, 16.23])),
+            )
+            .problem(422);
         assert!(p["detail"].as_str().unwrap().contains("positional"), "{p}");
-        curl("POST", &url, Some(ENGINEER), &[], Some(&body)).problem(403);
-        curl("POST", &url, None, &[], Some(&body)).problem(401);
-        curl(
-            "GET",
-            &format!("{base}/v1/rails/R-404/report"),
-            Some(PLANNER),
-            &[],
-            None,
-        )
-        .problem(404);
+        api.post(url, Some(ENGINEER), &body).problem(403);
+        api.post(url, None, &body).problem(401);
+        api.rail_report("R-404").problem(404);
         assert_eq!(
             before,
             history(),
             "a rejected measurement changed stored data"
         );
-        let rails = curl("GET", &format!("{base}/v1/rails"), Some(PLANNER), &[], None).json();
+        let rails = api.get("/v1/rails", Some(PLANNER)).json();
         assert_eq!(rails["items"].as_array().unwrap().len(), 1);
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
-    let dir = TempDir::new("latest");
+    let dir = temp_dir("latest");
     let service = start(test_config(&dir.db_url()), false).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
-        let url = format!("{base}/v1/rails/R-7/measurements");
+        let url = "/v1/rails/R-7/measurements";
         let post = |dims: LauncherDimensions, measured_at: &str| {
             let mut v: serde_json::Value = serde_json::from_str(&measurement(dims)).unwrap();
             v["measured_at"] = json!(measured_at);
-            let r = curl("POST", &url, Some(PLANNER), &[], Some(&v.to_string()));
+            let r = api.post(url, Some(PLANNER), &v.to_string());
             assert_eq!(r.status, 201, "{}", r.body);
             r.json()
         };
         let current = post(LauncherDimensions::loose(), "2024-05-01T08:30:00Z");
         // A 2019 paper reading back-filled afterwards: recorded last, measured first.
         let old = post(LauncherDimensions::design(), "2019-03-04");
-        let report = curl(
-            "GET",
-            &format!("{base}/v1/rails/R-7/report"),
-            Some(PLANNER),
-            &[],
-            None,
-        );
+        let report = api.rail_report("R-7");
         assert_eq!(report.status, 200, "{}", report.body);
         let report = report.json();
         assert_eq!(report["measurement"]["id"], current["id"], "{report}");
         assert_eq!(report["rattle_space"], current["rattle_space"]);
         // History shows both times for each measurement.
-        let history = curl("GET", &url, Some(PLANNER), &[], None).json();
+        let history = api.get(url, Some(PLANNER)).json();
         let items = history["items"].as_array().unwrap();
         assert_eq!(items.len(), 2);
         for item in items {
@@ -373,47 +299,28 @@ async fn the_report_uses_the_latest_measured_at_not_the_last_recorded() {
     service.stop().await;
 }
 
-fn report_of(base: &str, serial: &str) -> serde_json::Value {
-    let r = curl(
-        "GET",
-        &format!("{base}/v1/rails/{serial}/report"),
-        Some(PLANNER),
-        &[],
-        None,
-    );
+fn report_of(api: &Api, serial: &str) -> serde_json::Value {
+    let r = api.rail_report(serial);
     assert_eq!(r.status, 200, "{}", r.body);
     r.json()
 }
 
-fn run_sweep(base: &str, body: &str) -> String {
-    let r = curl(
-        "POST",
-        &format!("{base}/v1/jobs"),
-        Some(ENGINEER),
-        &[],
-        Some(body),
-    );
+fn run_sweep(api: &Api, body: &str) -> String {
+    let r = api.post("/v1/jobs", Some(ENGINEER), body);
     assert_eq!(r.status, 201, "{}", r.body);
     let id = r.json()["id"].as_str().unwrap().to_string();
     wait_for(Duration::from_secs(30), "sweep success", || {
-        let j = curl(
-            "GET",
-            &format!("{base}/v1/jobs/{id}"),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
+        let j = api.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
         assert_ne!(j["status"], "failed", "{j}");
         (j["status"] == "succeeded").then_some(())
     });
     id
 }
 
-fn publish(base: &str, id: i64, body: Option<&str>) -> service_support::Reply {
-    curl(
+fn publish(api: &Api, id: i64, body: Option<&str>) -> crate::helpers::Reply {
+    api.request(
         "POST",
-        &format!("{base}/v1/curves/{id}/publish"),
+        &format!("/v1/curves/{id}/publish"),
         Some(ENGINEER),
         &[],
         body,
@@ -425,18 +332,12 @@ fn publish(base: &str, id: i64, body: Option<&str>) -> service_support::Reply {
 /// default sweep forever); running and publishing it gives them a service life.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
-    let dir = TempDir::new("rails-range");
+    let dir = temp_dir("rails-range");
     let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let api = Api::new(&format!("http://{}", service.addr));
     tokio::task::spawn_blocking(move || {
         let post = |serial: &str, dims: LauncherDimensions| {
-            let r = curl(
-                "POST",
-                &format!("{base}/v1/rails/{serial}/measurements"),
-                Some(PLANNER),
-                &[],
-                Some(&measurement(dims)),
-            );
+            let r = api.post_rail(serial, &measurement(dims));
             assert_eq!(r.status, 201, "{}", r.body);
             r.json()["rattle_space"].as_f64().unwrap()
         };
@@ -457,28 +358,18 @@ async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
         let design_k = LauncherDimensions::design().rattle_space().unwrap();
 
         // The default sweep's curve, published, covers neither.
-        let id = run_sweep(
-            &base,
-            r#"{"kind":"sweep","params":{"steps":1,"step_ms":1}}"#,
-        );
-        let rep = report_of(&base, "R-LOOSE");
+        let id = run_sweep(&api, r#"{"kind":"sweep","params":{"steps":1,"step_ms":1}}"#);
+        let rep = report_of(&api, "R-LOOSE");
         // Stored but not published, and it would not cover the rail anyway.
         assert!(
             rep["missing_curve"]["unpublished_curve_id"].is_null(),
             "{rep}"
         );
-        let list = curl(
-            "GET",
-            &format!("{base}/v1/curves"),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
-        .json();
+        let list = api.get("/v1/curves", Some(ENGINEER)).json();
         let v1 = list["items"][0]["id"].as_i64().unwrap();
-        assert_eq!(publish(&base, v1, None).status, 200);
+        assert_eq!(publish(&api, v1, None).status, 200);
         for (serial, k) in [("R-LOOSE", loose), ("R-TIGHT", tight)] {
-            let rep = report_of(&base, serial);
+            let rep = report_of(&api, serial);
             assert!(rep["service_life"].is_null(), "{rep}");
             // The published curve (the default sweep's, then the loose rail's) is named.
             assert!(rep["curve"]["id"].is_i64(), "{rep}");
@@ -502,14 +393,14 @@ async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
             }
             // Run it (the counting runner's closed-form curve over the planned points), then
             // the report names it as the version to publish.
-            let sweep = run_sweep(&base, &job.to_string());
-            let rep = report_of(&base, serial);
+            let sweep = run_sweep(&api, &job.to_string());
+            let rep = report_of(&api, serial);
             let v = rep["missing_curve"]["unpublished_curve_id"]
                 .as_i64()
                 .unwrap_or_else(|| panic!("{rep}"));
-            let r = publish(&base, v, None);
+            let r = publish(&api, v, None);
             assert_eq!(r.status, 200, "{}", r.body);
-            let rep = report_of(&base, serial);
+            let rep = report_of(&api, serial);
             let life = &rep["service_life"];
             assert!(life["k_sl"].as_f64().is_some(), "{rep}");
             assert_eq!(rep["curve"]["id"], v);
@@ -526,28 +417,21 @@ async fn a_rail_outside_every_curve_gets_a_sweep_that_covers_it() {
 /// the report names the curve, its fidelity, and carries K_SL's interval over seeds.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
-    let dir = TempDir::new("rails-publish");
-    let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         let dims = LauncherDimensions::design().with_material_condition(0.1);
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/rails/R-7/measurements"),
-            Some(PLANNER),
-            &[],
-            Some(&measurement(dims)),
-        );
+        let r = api.post_rail("R-7", &measurement(dims));
         assert_eq!(r.status, 201, "{}", r.body);
         let k = r.json()["rattle_space"].as_f64().unwrap();
         let kd = LauncherDimensions::design().rattle_space().unwrap();
 
         // Production curve: 5 points, 3 seeds, 10 s per point; published.
         run_sweep(
-            &base,
+            &api,
             r#"{"kind":"sweep","params":{"steps":1,"step_ms":1,"rattle_space_range":{"min":0.76,"max":0.84},"points":5,"seeds":3,"duration_s":10}}"#,
         );
-        let list = curl("GET", &format!("{base}/v1/curves"), Some(PLANNER), &[], None).json();
+        let list = api.get("/v1/curves", Some(PLANNER)).json();
         let v1 = &list["items"][0];
         assert_eq!(v1["version"], 1);
         assert_eq!(v1["published"], false);
@@ -555,8 +439,8 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         assert!(v1["code_version"].as_str().is_some_and(|v| !v.is_empty()));
         assert_eq!(v1["fidelity"]["seeds"], 3);
         let v1 = v1["id"].as_i64().unwrap();
-        assert_eq!(publish(&base, v1, Some(r#"{"force":false}"#)).status, 200);
-        let rep = report_of(&base, "R-7");
+        assert_eq!(publish(&api, v1, Some(r#"{"force":false}"#)).status, 200);
+        let rep = report_of(&api, "R-7");
         let life = rep["service_life"].clone();
         assert_eq!(rep["curve"]["id"], v1);
         assert_eq!(rep["curve"]["fidelity"]["points"], 5);
@@ -582,40 +466,34 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         // A 2-point, 1-seed, 0.3 s trial sweep stores version 2 and changes nothing planners
         // read.
         run_sweep(
-            &base,
+            &api,
             r#"{"kind":"sweep","params":{"steps":1,"step_ms":1,"rattle_space_range":{"min":0.78,"max":0.82},"points":2,"seeds":1,"duration_s":0.3}}"#,
         );
-        let rep = report_of(&base, "R-7");
+        let rep = report_of(&api, "R-7");
         assert_eq!(rep["curve"]["id"], v1);
         assert_eq!(rep["service_life"], life);
-        let list = curl(
-            "GET",
-            &format!("{base}/v1/curves?curve_key=ah64/clean/modified-archard"),
-            Some(ENGINEER),
-            &[],
-            None,
-        )
+        let list = api.get("/v1/curves?curve_key=ah64/clean/modified-archard", Some(ENGINEER))
         .json();
         let v2 = &list["items"][0];
         assert_eq!((v2["version"].as_i64(), v2["published"].as_bool()), (Some(2), Some(false)));
         let v2 = v2["id"].as_i64().unwrap();
         // Publishing it over the 5-point curve is refused without force.
-        let p = publish(&base, v2, None).problem(409);
+        let p = publish(&api, v2, None).problem(409);
         assert_eq!(p["field"], "force");
         assert!(p["detail"].as_str().unwrap().contains("2 points < 5"), "{p}");
-        assert_eq!(report_of(&base, "R-7")["curve"]["id"], v1);
+        assert_eq!(report_of(&api, "R-7")["curve"]["id"], v1);
         // Unknown keys and bad ids are refused naming the field.
         // JSON `null` (the document allows it: the body is optional) is no force either.
-        let p = publish(&base, v2, Some("null")).problem(409);
+        let p = publish(&api, v2, Some("null")).problem(409);
         assert_eq!(p["field"], "force");
-        let p = publish(&base, v2, Some(r#"{"forse":true}"#)).problem(422);
+        let p = publish(&api, v2, Some(r#"{"forse":true}"#)).problem(422);
         assert!(p["detail"].as_str().unwrap().contains("forse"), "{p}");
-        publish(&base, 0, None).problem(400);
-        publish(&base, 999_999, None).problem(404);
+        publish(&api, 0, None).problem(400);
+        publish(&api, 999_999, None).problem(404);
         // With force it is published; the report says so and has no interval (one seed).
-        let r = publish(&base, v2, Some(r#"{"force":true}"#));
+        let r = publish(&api, v2, Some(r#"{"force":true}"#));
         assert_eq!(r.status, 200, "{}", r.body);
-        let rep = report_of(&base, "R-7");
+        let rep = report_of(&api, "R-7");
         assert_eq!(rep["curve"]["id"], v2);
         assert_eq!(rep["curve"]["fidelity"]["seeds"], 1);
         assert!(rep["service_life"]["interval"].is_null(), "{rep}");
@@ -623,13 +501,13 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
             .as_str()
             .unwrap()
             .contains("one seed"));
-        let one = curl("GET", &format!("{base}/v1/curves/{v1}"), Some(PLANNER), &[], None).json();
+        let one = api.get(&format!("/v1/curves/{v1}"), Some(PLANNER)).json();
         assert_eq!(one["published"], false);
         assert_eq!(one["provenance"]["created_by"], "eng");
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 /// Issue 17: a report query naming a vehicle profile, environment or wear law no sweep can run
@@ -637,27 +515,12 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
 /// life or an unknown or repeated parameter is a 400 naming it.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn report_labels_must_name_what_a_sweep_runs() {
-    let dir = TempDir::new("report-labels");
-    let service = start(test_config(&dir.db_url()), false).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_idle().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/rails/R-7/measurements"),
-            Some(PLANNER),
-            &[],
-            Some(&measurement(LauncherDimensions::design())),
-        );
+        let r = api.post_rail("R-7", &measurement(LauncherDimensions::design()));
         assert_eq!(r.status, 201, "{}", r.body);
-        let get = |query: &str| {
-            curl(
-                "GET",
-                &format!("{base}/v1/rails/R-7/report?{query}"),
-                Some(PLANNER),
-                &[],
-                None,
-            )
-        };
+        let get = |query: &str| api.get(&format!("/v1/rails/R-7/report?{query}"), Some(PLANNER));
         for (query, field, words) in [
             (
                 "vehicle_profile=uh60",
@@ -709,5 +572,5 @@ async fn report_labels_must_name_what_a_sweep_runs() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }

@@ -1,16 +1,12 @@
 //! The dashboard in headless Chromium (driven through chromedriver's WebDriver HTTP API with
-//! curl): the page lists a submitted job and shows it reach success, then shows a rail report;
+//! the test client): the page lists a submitted job and shows it reach success, then shows a rail report;
 //! a test engineer starts a diagnosis of a stored campaign from the page and sees its report
 //! (verdict, ranking, figures) as the API gives it. Skipped with a message when Chromium is
 //! absent, unless RAILWEAR_REQUIRE_BROWSER is set (`.ci/run` sets it and installs the browser).
 
-mod service_support;
-
+use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::support::{ENGINEER, PLANNER, TEST_ENGINEER};
 use serde_json::{json, Value};
-use service_support::runner::{start, start_library, test_config};
-use service_support::{
-    curl, submit_job, upload_campaign, wait_for, TempDir, ENGINEER, PLANNER, TEST_ENGINEER,
-};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
@@ -25,7 +21,8 @@ fn find(program: &str) -> Option<String> {
 
 struct Driver {
     child: Child,
-    base: String,
+    /// chromedriver's WebDriver HTTP API.
+    api: Api,
     session: String,
 }
 
@@ -41,18 +38,17 @@ impl Driver {
             .stderr(Stdio::null())
             .spawn()
             .expect("start chromedriver");
-        let base = format!("http://127.0.0.1:{port}");
         let mut driver = Driver {
             child,
-            base,
+            api: Api::new(&format!("http://127.0.0.1:{port}")),
             session: String::new(),
         };
         wait_for(Duration::from_secs(30), "chromedriver", || {
-            let out = Command::new("curl")
-                .args(["-s", &format!("{}/status", driver.base)])
-                .output()
+            let out = driver
+                .api
+                .try_request("GET", "/status", None, &[], None)
                 .ok()?;
-            let status: Value = serde_json::from_slice(&out.stdout).ok()?;
+            let status: Value = serde_json::from_str(&out.body).ok()?;
             (status["value"]["ready"] == true).then_some(())
         });
         let capabilities = json!({"capabilities": {"alwaysMatch": {"goog:chromeOptions": {
@@ -70,13 +66,7 @@ impl Driver {
 
     fn call(&self, method: &str, path: &str, body: Option<Value>) -> Value {
         let body = body.map(|b| b.to_string());
-        let r = curl(
-            method,
-            &format!("{}{path}", self.base),
-            None,
-            &[],
-            body.as_deref(),
-        );
+        let r = self.api.request(method, path, None, &[], body.as_deref());
         let v: Value = serde_json::from_str(&r.body).unwrap_or(Value::Null);
         v["value"].clone()
     }
@@ -129,17 +119,16 @@ async fn dashboard_shows_a_job_reach_success() {
     let Some((chromium, chromedriver)) = browser() else {
         return;
     };
-    let dir = TempDir::new("dash");
-    let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         // The page is open before the job is submitted (a browser can take seconds to start on
         // a loaded machine), and the job runs 40 steps of 100 ms: several of the page's 1 s
         // polls see it queued or running before it succeeds.
         let driver = Driver::start(&chromium, &chromedriver);
-        driver.goto(&format!("{base}/#token={ENGINEER}"));
+        driver.goto(&api.url(&format!("/#token={ENGINEER}")));
         let body = r#"{"kind":"simulate","params":{"steps":40,"step_ms":100,"samples":50}}"#;
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         let row_status = format!(
             "const r = document.getElementById('job-{id}'); return r ? r.dataset.status : null;"
         );
@@ -174,11 +163,11 @@ async fn dashboard_shows_a_job_reach_success() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 /// The smallest campaign that runs a real diagnosis (shared with tests/service_diagnose.rs).
-const CAMPAIGN: &str = include_str!("fixtures/small-campaign.toml");
+const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
 
 /// Sets an input's value through the page (as typing would).
 fn fill(driver: &Driver, id: &str, value: &str) {
@@ -194,17 +183,16 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
     let Some((chromium, chromedriver)) = browser() else {
         return;
     };
-    let dir = TempDir::new("dash-diagnose");
-    let service = start_library(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_with(Runner::Library, true, |_| {}).await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let campaign_id = upload_campaign(&base, CAMPAIGN);
+        let campaign_id = api.upload_campaign(CAMPAIGN);
         let driver = Driver::start(&chromium, &chromedriver);
         let row = format!("document.getElementById('campaign-{campaign_id}')");
         let buttons = format!("{row}.querySelectorAll('button.start-diagnosis').length");
 
         // A planner sees the campaign but no way to start a diagnosis (the API would say 403).
-        driver.goto(&format!("{base}/?as=planner#token={PLANNER}"));
+        driver.goto(&api.url(&format!("/?as=planner#token={PLANNER}")));
         wait_for(Duration::from_secs(30), "the campaign listed", || {
             (driver.script(&format!("return {row} !== null;")) == true).then_some(())
         });
@@ -215,7 +203,7 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         );
 
         // A test engineer does.
-        driver.goto(&format!("{base}/?as=lab#token={TEST_ENGINEER}"));
+        driver.goto(&api.url(&format!("/?as=lab#token={TEST_ENGINEER}")));
         wait_for(Duration::from_secs(30), "the start button", || {
             (driver.script(&format!("return {row} !== null && {buttons} === 1;")) == true)
                 .then_some(())
@@ -260,13 +248,7 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         });
 
         // The page shows what the API returns.
-        let r = curl(
-            "GET",
-            &format!("{base}/v1/jobs/{job}/result"),
-            Some(TEST_ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.get(&format!("/v1/jobs/{job}/result"), Some(TEST_ENGINEER));
         assert_eq!(r.status, 200, "{}", r.body);
         let result = r.json();
         assert_eq!(result["kind"], "diagnose");
@@ -331,5 +313,5 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }

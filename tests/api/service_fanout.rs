@@ -4,16 +4,15 @@
 //! assembled once from the children's results in index order; a failing child fails the sweep
 //! naming it and cancels the rest; cancelling the sweep cancels its children.
 
-mod service_support;
-
+use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::support::runner::sample;
+use crate::support::ENGINEER;
 use railwear::store::AttemptOutcome;
 use serde_json::{json, Value};
-use service_support::runner::{sample, start, test_config};
-use service_support::{curl, get_job, get_json, submit_job, wait_for, TempDir, ENGINEER};
 use std::time::Duration;
 
-fn children(base: &str, id: &str) -> Vec<Value> {
-    get_json(base, &format!("/v1/jobs?parent={id}&limit=100"))["items"]
+fn children(api: &Api, id: &str) -> Vec<Value> {
+    api.get_json(&format!("/v1/jobs?parent={id}&limit=100"))["items"]
         .as_array()
         .cloned()
         .unwrap_or_default()
@@ -25,17 +24,17 @@ fn count(items: &[Value], status: &str) -> usize {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
-    let dir = TempDir::new("fanout");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 3;
-    let service = start(config, true).await;
-    let store = service.state.store.clone();
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 3;
+    })
+    .await;
+    let store = app.service.state.store.clone();
+    let api = app.api.clone();
     let (id, child_ids) = tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":3,"step_ms":20,"seed":42}}"#;
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         let done = wait_for(Duration::from_secs(30), "sweep success", || {
-            let j = get_job(&base, &id);
+            let j = api.get_job(&id);
             assert_ne!(j["status"], "failed", "{j}");
             (j["status"] == "succeeded").then_some(j)
         });
@@ -50,7 +49,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
             format!("/v1/jobs?parent={id}&limit=100").as_str()
         );
 
-        let kids = children(&base, &id);
+        let kids = children(&api, &id);
         assert_eq!(kids.len(), 6);
         let mut indices: Vec<i64> = kids
             .iter()
@@ -66,13 +65,13 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
             assert_eq!(c["children"], Value::Null);
         }
         // Submitted jobs only: the children stay out of the top-level list.
-        let top = get_json(&base, "/v1/jobs?top_level=true")["items"].clone();
+        let top = api.get_json("/v1/jobs?top_level=true")["items"].clone();
         assert_eq!(top.as_array().map(Vec::len), Some(1));
         assert_eq!(top[0]["id"], id.as_str());
 
         // The assembled result lists the children's results in index order; each is the
         // runner's value for the sweep's seed and that point, so the seed reached every child.
-        let result = get_json(&base, &format!("/v1/jobs/{id}/result"));
+        let result = api.get_json(&format!("/v1/jobs/{id}/result"));
         let points = result["summary"]["points"].as_array().unwrap().clone();
         assert_eq!(points.len(), 6);
         for (i, p) in points.iter().enumerate() {
@@ -84,7 +83,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         }
         assert_eq!(result["plots"][0]["name"], "penalization.svg");
         // The attempt log over HTTP: fanned out once, assembled once, both ended.
-        let log = get_json(&base, &format!("/v1/jobs/{id}/attempts"));
+        let log = api.get_json(&format!("/v1/jobs/{id}/attempts"));
         let outcomes: Vec<&str> = log
             .as_array()
             .map(|rows| rows.iter().filter_map(|a| a["outcome"].as_str()).collect())
@@ -97,21 +96,12 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
             done["links"]["attempts"],
             format!("/v1/jobs/{id}/attempts").as_str()
         );
-        let missing = curl(
-            "GET",
-            &format!("{base}/v1/jobs/{}/attempts", uuid::Uuid::new_v4()),
+        let missing = api.get(
+            &format!("/v1/jobs/{}/attempts", uuid::Uuid::new_v4()),
             Some(ENGINEER),
-            &[],
-            None,
         );
         assert_eq!(missing.status, 404, "{}", missing.body);
-        let malformed = curl(
-            "GET",
-            &format!("{base}/v1/jobs/not-a-uuid/attempts"),
-            Some(ENGINEER),
-            &[],
-            None,
-        );
+        let malformed = api.get("/v1/jobs/not-a-uuid/attempts", Some(ENGINEER));
         assert_eq!(malformed.status, 400, "{}", malformed.body);
         assert!(malformed.body.contains("id"), "{}", malformed.body);
         let child_ids: Vec<uuid::Uuid> = kids
@@ -142,24 +132,23 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         .unwrap()
         .unwrap();
     assert_eq!(curve.job_id, id);
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
-    let dir = TempDir::new("fanout-fail");
-    let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":5,"step_ms":40,"fail_point":0,"seed":1}}"#;
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         let failed = wait_for(Duration::from_secs(30), "sweep failure", || {
-            let j = get_job(&base, &id);
+            let j = api.get_job(&id);
             assert_ne!(j["status"], "succeeded", "{j}");
             (j["status"] == "failed").then_some(j)
         });
         let kids = wait_for(Duration::from_secs(30), "children ended", || {
-            let kids = children(&base, &id);
+            let kids = children(&api, &id);
             (count(&kids, "queued") + count(&kids, "running") == 0).then_some(kids)
         });
         let first = kids
@@ -180,7 +169,7 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
         assert_eq!(count(&kids, "failed"), 1);
         assert_eq!(count(&kids, "succeeded") + count(&kids, "cancelled"), 5);
         assert!(count(&kids, "cancelled") >= 3, "queued children were not cancelled");
-        let parent = get_job(&base, &id);
+        let parent = api.get_job(&id);
         assert_eq!(parent["status"], "failed");
         assert_eq!(
             parent["children"],
@@ -191,73 +180,57 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
                 "cancelled": count(&kids, "cancelled"),
             })
         );
-        let r = curl(
-            "GET",
-            &format!("{base}/v1/jobs/{id}/result"),
-            Some(ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
         r.problem(409);
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
-    let dir = TempDir::new("fanout-cancel");
-    let service = start(test_config(&dir.db_url()), true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         // 600 steps of 50 ms = 30 s per child if not cancelled.
         let body = r#"{"kind":"sweep","params":{"children":5,"steps":600,"step_ms":50}}"#;
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         wait_for(Duration::from_secs(20), "two running children", || {
-            let kids = children(&base, &id);
+            let kids = children(&api, &id);
             (kids.len() == 5 && count(&kids, "running") == 2).then_some(())
         });
-        let waiting = get_job(&base, &id);
+        let waiting = api.get_job(&id);
         assert_eq!(waiting["status"], "waiting");
         assert_eq!(waiting["worker"], Value::Null);
         assert_eq!(waiting["progress"]["fraction"], 0.0);
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs/{id}/cancel"),
-            Some(ENGINEER),
-            &[],
-            None,
-        );
+        let r = api.cancel_job(&id);
         assert_eq!(r.status, 202, "{}", r.body);
         assert_eq!(r.json()["status"], "cancelled");
         // The running children stop at once: the cancel reaches them in this process.
         let kids = wait_for(Duration::from_secs(5), "children cancelled", || {
-            let kids = children(&base, &id);
+            let kids = children(&api, &id);
             (count(&kids, "cancelled") == 5).then_some(kids)
         });
         assert!(kids.iter().all(|c| c["cancel_requested"] == true));
-        let parent = get_job(&base, &id);
+        let parent = api.get_job(&id);
         assert_eq!(parent["status"], "cancelled");
         assert_eq!(parent["children"]["cancelled"], 5);
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sweep_points_cannot_be_submitted_and_bad_filters_are_refused() {
-    let dir = TempDir::new("fanout-refuse");
-    let service = start(test_config(&dir.db_url()), false).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_idle().await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let r = curl(
-            "POST",
-            &format!("{base}/v1/jobs"),
+        let r = api.post(
+            "/v1/jobs",
             Some(ENGINEER),
-            &[],
-            Some(r#"{"kind":"sweep_point","params":{"point":0}}"#),
+            r#"{"kind":"sweep_point","params":{"point":0}}"#,
         );
         assert_eq!(r.problem(422)["field"], "kind");
         for (query, field) in [
@@ -265,19 +238,13 @@ async fn sweep_points_cannot_be_submitted_and_bad_filters_are_refused() {
             ("top_level=yes", "top_level"),
             ("status=done", "status"),
         ] {
-            let r = curl(
-                "GET",
-                &format!("{base}/v1/jobs?{query}"),
-                Some(ENGINEER),
-                &[],
-                None,
-            );
+            let r = api.get(&format!("/v1/jobs?{query}"), Some(ENGINEER));
             assert_eq!(r.problem(400)["field"], field, "{query}");
         }
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 /// The value of the Prometheus sample `name{labels}` in `text`, if present.
@@ -292,27 +259,27 @@ fn sample_value(text: &str, series: &str) -> Option<f64> {
 /// failure ends the sweep; each sweep once.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_sweep_duration_histogram_counts_whole_sweeps() {
-    let dir = TempDir::new("fanout-metrics");
-    let mut config = test_config(&dir.db_url());
-    config.workers = 2;
-    let service = start(config, true).await;
-    let base = format!("http://{}", service.addr);
+    let app = TestApp::spawn_with(Runner::Counting, true, |config| {
+        config.workers = 2;
+    })
+    .await;
+    let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         // 4 children of 5 x 60 ms on 2 workers: at least 0.6 s of wall time.
         let body = r#"{"kind":"sweep","params":{"children":4,"steps":5,"step_ms":60,"seed":3}}"#;
-        let id = submit_job(&base, body);
+        let id = api.submit_job(body);
         let failing =
             r#"{"kind":"sweep","params":{"children":3,"steps":5,"step_ms":60,"fail_point":1}}"#;
-        let failed_id = submit_job(&base, failing);
+        let failed_id = api.submit_job(failing);
         for (job, status) in [(&id, "succeeded"), (&failed_id, "failed")] {
             wait_for(Duration::from_secs(30), "sweep end", || {
-                (get_job(&base, job)["status"] == status).then_some(())
+                (api.get_job(job)["status"] == status).then_some(())
             });
         }
-        let job = get_job(&base, &id);
+        let job = api.get_job(&id);
         let whole_s = (chrono_ms(&job["finished_at"]) - chrono_ms(&job["started_at"])) / 1000.0;
         assert!(whole_s >= 0.6, "{job}");
-        let text = curl("GET", &format!("{base}/metrics"), None, &[], None).body;
+        let text = api.get("/metrics", None).body;
         let sum = sample_value(
             &text,
             "railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"succeeded\"}",
@@ -347,7 +314,7 @@ async fn the_sweep_duration_histogram_counts_whole_sweeps() {
     })
     .await
     .unwrap();
-    service.stop().await;
+    app.stop().await;
 }
 
 /// Unix ms of an RFC 3339 time as the API writes it (`2024-05-01T08:30:00.123Z`).

@@ -1,0 +1,20 @@
+//! The API test binary: the service over HTTP, in process ([`helpers::TestApp`]) or as the real
+//! `railwear` binary, on SQLite or PostgreSQL. One module per concern.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod helpers;
+
+mod api_schemathesis;
+mod postgres_binary;
+mod service_binary;
+mod service_campaigns;
+mod service_dashboard;
+mod service_diagnose;
+mod service_fanout;
+mod service_jobs;
+mod service_openapi;
+mod service_queue;
+mod service_rails;
+mod service_shutdown;

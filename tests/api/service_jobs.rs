@@ -1,0 +1,184 @@
+//! Issue 17 over HTTP against an in-process service with the production runner
+//! (`LibraryRunner`, the shipped `configs/`) and no workers, so nothing runs: job parameters
+//! are checked completely at submission (422 problem+json naming the field, nothing stored),
+//! authorization comes before body parsing, every error is problem+json, drawn seeds are
+//! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
+
+use crate::helpers::{Api, Runner, TestApp};
+use crate::support::{ENGINEER, PLANNER};
+use serde_json::json;
+
+fn stored_jobs(api: &Api) -> usize {
+    let r = api.get("/v1/jobs?limit=100", Some(ENGINEER));
+    assert_eq!(r.status, 200, "{}", r.body);
+    r.json()["items"].as_array().map_or(0, Vec::len)
+}
+
+/// A short simulate request on rattle-box-c with `simulation` overrides merged in.
+fn simulate_with(simulation: serde_json::Value) -> String {
+    let mut sim = json!({"settle_s": 0.05, "duration_s": 0.05, "record_interval_s": 0.01});
+    if let (Some(base), Some(extra)) = (sim.as_object_mut(), simulation.as_object()) {
+        for (k, v) in extra {
+            base.insert(k.clone(), v.clone());
+        }
+    }
+    json!({"kind": "simulate", "params": {"config": "rattle-box-c", "seed": 1,
+        "overrides": {"simulation": sim}}})
+    .to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        let jobs = "/v1/jobs";
+        let sim = |s: serde_json::Value| simulate_with(s);
+        let raw = |s: &str| s.to_string();
+        let duration = "params.overrides.simulation.duration_s";
+        // (case, body, field the 422 names, a word its detail must contain)
+        let cases: Vec<(&str, String, &str, Option<&str>)> = vec![
+            // Durations: not positive, absurd (1e308 once ran with eta 1.8e307 s).
+            ("negative duration", sim(json!({"duration_s": -1.0})), duration, None),
+            ("zero duration", sim(json!({"duration_s": 0.0})), duration, None),
+            ("absurd duration", sim(json!({"duration_s": 1e308})), duration, None),
+            ("duration over a day", sim(json!({"duration_s": 86_401.0})), duration, None),
+            ("settle over a day", sim(json!({"settle_s": 1e6})), "params.overrides.simulation.settle_s", None),
+            ("loose tolerance", sim(json!({"rel_tolerance": 0.5})), "params.overrides.simulation.rel_tolerance", None),
+            ("metre tolerance", sim(json!({"abs_tolerance_m": 1.0})), "params.overrides.simulation.abs_tolerance_m", None),
+            ("nanosecond records", sim(json!({"record_interval_s": 1e-9})), "params.overrides.simulation.record_interval_s", None),
+            // 24 h at the default 0.1 ms interval records far more than memory holds.
+            (
+                "24 h of default records",
+                json!({"kind": "simulate", "params": {"config": "rattle-box-c",
+                    "overrides": {"simulation": {"duration_s": 86_400.0}}}})
+                .to_string(),
+                "params.overrides.simulation.record_interval_s",
+                None,
+            ),
+            // A typo in an override key, overrides that are not an object, unknown params.
+            ("override typo", sim(json!({"durationn_s": 1.0})), "params.overrides.simulation.durationn_s", Some("durationn_s")),
+            ("overrides an array", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":[1,2]}}"#), "params.overrides", None),
+            ("params typo", raw(r#"{"kind":"simulate","params":{"confg":"rattle-box-c"}}"#), "params.confg", None),
+            ("no config", raw(r#"{"kind":"simulate","params":{"seed":3}}"#), "params.config", None),
+            // Names the directory searched.
+            ("config not a model", raw(r#"{"kind":"simulate","params":{"config":"service"}}"#), "params.config", Some("configs")),
+            ("unknown config", raw(r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#), "params.config", None),
+            ("seed 2^53", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9007199254740992}}"#), "params.seed", None),
+            // Sweeps: point counts, launcher-only, labels that must select something real.
+            ("one point", raw(r#"{"kind":"sweep","params":{"points":1}}"#), "params.points", None),
+            ("500 points", raw(r#"{"kind":"sweep","params":{"points":500}}"#), "params.points", None),
+            ("sweep of a rattle box", raw(r#"{"kind":"sweep","params":{"config":"rattle-box-c"}}"#), "params.config", None),
+            ("unknown vehicle", raw(r#"{"kind":"sweep","params":{"vehicle_profile":"uh60"}}"#), "params.vehicle_profile", Some("ah64")),
+            ("unknown wear law", raw(r#"{"kind":"sweep","params":{"wear_law":"totally-made-up"}}"#), "params.wear_law", None),
+            // `archard` is a real law but needs its coefficient: the default config has none.
+            ("archard without coefficient", raw(r#"{"kind":"sweep","params":{"wear_law":"archard"}}"#), "params.wear_law", None),
+            ("unknown environment", raw(r#"{"kind":"sweep","params":{"environment":"desert-sand"}}"#), "params.environment", None),
+            ("point on a sweep", raw(r#"{"kind":"sweep","params":{"point":0}}"#), "params.point", None),
+            ("sweep negative duration", raw(r#"{"kind":"sweep","params":{"overrides":{"simulation":{"duration_s":-2}}}}"#), duration, None),
+            // Calibration data: required, typed, no unknown keys.
+            ("no calibration data", raw(r#"{"kind":"calibrate","params":{}}"#), "params", None),
+            ("calibration typo", raw(r#"{"kind":"calibrate","params":{"wear_law":{"records":[],"densty":1}}}"#), "params.wear_law.densty", None),
+            ("absurd density", raw(r#"{"kind":"calibrate","params":{"wear_law":{"density_kg_m3":1e9,"records":[]}}}"#), "params.wear_law.density_kg_m3", None),
+        ];
+        for (case, body, field, word) in &cases {
+            let p = api.post(jobs, Some(ENGINEER), body).problem(422);
+            assert_eq!(p["field"], *field, "{case}: {body}: {p}");
+            if let Some(word) = word {
+                assert!(p["detail"].as_str().unwrap().contains(word), "{case}: {p}");
+            }
+        }
+        // A config that is an object: the field is under params.config.
+        let p = api
+            .post(
+                jobs,
+                Some(ENGINEER),
+                r#"{"kind":"simulate","params":{"config":{"garbage":true}}}"#,
+            )
+            .problem(422);
+        assert!(
+            p["field"].as_str().unwrap().starts_with("params.config"),
+            "{p}"
+        );
+
+        assert_eq!(stored_jobs(&api), 0, "a rejected job stores nothing");
+
+        // What is valid is accepted: the sweep's curve selectors are stored with it.
+        let r = api.post(jobs, Some(ENGINEER), &simulate_with(json!({})));
+        assert_eq!(r.status, 201, "{}", r.body);
+        let r = api.post(
+            jobs,
+            Some(ENGINEER),
+            r#"{"kind":"sweep","params":{"points":3}}"#,
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let sweep = r.json();
+        assert_eq!(sweep["curve_key"], "ah64/clean/modified-archard");
+        assert_eq!(sweep["params"]["vehicle_profile"], "ah64");
+        // Drawn seeds are below 2^53: JSON readers that use doubles read them exactly.
+        let seed = sweep["seed"].as_u64().expect("seed");
+        assert!(seed < 1 << 53, "{seed}");
+        assert_eq!(stored_jobs(&api), 2);
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn drawn_seeds_are_below_two_to_the_53() {
+    for _ in 0..1000 {
+        assert!(railwear::jobs::draw_seed() < 1 << 53);
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        let jobs = "/v1/jobs";
+        // A planner may not submit jobs, whatever the body holds.
+        api.post(jobs, Some(PLANNER), "{not json").problem(403);
+        api.request(
+            "POST",
+            jobs,
+            Some(PLANNER),
+            &[("Content-Type", "text/plain")],
+            Some("x"),
+        )
+        .problem(403);
+        // An engineer may not record measurements, whatever the body holds.
+        api.post("/v1/rails/R-1/measurements", Some(ENGINEER), "[1,2")
+            .problem(403);
+        // A repeated query key and invalid percent-encoding answer problem+json.
+        let p = api
+            .get(&format!("{jobs}?limit=1&limit=2"), Some(ENGINEER))
+            .problem(400);
+        assert_eq!(p["field"], "limit", "{p}");
+        api.get_problem("/v1/rails/%FF%FE/report", Some(PLANNER), 400);
+        api.get_problem("/v1/jobs/%FF", Some(ENGINEER), 400);
+
+        // /metrics: never -0, and HTTP requests per route with a latency histogram.
+        let r = api.get("/metrics", None);
+        assert_eq!(r.status, 200);
+        assert!(!r.body.contains(" -0"), "{}", r.body);
+        assert!(
+            r.body.contains(
+                "railwear_http_requests_total{method=\"POST\",route=\"/v1/jobs\",status=\"403\"} 2"
+            ),
+            "{}",
+            r.body
+        );
+        assert!(
+            r.body.contains(
+                "railwear_http_request_duration_seconds_count{method=\"GET\",route=\"/v1/jobs\"} 1"
+            ),
+            "{}",
+            r.body
+        );
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}

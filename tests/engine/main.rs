@@ -1,0 +1,17 @@
+//! The engine test binary: physics, models, the gap diagnosis, checkpoints, closed forms, energy
+//! and error control, called as a library (no HTTP, no store). One module per concern.
+
+mod checkpoint_resume;
+mod energy_passivity;
+mod engine_closed_forms;
+mod error_control;
+mod gap_campaign;
+mod gap_diagnose;
+mod gap_effects;
+mod gap_rig;
+mod launcher_model;
+mod launcher_trend;
+mod multi_missile;
+mod newton_matrix;
+mod rattle_box;
+mod step_diagnostics;
