@@ -337,7 +337,7 @@ impl CaseRunner for LibraryRunner {
         self.run_from(kind, params, control, None)
     }
 
-    /// Simulate jobs and sweep points checkpoint and resume (`models::case::run_case_from`);
+    /// Simulate jobs and sweep points checkpoint and resume (`report::run_case_from`);
     /// the other kinds stop as cancelled on a checkpoint request and start over.
     fn run_from(
         &self,

@@ -172,6 +172,3 @@ pub fn run_options(case: &CaseSpec) -> Result<RunOptions, RunError> {
     })
 }
 
-// Former paths of the run-and-package functions, kept for the integration tests that import
-// them from here; the library's callers use `crate::report`.
-pub use crate::report::{run_case, run_case_from};

@@ -32,7 +32,7 @@ pub enum RunError {
     /// Stopped with a checkpoint
     /// ([`RunControl::request_checkpoint`](crate::physics::control::RunControl::request_checkpoint)):
     /// handing its bytes to the same computation again resumes it
-    /// (`models::case::run_case_from`).
+    /// (`report::run_case_from`).
     #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
     Checkpointed(Box<super::checkpoint::Checkpoint>),
 }

@@ -5,7 +5,8 @@
 //! excited window, twice in a row). A checkpoint of another case, code version or format is
 //! not resumed: the run restarts from t = 0 (and gives that case's own result).
 
-use railwear::models::case::{build, code_version, load_case, run_case_from};
+use railwear::models::case::{build, code_version, load_case};
+use railwear::report::run_case_from;
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
 use railwear::models::specs::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;

@@ -3,7 +3,8 @@
 //! never above 1.
 
 use railwear::analysis::penalization::{PenalizationCurve, SweepPoint};
-use railwear::models::case::{load_case, run_case};
+use railwear::models::case::load_case;
+use railwear::report::run_case;
 use railwear::pipeline::RunControl;
 use std::path::Path;
 

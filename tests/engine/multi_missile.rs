@@ -5,7 +5,8 @@
 //! single rail moved; it must wear as the single rail does), the account of the merged run
 //! closes, and stations whose missiles would overlap are refused.
 
-use railwear::models::case::{build, load_case, run_case};
+use railwear::models::case::{build, load_case};
+use railwear::report::run_case;
 use railwear::models::specs::{CaseSpec, ModelSpecRef};
 use railwear::physics::partition::independent_parts;
 use railwear::pipeline::RunControl;

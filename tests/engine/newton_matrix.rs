@@ -6,7 +6,8 @@
 //! window must agree to well within 1 % (the launcher's 2 s window is not chaotic: successive
 //! engine versions give it to 0.2 %).
 
-use railwear::models::case::{load_case, run_case};
+use railwear::models::case::load_case;
+use railwear::report::run_case;
 use railwear::physics::integrator::{ContactPatches, NewtonJacobian};
 use railwear::pipeline::RunControl;
 use std::path::Path;

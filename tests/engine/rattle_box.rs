@@ -1,7 +1,8 @@
 //! Rattle box (thesis chapter 5) end to end: convergence of the friction power (issue 2 item 5),
 //! wear reported in mg/h with the documented split, static equilibrium without excitation.
 
-use railwear::models::case::{load_case, run_case};
+use railwear::models::case::load_case;
+use railwear::report::run_case;
 use railwear::models::run::RunReport;
 use railwear::pipeline::RunControl;
 use railwear::units::STANDARD_GRAVITY;
