@@ -19,6 +19,7 @@ pub mod cli;
 pub mod config;
 pub mod contact_models;
 pub mod excitation;
+pub mod field_error;
 pub mod gap;
 pub mod geometry;
 pub mod http;

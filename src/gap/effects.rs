@@ -419,7 +419,7 @@ impl Effect {
             "friction_drift" => {
                 let d = self.get("delta_mu")
                     * (1.0 - (-state.slip_distance_m / self.get("slip_scale_m")).exp());
-                let shift = |f: &mut crate::models::specs::FrictionSpec| {
+                let shift = |f: &mut crate::physics::friction::FrictionParams| {
                     f.mu_static += d;
                     f.mu_dynamic += d;
                 };

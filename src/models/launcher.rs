@@ -472,7 +472,7 @@ pub fn build(
             None,
         ]
     };
-    let friction = Some(spec.friction.to_friction_params());
+    let friction = Some(spec.friction);
     let c = &spec.contacts;
     let tooth = &l.tooth;
     let tooth_rear_z = tooth.centre_m[2] - tooth.half_extents_m[2];

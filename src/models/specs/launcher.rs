@@ -262,7 +262,8 @@ pub struct LauncherSpec {
     /// Contact parameters (Table 6.2).
     pub contacts: LauncherContacts,
     /// Friction for all contacts (Table 6.1).
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
     /// Rail stations of a multi-rail launcher (the AH-64's M299 carries four missiles): the
     /// offset of each rail's frame from the launcher's reference, m. Every station is the
     /// rail above with its own missile, latch, springs and five contacts; all rails move with
@@ -648,7 +649,7 @@ impl LauncherSpec {
         c.mid_shoe_rail.validate(&path(&cp, "mid_shoe_rail"))?;
         c.mid_shoe_latch.validate(&path(&cp, "mid_shoe_latch"))?;
         c.rear_shoe_rail.validate(&path(&cp, "rear_shoe_rail"))?;
-        self.friction.validate(&p("friction"))?;
+        validate_friction(&self.friction, &p("friction"))?;
         Ok(())
     }
 }

@@ -5,12 +5,12 @@
 //! `_n_per_mm_e`); y is vertical (up, towards the vehicle), gravity is standard gravity along -y;
 //! for the launcher the rail frame has its origin at the rail's centre of mass, z longitudinal
 //! (firing direction), x transverse. Contact and friction parameters are written in the thesis'
-//! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`] and
-//! [`FrictionSpec::to_friction_params`]. Values the thesis does not give are engineering
+//! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`]; friction is the
+//! engine's own [`FrictionParams`], read from and written to mm/s by [`in_mm_per_s`]. Values the thesis does not give are engineering
 //! estimates, flagged `estimate` in `docs/models.md`.
 
 use crate::analysis::rattle_space::{self, LauncherDimensions, RattleSpaceError};
-use crate::physics::friction::FrictionParams;
+use crate::physics::friction::{in_mm_per_s, FrictionParams};
 use crate::physics::impact::ImpactParams;
 use crate::physics::step::StepKind;
 use crate::units;

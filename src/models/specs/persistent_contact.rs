@@ -89,7 +89,8 @@ pub struct PersistentContactSpec {
     /// Pad-coupon contact, Table 4.1.
     pub contact: ContactSpec,
     /// Friction, Table 4.2.
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
 }
 
 impl PersistentContactSpec {
@@ -133,7 +134,7 @@ impl PersistentContactSpec {
         positive(prefix, "normal_load_n", self.normal_load_n)?;
         self.rotation.validate(&path(prefix, "rotation"))?;
         self.contact.validate(&path(prefix, "contact"))?;
-        self.friction.validate(&path(prefix, "friction"))?;
+        validate_friction(&self.friction, &path(prefix, "friction"))?;
         let half_diag = 0.5 * self.pad_size_m[0].hypot(self.pad_size_m[2]);
         if self.mean_radius_m + half_diag > 0.5 * self.coupon_side_m {
             return Err(err(

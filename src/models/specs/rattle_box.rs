@@ -35,7 +35,8 @@ pub struct RattleBoxSpec {
     /// Cube-tube contact, Table 5.2.
     pub contact: ContactSpec,
     /// Cube-tube friction, Table 5.2.
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
 }
 
 pub(super) fn default_true() -> bool {
@@ -109,7 +110,7 @@ impl RattleBoxSpec {
             }
         }
         self.contact.validate(&path(prefix, "contact"))?;
-        self.friction.validate(&path(prefix, "friction"))?;
+        validate_friction(&self.friction, &path(prefix, "friction"))?;
         Ok(())
     }
 }

@@ -58,68 +58,13 @@ impl ContactSpec {
     }
 }
 
-/// ADAMS Coulomb friction (eq. 4.5) with speeds in mm/s, as the thesis tables print them.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FrictionSpec {
-    /// Static coefficient mu_s. Tables 4.2, 5.2, 6.1: 0.1799.
-    pub mu_static: f64,
-    /// Dynamic coefficient mu_d. Tables 4.2, 5.2, 6.1: 0.1660.
-    pub mu_dynamic: f64,
-    /// Stiction transition speed v_s, mm/s. Tables 5.2, 6.1: 6.4634 (Table 4.2 rounds to 6.46).
-    pub stiction_transition_speed_mm_per_s: f64,
-    /// Friction transition speed v_d, mm/s (> v_s). Tables 4.2, 5.2, 6.1: 12.0.
-    pub friction_transition_speed_mm_per_s: f64,
-    /// Transition shape: `cycloidal` (eq. 4.6, default) or `cubic`.
-    #[serde(default)]
-    pub step: StepKind,
-}
-
-impl FrictionSpec {
-    /// Thesis Table 5.2 / 6.1 (dry anodized 7075 on 7075).
-    pub const fn thesis_default() -> Self {
-        Self {
-            mu_static: 0.1799,
-            mu_dynamic: 0.1660,
-            stiction_transition_speed_mm_per_s: 6.4634,
-            friction_transition_speed_mm_per_s: 12.0,
-            step: StepKind::Cycloidal,
-        }
-    }
-
-    /// Converts to SI [`FrictionParams`] (speeds in m/s).
-    pub fn to_friction_params(&self) -> FrictionParams {
-        FrictionParams {
-            mu_static: self.mu_static,
-            mu_dynamic: self.mu_dynamic,
-            stiction_transition_speed: units::mm(self.stiction_transition_speed_mm_per_s),
-            friction_transition_speed: units::mm(self.friction_transition_speed_mm_per_s),
-            step: self.step,
-        }
-    }
-
-    /// Field rules of [`FrictionParams::validate`], reported with this struct's field names.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
-        non_negative(prefix, "mu_static", self.mu_static)?;
-        non_negative(prefix, "mu_dynamic", self.mu_dynamic)?;
-        positive(
-            prefix,
-            "stiction_transition_speed_mm_per_s",
-            self.stiction_transition_speed_mm_per_s,
-        )?;
-        finite(
-            prefix,
-            "friction_transition_speed_mm_per_s",
-            self.friction_transition_speed_mm_per_s,
-        )?;
-        if self.friction_transition_speed_mm_per_s <= self.stiction_transition_speed_mm_per_s {
-            return Err(err(
-                path(prefix, "friction_transition_speed_mm_per_s"),
-                "must be greater than stiction_transition_speed_mm_per_s",
-            ));
-        }
-        Ok(())
-    }
+/// A case's friction (the one [`FrictionParams`] type, written in mm/s in case files through
+/// [`in_mm_per_s`]), checked with its own rules and reported at `prefix`
+/// (e.g. `rattle_box.friction.mu_dynamic`).
+pub fn validate_friction(friction: &FrictionParams, prefix: &str) -> Result<(), SpecError> {
+    friction
+        .validate()
+        .map_err(|e| err(path(prefix, &e.field), e.rule))
 }
 
 /// The material of a case's contacting parts: the one [`Material`] type, checked with its own
