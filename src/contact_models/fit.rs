@@ -3,6 +3,7 @@
 
 use super::quasistatic::{QuasistaticModel, SphereOnFlat};
 use super::ContactModelError;
+use crate::field_error::FieldError;
 use crate::units::{impact_stiffness_si, M_PER_MM};
 use serde::{Deserialize, Serialize};
 
@@ -55,16 +56,16 @@ pub fn fit_power_law(
     space: FitSpace,
 ) -> Result<PowerLawFit, ContactModelError> {
     if !(max_interference_m.is_finite() && max_interference_m > 0.0) {
-        return Err(ContactModelError::Invalid {
-            field: "max_interference_m",
-            rule: "must be a finite number > 0".into(),
-        });
+        return Err(ContactModelError::Invalid(FieldError::new(
+            "max_interference_m",
+            "must be a finite number > 0",
+        )));
     }
     if !(3..=1_000_000).contains(&samples) {
-        return Err(ContactModelError::Invalid {
-            field: "samples",
-            rule: "must be in 3..=1000000".into(),
-        });
+        return Err(ContactModelError::Invalid(FieldError::new(
+            "samples",
+            "must be in 3..=1000000",
+        )));
     }
     let ws: Vec<f64> = match space {
         FitSpace::Linear => (1..=samples)
@@ -353,10 +354,7 @@ mod tests {
         let r = fit_power_law(|w| w, -1.0, 10, FitSpace::Log);
         assert!(matches!(
             r,
-            Err(ContactModelError::Invalid {
-                field: "max_interference_m",
-                ..
-            })
+            Err(ContactModelError::Invalid(FieldError { ref field, .. })) if field == "max_interference_m"
         ));
     }
 }

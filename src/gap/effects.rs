@@ -398,7 +398,7 @@ impl Effect {
         if self.magnitude() == 0.0 || info.acts == Acts::WearLaw {
             return Ok(());
         }
-        let bad = |e: crate::models::specs::SpecError| {
+        let bad = |e: crate::models::specs::FieldError| {
             GapError::field(
                 format!("effect.{}", self.name),
                 format!("{}: {}", e.field, e.rule),

@@ -38,12 +38,13 @@ pub fn router() -> Router<AppState> {
 pub mod seam {
     use crate::analysis::penalization::PenalizationCurve;
     use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
+    use crate::field_error::FieldError;
 
     /// Rattle space k_rs (eq. 6.1-6.3) of measured dimensions, or the field at fault and why.
-    pub fn rattle_space(dimensions: &LauncherDimensions) -> Result<f64, (String, String)> {
-        dimensions.rattle_space().map_err(|e| match e {
-            RattleSpaceError::InvalidDimension { field, rule } => (field.to_string(), rule),
-        })
+    pub fn rattle_space(dimensions: &LauncherDimensions) -> Result<f64, FieldError> {
+        dimensions
+            .rattle_space()
+            .map_err(|RattleSpaceError::InvalidDimension(e)| e)
     }
 
     /// K_SL at `k_rs` and its 0.9/0.8 bands (eq. 6.4), or why the curve does not cover it.
@@ -458,7 +459,7 @@ pub async fn post_measurement(
     let recorded_ms = clock::now_ms();
     let measured_ms = check_measured_at(&measured_at, recorded_ms)?;
     let rattle_space = seam::rattle_space(&request.dimensions_mm)
-        .map_err(|(field, rule)| Problem::invalid_field(format!("dimensions_mm.{field}"), rule))?;
+        .map_err(|e| Problem::from(e.at("dimensions_mm")))?;
     let dimensions_mm =
         serde_json::to_value(request.dimensions_mm).map_err(|e| Problem::internal(&e))?;
     let record = state

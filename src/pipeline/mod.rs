@@ -22,6 +22,7 @@ pub use sweep_range::*;
 
 use crate::physics::track::TrackSample;
 
+use crate::field_error::FieldError;
 pub use crate::physics::control::{Progress, RunControl};
 
 /// What a finished case produces.
@@ -54,10 +55,11 @@ pub enum RunError {
     Checkpointed(Box<crate::models::checkpoint::Checkpoint>),
 }
 
-fn invalid(field: &str, rule: impl Into<String>) -> RunError {
-    RunError::InvalidConfig {
-        field: field.to_string(),
-        rule: rule.into(),
+/// A field error is an invalid configuration (the variant keeps its named fields, which
+/// callers and tests construct).
+impl From<FieldError> for RunError {
+    fn from(FieldError { field, rule }: FieldError) -> Self {
+        RunError::InvalidConfig { field, rule }
     }
 }
 
@@ -150,7 +152,7 @@ pub fn check_keys<'a>(
 ) -> Result<&'a serde_json::Map<String, serde_json::Value>, RunError> {
     let map = value
         .as_object()
-        .ok_or_else(|| invalid(field, "must be a JSON object"))?;
+        .ok_or_else(|| FieldError::new(field, "must be a JSON object"))?;
     for key in map.keys() {
         if !allowed.contains(&key.as_str()) {
             let path = if field == "params" {
@@ -158,10 +160,11 @@ pub fn check_keys<'a>(
             } else {
                 format!("{field}.{key}")
             };
-            return Err(invalid(
+            return Err(FieldError::new(
                 &path,
                 format!("is not a known parameter (known: {})", allowed.join(", ")),
-            ));
+            )
+            .into());
         }
     }
     Ok(map)
@@ -173,9 +176,10 @@ pub fn parse_seed(value: &serde_json::Value) -> Result<u64, RunError> {
         .as_u64()
         .filter(|s| *s <= limits::MAX_SEED)
         .ok_or_else(|| {
-            invalid(
+            FieldError::new(
                 "seed",
                 "must be an integer in [0, 2^53) (JavaScript reads larger integers inexactly)",
             )
+            .into()
         })
 }

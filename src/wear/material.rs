@@ -1,6 +1,7 @@
 //! Bulk material properties used by wear allocation and the quasistatic contact models.
 
 use super::WearError;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Pa per Brinell unit: HB is a load in kgf over an area in mm², so 1 HB = 9.80665 N/mm².
@@ -71,18 +72,20 @@ impl Material {
         ];
         for (field, x) in positive {
             if !(x.is_finite() && x > 0.0) {
-                return Err(WearError::invalid(
+                return Err(FieldError::new(
                     field,
                     format!("must be a finite number > 0, got {x}"),
-                ));
+                )
+                .into());
             }
         }
         let nu = self.poisson_ratio;
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-            return Err(WearError::invalid(
+            return Err(FieldError::new(
                 "poisson_ratio",
                 format!("must lie in (-1, 0.5), got {nu}"),
-            ));
+            )
+            .into());
         }
         Ok(())
     }
@@ -113,19 +116,13 @@ mod tests {
         m.poisson_ratio = 0.7;
         assert_eq!(
             m.validate(),
-            Err(WearError::invalid(
-                "poisson_ratio",
-                "must lie in (-1, 0.5), got 0.7"
-            ))
+            Err(FieldError::new("poisson_ratio", "must lie in (-1, 0.5), got 0.7").into())
         );
         m.poisson_ratio = 0.33;
         m.density_kg_per_m3 = -1.0;
         assert!(matches!(
             m.validate(),
-            Err(WearError::Invalid {
-                field: "density_kg_per_m3",
-                ..
-            })
+            Err(WearError::Invalid(FieldError { ref field, .. })) if field == "density_kg_per_m3"
         ));
     }
 

@@ -1,6 +1,7 @@
 //! Specs shared by every model: material, contact and friction (ADAMS units), rounded boxes, the simulation settings.
 
 use super::*;
+use crate::field_error::FieldError;
 
 /// ADAMS IMPACT contact parameters in ADAMS units (N, mm, s), eq. 2.1-2.3.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -44,10 +45,10 @@ impl ContactSpec {
     }
 
     /// Field rules (k > 0, e >= 1, c >= 0, d > 0), reported under `prefix`.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         positive(prefix, "stiffness_n_per_mm_e", self.stiffness_n_per_mm_e)?;
         if !(self.exponent.is_finite() && self.exponent >= 1.0) {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "exponent"),
                 format!("must be a finite number >= 1, got {}", self.exponent),
             ));
@@ -61,18 +62,16 @@ impl ContactSpec {
 /// A case's friction (the one [`FrictionParams`] type, written in mm/s in case files through
 /// [`in_mm_per_s`]), checked with its own rules and reported at `prefix`
 /// (e.g. `rattle_box.friction.mu_dynamic`).
-pub fn validate_friction(friction: &FrictionParams, prefix: &str) -> Result<(), SpecError> {
-    friction
-        .validate()
-        .map_err(|e| err(path(prefix, &e.field), e.rule))
+pub fn validate_friction(friction: &FrictionParams, prefix: &str) -> Result<(), FieldError> {
+    friction.validate().map_err(|e| e.at(prefix))
 }
 
 /// The material of a case's contacting parts: the one [`Material`] type, checked with its own
 /// rules and reported at `prefix` (e.g. `rattle_box.material.poisson_ratio`).
-pub fn validate_material(material: &Material, prefix: &str) -> Result<(), SpecError> {
-    material.validate().map_err(|e| match e {
-        crate::wear::WearError::Invalid { field, rule } => err(path(prefix, field), rule),
-    })
+pub fn validate_material(material: &Material, prefix: &str) -> Result<(), FieldError> {
+    material
+        .validate()
+        .map_err(|crate::wear::WearError::Invalid(e)| e.at(prefix))
 }
 
 /// A box with rounded edges and corners (a convex contact piece, SPEC 2), given by its centre
@@ -91,12 +90,12 @@ pub struct RoundedBoxSpec {
 
 impl RoundedBoxSpec {
     /// Field rules: finite centre, half extents > edge radius >= 0.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         finite3(prefix, "centre_m", self.centre_m)?;
         non_negative(prefix, "edge_radius_m", self.edge_radius_m)?;
         for h in self.half_extents_m {
             if !(h.is_finite() && h > self.edge_radius_m) {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "half_extents_m"),
                     format!(
                         "each half extent must be finite and larger than edge_radius_m = {}, got {:?}",
@@ -215,12 +214,12 @@ pub(super) fn default_record_interval_s() -> f64 {
 impl SimulationSpec {
     /// Field rules: settle >= 0, duration > 0, tolerances in range, record interval in
     /// (0, duration], integrator a non-empty lower-case identifier.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         non_negative(prefix, "settle_s", self.settle_s)?;
         positive(prefix, "duration_s", self.duration_s)?;
         if !(self.rel_tolerance.is_finite() && self.rel_tolerance > 0.0 && self.rel_tolerance < 1.0)
         {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "rel_tolerance"),
                 format!("must lie in (0, 1), got {}", self.rel_tolerance),
             ));
@@ -229,7 +228,7 @@ impl SimulationSpec {
         positive(prefix, "record_interval_s", self.record_interval_s)?;
         if let Some(e) = self.energy_rel_tolerance {
             if !(e.is_finite() && (0.0..1.0).contains(&e)) {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "energy_rel_tolerance"),
                     format!("must lie in [0, 1), got {e}"),
                 ));
@@ -237,7 +236,7 @@ impl SimulationSpec {
         }
         let (lo, hi) = crate::geometry::lattice::POINTS_PER_EDGE_RANGE;
         if !(lo..=hi).contains(&self.contact_points_per_edge) {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "contact_points_per_edge"),
                 format!(
                     "must lie in [{lo}, {hi}], got {}",
@@ -246,7 +245,7 @@ impl SimulationSpec {
             ));
         }
         if self.record_interval_s > self.duration_s {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "record_interval_s"),
                 "must not exceed duration_s",
             ));
@@ -257,7 +256,7 @@ impl SimulationSpec {
                 .chars()
                 .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-');
         if !ok {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "integrator"),
                 format!(
                     "must be a lower-case name such as \"trbdf2\", got {:?}",
