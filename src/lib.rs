@@ -28,6 +28,7 @@ pub mod models;
 pub mod physics;
 pub mod pipeline;
 pub mod store;
+pub mod thesis;
 pub mod units;
 pub mod validation;
 pub mod wear;

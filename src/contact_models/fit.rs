@@ -252,7 +252,10 @@ mod tests {
 
     /// Table 2.2 load: 1000 N plus the weight of the 50 mm 7075 sphere (4/3 pi R³ 2810 kg/m³).
     fn table_2_2_load() -> f64 {
-        let mass = 4.0 / 3.0 * std::f64::consts::PI * 0.05f64.powi(3) * 2810.0;
+        let mass = 4.0 / 3.0
+            * std::f64::consts::PI
+            * 0.05f64.powi(3)
+            * crate::thesis::DENSITY_7075_KG_PER_M3;
         1000.0 + mass * STANDARD_GRAVITY
     }
 

@@ -7,7 +7,7 @@
 
 use super::step::StepKind;
 use crate::field_error::FieldError;
-use crate::units;
+use crate::{thesis, units};
 use serde::{Deserialize, Serialize};
 
 /// Friction parameters (thesis Table 4.2 / 5.2 / 6.1): the one friction type, speeds in m/s.
@@ -34,10 +34,10 @@ impl FrictionParams {
     /// Thesis Table 5.2 (dry 7075-T73 on 7075-T73), in SI.
     pub fn thesis_table_5_2() -> Self {
         Self {
-            mu_static: 0.1799,
-            mu_dynamic: 0.1660,
-            stiction_transition_speed: 6.4634e-3,
-            friction_transition_speed: 12.0e-3,
+            mu_static: thesis::MU_STATIC,
+            mu_dynamic: thesis::MU_DYNAMIC,
+            stiction_transition_speed: thesis::STICTION_TRANSITION_SPEED_MM_PER_S * units::M_PER_MM,
+            friction_transition_speed: thesis::FRICTION_TRANSITION_SPEED_MM_PER_S * units::M_PER_MM,
             step: StepKind::Cycloidal,
         }
     }
@@ -171,6 +171,9 @@ mod tests {
     #[test]
     fn table_5_2_values_at_the_breakpoints() {
         let f = FrictionParams::thesis_table_5_2();
+        // Table 5.2 in SI, the bits a case file's 6.4634 and 12.0 mm/s read as.
+        assert_eq!(f.stiction_transition_speed, 6.4634e-3);
+        assert_eq!(f.friction_transition_speed, 12.0e-3);
         assert_eq!(f.coefficient(0.0), 0.0);
         assert!((f.coefficient(6.4634e-3) - 0.1799).abs() < 1e-12);
         assert!((f.coefficient(12.0e-3) - 0.1660).abs() < 1e-12);

@@ -24,10 +24,10 @@ impl ContactSpec {
     /// Thesis Table 4.1 / 5.2 / 6.2 default contact: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
     pub const fn thesis_default() -> Self {
         Self {
-            stiffness_n_per_mm_e: 1000.0,
-            exponent: 2.0,
-            damping_ns_per_mm: 500.0,
-            penetration_depth_mm: 0.01,
+            stiffness_n_per_mm_e: crate::thesis::IMPACT_STIFFNESS_N_PER_MM_E,
+            exponent: crate::thesis::IMPACT_EXPONENT,
+            damping_ns_per_mm: crate::thesis::IMPACT_DAMPING_NS_PER_MM,
+            penetration_depth_mm: crate::thesis::IMPACT_PENETRATION_DEPTH_MM,
             step: StepKind::Cycloidal,
         }
     }
