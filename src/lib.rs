@@ -27,6 +27,7 @@ pub mod jobs;
 pub mod models;
 pub mod physics;
 pub mod pipeline;
+pub mod sampling;
 pub mod store;
 pub mod thesis;
 pub mod units;
