@@ -39,9 +39,9 @@ fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
 }
 
 /// Checks the run-control bounds of [`limits`]; the error's field is a case path.
-fn check_simulation_bounds(case: &CaseSpec) -> Result<(), (String, String)> {
+fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     let s = &case.simulation;
-    let bad = |field: &str, rule: String| Err((format!("simulation.{field}"), rule));
+    let bad = |field: &str, rule: String| Err(FieldError::new(field, rule).at("simulation"));
     if !(s.duration_s.is_finite() && s.duration_s > 0.0 && s.duration_s <= limits::MAX_DURATION_S) {
         return bad(
             "duration_s",
@@ -163,8 +163,7 @@ pub fn resolve_case(
         other => other,
     };
     case.validate().map_err(|e| relocate(e.into()))?;
-    check_simulation_bounds(&case)
-        .map_err(|(field, rule)| relocate(FieldError::new(&field, rule).into()))?;
+    check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
     crate::models::case::build(&case, configs_dir).map_err(relocate)?;
     Ok(case)
