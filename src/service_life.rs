@@ -8,12 +8,13 @@ use crate::analysis::penalization::{
     KslInterval, PenalizationCurve, PenalizationError, PenalizedLife,
 };
 use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
+use crate::field_error::FieldError;
 
 /// Rattle space k_rs (eq. 6.1-6.3) of measured dimensions, or the field at fault and why.
-pub fn rattle_space(dimensions: &LauncherDimensions) -> Result<f64, (String, String)> {
-    dimensions.rattle_space().map_err(|e| match e {
-        RattleSpaceError::InvalidDimension { field, rule } => (field.to_string(), rule),
-    })
+pub fn rattle_space(dimensions: &LauncherDimensions) -> Result<f64, FieldError> {
+    dimensions
+        .rattle_space()
+        .map_err(|RattleSpaceError::InvalidDimension(e)| e)
 }
 
 /// [k_rs, K_SL] at the curve's swept rattle spaces (for a plot of the curve).

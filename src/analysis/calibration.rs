@@ -455,7 +455,7 @@ pub fn synthetic_torque_records(
     noise: f64,
     seed: u64,
 ) -> (Fixture, Vec<TorqueRecord>) {
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     let fixture = Fixture {
         polar_inertia_kg_m2: 0.02,
         mean_radius_m: 0.02,
@@ -471,8 +471,7 @@ pub fn synthetic_torque_records(
             let mu = truth.coefficient(v.abs()) * v.signum();
             let torque =
                 fixture.polar_inertia_kg_m2 * thdd + 3.0 * fixture.mean_radius_m * 300.0 * mu;
-            let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
-            let gauss = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
+            let gauss = crate::sampling::standard_normal(&mut rng);
             TorqueRecord {
                 time_s: t,
                 angle_rad: -1.5 / w * (w * t).cos(),
@@ -488,15 +487,8 @@ pub fn synthetic_torque_records(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
-        // Box-Muller.
-        let u1: f64 = rng.gen_range(f64::MIN_POSITIVE..1.0);
-        let u2: f64 = rng.gen();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
 
     /// Table 4.2 (6.46 mm/s as printed there).
     fn table_4_2() -> FrictionParams {
@@ -572,7 +564,11 @@ mod tests {
             for _ in 0..repeats {
                 let n = sigma * 1e-4;
                 let k = law.coefficient_m2_per_n(sigma).unwrap_or(0.0);
-                let mass = 2810.0 * k * n * 100.0 * (1.0 + noise * gaussian(&mut rng));
+                let mass = 2810.0
+                    * k
+                    * n
+                    * 100.0
+                    * (1.0 + noise * crate::sampling::standard_normal(&mut rng));
                 out.push(WearTestRecord {
                     normal_load_n: n,
                     contact_pressure_pa: sigma,

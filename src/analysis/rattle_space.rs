@@ -10,6 +10,7 @@
 //! each letter in [`LauncherDimensions`] is inferred from the role it plays in eq. 6.1-6.2; the
 //! decisions are listed in `docs/launcher-dimensions.md`.
 
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Why a rattle space could not be computed. Names the offending field and the rule it broke.
@@ -17,29 +18,18 @@ use serde::{Deserialize, Serialize};
 pub enum RattleSpaceError {
     /// A dimension is not usable: not finite, not positive, implausible in magnitude, or it
     /// describes an item that cannot fit its enclosure (interference).
-    #[error("invalid dimension `{field}`: {rule}")]
-    InvalidDimension {
-        /// Name of the field (as in the struct / JSON body), e.g. `n_shoe_mm`.
-        field: &'static str,
-        /// The rule that was broken, in words, with the offending value.
-        rule: String,
-    },
-}
-
-fn invalid(field: &'static str, rule: String) -> RattleSpaceError {
-    RattleSpaceError::InvalidDimension { field, rule }
+    /// (The field is named as in the struct / JSON body, e.g. `n_shoe_mm`.)
+    #[error("invalid dimension `{}`: {}", .0.field, .0.rule)]
+    InvalidDimension(#[from] FieldError),
 }
 
 /// Checks that a length is a finite number > 0.
 fn positive_finite(field: &'static str, value: f64) -> Result<(), RattleSpaceError> {
     if !value.is_finite() {
-        return Err(invalid(
-            field,
-            format!("must be a finite number, got {value}"),
-        ));
+        return Err(FieldError::new(field, format!("must be a finite number, got {value}")).into());
     }
     if value <= 0.0 {
-        return Err(invalid(field, format!("must be > 0, got {value}")));
+        return Err(FieldError::new(field, format!("must be > 0, got {value}")).into());
     }
     Ok(())
 }
@@ -59,20 +49,22 @@ pub fn rattle_space_rectangular(
     positive_finite("enclosure_side_1", enclosure_side_1)?;
     positive_finite("enclosure_side_2", enclosure_side_2)?;
     if item_side_1 > enclosure_side_1 {
-        return Err(invalid(
+        return Err(FieldError::new(
             "item_side_1",
             format!(
                 "interference: item side {item_side_1} exceeds enclosure side {enclosure_side_1}"
             ),
-        ));
+        )
+        .into());
     }
     if item_side_2 > enclosure_side_2 {
-        return Err(invalid(
+        return Err(FieldError::new(
             "item_side_2",
             format!(
                 "interference: item side {item_side_2} exceeds enclosure side {enclosure_side_2}"
             ),
-        ));
+        )
+        .into());
     }
     // eq. 5.1 with the areas of eq. 5.2
     Ok((item_side_1 * item_side_2) / (enclosure_side_1 * enclosure_side_2))
@@ -83,13 +75,14 @@ pub fn rattle_space_rectangular(
 /// Table 5.1: 1 in cube in 2.0 / 1.5 / 1.25 / 1.125 in tubes gives 0.25 / 0.44 / 0.64 / 0.79.
 pub fn rattle_space_square(cube_side: f64, tube_inner_side: f64) -> Result<f64, RattleSpaceError> {
     rattle_space_rectangular(cube_side, cube_side, tube_inner_side, tube_inner_side).map_err(
-        |RattleSpaceError::InvalidDimension { field, rule }| {
+        |RattleSpaceError::InvalidDimension(FieldError { field, rule })| {
             let field = if field.starts_with("item") {
                 "cube_side"
             } else {
                 "tube_inner_side"
-            };
-            RattleSpaceError::InvalidDimension { field, rule }
+            }
+            .to_string();
+            RattleSpaceError::InvalidDimension(FieldError { field, rule })
         },
     )
 }
@@ -259,22 +252,24 @@ impl LauncherDimensions {
         }
         for (field, value) in self.named_fields() {
             if value < MIN_PLAUSIBLE_DIMENSION_MM {
-                return Err(invalid(
+                return Err(FieldError::new(
                     field,
                     format!(
                         "{value} mm is below {MIN_PLAUSIBLE_DIMENSION_MM} mm, implausible for a \
                          rail or shoe dimension: probably inches or metres entered as mm"
                     ),
-                ));
+                )
+                .into());
             }
             if value > MAX_PLAUSIBLE_DIMENSION_MM {
-                return Err(invalid(
+                return Err(FieldError::new(
                     field,
                     format!(
                         "{value} mm is above {MAX_PLAUSIBLE_DIMENSION_MM} mm (the missile \
                          diameter), implausible for a rail or shoe dimension"
                     ),
-                ));
+                )
+                .into());
             }
         }
         let stations = [
@@ -285,56 +280,60 @@ impl LauncherDimensions {
         ];
         for (thick_name, thick, height_name, height) in stations {
             if thick >= height {
-                return Err(invalid(
+                return Err(FieldError::new(
                     thick_name,
                     format!(
                         "head thickness {thick} mm must be smaller than the overall shoe height \
                          {height_name} = {height} mm (the neck height would be <= 0)"
                     ),
-                ));
+                )
+                .into());
             }
         }
         if self.a_shoe_mm <= self.b_rail_mm {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "a_shoe_mm",
                 format!(
                     "shoe head width {} mm must be wider than the rail slot b_rail_mm = {} mm: \
                      a narrower head pulls out through the slot (the missile falls out)",
                     self.a_shoe_mm, self.b_rail_mm
                 ),
-            ));
+            )
+            .into());
         }
         for (neck_name, neck) in [("n_shoe_mm", self.n_shoe_mm), ("o_shoe_mm", self.o_shoe_mm)] {
             if neck >= self.a_shoe_mm {
-                return Err(invalid(
+                return Err(FieldError::new(
                     neck_name,
                     format!(
                         "neck width {neck} mm must be smaller than the head width a_shoe_mm = {} mm",
                         self.a_shoe_mm
                     ),
-                ));
+                ).into());
             }
             if neck >= self.b_rail_mm {
-                return Err(invalid(
+                return Err(FieldError::new(
                     neck_name,
                     format!(
                         "interference: shoe neck width {neck} mm must be smaller than the rail \
                          slot width b_rail_mm = {} mm",
                         self.b_rail_mm
                     ),
-                ));
+                )
+                .into());
             }
         }
         let chamber = self.n_rail_mm.min(self.q_rail_mm);
         for (thick_name, thick, _, _) in stations {
             if thick >= chamber {
-                return Err(invalid(
+                return Err(FieldError::new(
                     thick_name,
                     format!(
                         "interference: shoe head thickness {thick} mm must be smaller than the \
                          rail chamber height min(n_rail_mm, q_rail_mm) = {chamber} mm"
                     ),
-                ));
+                )
+                .into());
             }
         }
         let design = Self::design().named_fields();
@@ -342,13 +341,14 @@ impl LauncherDimensions {
             let lo = nominal * (1.0 - PLAUSIBLE_FRACTION_OF_DESIGN);
             let hi = nominal * (1.0 + PLAUSIBLE_FRACTION_OF_DESIGN);
             if !(lo..=hi).contains(&value) {
-                return Err(invalid(
+                return Err(FieldError::new(
                     field,
                     format!(
                         "{value} mm is outside the plausible range [{lo:.2}, {hi:.2}] mm (design \
                          {nominal} mm +-50 %) of this rail class: a typing error or another rail"
                     ),
-                ));
+                )
+                .into());
             }
         }
         Ok(())
@@ -447,26 +447,17 @@ mod tests {
         let err = rattle_space_square(1.2, 1.0).unwrap_err();
         assert!(matches!(
             err,
-            RattleSpaceError::InvalidDimension {
-                field: "cube_side",
-                ..
-            }
+            RattleSpaceError::InvalidDimension(FieldError { ref field, .. }) if field == "cube_side"
         ));
         let err = rattle_space_square(1.0, f64::NAN).unwrap_err();
         assert!(matches!(
             err,
-            RattleSpaceError::InvalidDimension {
-                field: "tube_inner_side",
-                ..
-            }
+            RattleSpaceError::InvalidDimension(FieldError { ref field, .. }) if field == "tube_inner_side"
         ));
         let err = rattle_space_rectangular(1.0, -1.0, 2.0, 2.0).unwrap_err();
         assert!(matches!(
             err,
-            RattleSpaceError::InvalidDimension {
-                field: "item_side_2",
-                ..
-            }
+            RattleSpaceError::InvalidDimension(FieldError { ref field, .. }) if field == "item_side_2"
         ));
     }
 
@@ -521,7 +512,7 @@ mod tests {
     #[test]
     fn validation_names_the_field() {
         let field_of = |d: LauncherDimensions| match d.rattle_space().unwrap_err() {
-            RattleSpaceError::InvalidDimension { field, .. } => field,
+            RattleSpaceError::InvalidDimension(FieldError { field, .. }) => field,
         };
         let base = LauncherDimensions::design();
         assert_eq!(
@@ -610,7 +601,7 @@ mod tests {
     #[test]
     fn assembly_and_plausible_ranges() {
         let field_of = |d: LauncherDimensions| match d.validate().unwrap_err() {
-            RattleSpaceError::InvalidDimension { field, rule } => (field, rule),
+            RattleSpaceError::InvalidDimension(FieldError { field, rule }) => (field, rule),
         };
         let base = LauncherDimensions::design();
         // Issue 17: a 10.0 mm head in a 10.23 mm slot falls out (neck 9.53 still fits).

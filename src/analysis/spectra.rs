@@ -1,6 +1,7 @@
 //! Power spectral density (Welch) and amplitude spectrum, for comparing simulated and measured
 //! accelerations in the frequency domain (thesis 6.6 figures) and checking synthesised profiles.
 
+use crate::field_error::FieldError;
 use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
 
@@ -8,20 +9,8 @@ use rustfft::FftPlanner;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpectraError {
     /// An argument breaks a rule.
-    #[error("spectrum argument `{field}`: {rule}")]
-    InvalidInput {
-        /// Argument name.
-        field: &'static str,
-        /// Rule broken.
-        rule: String,
-    },
-}
-
-fn invalid(field: &'static str, rule: impl Into<String>) -> SpectraError {
-    SpectraError::InvalidInput {
-        field,
-        rule: rule.into(),
-    }
+    #[error("spectrum argument `{}`: {}", .0.field, .0.rule)]
+    InvalidInput(#[from] FieldError),
 }
 
 /// One-sided power spectral density.
@@ -89,13 +78,14 @@ fn window_values(window: Window, n: usize) -> Vec<f64> {
 
 fn check_signal(signal: &[f64], sample_rate_hz: f64) -> Result<(), SpectraError> {
     if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "sample_rate_hz",
             format!("must be finite and > 0, got {sample_rate_hz}"),
-        ));
+        )
+        .into());
     }
     if let Some(i) = signal.iter().position(|v| !v.is_finite()) {
-        return Err(invalid("signal", format!("sample {i} is not finite")));
+        return Err(FieldError::new("signal", format!("sample {i} is not finite")).into());
     }
     Ok(())
 }
@@ -110,16 +100,18 @@ pub fn welch_psd(
 ) -> Result<Psd, SpectraError> {
     check_signal(signal, sample_rate_hz)?;
     if segment_len < 4 {
-        return Err(invalid(
+        return Err(FieldError::new(
             "segment_len",
             format!("must be at least 4, got {segment_len}"),
-        ));
+        )
+        .into());
     }
     if segment_len > signal.len() {
-        return Err(invalid(
+        return Err(FieldError::new(
             "segment_len",
             format!("{segment_len} exceeds the signal length {}", signal.len()),
-        ));
+        )
+        .into());
     }
     let window = window_values(Window::Hann, segment_len);
     let window_power: f64 = window.iter().map(|w| w * w).sum();
@@ -166,7 +158,7 @@ pub fn amplitude_spectrum(
     check_signal(signal, sample_rate_hz)?;
     let n = signal.len();
     if n < 2 {
-        return Err(invalid("signal", "needs at least 2 samples"));
+        return Err(FieldError::new("signal", "needs at least 2 samples").into());
     }
     let w = window_values(window, n);
     let gain: f64 = w.iter().sum();

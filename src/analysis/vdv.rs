@@ -6,24 +6,14 @@
 //! ISO 2631-1's VDV omits the `1/T` and is in m/s^1.75. Only ratios are used in the thesis, so
 //! the normalisation does not change its conclusions.
 
+use crate::field_error::FieldError;
+
 /// Errors from the VDV; each names the argument and the rule broken.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum VdvError {
     /// An argument breaks a rule.
-    #[error("VDV argument `{field}`: {rule}")]
-    InvalidInput {
-        /// Argument name.
-        field: &'static str,
-        /// Rule broken.
-        rule: String,
-    },
-}
-
-fn invalid(field: &'static str, rule: impl Into<String>) -> VdvError {
-    VdvError::InvalidInput {
-        field,
-        rule: rule.into(),
-    }
+    #[error("VDV argument `{}`: {}", .0.field, .0.rule)]
+    InvalidInput(#[from] FieldError),
 }
 
 /// VDV of eq. 2.51 for samples `acceleration[i]` at `time_s[i]` (strictly increasing, any
@@ -31,29 +21,31 @@ fn invalid(field: &'static str, rule: impl Into<String>) -> VdvError {
 /// `acceleration`.
 pub fn vibration_dose_value(time_s: &[f64], acceleration: &[f64]) -> Result<f64, VdvError> {
     if time_s.len() != acceleration.len() {
-        return Err(invalid(
+        return Err(FieldError::new(
             "acceleration",
             format!(
                 "length {} differs from time_s length {}",
                 acceleration.len(),
                 time_s.len()
             ),
-        ));
+        )
+        .into());
     }
     if time_s.len() < 2 {
-        return Err(invalid("time_s", "needs at least 2 samples"));
+        return Err(FieldError::new("time_s", "needs at least 2 samples").into());
     }
     if let Some(i) = acceleration.iter().position(|a| !a.is_finite()) {
-        return Err(invalid("acceleration", format!("sample {i} is not finite")));
+        return Err(FieldError::new("acceleration", format!("sample {i} is not finite")).into());
     }
     let mut integral = 0.0;
     for i in 1..time_s.len() {
         let dt = time_s[i] - time_s[i - 1];
         if !(dt.is_finite() && dt > 0.0) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "time_s",
                 format!("must increase strictly; sample {i} does not"),
-            ));
+            )
+            .into());
         }
         integral += 0.5 * dt * (acceleration[i].powi(4) + acceleration[i - 1].powi(4));
     }
@@ -64,16 +56,13 @@ pub fn vibration_dose_value(time_s: &[f64], acceleration: &[f64]) -> Result<f64,
 /// VDV of eq. 2.51 for uniformly sampled acceleration with step `dt_s` (trapezoid rule).
 pub fn vibration_dose_value_uniform(acceleration: &[f64], dt_s: f64) -> Result<f64, VdvError> {
     if !(dt_s.is_finite() && dt_s > 0.0) {
-        return Err(invalid(
-            "dt_s",
-            format!("must be finite and > 0, got {dt_s}"),
-        ));
+        return Err(FieldError::new("dt_s", format!("must be finite and > 0, got {dt_s}")).into());
     }
     if acceleration.len() < 2 {
-        return Err(invalid("acceleration", "needs at least 2 samples"));
+        return Err(FieldError::new("acceleration", "needs at least 2 samples").into());
     }
     if let Some(i) = acceleration.iter().position(|a| !a.is_finite()) {
-        return Err(invalid("acceleration", format!("sample {i} is not finite")));
+        return Err(FieldError::new("acceleration", format!("sample {i} is not finite")).into());
     }
     let n = acceleration.len();
     let interior: f64 = acceleration[1..n - 1].iter().map(|a| a.powi(4)).sum();

@@ -1,6 +1,7 @@
 //! Service settings, layered: built-in defaults, then `configs/service.toml` (every key is
 //! documented there), then `RAILWEAR_*` environment variables (and `DATABASE_URL`).
 
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -124,15 +125,8 @@ pub enum ConfigError {
         source: Box<toml::de::Error>,
     },
     /// A setting (from file or environment) breaks a rule.
-    #[error("setting `{field}` {rule}")]
-    Invalid { field: String, rule: String },
-}
-
-fn invalid(field: &str, rule: &str) -> ConfigError {
-    ConfigError::Invalid {
-        field: field.to_string(),
-        rule: rule.to_string(),
-    }
+    #[error("setting `{}` {}", .0.field, .0.rule)]
+    Invalid(#[from] FieldError),
 }
 
 impl ServiceConfig {
@@ -167,7 +161,7 @@ impl ServiceConfig {
         fn num<T: std::str::FromStr>(field: &str, text: &str) -> Result<T, ConfigError> {
             text.trim()
                 .parse()
-                .map_err(|_| invalid(field, "must be a number"))
+                .map_err(|_| FieldError::new(field, "must be a number").into())
         }
         if let Some(v) = env("RAILWEAR_LISTEN") {
             self.listen = v;
@@ -215,13 +209,14 @@ impl ServiceConfig {
                 let (Some(name), Some(role), Some(token)) =
                     (parts.next(), parts.next(), parts.next())
                 else {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "RAILWEAR_TOKENS",
                         "entries must be name:role:token",
-                    ));
+                    )
+                    .into());
                 };
                 let role = Role::parse(role).ok_or_else(|| {
-                    invalid(
+                    FieldError::new(
                         "RAILWEAR_TOKENS",
                         "role must be planner, engineer, test_engineer or admin",
                     )
@@ -239,53 +234,54 @@ impl ServiceConfig {
     /// Check the rules every setting must follow.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if !(self.lease_s.is_finite() && self.lease_s > 0.0) {
-            return Err(invalid("lease_s", "must be a positive number of seconds"));
+            return Err(FieldError::new("lease_s", "must be a positive number of seconds").into());
         }
         if !(self.heartbeat_s.is_finite() && self.heartbeat_s > 0.0) {
-            return Err(invalid(
-                "heartbeat_s",
-                "must be a positive number of seconds",
-            ));
+            return Err(
+                FieldError::new("heartbeat_s", "must be a positive number of seconds").into(),
+            );
         }
         if self.heartbeat_s * 2.0 > self.lease_s {
-            return Err(invalid("heartbeat_s", "must be at most half of lease_s"));
+            return Err(FieldError::new("heartbeat_s", "must be at most half of lease_s").into());
         }
         if !(self.shutdown_grace_s.is_finite() && (0.0..=300.0).contains(&self.shutdown_grace_s)) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "shutdown_grace_s",
                 "must be a number of seconds in [0, 300]",
-            ));
+            )
+            .into());
         }
         if self.max_attempts == 0 {
-            return Err(invalid("max_attempts", "must be at least 1"));
+            return Err(FieldError::new("max_attempts", "must be at least 1").into());
         }
         if self.body_limit_bytes < 1024 {
-            return Err(invalid("body_limit_bytes", "must be at least 1024"));
+            return Err(FieldError::new("body_limit_bytes", "must be at least 1024").into());
         }
         if self.campaign_body_limit_bytes < 1024 {
-            return Err(invalid(
-                "campaign_body_limit_bytes",
-                "must be at least 1024",
-            ));
+            return Err(
+                FieldError::new("campaign_body_limit_bytes", "must be at least 1024").into(),
+            );
         }
         if self.track_block_samples == 0 {
-            return Err(invalid("track_block_samples", "must be at least 1"));
+            return Err(FieldError::new("track_block_samples", "must be at least 1").into());
         }
         if self.log_format != "text" && self.log_format != "json" {
-            return Err(invalid("log_format", "must be `text` or `json`"));
+            return Err(FieldError::new("log_format", "must be `text` or `json`").into());
         }
         if !(self.report.design_life_h.is_finite() && self.report.design_life_h > 0.0) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "report.design_life_h",
                 "must be a positive number of hours",
-            ));
+            )
+            .into());
         }
         for (i, token) in self.tokens.iter().enumerate() {
             if token.token.len() < 16 {
-                return Err(invalid(
-                    &format!("tokens[{i}].token"),
+                return Err(FieldError::new(
+                    format!("tokens[{i}].token"),
                     "must be at least 16 characters",
-                ));
+                )
+                .into());
             }
         }
         Ok(())
@@ -376,12 +372,14 @@ mod tests {
         let env = |key: &str| (key == "RAILWEAR_HEARTBEAT_S").then(|| "30".to_string());
         let err =
             ServiceConfig::load(Path::new("/nonexistent/service.toml"), false, env).unwrap_err();
-        assert!(matches!(err, ConfigError::Invalid { ref field, .. } if field == "heartbeat_s"));
+        assert!(
+            matches!(err, ConfigError::Invalid(FieldError { ref field, .. }) if field == "heartbeat_s")
+        );
         let env = |key: &str| (key == "RAILWEAR_WORKERS").then(|| "many".to_string());
         let err =
             ServiceConfig::load(Path::new("/nonexistent/service.toml"), false, env).unwrap_err();
         assert!(
-            matches!(err, ConfigError::Invalid { ref field, .. } if field == "RAILWEAR_WORKERS")
+            matches!(err, ConfigError::Invalid(FieldError { ref field, .. }) if field == "RAILWEAR_WORKERS")
         );
     }
 

@@ -3,6 +3,7 @@
 
 use super::quasistatic::{QuasistaticModel, SphereOnFlat};
 use super::ContactModelError;
+use crate::field_error::FieldError;
 use crate::units::{impact_stiffness_si, M_PER_MM};
 use serde::{Deserialize, Serialize};
 
@@ -55,16 +56,16 @@ pub fn fit_power_law(
     space: FitSpace,
 ) -> Result<PowerLawFit, ContactModelError> {
     if !(max_interference_m.is_finite() && max_interference_m > 0.0) {
-        return Err(ContactModelError::Invalid {
-            field: "max_interference_m",
-            rule: "must be a finite number > 0".into(),
-        });
+        return Err(ContactModelError::Invalid(FieldError::new(
+            "max_interference_m",
+            "must be a finite number > 0",
+        )));
     }
     if !(3..=1_000_000).contains(&samples) {
-        return Err(ContactModelError::Invalid {
-            field: "samples",
-            rule: "must be in 3..=1000000".into(),
-        });
+        return Err(ContactModelError::Invalid(FieldError::new(
+            "samples",
+            "must be in 3..=1000000",
+        )));
     }
     let ws: Vec<f64> = match space {
         FitSpace::Linear => (1..=samples)
@@ -251,7 +252,10 @@ mod tests {
 
     /// Table 2.2 load: 1000 N plus the weight of the 50 mm 7075 sphere (4/3 pi R³ 2810 kg/m³).
     fn table_2_2_load() -> f64 {
-        let mass = 4.0 / 3.0 * std::f64::consts::PI * 0.05f64.powi(3) * 2810.0;
+        let mass = 4.0 / 3.0
+            * std::f64::consts::PI
+            * 0.05f64.powi(3)
+            * crate::thesis::DENSITY_7075_KG_PER_M3;
         1000.0 + mass * STANDARD_GRAVITY
     }
 
@@ -353,10 +357,7 @@ mod tests {
         let r = fit_power_law(|w| w, -1.0, 10, FitSpace::Log);
         assert!(matches!(
             r,
-            Err(ContactModelError::Invalid {
-                field: "max_interference_m",
-                ..
-            })
+            Err(ContactModelError::Invalid(FieldError { ref field, .. })) if field == "max_interference_m"
         ));
     }
 }

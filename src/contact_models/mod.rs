@@ -13,17 +13,14 @@ pub use fit::{
 };
 pub use quasistatic::{QuasistaticModel, SphereOnFlat};
 
+use crate::field_error::FieldError;
+
 /// Errors of the contact-model library; each names the field and the rule.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ContactModelError {
     /// A parameter broke a rule.
-    #[error("invalid {field}: {rule}")]
-    Invalid {
-        /// Name of the field.
-        field: &'static str,
-        /// The rule it broke, with the value where useful.
-        rule: String,
-    },
+    #[error("invalid {}: {}", .0.field, .0.rule)]
+    Invalid(#[from] FieldError),
     /// The fit did not converge or the data could not be fitted.
     #[error("fit failed: {0}")]
     Fit(&'static str),

@@ -12,6 +12,7 @@
 //!   KE's own K H = (0.454 + 0.41 nu) 2.8 S_y differs from JG's C S_y by under 0.1 % for nu = 0.33.
 
 use super::ContactModelError;
+use crate::field_error::FieldError;
 use crate::wear::Material;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -129,17 +130,14 @@ impl SphereOnFlat {
     /// Builds and validates a sphere-on-flat contact.
     pub fn new(radius_m: f64, sphere: Material, flat: Material) -> Result<Self, ContactModelError> {
         if !(radius_m.is_finite() && radius_m > 0.0) {
-            return Err(ContactModelError::Invalid {
-                field: "radius_m",
-                rule: "must be a finite number > 0".into(),
-            });
+            return Err(ContactModelError::Invalid(FieldError::new(
+                "radius_m",
+                "must be a finite number > 0",
+            )));
         }
         for m in [&sphere, &flat] {
-            m.validate().map_err(|e| match e {
-                crate::wear::WearError::Invalid { field, rule } => {
-                    ContactModelError::Invalid { field, rule }
-                }
-            })?;
+            m.validate()
+                .map_err(|crate::wear::WearError::Invalid(e)| ContactModelError::Invalid(e))?;
         }
         Ok(Self {
             radius_m,
@@ -300,10 +298,7 @@ mod tests {
         let m = Material::aluminium_7075_t73();
         assert!(matches!(
             SphereOnFlat::new(-1.0, m, m),
-            Err(ContactModelError::Invalid {
-                field: "radius_m",
-                ..
-            })
+            Err(ContactModelError::Invalid(FieldError { ref field, .. })) if field == "radius_m"
         ));
     }
 }

@@ -20,9 +20,9 @@ use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
 
 use super::{
-    invalid, require_positive, AccelUnit, ExcitationError, MotionSample, SampledRecord,
-    MAX_RECORD_SAMPLES,
+    require_positive, AccelUnit, ExcitationError, MotionSample, SampledRecord, MAX_RECORD_SAMPLES,
 };
+use crate::field_error::FieldError;
 
 /// Column names of the CSV header, in order.
 pub const CSV_COLUMNS: [&str; 4] = ["time_s", "a_x", "a_y", "a_z"];
@@ -123,13 +123,14 @@ impl AccelerationRecord {
     /// offending element as `samples[i][j]`.
     pub fn from_samples(samples: &[[f64; 4]], units: AccelUnit) -> Result<Self, ExcitationError> {
         validated(samples, units.to_si()).map_err(|bad| {
-            invalid(
+            FieldError::new(
                 format!(
                     "samples[{}][{}] ({})",
                     bad.index, bad.column, CSV_COLUMNS[bad.column]
                 ),
                 bad.rule,
             )
+            .into()
         })
     }
 
@@ -149,10 +150,11 @@ impl AccelerationRecord {
         let dt = self.median_step_s();
         let nyquist = 0.5 / dt;
         if highpass_hz >= nyquist {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "highpass_hz",
                 format!("must be below the record's Nyquist frequency {nyquist} Hz"),
-            ));
+            )
+            .into());
         }
         let uniform = self.resample_uniform(dt)?;
         let n = uniform.len();
@@ -180,8 +182,9 @@ impl AccelerationRecord {
                 s.acceleration_m_s2[c] = a[m] - la[m];
             }
         }
-        SampledRecord::new(dt, samples)
-            .ok_or_else(|| invalid("time_s", "median sample step must be finite and > 0"))
+        SampledRecord::new(dt, samples).ok_or_else(|| {
+            FieldError::new("time_s", "median sample step must be finite and > 0").into()
+        })
     }
 
     /// Linear resampling onto `t0 + m dt`, m = 0.. while inside the record.
@@ -190,13 +193,14 @@ impl AccelerationRecord {
         let span = self.time_s[self.time_s.len() - 1] - t0;
         let count = (span / dt * (1.0 + 1e-12)).floor() + 1.0;
         if !(count.is_finite() && count <= (MAX_RECORD_SAMPLES / 2) as f64) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "time_s",
                 format!(
                     "record needs {count} uniform samples; at most {} allowed",
                     MAX_RECORD_SAMPLES / 2
                 ),
-            ));
+            )
+            .into());
         }
         let count = count as usize;
         let mut out = Vec::with_capacity(count);

@@ -26,6 +26,7 @@ pub use measured::{parse_acceleration_csv, AccelerationRecord};
 pub use motion::{BaseMotion, MotionState};
 pub use random::{psd_at, psd_mean_square, synthesize_random};
 
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Default settle time before any input, s (thesis 6.6.1: "2 seconds of no input").
@@ -206,13 +207,9 @@ pub enum ExcitationSpec {
 #[derive(Debug, thiserror::Error)]
 pub enum ExcitationError {
     /// A spec field breaks a rule.
-    #[error("excitation field `{field}`: {rule}")]
-    InvalidField {
-        /// Dotted field path, e.g. `tones[2].frequency_hz`.
-        field: String,
-        /// The rule broken.
-        rule: String,
-    },
+    /// (The field is a dotted path, e.g. `tones[2].frequency_hz`.)
+    #[error("excitation field `{}`: {}", .0.field, .0.rule)]
+    InvalidField(#[from] FieldError),
     /// A measured CSV cell or row is malformed.
     #[error("acceleration CSV row {row}, column `{column}`: {rule}")]
     Csv {
@@ -237,22 +234,12 @@ pub enum ExcitationError {
     Toml(#[from] toml::de::Error),
 }
 
-pub(crate) fn invalid(field: impl Into<String>, rule: impl Into<String>) -> ExcitationError {
-    ExcitationError::InvalidField {
-        field: field.into(),
-        rule: rule.into(),
-    }
-}
-
 /// Checks that `value` is finite and strictly positive.
 pub(crate) fn require_positive(field: &str, value: f64) -> Result<(), ExcitationError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(invalid(
-            field,
-            format!("must be finite and > 0, got {value}"),
-        ))
+        Err(FieldError::new(field, format!("must be finite and > 0, got {value}")).into())
     }
 }
 
@@ -261,9 +248,6 @@ pub(crate) fn require_non_negative(field: &str, value: f64) -> Result<(), Excita
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(invalid(
-            field,
-            format!("must be finite and >= 0, got {value}"),
-        ))
+        Err(FieldError::new(field, format!("must be finite and >= 0, got {value}")).into())
     }
 }

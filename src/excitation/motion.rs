@@ -7,9 +7,10 @@ use super::measured::{parse_acceleration_csv, AccelerationRecord};
 use super::random::{synthesize_random, validate_breakpoints};
 use super::sine::{sine_terms, SineTerm};
 use super::{
-    invalid, require_non_negative, require_positive, ExcitationError, ExcitationSpec, RampSpec,
+    require_non_negative, require_positive, ExcitationError, ExcitationSpec, RampSpec,
     SampledRecord,
 };
+use crate::field_error::FieldError;
 
 /// Base displacement, velocity and acceleration at one instant (rail frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,10 +103,11 @@ impl BaseMotion {
                 ramp,
             } => {
                 if tones.is_empty() {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "tones",
                         "a sine excitation needs at least one tone",
-                    ));
+                    )
+                    .into());
                 }
                 let terms = sine_terms(tones)?;
                 let lowest = terms
@@ -163,10 +165,11 @@ impl BaseMotion {
                     }
                     (None, Some(rows)) => AccelerationRecord::from_samples(rows, *units)?,
                     _ => {
-                        return Err(invalid(
+                        return Err(FieldError::new(
                             "csv_path",
                             "give exactly one of `csv_path` and `samples`",
-                        ))
+                        )
+                        .into())
                     }
                 };
                 let motion = record.integrate(*highpass_hz)?;

@@ -15,28 +15,30 @@ use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
 
 use super::{
-    invalid, require_positive, Axis, ExcitationError, MotionSample, SampledRecord,
-    MAX_RECORD_SAMPLES,
+    require_positive, Axis, ExcitationError, MotionSample, SampledRecord, MAX_RECORD_SAMPLES,
 };
+use crate::field_error::FieldError;
 use crate::units::STANDARD_GRAVITY;
 
 /// Validates PSD breakpoints `(Hz, g²/Hz)`: at least two, frequencies finite, > 0 and strictly
 /// increasing, levels finite and > 0 (log-log interpolation needs positive values).
 pub(crate) fn validate_breakpoints(breakpoints: &[(f64, f64)]) -> Result<(), ExcitationError> {
     if breakpoints.len() < 2 {
-        return Err(invalid(
+        return Err(FieldError::new(
             "psd_breakpoints",
             "needs at least two (frequency_hz, g2_per_hz) pairs",
-        ));
+        )
+        .into());
     }
     for (i, &(f, g)) in breakpoints.iter().enumerate() {
         require_positive(&format!("psd_breakpoints[{i}].frequency_hz"), f)?;
         require_positive(&format!("psd_breakpoints[{i}].g2_per_hz"), g)?;
         if i > 0 && f <= breakpoints[i - 1].0 {
-            return Err(invalid(
+            return Err(FieldError::new(
                 format!("psd_breakpoints[{i}].frequency_hz"),
                 "frequencies must be strictly increasing",
-            ));
+            )
+            .into());
         }
     }
     Ok(())
@@ -97,14 +99,13 @@ pub fn synthesize_random(
     low_cutoff_hz: f64,
 ) -> Result<SampledRecord, ExcitationError> {
     if axes.is_empty() {
-        return Err(invalid("axes", "must name at least one axis (x, y or z)"));
+        return Err(FieldError::new("axes", "must name at least one axis (x, y or z)").into());
     }
     for (i, axis) in axes.iter().enumerate() {
         if axes[..i].contains(axis) {
-            return Err(invalid(
-                format!("axes[{i}]"),
-                "each axis may appear only once",
-            ));
+            return Err(
+                FieldError::new(format!("axes[{i}]"), "each axis may appear only once").into(),
+            );
         }
     }
     validate_breakpoints(psd_breakpoints)?;
@@ -113,28 +114,30 @@ pub fn synthesize_random(
     require_positive("low_cutoff_hz", low_cutoff_hz)?;
     let f_max = psd_breakpoints[psd_breakpoints.len() - 1].0;
     if f_max >= 0.5 * sample_rate_hz {
-        return Err(invalid(
+        return Err(FieldError::new(
             "sample_rate_hz",
             format!(
                 "Nyquist frequency {} Hz must exceed the last PSD breakpoint {f_max} Hz",
                 0.5 * sample_rate_hz
             ),
-        ));
+        )
+        .into());
     }
     if low_cutoff_hz >= f_max {
-        return Err(invalid(
+        return Err(FieldError::new(
             "low_cutoff_hz",
             format!("must be below the last PSD breakpoint {f_max} Hz"),
-        ));
+        )
+        .into());
     }
     let n_f = (duration_s * sample_rate_hz).round();
     if !(16.0..=MAX_RECORD_SAMPLES as f64).contains(&n_f) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "duration_s",
             format!(
                 "duration_s * sample_rate_hz = {n_f} samples; must be between 16 and {MAX_RECORD_SAMPLES}"
             ),
-        ));
+        ).into());
     }
     let n = n_f as usize;
     let df = sample_rate_hz / n as f64;
@@ -188,7 +191,7 @@ pub fn synthesize_random(
         }
     }
     SampledRecord::new(1.0 / sample_rate_hz, samples)
-        .ok_or_else(|| invalid("sample_rate_hz", "must be finite and > 0"))
+        .ok_or_else(|| FieldError::new("sample_rate_hz", "must be finite and > 0").into())
 }
 
 #[cfg(test)]

@@ -22,16 +22,16 @@ impl SineTerm {
     pub fn from_tone(tone: &Tone, field: &str) -> Result<Self, ExcitationError> {
         require_positive(&format!("{field}.frequency_hz"), tone.frequency_hz)?;
         if !tone.amplitude_g.is_finite() || tone.amplitude_g < 0.0 {
-            return Err(super::invalid(
+            return Err(super::FieldError::new(
                 format!("{field}.amplitude_g"),
                 format!("must be finite and >= 0, got {}", tone.amplitude_g),
-            ));
+            )
+            .into());
         }
         if !tone.phase_deg.is_finite() {
-            return Err(super::invalid(
-                format!("{field}.phase_deg"),
-                "must be finite",
-            ));
+            return Err(
+                super::FieldError::new(format!("{field}.phase_deg"), "must be finite").into(),
+            );
         }
         Ok(Self {
             axis: tone.axis.index(),

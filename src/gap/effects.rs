@@ -398,7 +398,7 @@ impl Effect {
         if self.magnitude() == 0.0 || info.acts == Acts::WearLaw {
             return Ok(());
         }
-        let bad = |e: crate::models::specs::SpecError| {
+        let bad = |e: crate::models::specs::FieldError| {
             GapError::field(
                 format!("effect.{}", self.name),
                 format!("{}: {}", e.field, e.rule),
@@ -419,7 +419,7 @@ impl Effect {
             "friction_drift" => {
                 let d = self.get("delta_mu")
                     * (1.0 - (-state.slip_distance_m / self.get("slip_scale_m")).exp());
-                let shift = |f: &mut crate::models::specs::FrictionSpec| {
+                let shift = |f: &mut crate::physics::friction::FrictionParams| {
                     f.mu_static += d;
                     f.mu_dynamic += d;
                 };

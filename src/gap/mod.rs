@@ -70,6 +70,14 @@ pub enum GapError {
     },
 }
 
+/// A field error of the campaign (the variant keeps its named fields, which callers and tests
+/// match).
+impl From<crate::field_error::FieldError> for GapError {
+    fn from(e: crate::field_error::FieldError) -> Self {
+        Self::field(e.field, e.rule)
+    }
+}
+
 impl GapError {
     /// A field error.
     pub fn field(field: impl Into<String>, rule: impl Into<String>) -> Self {

@@ -30,8 +30,9 @@ use super::window::{WindowCache, WindowOptions, WindowRun};
 use super::GapError;
 use crate::models::specs::CaseSpec;
 use crate::physics::control::RunControl;
+use crate::sampling::standard_normal;
 use crate::units::S_PER_H;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -177,13 +178,6 @@ pub(crate) struct ModelIncrement {
     pub(crate) slip_end_m: f64,
 }
 
-fn normal(rng: &mut ChaCha20Rng) -> f64 {
-    // Box-Muller; 1 - u keeps the logarithm's argument in (0, 1].
-    let u1: f64 = 1.0 - rng.gen::<f64>();
-    let u2: f64 = rng.gen::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
-
 fn check_options(o: &RigOptions) -> Result<(), GapError> {
     let rule = GapError::require;
     rule(
@@ -282,8 +276,9 @@ pub fn run_cached(
         let mut factors = BTreeMap::new();
         let out_test = &mut out.tests[ti];
         for spec in out_test.specimens.iter_mut() {
-            let factor =
-                (options.scatter_rel * normal(&mut rng) - 0.5 * options.scatter_rel.powi(2)).exp();
+            let factor = (options.scatter_rel * standard_normal(&mut rng)
+                - 0.5 * options.scatter_rel.powi(2))
+            .exp();
             factors.insert(spec.id.clone(), factor);
             let n = spec.increments.len();
             let mut new_spec = Specimen {
@@ -295,7 +290,8 @@ pub fn run_cached(
                 let mut inc = Increment::default();
                 for comp in &test.components {
                     let true_mg = m.mass_mg.get(comp).copied().unwrap_or(0.0) * factor;
-                    let noisy = (true_mg * (1.0 + options.noise_rel * normal(&mut rng))).max(0.0);
+                    let noisy =
+                        (true_mg * (1.0 + options.noise_rel * standard_normal(&mut rng))).max(0.0);
                     inc.mass_loss_mg
                         .insert(comp.clone(), quantize(noisy, test.scale_resolution_mg));
                 }
@@ -313,7 +309,7 @@ pub fn run_cached(
                             .map(|(i, a)| {
                                 let mut s = [i as f64 / rate, a[0], a[1], a[2]];
                                 for x in s.iter_mut().skip(1) {
-                                    *x += options.sensor_noise_m_s2 * normal(&mut rng);
+                                    *x += options.sensor_noise_m_s2 * standard_normal(&mut rng);
                                 }
                                 s
                             })

@@ -469,9 +469,7 @@ pub async fn submit_diagnosis(
         )
         .await
         .map_err(|e| match e {
-            crate::jobs::SubmitError::Invalid { field, rule } => {
-                Problem::invalid_field(field, rule)
-            }
+            crate::jobs::SubmitError::Invalid(e) => Problem::from(e),
             crate::jobs::SubmitError::Store(e) => Problem::from(e),
         })?;
     super::jobs::submitted_response(submitted)

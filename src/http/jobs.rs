@@ -343,7 +343,7 @@ pub async fn submit_job(
         .submit(request.kind, request.params, &caller.name, key)
         .await
         .map_err(|e| match e {
-            SubmitError::Invalid { field, rule } => Problem::invalid_field(field, rule),
+            SubmitError::Invalid(e) => Problem::from(e),
             SubmitError::Store(e) => Problem::from(e),
         })?;
     submitted_response(submitted)

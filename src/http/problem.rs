@@ -106,6 +106,13 @@ impl Problem {
     }
 }
 
+/// A field that breaks a rule, anywhere below the HTTP edge, is a 422 naming it.
+impl From<crate::field_error::FieldError> for Problem {
+    fn from(e: crate::field_error::FieldError) -> Self {
+        Self::invalid_field(e.field, e.rule)
+    }
+}
+
 impl IntoResponse for Problem {
     fn into_response(self) -> Response {
         let status = self.status_code();

@@ -5,6 +5,7 @@
 //! Runners run on tokio's blocking threads; the store is async, so a read here blocks the
 //! calling thread on the runtime the worker runs in.
 
+use crate::field_error::FieldError;
 use crate::models::outcome::RunError;
 use crate::store::Store;
 use sha2::{Digest, Sha256};
@@ -36,29 +37,24 @@ impl StoredInputs {
     /// name `campaign_id` (gone, or no store) or `campaign_sha256` (other content). Must be
     /// called on a thread that may block (not inside an async task) of a tokio runtime.
     pub fn campaign(&self, id: Uuid, sha256: &str) -> Result<String, RunError> {
-        let invalid = |field: &str, rule: String| RunError::InvalidConfig {
-            field: field.into(),
-            rule,
-        };
         let store = self.store.get().ok_or_else(|| {
-            invalid(
+            FieldError::new(
                 "campaign_id",
                 "cannot be read: this runner has no store (diagnoses run in the service's \
-                 workers)"
-                    .into(),
+                 workers)",
             )
         })?;
         let runtime = tokio::runtime::Handle::try_current().map_err(|_| {
-            invalid(
+            FieldError::new(
                 "campaign_id",
-                "cannot be read: no async runtime to read the store with".into(),
+                "cannot be read: no async runtime to read the store with",
             )
         })?;
         let record = runtime
             .block_on(store.get_campaign(id))
-            .map_err(|e| invalid("campaign_id", format!("could not be read: {e}")))?
+            .map_err(|e| FieldError::new("campaign_id", format!("could not be read: {e}")))?
             .ok_or_else(|| {
-                invalid(
+                FieldError::new(
                     "campaign_id",
                     format!(
                         "names campaign {id}, which is no longer stored: upload it again and \
@@ -68,13 +64,14 @@ impl StoredInputs {
             })?;
         let found = super::hex(&Sha256::digest(record.content.as_bytes()));
         if found != sha256 {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "campaign_sha256",
                 format!(
                     "is {sha256}, but campaign {id} as stored has SHA-256 {found}: its content \
                      is not the content this diagnosis was submitted for"
                 ),
-            ));
+            )
+            .into());
         }
         Ok(record.content)
     }

@@ -5,6 +5,7 @@
 pub mod host;
 pub mod inputs;
 pub mod metrics;
+use crate::field_error::FieldError;
 /// The job records live with the store that keeps them (`store::job_records`).
 pub use crate::store::job_records as model;
 pub mod runner;
@@ -54,8 +55,8 @@ pub struct CurveDefaults {
 #[derive(Debug, thiserror::Error)]
 pub enum SubmitError {
     /// A parameter broke a rule (`field` is a dotted path in the request body).
-    #[error("field `{field}` {rule}")]
-    Invalid { field: String, rule: String },
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
     #[error(transparent)]
     Store(#[from] StoreError),
 }
@@ -177,19 +178,17 @@ impl Jobs {
         idempotency_key: Option<String>,
     ) -> Result<Submitted, SubmitError> {
         if kind == JobKind::SweepPoint {
-            return Err(SubmitError::Invalid {
-                field: "kind".into(),
-                rule: "sweep_point jobs are created by sweep jobs (one per point); submit a sweep"
-                    .into(),
-            });
+            return Err(SubmitError::Invalid(FieldError::new(
+                "kind",
+                "sweep_point jobs are created by sweep jobs (one per point); submit a sweep",
+            )));
         }
         if kind == JobKind::Diagnose {
-            return Err(SubmitError::Invalid {
-                field: "kind".into(),
-                rule: "diagnose jobs are submitted for a stored campaign: POST \
-                       /v1/campaigns/{id}/diagnoses"
-                    .into(),
-            });
+            return Err(SubmitError::Invalid(FieldError::new(
+                "kind",
+                "diagnose jobs are submitted for a stored campaign: POST \
+                       /v1/campaigns/{id}/diagnoses",
+            )));
         }
         self.submit_checked(kind, params, submitted_by, idempotency_key)
             .await
@@ -209,22 +208,22 @@ impl Jobs {
         idempotency_key: Option<String>,
     ) -> Result<Submitted, SubmitError> {
         let Some(map) = options.as_object() else {
-            return Err(SubmitError::Invalid {
-                field: "body".into(),
-                rule: "must be a JSON object".into(),
-            });
+            return Err(SubmitError::Invalid(FieldError::new(
+                "body",
+                "must be a JSON object",
+            )));
         };
         if let Some(key) = map
             .keys()
             .find(|k| !runner::DIAGNOSE_CLIENT_KEYS.contains(&k.as_str()))
         {
-            return Err(SubmitError::Invalid {
-                field: key.clone(),
-                rule: format!(
+            return Err(SubmitError::Invalid(FieldError::new(
+                key.clone(),
+                format!(
                     "is not a known parameter (known: {})",
                     runner::DIAGNOSE_CLIENT_KEYS.join(", ")
                 ),
-            });
+            )));
         }
         let mut params = map.clone();
         params.insert("campaign_id".into(), campaign_id.to_string().into());
@@ -237,13 +236,13 @@ impl Jobs {
         )
         .await
         .map_err(|e| match e {
-            SubmitError::Invalid { field, rule } => SubmitError::Invalid {
+            SubmitError::Invalid(FieldError { field, rule }) => SubmitError::Invalid(FieldError {
                 field: field
                     .strip_prefix("params.")
                     .map(str::to_string)
                     .unwrap_or(field),
                 rule,
-            },
+            }),
             other => other,
         })
     }
@@ -256,21 +255,20 @@ impl Jobs {
         idempotency_key: Option<String>,
     ) -> Result<Submitted, SubmitError> {
         if !params.is_object() {
-            return Err(SubmitError::Invalid {
-                field: "params".into(),
-                rule: "must be a JSON object".into(),
-            });
+            return Err(SubmitError::Invalid(FieldError::new(
+                "params",
+                "must be a JSON object",
+            )));
         }
         let seed = match params.get("seed") {
             None => draw_seed(),
-            Some(value) => {
-                crate::pipeline::parse_seed(value).map_err(|_| SubmitError::Invalid {
-                    field: "params.seed".into(),
-                    rule: "must be an integer in [0, 2^53) (JavaScript reads larger integers \
-                       inexactly)"
-                        .into(),
-                })?
-            }
+            Some(value) => crate::pipeline::parse_seed(value).map_err(|_| {
+                SubmitError::Invalid(FieldError::new(
+                    "params.seed",
+                    "must be an integer in [0, 2^53) (JavaScript reads larger integers \
+                       inexactly)",
+                ))
+            })?,
         };
         // The request as submitted is what an Idempotency-Key is compared against.
         let canonical = serde_json::json!({ "kind": kind, "params": params }).to_string();
@@ -297,23 +295,22 @@ impl Jobs {
         let checked =
             tokio::task::spawn_blocking(move || runner.validate(&check_kind, &check_params))
                 .await
-                .map_err(|e| SubmitError::Invalid {
-                    field: "params".into(),
-                    rule: format!("could not be checked: {e}"),
+                .map_err(|e| {
+                    SubmitError::Invalid(FieldError::new(
+                        "params",
+                        format!("could not be checked: {e}"),
+                    ))
                 })?;
         checked.map_err(|e| match e {
-            crate::pipeline::RunError::InvalidConfig { field, rule } => SubmitError::Invalid {
-                field: if field == "params" {
-                    field
+            crate::pipeline::RunError::InvalidConfig { field, rule } => {
+                let e = FieldError::new(field, rule);
+                SubmitError::Invalid(if e.field == "params" {
+                    e
                 } else {
-                    format!("params.{field}")
-                },
-                rule,
-            },
-            other => SubmitError::Invalid {
-                field: "params".into(),
-                rule: other.to_string(),
-            },
+                    e.at("params")
+                })
+            }
+            other => SubmitError::Invalid(FieldError::new("params", other.to_string())),
         })?;
         let curve_key = (kind == JobKind::Sweep).then(|| {
             let part = |name: &str| {

@@ -4,6 +4,7 @@
 
 use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
+use crate::field_error::FieldError;
 use crate::models::specs::CaseSpec;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
@@ -174,44 +175,43 @@ impl DiagnosePlan {
         configs_dir: &std::path::Path,
         inputs: &super::inputs::StoredInputs,
     ) -> Result<Self, RunError> {
-        let invalid = |field: &str, rule: String| RunError::InvalidConfig {
-            field: field.to_string(),
-            rule,
-        };
         let map = params
             .as_object()
-            .ok_or_else(|| invalid("params", "must be a JSON object".into()))?;
+            .ok_or_else(|| FieldError::new("params", "must be a JSON object"))?;
         for key in map.keys() {
             if !DIAGNOSE_KEYS.contains(&key.as_str()) {
-                return Err(invalid(
+                return Err(FieldError::new(
                     key,
                     format!(
                         "is not a known parameter (known: {})",
                         DIAGNOSE_CLIENT_KEYS.join(", ")
                     ),
-                ));
+                )
+                .into());
             }
         }
         let submit_here = "is required (submit through POST /v1/campaigns/{id}/diagnoses)";
         let campaign_id = map
             .get("campaign_id")
-            .ok_or_else(|| invalid("campaign_id", submit_here.into()))?
+            .ok_or_else(|| FieldError::new("campaign_id", submit_here))?
             .as_str()
             .and_then(|s| uuid::Uuid::parse_str(s).ok())
-            .ok_or_else(|| invalid("campaign_id", "must be a campaign's UUID".into()))?;
+            .ok_or_else(|| FieldError::new("campaign_id", "must be a campaign's UUID"))?;
         let is_sha256 =
             |s: &&str| s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
         let sha256 = map
             .get("campaign_sha256")
-            .ok_or_else(|| invalid("campaign_sha256", submit_here.into()))?
+            .ok_or_else(|| FieldError::new("campaign_sha256", submit_here))?
             .as_str()
             .filter(is_sha256)
-            .ok_or_else(|| invalid("campaign_sha256", "must be 64 lower-case hex digits".into()))?;
+            .ok_or_else(|| {
+                FieldError::new("campaign_sha256", "must be 64 lower-case hex digits")
+            })?;
         let content = inputs.campaign(campaign_id, sha256)?;
         let campaign = crate::gap::Campaign::from_json_str(&content)
             .and_then(|c| c.validate(configs_dir).map(|_| c))
             .map_err(|e| {
-                invalid(
+                FieldError::new(
                     "campaign_id",
                     format!("names a campaign that no longer checks out against the configs: {e}"),
                 )
@@ -224,10 +224,12 @@ impl DiagnosePlan {
                 };
                 let bound = if lo_open { "(" } else { "[" };
                 let rule = || format!("must be a number in {bound}{lo}, {hi}] s");
-                let x = value.as_f64().ok_or_else(|| invalid(name, rule()))?;
+                let x = value
+                    .as_f64()
+                    .ok_or_else(|| FieldError::new(name, rule()))?;
                 let above = if lo_open { x > lo } else { x >= lo };
                 if !(x.is_finite() && above && x <= hi) {
-                    return Err(invalid(name, rule()));
+                    return Err(FieldError::new(name, rule()).into());
                 }
                 Ok(Some(x))
             };
@@ -241,26 +243,27 @@ impl DiagnosePlan {
             let n = value
                 .as_u64()
                 .filter(|n| (2..=12).contains(n))
-                .ok_or_else(|| invalid("grid_points", "must be an integer in 2..=12".into()))?;
+                .ok_or_else(|| FieldError::new("grid_points", "must be an integer in 2..=12"))?;
             options.emulator.grid_points = n as usize;
         }
         if let Some(value) = map.get("effects") {
             let names: Vec<String> = serde_json::from_value(value.clone())
-                .map_err(|_| invalid("effects", "must be a list of effect names".into()))?;
+                .map_err(|_| FieldError::new("effects", "must be a list of effect names"))?;
             if names.is_empty() {
-                return Err(invalid("effects", "must name at least one effect".into()));
+                return Err(FieldError::new("effects", "must name at least one effect").into());
             }
             let library = crate::gap::effects::LIBRARY;
             for (i, name) in names.iter().enumerate() {
                 if !library.iter().any(|e| e.name == name) {
                     let known: Vec<&str> = library.iter().map(|e| e.name).collect();
-                    return Err(invalid(
-                        &format!("effects[{i}]"),
+                    return Err(FieldError::new(
+                        format!("effects[{i}]"),
                         format!(
                             "`{name}` is not a library effect (known: {})",
                             known.join(", ")
                         ),
-                    ));
+                    )
+                    .into());
                 }
             }
             options.emulator.effects = Some(names);

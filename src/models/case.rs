@@ -5,9 +5,10 @@
 use super::outcome::RunError;
 use super::rattle_box;
 use super::run::{BuiltModel, ModelRunError, RunOptions};
-use super::specs::{CaseSpec, ModelSpecRef, SpecError};
+use super::specs::{CaseSpec, ModelSpecRef};
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
+use crate::field_error::FieldError;
 use crate::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
 use crate::physics::simulate::{DivergenceLimits, SimError};
 use serde_json::{json, Value};
@@ -28,19 +29,6 @@ pub fn code_version() -> &'static str {
     })
 }
 
-fn invalid(field: impl Into<String>, rule: impl Into<String>) -> RunError {
-    RunError::InvalidConfig {
-        field: field.into(),
-        rule: rule.into(),
-    }
-}
-
-impl From<SpecError> for RunError {
-    fn from(e: SpecError) -> Self {
-        invalid(e.field, e.rule)
-    }
-}
-
 impl From<ModelRunError> for RunError {
     fn from(e: ModelRunError) -> Self {
         match e {
@@ -59,7 +47,7 @@ impl From<ModelRunError> for RunError {
 /// Reads and validates a case file.
 pub fn load_case(path: &Path) -> Result<CaseSpec, RunError> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| invalid("config", format!("cannot read {}: {e}", path.display())))?;
+        .map_err(|e| FieldError::new("config", format!("cannot read {}: {e}", path.display())))?;
     Ok(CaseSpec::from_toml_str(&text)?)
 }
 
@@ -72,24 +60,25 @@ pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<Excitat
         let name = value
             .get("profile")
             .and_then(Value::as_str)
-            .ok_or_else(|| invalid("excitation.profile", "must name a file in configs/profiles"))?;
+            .ok_or_else(|| {
+                FieldError::new("excitation.profile", "must name a file in configs/profiles")
+            })?;
         if name.contains('/') || name.contains("..") {
-            return Err(invalid(
-                "excitation.profile",
-                "must be a plain profile name",
-            ));
+            return Err(
+                FieldError::new("excitation.profile", "must be a plain profile name").into(),
+            );
         }
         let path = configs_dir.join("profiles").join(format!("{name}.toml"));
         let text = std::fs::read_to_string(&path).map_err(|e| {
-            invalid(
+            FieldError::new(
                 "excitation.profile",
                 format!("cannot read {}: {e}", path.display()),
             )
         })?;
         let file = ProfileFile::from_toml_str(&text)
-            .map_err(|e| invalid("excitation.profile", e.to_string()))?;
+            .map_err(|e| FieldError::new("excitation.profile", e.to_string()))?;
         value = serde_json::to_value(&file.excitation)
-            .map_err(|e| invalid("excitation", e.to_string()))?;
+            .map_err(|e| FieldError::new("excitation", e.to_string()))?;
         if let Some(obj) = value.as_object_mut() {
             if obj.contains_key("seed") {
                 obj.insert("seed".into(), json!(case.simulation.seed));
@@ -101,7 +90,7 @@ pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<Excitat
             obj.insert("settle_s".into(), json!(case.simulation.settle_s));
         }
     }
-    serde_json::from_value(value).map_err(|e| invalid("excitation", e.to_string()))
+    serde_json::from_value(value).map_err(|e| FieldError::new("excitation", e.to_string()).into())
 }
 
 /// Maps the `[simulation]` table to integrator settings. The position tolerance sets the
@@ -113,10 +102,11 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
         "sdirk2" => IntegratorKind::Sdirk2,
         "dopri5" => IntegratorKind::Dopri5,
         other => {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "simulation.integrator",
                 format!("unknown integrator {other:?}; use trbdf2, sdirk2 or dopri5"),
-            ))
+            )
+            .into())
         }
     };
     let a = case.simulation.abs_tolerance_m;
@@ -148,15 +138,15 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
 pub fn build(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError> {
     case.validate()?;
     let excitation = resolve_excitation(case, configs_dir)?;
-    let motion =
-        BaseMotion::from_spec(&excitation).map_err(|e| invalid("excitation", e.to_string()))?;
+    let motion = BaseMotion::from_spec(&excitation)
+        .map_err(|e| FieldError::new("excitation", e.to_string()))?;
     match case.model_spec()? {
         ModelSpecRef::RattleBox(spec) => Ok(rattle_box::build(case, spec, motion)),
         ModelSpecRef::Launcher(spec) => super::launcher::build(case, spec, motion),
-        ModelSpecRef::PersistentContact(_) => Err(invalid(
+        ModelSpecRef::PersistentContact(_) => Err(FieldError::new(
             "model",
             "the persistent-contact fixture runs through `railwear calibrate`, not as a dynamic case in this build",
-        )),
+        ).into()),
     }
 }
 
@@ -171,4 +161,3 @@ pub fn run_options(case: &CaseSpec) -> Result<RunOptions, RunError> {
         response_rate_hz: 2000.0,
     })
 }
-

@@ -20,6 +20,7 @@ use super::outcome::RunError;
 use super::run::BuiltModel;
 use super::specs::{CaseSpec, LatchJoint, LauncherSpec, PlanarFace, RoundedBoxSpec};
 use crate::excitation::BaseMotion;
+use crate::field_error::FieldError;
 use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};
 use crate::models::motion::TranslatingBase;
 use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
@@ -66,13 +67,6 @@ pub const LATCH_JOINT_FREQUENCY_HZ: f64 = 5000.0;
 
 /// Damping ratio of the joint's stiff axes (critical: the penalty mode dies within a period).
 pub const LATCH_JOINT_DAMPING_RATIO: f64 = 1.0;
-
-fn invalid(field: &str, rule: impl Into<String>) -> RunError {
-    RunError::InvalidConfig {
-        field: field.to_string(),
-        rule: rule.into(),
-    }
-}
 
 fn v3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
@@ -143,7 +137,7 @@ fn rail_planes(spec: &LauncherSpec) -> Result<RailPlanes, RunError> {
             .iter()
             .find(|f| f.name == name)
             .map(half_space)
-            .ok_or_else(|| invalid("launcher.rail", format!("rail face `{name}` missing")))
+            .ok_or_else(|| FieldError::new("launcher.rail", format!("rail face `{name}` missing")))
     };
     let (roof_l, roof_r) = (get("roof_left")?, get("roof_right")?);
     // Roof normals point -y, offset = -y_roof: the lower roof half has the larger offset. An
@@ -158,7 +152,7 @@ fn rail_planes(spec: &LauncherSpec) -> Result<RailPlanes, RunError> {
             .iter()
             .find(|f| f.name == name)
             .map(lip_face)
-            .ok_or_else(|| invalid("launcher.rail", format!("rail face `{name}` missing")))
+            .ok_or_else(|| FieldError::new("launcher.rail", format!("rail face `{name}` missing")))
     };
     Ok(RailPlanes {
         floor: [lip("lip_top_left")?, lip("lip_top_right")?],
@@ -472,12 +466,12 @@ pub fn build(
             None,
         ]
     };
-    let friction = Some(spec.friction.to_friction_params());
+    let friction = Some(spec.friction);
     let c = &spec.contacts;
     let tooth = &l.tooth;
     let tooth_rear_z = tooth.centre_m[2] - tooth.half_extents_m[2];
     let protrusion = spec.mid_shoe.protrusion.ok_or_else(|| {
-        invalid(
+        FieldError::new(
             "launcher.mid_shoe.protrusion",
             "the mid shoe needs its front protrusion: it is the piece the latch tooth holds \
              (thesis 6.2.3)",
@@ -607,10 +601,11 @@ pub fn build(
         }
     }
     if y.iter().any(|v| !v.is_finite()) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "launcher",
             "the static rest estimate is not finite (check masses, stiffnesses and positions)",
-        ));
+        )
+        .into());
     }
     let mat = spec.material;
     Ok(BuiltModel {

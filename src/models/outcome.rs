@@ -36,3 +36,13 @@ pub enum RunError {
     #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
     Checkpointed(Box<super::checkpoint::Checkpoint>),
 }
+
+/// A field error is an invalid configuration (the variant keeps its named fields, which
+/// callers and tests construct).
+impl From<crate::field_error::FieldError> for RunError {
+    fn from(
+        crate::field_error::FieldError { field, rule }: crate::field_error::FieldError,
+    ) -> Self {
+        RunError::InvalidConfig { field, rule }
+    }
+}

@@ -98,7 +98,7 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         1,
         faces,
         impact,
-        Some(spec.friction.to_friction_params()),
+        Some(spec.friction),
     )
     .with_face_extents(extents)
     .with_points_per_edge(case.simulation.contact_points_per_edge);

@@ -6,9 +6,15 @@
 //! at the friction transition speed `v_d` and stays there.
 
 use super::step::StepKind;
+use crate::field_error::FieldError;
+use crate::{thesis, units};
 use serde::{Deserialize, Serialize};
 
-/// Friction parameters (thesis Table 4.2 / 5.2 / 6.1). Speeds in m/s.
+/// Friction parameters (thesis Table 4.2 / 5.2 / 6.1): the one friction type, speeds in m/s.
+///
+/// Case files write it with the speeds in mm/s, as the thesis tables print them: the spec
+/// fields read and write it through [`in_mm_per_s`], the one place the units are converted.
+/// Its own serde form (SI field names and units) is the calibration's output.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FrictionParams {
     /// Static coefficient mu_s (dimensionless). Thesis Table 5.2: 0.1799.
@@ -28,40 +34,47 @@ impl FrictionParams {
     /// Thesis Table 5.2 (dry 7075-T73 on 7075-T73), in SI.
     pub fn thesis_table_5_2() -> Self {
         Self {
-            mu_static: 0.1799,
-            mu_dynamic: 0.1660,
-            stiction_transition_speed: 6.4634e-3,
-            friction_transition_speed: 12.0e-3,
+            mu_static: thesis::MU_STATIC,
+            mu_dynamic: thesis::MU_DYNAMIC,
+            stiction_transition_speed: thesis::STICTION_TRANSITION_SPEED_MM_PER_S * units::M_PER_MM,
+            friction_transition_speed: thesis::FRICTION_TRANSITION_SPEED_MM_PER_S * units::M_PER_MM,
             step: StepKind::Cycloidal,
         }
     }
 
-    /// Checks the physical rules; returns the name of the offending field and the rule.
-    pub fn validate(&self) -> Result<(), (&'static str, &'static str)> {
-        let finite = [
-            self.mu_static,
-            self.mu_dynamic,
-            self.stiction_transition_speed,
-            self.friction_transition_speed,
-        ]
-        .iter()
-        .all(|x| x.is_finite());
-        if !finite {
-            return Err(("friction", "all parameters must be finite numbers"));
+    /// Checks the rules of eq. 4.5: mu_s, mu_d finite and >= 0, 0 < v_s < v_d, both finite.
+    /// The error names the field as case files write it (speeds in mm/s, with the value in
+    /// mm/s), for the caller to place under its path.
+    pub fn validate(&self) -> Result<(), FieldError> {
+        for (field, mu) in [
+            ("mu_static", self.mu_static),
+            ("mu_dynamic", self.mu_dynamic),
+        ] {
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(FieldError::new(
+                    field,
+                    format!("must be a finite number >= 0, got {mu}"),
+                ));
+            }
         }
-        if self.mu_static < 0.0 {
-            return Err(("mu_static", "must be >= 0"));
+        let vs = self.stiction_transition_speed;
+        if !(vs.is_finite() && vs > 0.0) {
+            return Err(FieldError::new(
+                "stiction_transition_speed_mm_per_s",
+                format!("must be a finite number > 0, got {}", units::to_mm(vs)),
+            ));
         }
-        if self.mu_dynamic < 0.0 {
-            return Err(("mu_dynamic", "must be >= 0"));
+        let vd = self.friction_transition_speed;
+        if !vd.is_finite() {
+            return Err(FieldError::new(
+                "friction_transition_speed_mm_per_s",
+                format!("must be a finite number, got {}", units::to_mm(vd)),
+            ));
         }
-        if self.stiction_transition_speed <= 0.0 {
-            return Err(("stiction_transition_speed", "must be > 0 m/s"));
-        }
-        if self.friction_transition_speed <= self.stiction_transition_speed {
-            return Err((
-                "friction_transition_speed",
-                "must be greater than stiction_transition_speed",
+        if vd <= vs {
+            return Err(FieldError::new(
+                "friction_transition_speed_mm_per_s",
+                "must be greater than stiction_transition_speed_mm_per_s",
             ));
         }
         Ok(())
@@ -101,6 +114,56 @@ impl FrictionParams {
     }
 }
 
+/// The case-file form of [`FrictionParams`] (`#[serde(with = "in_mm_per_s")]` on a spec
+/// field): the speeds in mm/s under `_mm_per_s` names, as the thesis tables print them. Reading
+/// converts with [`units::mm`] (the engine's SI values); writing converts back with its exact
+/// inverse [`units::to_mm`], so a case written and read again (the overrides merge, the job
+/// store) runs with the same bits.
+pub mod in_mm_per_s {
+    use super::{FrictionParams, StepKind};
+    use crate::units;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// ADAMS Coulomb friction (eq. 4.5) with speeds in mm/s: the wire shape only (named as the
+    /// case files' schema has always named it, which serde's messages quote).
+    #[derive(Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct FrictionSpec {
+        mu_static: f64,
+        mu_dynamic: f64,
+        stiction_transition_speed_mm_per_s: f64,
+        friction_transition_speed_mm_per_s: f64,
+        #[serde(default)]
+        step: StepKind,
+    }
+
+    /// Writes `f` with its speeds in mm/s.
+    pub fn serialize<S: Serializer>(f: &FrictionParams, serializer: S) -> Result<S::Ok, S::Error> {
+        FrictionSpec {
+            mu_static: f.mu_static,
+            mu_dynamic: f.mu_dynamic,
+            stiction_transition_speed_mm_per_s: units::to_mm(f.stiction_transition_speed),
+            friction_transition_speed_mm_per_s: units::to_mm(f.friction_transition_speed),
+            step: f.step,
+        }
+        .serialize(serializer)
+    }
+
+    /// Reads friction with its speeds in mm/s into SI.
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        deserializer: D,
+    ) -> Result<FrictionParams, D::Error> {
+        let f = FrictionSpec::deserialize(deserializer)?;
+        Ok(FrictionParams {
+            mu_static: f.mu_static,
+            mu_dynamic: f.mu_dynamic,
+            stiction_transition_speed: units::mm(f.stiction_transition_speed_mm_per_s),
+            friction_transition_speed: units::mm(f.friction_transition_speed_mm_per_s),
+            step: f.step,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,6 +171,9 @@ mod tests {
     #[test]
     fn table_5_2_values_at_the_breakpoints() {
         let f = FrictionParams::thesis_table_5_2();
+        // Table 5.2 in SI, the bits a case file's 6.4634 and 12.0 mm/s read as.
+        assert_eq!(f.stiction_transition_speed, 6.4634e-3);
+        assert_eq!(f.friction_transition_speed, 12.0e-3);
         assert_eq!(f.coefficient(0.0), 0.0);
         assert!((f.coefficient(6.4634e-3) - 0.1799).abs() < 1e-12);
         assert!((f.coefficient(12.0e-3) - 0.1660).abs() < 1e-12);
@@ -130,6 +196,46 @@ mod tests {
     fn validation_names_the_field() {
         let mut f = FrictionParams::thesis_table_5_2();
         f.friction_transition_speed = 1e-3;
-        assert_eq!(f.validate().unwrap_err().0, "friction_transition_speed");
+        let e = f.validate().unwrap_err();
+        assert_eq!(e.field, "friction_transition_speed_mm_per_s");
+        assert_eq!(
+            e.rule,
+            "must be greater than stiction_transition_speed_mm_per_s"
+        );
+        f = FrictionParams::thesis_table_5_2();
+        f.stiction_transition_speed = -2.5e-3;
+        assert_eq!(
+            f.validate().unwrap_err().rule,
+            "must be a finite number > 0, got -2.5"
+        );
+        assert!(FrictionParams::thesis_table_5_2().validate().is_ok());
+    }
+
+    #[test]
+    fn case_files_write_the_speeds_in_mm_per_s() {
+        #[derive(Debug, PartialEq, Serialize, Deserialize)]
+        struct Spec {
+            #[serde(with = "in_mm_per_s")]
+            friction: FrictionParams,
+        }
+        let text = "[friction]\nmu_static = 0.1799\nmu_dynamic = 0.166\n\
+                    stiction_transition_speed_mm_per_s = 6.4634\n\
+                    friction_transition_speed_mm_per_s = 12.0\n";
+        let spec: Spec = toml::from_str(text).unwrap();
+        assert_eq!(spec.friction, FrictionParams::thesis_table_5_2());
+        // Written back: the typed decimals, and the same bits when read again.
+        let json = serde_json::to_value(&spec).unwrap();
+        assert_eq!(
+            json["friction"]["stiction_transition_speed_mm_per_s"],
+            6.4634
+        );
+        assert_eq!(json["friction"]["friction_transition_speed_mm_per_s"], 12.0);
+        let back: Spec = serde_json::from_value(json).unwrap();
+        assert_eq!(back, spec);
+        let unknown = toml::from_str::<Spec>(&text.replace("mu_static", "mu_s")).unwrap_err();
+        assert!(
+            unknown.to_string().contains("unknown field `mu_s`"),
+            "{unknown}"
+        );
     }
 }

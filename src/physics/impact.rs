@@ -38,7 +38,12 @@ impl ImpactParams {
 
     /// Thesis Table 5.2 / 4.1 / 6.2 default: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
     pub fn thesis_table_5_2() -> Self {
-        Self::from_adams_units(1000.0, 2.0, 500.0, 0.01)
+        Self::from_adams_units(
+            crate::thesis::IMPACT_STIFFNESS_N_PER_MM_E,
+            crate::thesis::IMPACT_EXPONENT,
+            crate::thesis::IMPACT_DAMPING_NS_PER_MM,
+            crate::thesis::IMPACT_PENETRATION_DEPTH_MM,
+        )
     }
 
     /// Checks the rules on each field; returns (field, rule) for the first violation.

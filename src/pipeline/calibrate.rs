@@ -1,6 +1,7 @@
 //! Calibrate jobs: friction and wear-law data sets, parsed and checked, and the fits.
 
-use super::{check_keys, invalid, limits, parse_seed, RunError, CALIBRATE_KEYS};
+use super::{check_keys, limits, parse_seed, RunError, CALIBRATE_KEYS};
+use crate::field_error::FieldError;
 
 /// Friction data of a calibrate job (thesis 4.3): the fixture and its torque records.
 #[derive(Debug, Clone)]
@@ -34,18 +35,19 @@ fn parse_records<T: serde::de::DeserializeOwned>(
     keys: &[&str],
 ) -> Result<Vec<T>, RunError> {
     let items = value
-        .ok_or_else(|| invalid(field, "is required (an array of records)"))?
+        .ok_or_else(|| FieldError::new(field, "is required (an array of records)"))?
         .as_array()
-        .ok_or_else(|| invalid(field, "must be an array of records"))?;
+        .ok_or_else(|| FieldError::new(field, "must be an array of records"))?;
     if items.is_empty() || items.len() > limits::MAX_CALIBRATION_RECORDS {
-        return Err(invalid(
+        return Err(FieldError::new(
             field,
             format!(
                 "must hold 1 to {} records, got {}",
                 limits::MAX_CALIBRATION_RECORDS,
                 items.len()
             ),
-        ));
+        )
+        .into());
     }
     items
         .iter()
@@ -53,7 +55,8 @@ fn parse_records<T: serde::de::DeserializeOwned>(
         .map(|(i, item)| {
             let at = format!("{field}[{i}]");
             check_keys(item, &at, keys)?;
-            serde_json::from_value(item.clone()).map_err(|e| invalid(&at, e.to_string()))
+            serde_json::from_value(item.clone())
+                .map_err(|e| FieldError::new(&at, e.to_string()).into())
         })
         .collect()
 }
@@ -69,10 +72,9 @@ fn bounded_number(
 ) -> Result<f64, RunError> {
     match map.get(name) {
         None => Ok(default),
-        Some(v) => v
-            .as_f64()
-            .filter(|x| *x >= lo && *x <= hi)
-            .ok_or_else(|| invalid(field, format!("must be a number in [{lo}, {hi}] ({why})"))),
+        Some(v) => v.as_f64().filter(|x| *x >= lo && *x <= hi).ok_or_else(|| {
+            FieldError::new(field, format!("must be a number in [{lo}, {hi}] ({why})")).into()
+        }),
     }
 }
 
@@ -93,14 +95,14 @@ impl CalibrateParams {
                 let f = check_keys(f, "friction", &["fixture", "records"])?;
                 let fixture_value = f
                     .get("fixture")
-                    .ok_or_else(|| invalid("friction.fixture", "is required"))?;
+                    .ok_or_else(|| FieldError::new("friction.fixture", "is required"))?;
                 check_keys(
                     fixture_value,
                     "friction.fixture",
                     &["polar_inertia_kg_m2", "mean_radius_m"],
                 )?;
                 let fixture: cal::Fixture = serde_json::from_value(fixture_value.clone())
-                    .map_err(|e| invalid("friction.fixture", e.to_string()))?;
+                    .map_err(|e| FieldError::new("friction.fixture", e.to_string()))?;
                 let records: Vec<cal::TorqueRecord> = parse_records(
                     f.get("records"),
                     "friction.records",
@@ -113,13 +115,14 @@ impl CalibrateParams {
                     ],
                 )?;
                 if records.len() < 8 {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "friction.records",
                         "need at least 8 records (the friction fit's minimum)",
-                    ));
+                    )
+                    .into());
                 }
                 cal::friction_samples(&records, &fixture)
-                    .map_err(|e| invalid("friction.records", e.to_string()))?;
+                    .map_err(|e| FieldError::new("friction.records", e.to_string()))?;
                 Some(FrictionData { fixture, records })
             }
         };
@@ -165,10 +168,11 @@ impl CalibrateParams {
             }
         };
         if friction.is_none() && wear_law.is_none() {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "params",
                 "give `friction` and/or `wear_law` calibration data",
-            ));
+            )
+            .into());
         }
         Ok(Self { friction, wear_law })
     }
@@ -186,20 +190,20 @@ pub fn run_calibration(params: &CalibrateParams) -> Result<serde_json::Value, Ru
     let mut out = serde_json::Map::new();
     if let Some(f) = &params.friction {
         let samples = cal::friction_samples(&f.records, &f.fixture)
-            .map_err(|e| invalid("friction.records", e.to_string()))?;
+            .map_err(|e| FieldError::new("friction.records", e.to_string()))?;
         let fit = cal::fit_friction(&samples, crate::physics::step::StepKind::Cycloidal)
-            .map_err(|e| invalid("friction", e.to_string()))?;
+            .map_err(|e| FieldError::new("friction", e.to_string()))?;
         out.insert(
             "friction".into(),
-            serde_json::to_value(fit).map_err(|e| invalid("friction", e.to_string()))?,
+            serde_json::to_value(fit).map_err(|e| FieldError::new("friction", e.to_string()))?,
         );
     }
     if let Some(w) = &params.wear_law {
         let fit = cal::fit_wear_law(&w.records, w.density_kg_m3, w.cutoff_pressure_pa)
-            .map_err(|e| invalid("wear_law", e.to_string()))?;
+            .map_err(|e| FieldError::new("wear_law", e.to_string()))?;
         out.insert(
             "wear_law".into(),
-            serde_json::to_value(fit).map_err(|e| invalid("wear_law", e.to_string()))?,
+            serde_json::to_value(fit).map_err(|e| FieldError::new("wear_law", e.to_string()))?,
         );
     }
     Ok(serde_json::Value::Object(out))

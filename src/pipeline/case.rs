@@ -1,9 +1,9 @@
 //! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, and the run.
 
 use super::{
-    check_keys, invalid, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError,
-    SIMULATE_KEYS,
+    check_keys, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError, SIMULATE_KEYS,
 };
+use crate::field_error::FieldError;
 use crate::models::case::load_case;
 use crate::models::specs::CaseSpec;
 use crate::report::run_case;
@@ -40,9 +40,9 @@ fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
 }
 
 /// Checks the run-control bounds of [`limits`]; the error's field is a case path.
-fn check_simulation_bounds(case: &CaseSpec) -> Result<(), (String, String)> {
+fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     let s = &case.simulation;
-    let bad = |field: &str, rule: String| Err((format!("simulation.{field}"), rule));
+    let bad = |field: &str, rule: String| Err(FieldError::new(field, rule).at("simulation"));
     if !(s.duration_s.is_finite() && s.duration_s > 0.0 && s.duration_s <= limits::MAX_DURATION_S) {
         return bad(
             "duration_s",
@@ -117,28 +117,30 @@ pub fn resolve_case(
     let mut value = match params.get("config") {
         Some(serde_json::Value::String(name)) => {
             let path = crate::models::reference::reference_config_path(configs_dir, name)
-                .map_err(|e| invalid("config", e.to_string()))?;
+                .map_err(|e| FieldError::new("config", e.to_string()))?;
             let case = load_case(&path)?;
-            serde_json::to_value(&case).map_err(|e| invalid("config", e.to_string()))?
+            serde_json::to_value(&case).map_err(|e| FieldError::new("config", e.to_string()))?
         }
         Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
         Some(_) => {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "config",
                 "must be a reference config name or a config object",
-            ))
+            )
+            .into())
         }
         None => {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "config",
                 "is required (a reference config name or a config object)",
-            ))
+            )
+            .into())
         }
     };
     let overrides = params.get("overrides");
     if let Some(over) = overrides {
         if !over.is_object() {
-            return Err(invalid("overrides", "must be an object"));
+            return Err(FieldError::new("overrides", "must be an object").into());
         }
         merge_json(&mut value, over);
     }
@@ -151,7 +153,7 @@ pub fn resolve_case(
     }
     let mut case: CaseSpec = serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
-        invalid(&locate(&path, overrides), e.into_inner().to_string())
+        FieldError::new(locate(&path, overrides), e.into_inner().to_string())
     })?;
     adjust(&mut case)?;
     let relocate = |e: RunError| match e {
@@ -162,7 +164,7 @@ pub fn resolve_case(
         other => other,
     };
     case.validate().map_err(|e| relocate(e.into()))?;
-    check_simulation_bounds(&case).map_err(|(field, rule)| relocate(invalid(&field, rule)))?;
+    check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
     crate::models::case::build(&case, configs_dir).map_err(relocate)?;
     Ok(case)

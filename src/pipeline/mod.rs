@@ -20,15 +20,9 @@ pub use case::*;
 pub use sweep::*;
 pub use sweep_range::*;
 
+use crate::field_error::FieldError;
 pub use crate::models::outcome::{CaseOutcome, RunError};
 pub use crate::physics::control::{Progress, RunControl};
-
-fn invalid(field: &str, rule: impl Into<String>) -> RunError {
-    RunError::InvalidConfig {
-        field: field.to_string(),
-        rule: rule.into(),
-    }
-}
 
 /// Deep-merges `patch` into `base` (objects merge key by key; anything else replaces).
 pub fn merge_json(base: &mut serde_json::Value, patch: &serde_json::Value) {
@@ -119,7 +113,7 @@ pub fn check_keys<'a>(
 ) -> Result<&'a serde_json::Map<String, serde_json::Value>, RunError> {
     let map = value
         .as_object()
-        .ok_or_else(|| invalid(field, "must be a JSON object"))?;
+        .ok_or_else(|| FieldError::new(field, "must be a JSON object"))?;
     for key in map.keys() {
         if !allowed.contains(&key.as_str()) {
             let path = if field == "params" {
@@ -127,10 +121,11 @@ pub fn check_keys<'a>(
             } else {
                 format!("{field}.{key}")
             };
-            return Err(invalid(
+            return Err(FieldError::new(
                 &path,
                 format!("is not a known parameter (known: {})", allowed.join(", ")),
-            ));
+            )
+            .into());
         }
     }
     Ok(map)
@@ -142,9 +137,10 @@ pub fn parse_seed(value: &serde_json::Value) -> Result<u64, RunError> {
         .as_u64()
         .filter(|s| *s <= limits::MAX_SEED)
         .ok_or_else(|| {
-            invalid(
+            FieldError::new(
                 "seed",
                 "must be an integer in [0, 2^53) (JavaScript reads larger integers inexactly)",
             )
+            .into()
         })
 }

@@ -2,9 +2,10 @@
 //! law), one point's run, and the sequential sweep.
 
 use super::{
-    check_keys, design_rattle_space, invalid, merge_json, replica_seed, resolve_case, Progress,
-    RunControl, RunError, SweepRange, SWEEP_KEYS,
+    check_keys, design_rattle_space, merge_json, replica_seed, resolve_case, Progress, RunControl,
+    RunError, SweepRange, SWEEP_KEYS,
 };
+use crate::field_error::FieldError;
 use crate::models::specs::CaseSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -93,14 +94,15 @@ pub fn vehicle_profile_file(configs_dir: &Path, name: &str) -> Result<String, Ru
     let dir = configs_dir.join("profiles");
     match crate::models::reference::reference_config_path(&dir, stem) {
         Ok(_) => Ok(stem.to_string()),
-        Err(_) => Err(invalid(
+        Err(_) => Err(FieldError::new(
             "vehicle_profile",
             format!(
                 "`{name}` is not a vehicle profile in {} (known: {})",
                 dir.display(),
                 vehicle_profile_names(configs_dir).join(", ")
             ),
-        )),
+        )
+        .into()),
     }
 }
 
@@ -120,13 +122,14 @@ pub fn wear_law_name(law: &crate::wear::law::WearLaw) -> &'static str {
 fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
     use crate::wear::law::WearLaw;
     if !WEAR_LAWS.contains(&name) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "wear_law",
             format!(
                 "`{name}` is not a wear law (known: {})",
                 WEAR_LAWS.join(", ")
             ),
-        ));
+        )
+        .into());
     }
     let current = case.wear.law;
     if wear_law_name(&current) == name {
@@ -137,7 +140,7 @@ fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
         "modified-archard" if preset => WearLaw::table_4_3(),
         "legacy-appendix" if preset => WearLaw::legacy_table_4_3(),
         _ => {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "wear_law",
                 format!(
                     "`{name}` does not match the config's wear law ({}); give its constants in \
@@ -145,7 +148,8 @@ fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
                      \"coefficient_m2_per_n\": 1e-15}})",
                     wear_law_name(&current)
                 ),
-            ))
+            )
+            .into())
         }
     };
     Ok(())
@@ -195,7 +199,7 @@ impl SweepPlan {
             match params.get(name) {
                 None => Ok(default.to_string()),
                 Some(serde_json::Value::String(s)) => Ok(s.clone()),
-                Some(_) => Err(invalid(name, "must be a string")),
+                Some(_) => Err(FieldError::new(name, "must be a string").into()),
             }
         };
         let vehicle_profile = text("vehicle_profile", DEFAULT_VEHICLE_PROFILE)?;
@@ -203,42 +207,42 @@ impl SweepPlan {
         let wear_law = text("wear_law", DEFAULT_WEAR_LAW)?;
         let profile_file = vehicle_profile_file(configs_dir, &vehicle_profile)?;
         if !ENVIRONMENTS.contains(&environment.as_str()) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "environment",
                 format!(
                     "`{environment}` is not modelled (known: {}; sand or dust abrasion is not \
                      part of the wear model)",
                     ENVIRONMENTS.join(", ")
                 ),
-            ));
+            )
+            .into());
         }
         if params
             .get("overrides")
             .is_some_and(|o| o.get("excitation").is_some())
         {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "overrides.excitation",
                 "a sweep's excitation is its vehicle_profile; remove it (or run simulate jobs)",
-            ));
+            )
+            .into());
         }
         let range = SweepRange::from_params(params)?;
         let n = range.offsets_mm.len();
-        let point = match params.get("point") {
-            None => None,
-            Some(v) => Some(
-                v.as_u64()
-                    .filter(|i| *i < n as u64)
-                    .ok_or_else(|| invalid("point", format!("must be an integer below {n}")))?
-                    as usize,
-            ),
-        };
+        let point =
+            match params.get("point") {
+                None => None,
+                Some(v) => Some(v.as_u64().filter(|i| *i < n as u64).ok_or_else(|| {
+                    FieldError::new("point", format!("must be an integer below {n}"))
+                })? as usize),
+            };
         let replica = match params.get("replica") {
             None => None,
             Some(v) => Some(
                 v.as_u64()
                     .filter(|i| *i < range.seeds as u64)
                     .ok_or_else(|| {
-                        invalid(
+                        FieldError::new(
                             "replica",
                             format!("must be an integer below {}", range.seeds),
                         )
@@ -251,11 +255,12 @@ impl SweepPlan {
         }
         let base = resolve_case(&p, configs_dir, |case| {
             if case.launcher.is_none() {
-                return Err(invalid(
+                return Err(FieldError::new(
                     "config",
                     "a sweep varies launcher rail dimensions: it needs a launcher case \
                      (launcher-tight, launcher-design, launcher-loose or an inline launcher)",
-                ));
+                )
+                .into());
             }
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
             select_wear_law(case, &wear_law)
@@ -313,14 +318,15 @@ impl SweepPlan {
     pub fn outcome(&self, runs: Vec<SweepPoint>) -> Result<SweepOutcome, RunError> {
         let per = self.seeds.len().max(1);
         if runs.len() != self.runs() {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "points",
                 format!(
                     "the sweep has {} runs but {} results",
                     self.runs(),
                     runs.len()
                 ),
-            ));
+            )
+            .into());
         }
         let mut points = Vec::with_capacity(self.len());
         let mut rates = Vec::with_capacity(self.len());
@@ -375,11 +381,11 @@ pub fn sweep_point_from(
     let offset_mm = *plan
         .offsets_mm
         .get(index)
-        .ok_or_else(|| invalid("point", format!("must be below {}", plan.len())))?;
+        .ok_or_else(|| FieldError::new("point", format!("must be below {}", plan.len())))?;
     let seed = *plan
         .seeds
         .get(replica)
-        .ok_or_else(|| invalid("replica", format!("must be below {}", plan.seeds.len())))?;
+        .ok_or_else(|| FieldError::new("replica", format!("must be below {}", plan.seeds.len())))?;
     let mut case = plan.base.clone();
     case.simulation.seed = seed;
     if let Some(l) = case.launcher.as_mut() {
@@ -396,7 +402,7 @@ pub fn sweep_point_from(
         .iter()
         .find(|b| b.name == "rail")
         .map(|b| b.mass_rate_mg_per_h)
-        .ok_or_else(|| invalid("config", "the launcher model has no body named `rail`"))?;
+        .ok_or_else(|| FieldError::new("config", "the launcher model has no body named `rail`"))?;
     Ok(SweepPoint {
         offset_mm,
         rattle_space,
@@ -427,7 +433,7 @@ pub fn sweep_replica_index(params: &serde_json::Value) -> Result<usize, RunError
         Some(v) => v
             .as_u64()
             .map(|i| i as usize)
-            .ok_or_else(|| invalid("replica", "must be a non-negative integer")),
+            .ok_or_else(|| FieldError::new("replica", "must be a non-negative integer").into()),
     }
 }
 
@@ -437,7 +443,7 @@ pub fn sweep_point_index(params: &serde_json::Value) -> Result<usize, RunError> 
         .get("point")
         .and_then(serde_json::Value::as_u64)
         .map(|i| i as usize)
-        .ok_or_else(|| invalid("point", "is required (a non-negative integer)"))
+        .ok_or_else(|| FieldError::new("point", "is required (a non-negative integer)").into())
 }
 
 /// A sweep job run in one process: the launcher case of `params` (default `launcher-design`) at
@@ -483,6 +489,7 @@ pub fn run_sweep(
         }
     }
     let outcome = plan.outcome(runs)?;
-    let summary = serde_json::to_value(&outcome).map_err(|e| invalid("sweep", e.to_string()))?;
+    let summary =
+        serde_json::to_value(&outcome).map_err(|e| FieldError::new("sweep", e.to_string()))?;
     Ok((summary, outcome))
 }

@@ -1,6 +1,7 @@
 //! The rattle-space range of a tolerance sweep and the sweep that covers a given rail.
 
-use super::{check_keys, invalid, limits, sweep_offsets_mm, RunError, DEFAULT_SWEEP_SEEDS};
+use super::{check_keys, limits, sweep_offsets_mm, RunError, DEFAULT_SWEEP_SEEDS};
+use crate::field_error::FieldError;
 
 /// The rattle-space range, points and seeds of a tolerance sweep, read from its params alone
 /// (no config is loaded: the report reads it from a queued sweep's params to tell whether that
@@ -97,14 +98,17 @@ fn parse_min_max(value: &serde_json::Value, field: &str) -> Result<(f64, f64), R
         map.get(name)
             .and_then(serde_json::Value::as_f64)
             .filter(|x| x.is_finite())
-            .ok_or_else(|| invalid(&format!("{field}.{name}"), "is required (a finite number)"))
+            .ok_or_else(|| {
+                FieldError::new(format!("{field}.{name}"), "is required (a finite number)")
+            })
     };
     let (min, max) = (num("min")?, num("max")?);
     if min >= max {
-        return Err(invalid(
+        return Err(FieldError::new(
             field,
             format!("needs min < max, got min {min} and max {max}"),
-        ));
+        )
+        .into());
     }
     Ok((min, max))
 }
@@ -119,7 +123,7 @@ impl SweepRange {
                 .as_u64()
                 .filter(|n| limits::SWEEP_POINTS.contains(n))
                 .ok_or_else(|| {
-                    invalid(
+                    FieldError::new(
                         "points",
                         format!(
                             "must be an integer in {}..={}",
@@ -135,7 +139,7 @@ impl SweepRange {
                 .as_u64()
                 .filter(|n| limits::SWEEP_SEEDS.contains(n))
                 .ok_or_else(|| {
-                    invalid(
+                    FieldError::new(
                         "seeds",
                         format!(
                             "must be an integer in {}..={} (seeds per point; 1 gives no \
@@ -147,24 +151,26 @@ impl SweepRange {
                 })?,
         };
         if n as u64 * seeds > limits::MAX_SWEEP_RUNS {
-            return Err(invalid(
+            return Err(FieldError::new(
                 "seeds",
                 format!(
                     "points x seeds = {} simulations; at most {} per sweep",
                     n as u64 * seeds,
                     limits::MAX_SWEEP_RUNS
                 ),
-            ));
+            )
+            .into());
         }
         let (base, design_base) = match params.get("base_dimensions_mm") {
             None => (LauncherDimensions::design(), true),
             Some(v) => {
                 if !v.is_object() {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "base_dimensions_mm",
                         "must be an object of named dimensions in mm (as a measurement's \
                          dimensions_mm)",
-                    ));
+                    )
+                    .into());
                 }
                 let dims: LauncherDimensions = serde_path_to_error::deserialize(v.clone())
                     .map_err(|e| {
@@ -174,13 +180,12 @@ impl SweepRange {
                         } else {
                             format!("base_dimensions_mm.{path}")
                         };
-                        invalid(&field, e.into_inner().to_string())
+                        FieldError::new(&field, e.into_inner().to_string())
                     })?;
                 dims.rattle_space().map_err(
-                    |crate::analysis::rattle_space::RattleSpaceError::InvalidDimension {
-                         field,
-                         rule,
-                     }| invalid(&format!("base_dimensions_mm.{field}"), rule),
+                    |crate::analysis::rattle_space::RattleSpaceError::InvalidDimension(e)| {
+                        e.at("base_dimensions_mm")
+                    },
                 )?;
                 (dims, dims == LauncherDimensions::design())
             }
@@ -198,15 +203,16 @@ impl SweepRange {
             params.get("offset_mm_range"),
         ) {
             (Some(_), Some(_)) => {
-                return Err(invalid(
+                return Err(FieldError::new(
                     "offset_mm_range",
                     "give either rattle_space_range or offset_mm_range, not both",
-                ))
+                )
+                .into())
             }
             (Some(range), None) => {
                 let (min, max) = parse_min_max(range, "rattle_space_range")?;
                 if min < k_lo || max > k_hi {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "rattle_space_range",
                         format!(
                             "[{min}, {max}] leaves the rattle spaces the base dimensions reach \
@@ -215,13 +221,14 @@ impl SweepRange {
                              base_dimensions_mm",
                             limits_mm.0, limits_mm.1
                         ),
-                    ));
+                    )
+                    .into());
                 }
                 let offsets = spaced(max, min)
                     .into_iter()
                     .map(|k| {
                         offset_for_rattle_space(&base, k, limits_mm).ok_or_else(|| {
-                            invalid(
+                            FieldError::new(
                                 "rattle_space_range",
                                 format!("rattle space {k} is not reached by the base dimensions"),
                             )
@@ -233,7 +240,7 @@ impl SweepRange {
             (None, Some(range)) => {
                 let (min, max) = parse_min_max(range, "offset_mm_range")?;
                 if min < limits_mm.0 || max > limits_mm.1 {
-                    return Err(invalid(
+                    return Err(FieldError::new(
                         "offset_mm_range",
                         format!(
                             "[{min}, {max}] mm leaves the offsets at which the base dimensions \
@@ -241,7 +248,8 @@ impl SweepRange {
                              design, docs/launcher-dimensions.md)",
                             limits_mm.0, limits_mm.1
                         ),
-                    ));
+                    )
+                    .into());
                 }
                 (spaced(min, max), "offset_mm_range")
             }
@@ -251,7 +259,7 @@ impl SweepRange {
             .iter()
             .map(|&o| {
                 offset_rattle_space(&base, o).ok_or_else(|| {
-                    invalid(
+                    FieldError::new(
                         field,
                         format!(
                             "offset {o} mm does not give a valid rail from the base dimensions"
@@ -267,13 +275,14 @@ impl SweepRange {
                 (a.min(k), b.max(k))
             });
         if !(k_min <= design && design <= k_max) {
-            return Err(invalid(
+            return Err(FieldError::new(
                 field,
                 format!(
                     "gives rattle spaces [{k_min:.4}, {k_max:.4}], which must contain the design \
                      rattle space {design:.4}: K_SL is the ratio to the wear rate there (eq. 6.4)"
                 ),
-            ));
+            )
+            .into());
         }
         Ok(Self {
             base,

@@ -15,6 +15,7 @@ use crate::physics::impact::ImpactParams;
 use crate::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
 use crate::physics::simulate::{simulate, DivergenceLimits, StepView};
 use crate::physics::system::MultibodySystem;
+use crate::thesis;
 use crate::units::{inch, STANDARD_GRAVITY};
 use crate::wear::integrate::WearAccumulator;
 use crate::wear::law::WearLaw;
@@ -117,7 +118,7 @@ fn settings(kind: IntegratorKind, rel: f64) -> IntegratorSettings {
 pub fn sphere_on_floor(r: f64, impact: ImpactParams, load_n: f64) -> (MultibodySystem, Vec<f64>) {
     let sphere = RigidBody {
         name: "sphere".into(),
-        mass: MassProperties::solid_sphere(r, 2810.0),
+        mass: MassProperties::solid_sphere(r, thesis::DENSITY_7075_KG_PER_M3),
         kind: BodyKind::Dynamic { offset: 0 },
     };
     let contact = Contact::new(
@@ -215,7 +216,8 @@ pub fn table_2_2_anchors() -> Vec<Anchor> {
             tol,
         ));
     }
-    let e_star = 1.0 / (2.0 * (1.0 - 0.33f64.powi(2)) / 72e9);
+    let e_star =
+        1.0 / (2.0 * (1.0 - thesis::POISSON_RATIO_7075.powi(2)) / thesis::YOUNGS_MODULUS_7075_PA);
     let k_si = 4.0 / 3.0 * e_star * 0.05f64.sqrt();
     let k_adams = k_si * 1e-3f64.powf(1.5);
     v.push(anchor(
@@ -501,33 +503,33 @@ pub fn friction_calibration_anchors() -> Vec<Anchor> {
             "friction calibration: mu_s from noisy torque records",
             "Table 4.2, eq. 4.3 (within 3 %)",
             "-",
-            0.1799,
+            thesis::MU_STATIC,
             get(|p| p.mu_static),
-            0.03 * 0.1799,
+            0.03 * thesis::MU_STATIC,
         ),
         anchor(
             "friction calibration: mu_d from noisy torque records",
             "Table 4.2, eq. 4.3 (within 3 %)",
             "-",
-            0.1660,
+            thesis::MU_DYNAMIC,
             get(|p| p.mu_dynamic),
-            0.03 * 0.1660,
+            0.03 * thesis::MU_DYNAMIC,
         ),
         anchor(
             "friction calibration: stiction transition speed",
             "Table 4.2 (within 10 %)",
             "m/s",
-            6.4634e-3,
+            truth.stiction_transition_speed,
             get(|p| p.stiction_transition_speed),
-            0.1 * 6.4634e-3,
+            0.1 * truth.stiction_transition_speed,
         ),
         anchor(
             "friction calibration: friction transition speed",
             "Table 4.2 (within 10 %)",
             "m/s",
-            12.0e-3,
+            truth.friction_transition_speed,
             get(|p| p.friction_transition_speed),
-            0.1 * 12.0e-3,
+            0.1 * truth.friction_transition_speed,
         ),
     ]
 }

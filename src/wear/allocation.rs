@@ -2,6 +2,7 @@
 
 use super::material::Material;
 use super::WearError;
+use crate::field_error::FieldError;
 use crate::units::{MG_PER_KG, S_PER_H};
 use serde::{Deserialize, Serialize};
 
@@ -36,16 +37,15 @@ impl VolumeSplit {
             Self::InverseHardness => {
                 let (ha, hb) = (a.hardness_pa(), b.hardness_pa());
                 if !(ha.is_finite() && ha > 0.0 && hb.is_finite() && hb > 0.0) {
-                    return Err(WearError::invalid(
-                        "brinell_hardness",
-                        "must be a finite number > 0",
-                    ));
+                    return Err(
+                        FieldError::new("brinell_hardness", "must be a finite number > 0").into(),
+                    );
                 }
                 Ok(hb / (ha + hb))
             }
             Self::Fixed { fraction_to_a } => {
                 if !(0.0..=1.0).contains(&fraction_to_a) {
-                    return Err(WearError::invalid("fraction_to_a", "must lie in [0, 1]"));
+                    return Err(FieldError::new("fraction_to_a", "must lie in [0, 1]").into());
                 }
                 Ok(fraction_to_a)
             }
@@ -60,10 +60,7 @@ impl VolumeSplit {
         b: &Material,
     ) -> Result<(BodyWear, BodyWear), WearError> {
         if !(volume_m3.is_finite() && volume_m3 >= 0.0) {
-            return Err(WearError::invalid(
-                "volume_m3",
-                "must be a finite number >= 0",
-            ));
+            return Err(FieldError::new("volume_m3", "must be a finite number >= 0").into());
         }
         let fa = self.fraction_to_a(a, b)?;
         let va = fa * volume_m3;
@@ -126,7 +123,7 @@ mod tests {
         assert_eq!((wa.volume_m3, wb.volume_m3), (5.0, 0.0));
         assert_eq!(
             VolumeSplit::Fixed { fraction_to_a: 1.5 }.split(5.0, &m, &m),
-            Err(WearError::invalid("fraction_to_a", "must lie in [0, 1]"))
+            Err(FieldError::new("fraction_to_a", "must lie in [0, 1]").into())
         );
     }
 

@@ -7,6 +7,7 @@
 use super::law::{Quadrature, WearLaw};
 use super::pressure_pdf::PressureHistogram;
 use super::WearError;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// What one track (or, after [`WearTotals::merge`], one contact) accumulated.
@@ -77,10 +78,11 @@ impl WearTotals {
     /// Adds another track of the same contact: sums volumes, work, times and histograms.
     pub fn merge(&mut self, other: &WearTotals) -> Result<(), WearError> {
         if self.cutoff_pressure_pa != other.cutoff_pressure_pa {
-            return Err(WearError::invalid(
+            return Err(FieldError::new(
                 "cutoff_pressure_pa",
                 "tracks must use the same law to merge",
-            ));
+            )
+            .into());
         }
         self.pressure_histogram.merge(&other.pressure_histogram)?;
         self.volume_m3 += other.volume_m3;
@@ -163,25 +165,16 @@ impl WearAccumulator {
         area_m2: f64,
     ) -> Result<(), WearError> {
         if !time_s.is_finite() {
-            return Err(WearError::invalid("time_s", "must be finite"));
+            return Err(FieldError::new("time_s", "must be finite").into());
         }
         if !(normal_force_n.is_finite() && normal_force_n >= 0.0) {
-            return Err(WearError::invalid(
-                "normal_force_n",
-                "must be a finite number >= 0",
-            ));
+            return Err(FieldError::new("normal_force_n", "must be a finite number >= 0").into());
         }
         if !(slip_speed_m_s.is_finite() && slip_speed_m_s >= 0.0) {
-            return Err(WearError::invalid(
-                "slip_speed_m_s",
-                "must be a finite number >= 0",
-            ));
+            return Err(FieldError::new("slip_speed_m_s", "must be a finite number >= 0").into());
         }
         if !(area_m2.is_finite() && area_m2 >= 0.0) {
-            return Err(WearError::invalid(
-                "area_m2",
-                "must be a finite number >= 0",
-            ));
+            return Err(FieldError::new("area_m2", "must be a finite number >= 0").into());
         }
         let in_contact = normal_force_n > 0.0;
         let pressure_pa = if !in_contact {
@@ -222,10 +215,7 @@ impl WearAccumulator {
             Some(p) => {
                 let dt = time_s - p.time_s;
                 if dt < 0.0 {
-                    return Err(WearError::invalid(
-                        "time_s",
-                        "must not decrease along a track",
-                    ));
+                    return Err(FieldError::new("time_s", "must not decrease along a track").into());
                 }
                 t.volume_m3 += match self.quadrature {
                     Quadrature::Trapezoid => 0.5 * (p.rate_m3_s + point.rate_m3_s) * dt,
@@ -383,18 +373,12 @@ mod tests {
         let mut acc = WearAccumulator::new(WearLaw::table_4_3()).unwrap();
         assert_eq!(
             acc.push(0.0, f64::NAN, 0.0, 1.0),
-            Err(WearError::invalid(
-                "normal_force_n",
-                "must be a finite number >= 0"
-            ))
+            Err(FieldError::new("normal_force_n", "must be a finite number >= 0").into())
         );
         acc.push(1.0, 1.0, 0.0, 1.0).unwrap();
         assert_eq!(
             acc.push(0.5, 1.0, 0.0, 1.0),
-            Err(WearError::invalid(
-                "time_s",
-                "must not decrease along a track"
-            ))
+            Err(FieldError::new("time_s", "must not decrease along a track").into())
         );
     }
 

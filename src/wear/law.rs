@@ -2,6 +2,7 @@
 //! and the behaviour of the thesis' appendix C post-processor (`CParse.C`) as a legacy option.
 
 use super::WearError;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Table 4.3, C1 (K in m²/N with sigma in Pa).
@@ -92,10 +93,11 @@ impl WearLaw {
                 coefficient_m2_per_n,
             } => {
                 if !(finite(coefficient_m2_per_n) && coefficient_m2_per_n >= 0.0) {
-                    return Err(WearError::invalid(
+                    return Err(FieldError::new(
                         "coefficient_m2_per_n",
                         "must be a finite number >= 0",
-                    ));
+                    )
+                    .into());
                 }
             }
             Self::Modified {
@@ -105,16 +107,16 @@ impl WearLaw {
                 cutoff_pressure_pa,
             } => {
                 if !finite(c1) {
-                    return Err(WearError::invalid("c1", "must be a finite number"));
+                    return Err(FieldError::new("c1", "must be a finite number").into());
                 }
                 if !(finite(c2) && c2 > 0.0) {
-                    return Err(WearError::invalid("c2", "must be a finite number > 0"));
+                    return Err(FieldError::new("c2", "must be a finite number > 0").into());
                 }
                 if !finite(c3) {
-                    return Err(WearError::invalid("c3", "must be a finite number"));
+                    return Err(FieldError::new("c3", "must be a finite number").into());
                 }
                 if cutoff_pressure_pa.is_nan() || cutoff_pressure_pa <= 0.0 {
-                    return Err(WearError::invalid("cutoff_pressure_pa", "must be > 0 Pa"));
+                    return Err(FieldError::new("cutoff_pressure_pa", "must be > 0 Pa").into());
                 }
             }
             Self::LegacyAppendix {
@@ -125,19 +127,17 @@ impl WearLaw {
                 output_unit_m3,
             } => {
                 if !(finite(c1) && finite(c2) && finite(c3)) {
-                    return Err(WearError::invalid("c1/c2/c3", "must be finite numbers"));
+                    return Err(FieldError::new("c1/c2/c3", "must be finite numbers").into());
                 }
                 if !(finite(speed_unit_m_s) && speed_unit_m_s > 0.0) {
-                    return Err(WearError::invalid(
-                        "speed_unit_m_s",
-                        "must be a finite number > 0",
-                    ));
+                    return Err(
+                        FieldError::new("speed_unit_m_s", "must be a finite number > 0").into(),
+                    );
                 }
                 if !(finite(output_unit_m3) && output_unit_m3 > 0.0) {
-                    return Err(WearError::invalid(
-                        "output_unit_m3",
-                        "must be a finite number > 0",
-                    ));
+                    return Err(
+                        FieldError::new("output_unit_m3", "must be a finite number > 0").into(),
+                    );
                 }
             }
         }
@@ -326,7 +326,7 @@ mod tests {
         };
         assert_eq!(
             law.validate(),
-            Err(WearError::invalid("c2", "must be a finite number > 0"))
+            Err(FieldError::new("c2", "must be a finite number > 0").into())
         );
         assert!(WearLaw::table_4_3().validate().is_ok());
     }

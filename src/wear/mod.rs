@@ -18,24 +18,13 @@ pub use law::{Quadrature, WearLaw};
 pub use material::Material;
 pub use pressure_pdf::PressureHistogram;
 
+use crate::field_error::FieldError;
+
 /// Errors of the wear module: each names the offending field and the rule it broke.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WearError {
     /// A parameter or sample value broke a rule.
-    #[error("invalid {field}: {rule}")]
-    Invalid {
-        /// Name of the field or sample column.
-        field: &'static str,
-        /// The rule it broke, with the value where useful.
-        rule: String,
-    },
-}
-
-impl WearError {
-    pub(crate) fn invalid(field: &'static str, rule: impl Into<String>) -> Self {
-        Self::Invalid {
-            field,
-            rule: rule.into(),
-        }
-    }
+    /// (The field is a parameter's name or a sample column.)
+    #[error("invalid {}: {}", .0.field, .0.rule)]
+    Invalid(#[from] FieldError),
 }

@@ -2,6 +2,7 @@
 //! N·|v_slip| (Figure 6.65 plots the probability density of contact pressure per contact).
 
 use super::WearError;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Histogram over log-spaced pressure bins plus under- and overflow tallies.
@@ -41,27 +42,20 @@ impl PressureHistogram {
         bins_per_decade: u32,
     ) -> Result<Self, WearError> {
         if !(min_pressure_pa.is_finite() && min_pressure_pa > 0.0) {
-            return Err(WearError::invalid(
-                "min_pressure_pa",
-                "must be a finite number > 0",
-            ));
+            return Err(FieldError::new("min_pressure_pa", "must be a finite number > 0").into());
         }
         if !(max_pressure_pa.is_finite() && max_pressure_pa > min_pressure_pa) {
-            return Err(WearError::invalid(
-                "max_pressure_pa",
-                "must be finite and > min_pressure_pa",
-            ));
+            return Err(
+                FieldError::new("max_pressure_pa", "must be finite and > min_pressure_pa").into(),
+            );
         }
         if bins_per_decade == 0 || bins_per_decade > 1000 {
-            return Err(WearError::invalid("bins_per_decade", "must be in 1..=1000"));
+            return Err(FieldError::new("bins_per_decade", "must be in 1..=1000").into());
         }
         let decades = (max_pressure_pa / min_pressure_pa).log10();
         let n = (decades * bins_per_decade as f64 - 1e-9).ceil().max(1.0) as usize;
         if n > 100_000 {
-            return Err(WearError::invalid(
-                "max_pressure_pa",
-                "gives more than 100000 bins",
-            ));
+            return Err(FieldError::new("max_pressure_pa", "gives more than 100000 bins").into());
         }
         Ok(Self {
             min_pressure_pa,
@@ -130,10 +124,7 @@ impl PressureHistogram {
             || self.bins_per_decade != other.bins_per_decade
             || self.len() != other.len()
         {
-            return Err(WearError::invalid(
-                "pressure_histogram",
-                "bins must match to merge",
-            ));
+            return Err(FieldError::new("pressure_histogram", "bins must match to merge").into());
         }
         for (a, b) in self.time_s.iter_mut().zip(&other.time_s) {
             *a += b;

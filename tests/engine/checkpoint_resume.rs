@@ -6,12 +6,12 @@
 //! not resumed: the run restarts from t = 0 (and gives that case's own result).
 
 use railwear::models::case::{build, code_version, load_case};
-use railwear::report::run_case_from;
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
 use railwear::models::specs::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
 use railwear::physics::track::TrackSample;
 use railwear::pipeline::{Progress, RunControl, RunError};
+use railwear::report::run_case_from;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;

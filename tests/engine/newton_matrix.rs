@@ -7,9 +7,9 @@
 //! engine versions give it to 0.2 %).
 
 use railwear::models::case::load_case;
-use railwear::report::run_case;
 use railwear::physics::integrator::{ContactPatches, NewtonJacobian};
 use railwear::pipeline::RunControl;
+use railwear::report::run_case;
 use std::path::Path;
 
 fn rail_rate(newton: NewtonJacobian, patches: ContactPatches) -> f64 {

@@ -2,9 +2,9 @@
 //! wear reported in mg/h with the documented split, static equilibrium without excitation.
 
 use railwear::models::case::load_case;
-use railwear::report::run_case;
 use railwear::models::run::RunReport;
 use railwear::pipeline::RunControl;
+use railwear::report::run_case;
 use railwear::units::STANDARD_GRAVITY;
 use std::path::Path;
 

@@ -233,7 +233,7 @@ pub async fn post_measurement(
     let recorded_ms = clock::now_ms();
     let measured_ms = check_measured_at(&measured_at, recorded_ms)?;
     let rattle_space = crate::service_life::rattle_space(&request.dimensions_mm)
-        .map_err(|(field, rule)| Problem::invalid_field(format!("dimensions_mm.{field}"), rule))?;
+        .map_err(|e| Problem::from(e.at("dimensions_mm")))?;
     let dimensions_mm =
         serde_json::to_value(request.dimensions_mm).map_err(|e| Problem::internal(&e))?;
     let record = state

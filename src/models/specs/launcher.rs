@@ -1,6 +1,7 @@
 //! Chapter 6: the launcher, its lettered dimensions and the derived geometry (rail faces, shoe heads).
 
 use super::*;
+use crate::field_error::FieldError;
 
 /// Rail extrusion layout (kinematic body, driven at its centre of mass, thesis 6.5). The channel
 /// cross-section comes from [`LauncherDimensions`]; this places it in the rail frame.
@@ -262,7 +263,8 @@ pub struct LauncherSpec {
     /// Contact parameters (Table 6.2).
     pub contacts: LauncherContacts,
     /// Friction for all contacts (Table 6.1).
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
     /// Rail stations of a multi-rail launcher (the AH-64's M299 carries four missiles): the
     /// offset of each rail's frame from the launcher's reference, m. Every station is the
     /// rail above with its own missile, latch, springs and five contacts; all rails move with
@@ -429,11 +431,11 @@ impl LauncherSpec {
     /// stiffnesses, real inertias, unit axes, exactly two double-barrel springs pushing +z, both
     /// shoes seated at the same height, shoes and pad inside the channel length, lips thinner
     /// than the neck, front pad clear of the rail bottom, latch tooth not below the lip tops.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         let p = |name: &str| path(prefix, name);
         validate_material(&self.material, &p("material"))?;
         if self.stations.is_empty() || self.stations.len() > MAX_STATIONS {
-            return Err(err(
+            return Err(FieldError::new(
                 p("stations"),
                 format!(
                     "must list 1 to {MAX_STATIONS} rail offsets, got {}",
@@ -443,13 +445,16 @@ impl LauncherSpec {
         }
         for (i, a) in self.stations.iter().enumerate() {
             if a.iter().any(|v| !v.is_finite()) {
-                return Err(err(format!("{}[{i}]", p("stations")), "must be finite"));
+                return Err(FieldError::new(
+                    format!("{}[{i}]", p("stations")),
+                    "must be finite",
+                ));
             }
             // No missile-missile contact is modelled: the missiles must not overlap.
             for b in &self.stations[..i] {
                 let apart = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
                 if apart < self.missile.diameter_m {
-                    return Err(err(
+                    return Err(FieldError::new(
                         format!("{}[{i}]", p("stations")),
                         format!(
                             "is {apart} m across the rails from another station: the missiles \
@@ -460,11 +465,9 @@ impl LauncherSpec {
                 }
             }
         }
-        self.dimensions.validate().map_err(
-            |RattleSpaceError::InvalidDimension { field, rule }| {
-                err(path(&p("dimensions"), field), rule)
-            },
-        )?;
+        self.dimensions
+            .validate()
+            .map_err(|RattleSpaceError::InvalidDimension(e)| e.at(&p("dimensions")))?;
         // Rail
         let rp = p("rail");
         positive(&rp, "channel_length_m", self.rail.channel_length_m)?;
@@ -473,14 +476,14 @@ impl LauncherSpec {
         positive(&rp, "lip_thickness_m", self.rail.lip_thickness_m)?;
         let neck_h = units::mm(self.dimensions.mean_neck_height_mm());
         if self.rail.lip_thickness_m >= neck_h {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&rp, "lip_thickness_m"),
                 format!("must be smaller than the shoes' mean neck height {neck_h} m"),
             ));
         }
         let half_w = 0.5 * units::mm(self.dimensions.chamber_width_mm());
         if !(self.rail.bottom_half_width_m.is_finite() && self.rail.bottom_half_width_m > half_w) {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&rp, "bottom_half_width_m"),
                 format!("must exceed the chamber half width {half_w} m"),
             ));
@@ -510,7 +513,7 @@ impl LauncherSpec {
                 .chain(neck.half_extents_m.iter())
                 .any(|h| *h <= shoe.edge_radius_m)
             {
-                return Err(err(
+                return Err(FieldError::new(
                     path(&sp, "edge_radius_m"),
                     "must be smaller than every half size of the head and neck",
                 ));
@@ -518,7 +521,7 @@ impl LauncherSpec {
             if let Some(pr) = &shoe.protrusion {
                 pr.validate(&path(&sp, "protrusion"))?;
                 if pr.min_y_m() < shoe.head_base_in_missile_m[1] {
-                    return Err(err(
+                    return Err(FieldError::new(
                         path(&sp, "protrusion"),
                         "reaches below the head base: it would intersect the rail lips at assembly",
                     ));
@@ -526,7 +529,7 @@ impl LauncherSpec {
             }
             let zc = self.missile_to_rail_m(shoe.head_base_in_missile_m)[2];
             if zc - 0.5 * shoe.length_m < z_lo || zc + 0.5 * shoe.length_m > z_hi {
-                return Err(err(
+                return Err(FieldError::new(
                     path(&sp, "head_base_in_missile_m"),
                     "the shoe lies outside the rail channel's length",
                 ));
@@ -539,7 +542,7 @@ impl LauncherSpec {
                 .abs()
                 > 1e-6
         {
-            return Err(err(
+            return Err(FieldError::new(
                 p("mid_shoe.head_base_in_missile_m"),
                 "x and y must equal the rear shoe's: both heads ride on the same lips",
             ));
@@ -550,7 +553,7 @@ impl LauncherSpec {
             self.missile_to_rail_m(self.front_pad.centre_m)[1] + self.front_pad.half_extents_m[1];
         let bottom = self.rail.lip_top_y_m - self.rail.lip_thickness_m;
         if pad_top > bottom {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&fp, "centre_m"),
                 format!("the pad top ({pad_top} m) is above the rail bottom face ({bottom} m): interference at assembly"),
             ));
@@ -559,7 +562,7 @@ impl LauncherSpec {
         if pz - self.front_pad.half_extents_m[2] < z_lo
             || pz + self.front_pad.half_extents_m[2] > z_hi
         {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&fp, "centre_m"),
                 "the pad lies outside the rail channel's length",
             ));
@@ -579,7 +582,7 @@ impl LauncherSpec {
         let tooth_bottom =
             self.latch.tooth_centre_in_rail_m()[1] - self.latch.tooth.half_extents_m[1];
         if tooth_bottom < self.rail.lip_top_y_m - 1e-9 {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&lp, "tooth"),
                 format!("the tooth bottom ({tooth_bottom} m) is below the lip tops: interference at assembly"),
             ));
@@ -596,13 +599,13 @@ impl LauncherSpec {
         finite3(&sp, "point_on_rail_m", self.latch_spring.point_on_rail_m)?;
         finite3(&sp, "point_on_latch_m", self.latch_spring.point_on_latch_m)?;
         if self.latch_spring_installed_length_m() <= 0.0 {
-            return Err(err(
+            return Err(FieldError::new(
                 path(&sp, "point_on_rail_m"),
                 "the two attachment points coincide at assembly",
             ));
         }
         if self.double_barrel_springs.len() != 2 {
-            return Err(err(
+            return Err(FieldError::new(
                 p("double_barrel_springs"),
                 format!(
                     "there are two double-barrel springs (thesis 6.5), got {}",
@@ -616,7 +619,7 @@ impl LauncherSpec {
             finite3(&fp, "point_in_missile_m", f.point_in_missile_m)?;
             unit3(&fp, "direction_in_rail", f.direction_in_rail)?;
             if f.direction_in_rail[2] <= 0.0 {
-                return Err(err(
+                return Err(FieldError::new(
                     path(&fp, "direction_in_rail"),
                     "must push forward (+z), opposite the latch (thesis 6.2.3)",
                 ));
@@ -648,7 +651,7 @@ impl LauncherSpec {
         c.mid_shoe_rail.validate(&path(&cp, "mid_shoe_rail"))?;
         c.mid_shoe_latch.validate(&path(&cp, "mid_shoe_latch"))?;
         c.rear_shoe_rail.validate(&path(&cp, "rear_shoe_rail"))?;
-        self.friction.validate(&p("friction"))?;
+        validate_friction(&self.friction, &p("friction"))?;
         Ok(())
     }
 }

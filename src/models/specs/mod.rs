@@ -5,35 +5,21 @@
 //! `_n_per_mm_e`); y is vertical (up, towards the vehicle), gravity is standard gravity along -y;
 //! for the launcher the rail frame has its origin at the rail's centre of mass, z longitudinal
 //! (firing direction), x transverse. Contact and friction parameters are written in the thesis'
-//! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`] and
-//! [`FrictionSpec::to_friction_params`]. Values the thesis does not give are engineering
+//! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`]; friction is the
+//! engine's own [`FrictionParams`], read from and written to mm/s by [`in_mm_per_s`]. Values the thesis does not give are engineering
 //! estimates, flagged `estimate` in `docs/models.md`.
 
 use crate::analysis::rattle_space::{self, LauncherDimensions, RattleSpaceError};
-use crate::physics::friction::FrictionParams;
+use crate::physics::friction::{in_mm_per_s, FrictionParams};
 use crate::physics::impact::ImpactParams;
 use crate::physics::step::StepKind;
 use crate::units;
 pub use crate::wear::material::Material;
 use serde::{Deserialize, Serialize};
 
-/// A specification that breaks a rule. `field` is the dotted path of the offending field as it
+/// A specification that breaks a rule: `field` is the dotted path of the offending field as it
 /// appears in the case file (e.g. `launcher.rail.lip_thickness_m`).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("invalid `{field}`: {rule}")]
-pub struct SpecError {
-    /// Dotted path of the field in the case file.
-    pub field: String,
-    /// The rule broken, in words, with the value where useful.
-    pub rule: String,
-}
-
-fn err(field: impl Into<String>, rule: impl Into<String>) -> SpecError {
-    SpecError {
-        field: field.into(),
-        rule: rule.into(),
-    }
-}
+pub use crate::field_error::FieldError;
 
 fn path(prefix: &str, name: &str) -> String {
     if prefix.is_empty() {
@@ -43,55 +29,55 @@ fn path(prefix: &str, name: &str) -> String {
     }
 }
 
-fn finite(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+fn finite(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(err(
+        Err(FieldError::new(
             path(prefix, name),
             format!("must be a finite number, got {v}"),
         ))
     }
 }
 
-fn positive(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+fn positive(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(err(
+        Err(FieldError::new(
             path(prefix, name),
             format!("must be a finite number > 0, got {v}"),
         ))
     }
 }
 
-fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), SpecError> {
+fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        Err(err(
+        Err(FieldError::new(
             path(prefix, name),
             format!("must be a finite number >= 0, got {v}"),
         ))
     }
 }
 
-fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), SpecError> {
+fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
-        Err(err(
+        Err(FieldError::new(
             path(prefix, name),
             format!("all components must be finite, got {v:?}"),
         ))
     }
 }
 
-fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), SpecError> {
+fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
     finite3(prefix, name, v)?;
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if (n - 1.0).abs() > 1e-6 {
-        return Err(err(
+        return Err(FieldError::new(
             path(prefix, name),
             format!("must be a unit vector, |v| = {n}"),
         ));
@@ -100,16 +86,16 @@ fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), SpecError> {
 }
 
 /// Principal moments must be > 0 and satisfy the triangle inequality (a real rigid body).
-fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), SpecError> {
+fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), FieldError> {
     if !i.iter().all(|x| x.is_finite() && *x > 0.0) {
-        return Err(err(
+        return Err(FieldError::new(
             path(prefix, name),
             format!("all moments must be finite and > 0, got {i:?}"),
         ));
     }
     let tol = 1e-12 * (i[0] + i[1] + i[2]);
     if i[0] + i[1] < i[2] - tol || i[1] + i[2] < i[0] - tol || i[0] + i[2] < i[1] - tol {
-        return Err(err(
+        return Err(FieldError::new(
             path(prefix, name),
             format!(
                 "principal moments {i:?} break the triangle inequality (no real body has them)"
@@ -207,15 +193,17 @@ impl Default for WearSpec {
 
 impl CaseSpec {
     /// Parses a TOML case file (unknown keys are errors) and validates it.
-    pub fn from_toml_str(text: &str) -> Result<Self, SpecError> {
-        let case: Self = toml::from_str(text).map_err(|e| err("toml", e.to_string()))?;
+    pub fn from_toml_str(text: &str) -> Result<Self, FieldError> {
+        let case: Self =
+            toml::from_str(text).map_err(|e| FieldError::new("toml", e.to_string()))?;
         case.validate()?;
         Ok(case)
     }
 
     /// The model table matching `model`.
-    pub fn model_spec(&self) -> Result<ModelSpecRef<'_>, SpecError> {
-        let missing = |t: &str| err(t, format!("model = {:?} needs a [{t}] table", self.model));
+    pub fn model_spec(&self) -> Result<ModelSpecRef<'_>, FieldError> {
+        let missing =
+            |t: &str| FieldError::new(t, format!("model = {:?} needs a [{t}] table", self.model));
         match self.model {
             ModelKind::PersistentContact => self
                 .persistent_contact
@@ -237,9 +225,9 @@ impl CaseSpec {
 
     /// Validates the whole case: name, the one matching model table, run control, and that the
     /// excitation is a table with a `kind`.
-    pub fn validate(&self) -> Result<(), SpecError> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         if self.name.trim().is_empty() {
-            return Err(err("name", "must not be empty"));
+            return Err(FieldError::new("name", "must not be empty"));
         }
         let extra = [
             (
@@ -257,7 +245,7 @@ impl CaseSpec {
         .into_iter()
         .find(|(_, present, kind)| *present && *kind != self.model);
         if let Some((table, _, _)) = extra {
-            return Err(err(
+            return Err(FieldError::new(
                 table,
                 format!("table present but model = {:?}", self.model),
             ));
@@ -270,7 +258,7 @@ impl CaseSpec {
         }
         match self.excitation.get("kind").and_then(|k| k.as_str()) {
             Some(k) if !k.is_empty() => Ok(()),
-            _ => Err(err(
+            _ => Err(FieldError::new(
                 "excitation.kind",
                 "the excitation table needs a `kind` string",
             )),

@@ -1,6 +1,7 @@
 //! Chapter 4: the persistent contact fixture.
 
 use super::*;
+use crate::field_error::FieldError;
 
 /// Prescribed rotation of the upper fixture about the vertical axis (thesis 4.3: "an angular
 /// motion was imposed on the cylindrical joint", by an equation or a spline of test data).
@@ -33,7 +34,7 @@ impl PrescribedRotation {
         }
     }
 
-    fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         match *self {
             Self::Oscillating {
                 amplitude_deg,
@@ -45,7 +46,10 @@ impl PrescribedRotation {
             Self::ConstantRate { rate_deg_per_s } => {
                 finite(prefix, "rate_deg_per_s", rate_deg_per_s)?;
                 if rate_deg_per_s == 0.0 {
-                    return Err(err(path(prefix, "rate_deg_per_s"), "must not be zero"));
+                    return Err(FieldError::new(
+                        path(prefix, "rate_deg_per_s"),
+                        "must not be zero",
+                    ));
                 }
                 Ok(())
             }
@@ -89,7 +93,8 @@ pub struct PersistentContactSpec {
     /// Pad-coupon contact, Table 4.1.
     pub contact: ContactSpec,
     /// Friction, Table 4.2.
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
 }
 
 impl PersistentContactSpec {
@@ -111,14 +116,17 @@ impl PersistentContactSpec {
 
     /// Field rules, plus: pads stay on the coupon at every angle (`r_avg` + pad half diagonal
     /// <= half coupon side) and do not overlap each other.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         validate_material(&self.material, &path(prefix, "material"))?;
         if self.pad_count == 0 {
-            return Err(err(path(prefix, "pad_count"), "must be >= 1 (thesis: 3)"));
+            return Err(FieldError::new(
+                path(prefix, "pad_count"),
+                "must be >= 1 (thesis: 3)",
+            ));
         }
         for s in self.pad_size_m {
             if !(s.is_finite() && s > 2.0 * self.pad_edge_radius_m) {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "pad_size_m"),
                     "each size must be finite and larger than twice pad_edge_radius_m",
                 ));
@@ -133,10 +141,10 @@ impl PersistentContactSpec {
         positive(prefix, "normal_load_n", self.normal_load_n)?;
         self.rotation.validate(&path(prefix, "rotation"))?;
         self.contact.validate(&path(prefix, "contact"))?;
-        self.friction.validate(&path(prefix, "friction"))?;
+        validate_friction(&self.friction, &path(prefix, "friction"))?;
         let half_diag = 0.5 * self.pad_size_m[0].hypot(self.pad_size_m[2]);
         if self.mean_radius_m + half_diag > 0.5 * self.coupon_side_m {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "coupon_side_m"),
                 format!(
                     "pads would run off the coupon: mean_radius_m + pad half diagonal = {} m > \
@@ -149,7 +157,7 @@ impl PersistentContactSpec {
             let spacing =
                 2.0 * self.mean_radius_m * (std::f64::consts::PI / self.pad_count as f64).sin();
             if spacing < 2.0 * half_diag {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "mean_radius_m"),
                     "pads at this radius would overlap each other",
                 ));

@@ -1,6 +1,7 @@
 //! Chapter 5: the rattle box.
 
 use super::*;
+use crate::field_error::FieldError;
 
 /// Table 5.1 enclosure (tube inner) sides, inches, for cases A-D (1 in cube).
 pub const TABLE_5_1_TUBE_SIDES_IN: [(&str, f64); 4] =
@@ -35,7 +36,8 @@ pub struct RattleBoxSpec {
     /// Cube-tube contact, Table 5.2.
     pub contact: ContactSpec,
     /// Cube-tube friction, Table 5.2.
-    pub friction: FrictionSpec,
+    #[serde(with = "in_mm_per_s")]
+    pub friction: FrictionParams,
 }
 
 pub(super) fn default_true() -> bool {
@@ -62,7 +64,7 @@ impl RattleBoxSpec {
 
     /// Field rules, plus: the cube fits the tube (in section and length), the roundover is
     /// smaller than half the cube side, and a Table 5.1 letter uses Table 5.1's tube side.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         validate_material(&self.material, &path(prefix, "material"))?;
         positive(prefix, "cube_side_m", self.cube_side_m)?;
         if let Some(m) = self.cube_mass_kg {
@@ -72,13 +74,13 @@ impl RattleBoxSpec {
         positive(prefix, "tube_length_m", self.tube_length_m)?;
         non_negative(prefix, "edge_radius_m", self.edge_radius_m)?;
         if self.edge_radius_m >= 0.5 * self.cube_side_m {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "edge_radius_m"),
                 "must be smaller than half the cube side",
             ));
         }
         if self.tube_inner_side_m < self.cube_side_m {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "tube_inner_side_m"),
                 format!(
                     "interference: tube inner side {} m is smaller than the cube side {} m",
@@ -87,7 +89,7 @@ impl RattleBoxSpec {
             ));
         }
         if self.tube_length_m < self.cube_side_m {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "tube_length_m"),
                 "must be at least the cube side",
             ));
@@ -97,7 +99,7 @@ impl RattleBoxSpec {
             .find(|(c, _)| *c == self.case)
         {
             if (self.tube_inner_side_m - units::inch(*side_in)).abs() > 1e-6 {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "tube_inner_side_m"),
                     format!(
                         "case {} of Table 5.1 has a {side_in} in ({} m) tube; use another case \
@@ -109,7 +111,7 @@ impl RattleBoxSpec {
             }
         }
         self.contact.validate(&path(prefix, "contact"))?;
-        self.friction.validate(&path(prefix, "friction"))?;
+        validate_friction(&self.friction, &path(prefix, "friction"))?;
         Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! Specs shared by every model: material, contact and friction (ADAMS units), rounded boxes, the simulation settings.
 
 use super::*;
+use crate::field_error::FieldError;
 
 /// ADAMS IMPACT contact parameters in ADAMS units (N, mm, s), eq. 2.1-2.3.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -23,10 +24,10 @@ impl ContactSpec {
     /// Thesis Table 4.1 / 5.2 / 6.2 default contact: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
     pub const fn thesis_default() -> Self {
         Self {
-            stiffness_n_per_mm_e: 1000.0,
-            exponent: 2.0,
-            damping_ns_per_mm: 500.0,
-            penetration_depth_mm: 0.01,
+            stiffness_n_per_mm_e: crate::thesis::IMPACT_STIFFNESS_N_PER_MM_E,
+            exponent: crate::thesis::IMPACT_EXPONENT,
+            damping_ns_per_mm: crate::thesis::IMPACT_DAMPING_NS_PER_MM,
+            penetration_depth_mm: crate::thesis::IMPACT_PENETRATION_DEPTH_MM,
             step: StepKind::Cycloidal,
         }
     }
@@ -44,10 +45,10 @@ impl ContactSpec {
     }
 
     /// Field rules (k > 0, e >= 1, c >= 0, d > 0), reported under `prefix`.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         positive(prefix, "stiffness_n_per_mm_e", self.stiffness_n_per_mm_e)?;
         if !(self.exponent.is_finite() && self.exponent >= 1.0) {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "exponent"),
                 format!("must be a finite number >= 1, got {}", self.exponent),
             ));
@@ -58,76 +59,19 @@ impl ContactSpec {
     }
 }
 
-/// ADAMS Coulomb friction (eq. 4.5) with speeds in mm/s, as the thesis tables print them.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FrictionSpec {
-    /// Static coefficient mu_s. Tables 4.2, 5.2, 6.1: 0.1799.
-    pub mu_static: f64,
-    /// Dynamic coefficient mu_d. Tables 4.2, 5.2, 6.1: 0.1660.
-    pub mu_dynamic: f64,
-    /// Stiction transition speed v_s, mm/s. Tables 5.2, 6.1: 6.4634 (Table 4.2 rounds to 6.46).
-    pub stiction_transition_speed_mm_per_s: f64,
-    /// Friction transition speed v_d, mm/s (> v_s). Tables 4.2, 5.2, 6.1: 12.0.
-    pub friction_transition_speed_mm_per_s: f64,
-    /// Transition shape: `cycloidal` (eq. 4.6, default) or `cubic`.
-    #[serde(default)]
-    pub step: StepKind,
-}
-
-impl FrictionSpec {
-    /// Thesis Table 5.2 / 6.1 (dry anodized 7075 on 7075).
-    pub const fn thesis_default() -> Self {
-        Self {
-            mu_static: 0.1799,
-            mu_dynamic: 0.1660,
-            stiction_transition_speed_mm_per_s: 6.4634,
-            friction_transition_speed_mm_per_s: 12.0,
-            step: StepKind::Cycloidal,
-        }
-    }
-
-    /// Converts to SI [`FrictionParams`] (speeds in m/s).
-    pub fn to_friction_params(&self) -> FrictionParams {
-        FrictionParams {
-            mu_static: self.mu_static,
-            mu_dynamic: self.mu_dynamic,
-            stiction_transition_speed: units::mm(self.stiction_transition_speed_mm_per_s),
-            friction_transition_speed: units::mm(self.friction_transition_speed_mm_per_s),
-            step: self.step,
-        }
-    }
-
-    /// Field rules of [`FrictionParams::validate`], reported with this struct's field names.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
-        non_negative(prefix, "mu_static", self.mu_static)?;
-        non_negative(prefix, "mu_dynamic", self.mu_dynamic)?;
-        positive(
-            prefix,
-            "stiction_transition_speed_mm_per_s",
-            self.stiction_transition_speed_mm_per_s,
-        )?;
-        finite(
-            prefix,
-            "friction_transition_speed_mm_per_s",
-            self.friction_transition_speed_mm_per_s,
-        )?;
-        if self.friction_transition_speed_mm_per_s <= self.stiction_transition_speed_mm_per_s {
-            return Err(err(
-                path(prefix, "friction_transition_speed_mm_per_s"),
-                "must be greater than stiction_transition_speed_mm_per_s",
-            ));
-        }
-        Ok(())
-    }
+/// A case's friction (the one [`FrictionParams`] type, written in mm/s in case files through
+/// [`in_mm_per_s`]), checked with its own rules and reported at `prefix`
+/// (e.g. `rattle_box.friction.mu_dynamic`).
+pub fn validate_friction(friction: &FrictionParams, prefix: &str) -> Result<(), FieldError> {
+    friction.validate().map_err(|e| e.at(prefix))
 }
 
 /// The material of a case's contacting parts: the one [`Material`] type, checked with its own
 /// rules and reported at `prefix` (e.g. `rattle_box.material.poisson_ratio`).
-pub fn validate_material(material: &Material, prefix: &str) -> Result<(), SpecError> {
-    material.validate().map_err(|e| match e {
-        crate::wear::WearError::Invalid { field, rule } => err(path(prefix, field), rule),
-    })
+pub fn validate_material(material: &Material, prefix: &str) -> Result<(), FieldError> {
+    material
+        .validate()
+        .map_err(|crate::wear::WearError::Invalid(e)| e.at(prefix))
 }
 
 /// A box with rounded edges and corners (a convex contact piece, SPEC 2), given by its centre
@@ -146,12 +90,12 @@ pub struct RoundedBoxSpec {
 
 impl RoundedBoxSpec {
     /// Field rules: finite centre, half extents > edge radius >= 0.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         finite3(prefix, "centre_m", self.centre_m)?;
         non_negative(prefix, "edge_radius_m", self.edge_radius_m)?;
         for h in self.half_extents_m {
             if !(h.is_finite() && h > self.edge_radius_m) {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "half_extents_m"),
                     format!(
                         "each half extent must be finite and larger than edge_radius_m = {}, got {:?}",
@@ -270,12 +214,12 @@ pub(super) fn default_record_interval_s() -> f64 {
 impl SimulationSpec {
     /// Field rules: settle >= 0, duration > 0, tolerances in range, record interval in
     /// (0, duration], integrator a non-empty lower-case identifier.
-    pub fn validate(&self, prefix: &str) -> Result<(), SpecError> {
+    pub fn validate(&self, prefix: &str) -> Result<(), FieldError> {
         non_negative(prefix, "settle_s", self.settle_s)?;
         positive(prefix, "duration_s", self.duration_s)?;
         if !(self.rel_tolerance.is_finite() && self.rel_tolerance > 0.0 && self.rel_tolerance < 1.0)
         {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "rel_tolerance"),
                 format!("must lie in (0, 1), got {}", self.rel_tolerance),
             ));
@@ -284,7 +228,7 @@ impl SimulationSpec {
         positive(prefix, "record_interval_s", self.record_interval_s)?;
         if let Some(e) = self.energy_rel_tolerance {
             if !(e.is_finite() && (0.0..1.0).contains(&e)) {
-                return Err(err(
+                return Err(FieldError::new(
                     path(prefix, "energy_rel_tolerance"),
                     format!("must lie in [0, 1), got {e}"),
                 ));
@@ -292,7 +236,7 @@ impl SimulationSpec {
         }
         let (lo, hi) = crate::geometry::lattice::POINTS_PER_EDGE_RANGE;
         if !(lo..=hi).contains(&self.contact_points_per_edge) {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "contact_points_per_edge"),
                 format!(
                     "must lie in [{lo}, {hi}], got {}",
@@ -301,7 +245,7 @@ impl SimulationSpec {
             ));
         }
         if self.record_interval_s > self.duration_s {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "record_interval_s"),
                 "must not exceed duration_s",
             ));
@@ -312,7 +256,7 @@ impl SimulationSpec {
                 .chars()
                 .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-');
         if !ok {
-            return Err(err(
+            return Err(FieldError::new(
                 path(prefix, "integrator"),
                 format!(
                     "must be a lower-case name such as \"trbdf2\", got {:?}",

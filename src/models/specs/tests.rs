@@ -68,7 +68,7 @@ fn rattle_box_cases_match_table_5_1_and_5_2() {
         assert!((ip.stiffness - 1.0e9).abs() < 1.0);
         assert!((ip.max_damping - 5.0e5).abs() < 1e-6);
         assert!((ip.full_damping_depth - 1.0e-5).abs() < 1e-15);
-        let fp = rb.friction.to_friction_params();
+        let fp = rb.friction;
         assert!((fp.stiction_transition_speed - 6.4634e-3).abs() < 1e-12);
         assert!((fp.friction_transition_speed - 12.0e-3).abs() < 1e-12);
         assert!((rb.edge_radius_m - 0.02 * 0.0254).abs() < 1e-12);
