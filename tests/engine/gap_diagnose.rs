@@ -358,3 +358,77 @@ fn simulated_tables_follow_the_physics_and_the_report_is_written() {
         );
     }
 }
+
+/// Adaptive refinement (issue 15): a magnitude between grid points is simulated and inserted
+/// into the table, and the point is the simulator's, not the interpolation's: the cross-axis
+/// drive at the refined share s puts s² of the drive's mean square on each other axis (within
+/// 5 %, the tone's share of a window), at a share no grid point holds.
+#[test]
+fn refinement_simulates_the_requested_magnitude() {
+    let text = include_str!("../fixtures/small-campaign.toml");
+    let c = Campaign::from_toml_str(text, Path::new(".")).unwrap();
+    let options = EmulatorOptions {
+        window_s: 0.25,
+        settle_s: 0.05,
+        grid_points: 2,
+        effects: Some(vec!["cross_axis".into()]),
+        ..EmulatorOptions::default()
+    };
+    let cache = WindowCache::new();
+    let control = RunControl::silent();
+    let mut em = Emulator::build(&c, &configs(), &options, &control, &cache, &|_, _| {}).unwrap();
+    let table = 0;
+    let grid = em.effects[table].magnitudes.clone();
+    let share = (grid[grid.len() - 1] * grid[grid.len() - 2]).sqrt();
+    assert!(!grid.contains(&share));
+    let simulations = em.simulations;
+    let added = em
+        .refine(
+            &c,
+            &configs(),
+            &[(table, share), (table, share)],
+            &control,
+            &cache,
+            &|_, _| {},
+        )
+        .unwrap();
+    assert_eq!(added, 1, "a repeated request is simulated once");
+    let t = &em.effects[table];
+    assert_eq!(t.magnitudes.len(), grid.len() + 1);
+    assert!(
+        t.magnitudes.windows(2).all(|w| w[0] < w[1]),
+        "kept in order"
+    );
+    assert_eq!(em.simulations, simulations + c.tests.len());
+    let at = t.magnitudes.iter().position(|m| *m == share).unwrap();
+    for (ti, (nominal_test, with_test)) in em.nominal.iter().zip(&t.predictions[at]).enumerate() {
+        let (nominal, with) = (&nominal_test[0], &with_test[0]);
+        let drive_axis = (0..3)
+            .max_by(|a, b| nominal.input_ms[*a].total_cmp(&nominal.input_ms[*b]))
+            .unwrap();
+        for axis in (0..3).filter(|a| *a != drive_axis) {
+            let expected = share * share * nominal.input_ms[drive_axis];
+            assert!(
+                (with.input_ms[axis] - expected).abs() <= 0.05 * expected,
+                "test {ti} axis {axis}: {} vs {expected}",
+                with.input_ms[axis]
+            );
+        }
+    }
+    // Requests outside the table, at 0 or already held add nothing.
+    let again = em
+        .refine(
+            &c,
+            &configs(),
+            &[
+                (table, share),
+                (table, 0.0),
+                (table, 10.0 * grid[grid.len() - 1]),
+            ],
+            &control,
+            &cache,
+            &|_, _| {},
+        )
+        .unwrap();
+    assert_eq!(again, 0);
+}
