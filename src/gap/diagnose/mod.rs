@@ -510,15 +510,20 @@ pub fn diagnose(
 ) -> Result<(Report, Emulator), GapError> {
     campaign.validate(configs_dir)?;
     check_options(options)?;
-    let emulator = Emulator::build(
+    let built = std::sync::atomic::AtomicUsize::new(0);
+    let mut emulator = Emulator::build(
         campaign,
         configs_dir,
         &options.emulator,
         control,
         cache,
-        progress,
+        &|done, total| {
+            built.fetch_max(done, std::sync::atomic::Ordering::SeqCst);
+            progress(done, total)
+        },
     )?;
-    let mut emulator = emulator;
+    // Refinement's simulations count on from the emulator's, so progress never goes back.
+    let offset = built.into_inner();
     let report = diagnose_refining(
         campaign,
         &mut emulator,
@@ -526,7 +531,7 @@ pub fn diagnose(
         configs_dir,
         control,
         cache,
-        progress,
+        &|done, total| progress(offset + done, offset + total),
     )?;
     Ok((report, emulator))
 }
@@ -545,12 +550,25 @@ pub fn diagnose_refining(
     cache: &WindowCache,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Report, GapError> {
+    // `progress` counts the test simulations of every round: a round's are added to those
+    // done before it, so the count never goes back (the total grows by what a round adds).
+    let mut done_before = 0;
     for _ in 0..options.refine_rounds {
         let requests = refinement_requests(campaign, emulator, options);
         if requests.is_empty() {
             break;
         }
-        let added = emulator.refine(campaign, configs_dir, &requests, control, cache, progress)?;
+        let offset = done_before;
+        let cumulative = |done: usize, total: usize| progress(offset + done, offset + total);
+        let added = emulator.refine(
+            campaign,
+            configs_dir,
+            &requests,
+            control,
+            cache,
+            &cumulative,
+        )?;
+        done_before = offset + added * campaign.tests.len();
         if added == 0 {
             break;
         }
