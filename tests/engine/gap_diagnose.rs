@@ -247,6 +247,24 @@ fn the_true_effect_is_named_with_its_magnitude() {
         assert!(best.shrink > 0.5 && best.shrink_interval[0] <= best.shrink);
         // Where: the groups that miss are flagged.
         assert!(r.location.any_flagged());
+        // Held-out predictions of every measured mass: with the effect fitted on the other
+        // tests the masses' error (in the measurement's uncertainty about the nominal) is at
+        // most half the nominal's, the shrink the issue asks of a found effect; the nominal
+        // misses by far more than the noise. (Cross-axis drive acts on the accelerations.)
+        let masses = &r.held_out_predictions;
+        assert!(!masses.is_empty());
+        assert!(masses.iter().all(|m| m.effect == name));
+        let rms = |f: &dyn Fn(&railwear::gap::diagnose::HeldOutPrediction) -> f64| {
+            (masses.iter().map(|m| f(m).powi(2)).sum::<f64>() / masses.len() as f64).sqrt()
+        };
+        let with = rms(&|m| (m.measured_mg - m.with_effect_mg) / m.uncertainty_mg);
+        let nominal = rms(&|m| (m.measured_mg - m.nominal_mg) / m.uncertainty_mg);
+        if name != "cross_axis" {
+            assert!(
+                with < 0.5 * nominal && nominal > 3.0,
+                "{name}: {with} vs {nominal}"
+            );
+        }
     }
 }
 

@@ -254,8 +254,38 @@ pub struct Report {
     pub alpha: f64,
     /// Predictions.
     pub emulator: EmulatorReport,
+    /// Held-out predictions of every measured mass: the nominal model's and the best-ranked
+    /// single effect's, fitted without the observation's group (what the model, given the
+    /// other tests, says this test should have lost).
+    #[serde(default)]
+    pub held_out_predictions: Vec<HeldOutPrediction>,
     /// railwear version.
     pub code_version: String,
+}
+
+/// One measured mass and what the model predicts for it when its group is held out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HeldOutPrediction {
+    /// Held-out group (test or increment).
+    pub group: String,
+    /// Test id.
+    pub test: String,
+    /// Increment, from 1.
+    pub increment: usize,
+    /// Quantity (`mass cube`).
+    pub quantity: String,
+    /// Specimens' mean, mg.
+    pub measured_mg: f64,
+    /// Its standard uncertainty about the nominal prediction, mg.
+    pub uncertainty_mg: f64,
+    /// Nominal model, mg.
+    pub nominal_mg: f64,
+    /// Best-ranked single effect (name), fitted on the other groups.
+    pub effect: String,
+    /// Its magnitude fitted without this group.
+    pub magnitude: f64,
+    /// The prediction with it, mg.
+    pub with_effect_mg: f64,
 }
 
 /// Likelihood of one prediction set.
@@ -757,6 +787,10 @@ pub fn diagnose_with(
         explains: c.explains(&nominal),
     };
     let ranking: Vec<RankEntry> = order.iter().map(|&i| entry(&singles[i], 1 + i)).collect();
+    let held_out_predictions = order
+        .first()
+        .map(|&i| held_out_predictions(campaign, &problem, &singles[i]))
+        .unwrap_or_default();
     let pair_entries: Vec<RankEntry> = pairs
         .iter()
         .enumerate()
@@ -855,8 +889,50 @@ pub fn diagnose_with(
                 "specimen scatter is common to a specimen's increments; that correlation is not modelled".into(),
             ],
         },
+        held_out_predictions,
         code_version: crate::models::case::code_version().to_string(),
     })
+}
+
+/// Every measured mass with the nominal prediction and `c`'s prediction at the magnitude
+/// fitted without the mass's group.
+fn held_out_predictions(
+    campaign: &Campaign,
+    problem: &Problem,
+    c: &Candidate,
+) -> Vec<HeldOutPrediction> {
+    let nominal = problem.emulator.predict(&[]);
+    let folds: Vec<emulator::TestPredictions> = c
+        .fold_magnitudes
+        .iter()
+        .map(|m| {
+            let spec: Vec<(usize, f64)> =
+                c.effects.iter().copied().zip(m.iter().copied()).collect();
+            problem.emulator.predict(&spec)
+        })
+        .collect();
+    problem
+        .obs
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| matches!(o.quantity, noise::Quantity::Mass(_)))
+        .map(|(i, o)| {
+            let g = problem.group[i];
+            let mu = o.predicted(&nominal);
+            HeldOutPrediction {
+                group: problem.group_labels[g].clone(),
+                test: campaign.tests[o.test].id.clone(),
+                increment: o.increment + 1,
+                quantity: o.quantity.label(),
+                measured_mg: o.value,
+                uncertainty_mg: problem.noise.u(o, mu),
+                nominal_mg: mu,
+                effect: problem.name_of(&c.effects),
+                magnitude: c.fold_magnitudes[g].first().copied().unwrap_or(0.0),
+                with_effect_mg: o.predicted(&folds[g]),
+            }
+        })
+        .collect()
 }
 
 fn best_effect(
