@@ -20,6 +20,9 @@ pub mod config;
 pub mod contact_models;
 pub mod excitation;
 pub mod field_error;
+/// The house rules (import floors, file length), checked on the source tree.
+#[cfg(test)]
+mod floors;
 pub mod gap;
 pub mod geometry;
 pub mod http;

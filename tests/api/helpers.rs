@@ -238,7 +238,7 @@ pub struct TestApp {
     pub api: Api,
     pub service: RunningService,
     /// Holds the SQLite file; removed when the app drops.
-    _dir: TempDir,
+    dir: TempDir,
 }
 
 impl std::ops::Deref for TestApp {
@@ -276,13 +276,16 @@ impl TestApp {
         TestApp {
             api: Api::new(&format!("http://{}", service.addr)),
             service,
-            _dir: dir,
+            dir,
         }
     }
 
     /// Clean shutdown ([`RunningService::stop`]); the database goes with the app.
-    pub async fn stop(self) {
+    /// Stops the service; the returned guard keeps its database file until it drops, for a
+    /// test that reads the store after the shutdown.
+    pub async fn stop(self) -> TempDir {
         self.service.stop().await;
+        self.dir
     }
 }
 

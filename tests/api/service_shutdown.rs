@@ -144,7 +144,7 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
     .await
     .unwrap();
     let asked = Instant::now();
-    app.stop().await;
+    let _db = app.stop().await;
     let took = asked.elapsed();
     assert!(
         took >= Duration::from_millis(450) && took < Duration::from_millis(1500),

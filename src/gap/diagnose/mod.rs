@@ -29,17 +29,24 @@
 
 pub mod bench;
 pub mod emulator;
+mod how_far;
 pub mod location;
 pub mod noise;
 pub mod plots;
+pub mod prediction;
+mod refine;
+mod report;
 pub mod stats;
+pub mod table;
 
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
 use emulator::{Emulator, EmulatorOptions};
+use how_far::{best_effect, held_out_predictions};
 use noise::{NoiseModel, Observation};
-use serde::{Deserialize, Serialize};
+pub use refine::diagnose_refining;
+pub use report::*;
 use std::path::Path;
 
 /// Held-out log-likelihood gain over the nominal model an effect must exceed to count as an
@@ -97,195 +104,6 @@ impl Default for DiagnoseOptions {
             refine_rounds: REFINE_ROUNDS,
         }
     }
-}
-
-/// The verdict.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Verdict {
-    /// The nominal model agrees with the measurements within their uncertainty.
-    NoGap,
-    /// An effect (or a pair) explains the gap on held-out tests.
-    Explained,
-    /// There is a gap and no effect of the library explains it.
-    NotExplained,
-}
-
-/// A fitted or fixed parameter of the chosen effect.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FittedParameter {
-    /// Effect.
-    pub effect: String,
-    /// Parameter name.
-    pub name: String,
-    /// Unit.
-    pub unit: String,
-    /// Value (fitted on all tests, or the library default when not fitted).
-    pub value: f64,
-    /// 95 % profile-likelihood interval (fitted parameters), clipped to the bounds.
-    pub interval: Option<[f64; 2]>,
-    /// Physical bounds.
-    pub bounds: [f64; 2],
-    /// True when fitted; false when held at the library default.
-    pub fitted: bool,
-}
-
-/// The chosen effect and how far it closes the gap.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BestEffect {
-    /// Effect name, or `a+b` for a pair.
-    pub name: String,
-    /// Parameters.
-    pub parameters: Vec<FittedParameter>,
-    /// Held-out RMS standardized error of the nominal model.
-    pub held_out_error_before: f64,
-    /// Held-out RMS standardized error with the effect.
-    pub held_out_error_after: f64,
-    /// 1 - after / before.
-    pub shrink: f64,
-    /// 90 % bootstrap interval of the shrink (over held-out groups).
-    pub shrink_interval: [f64; 2],
-    /// Lack-of-fit p-value of the residuals left with the effect (full-data fit).
-    pub residual_p_value: f64,
-    /// Held-out RMS standardized error per held-out group, before and after.
-    pub per_group: Vec<GroupError>,
-}
-
-/// Held-out error of one held-out group.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GroupError {
-    /// Group (test id, or increment).
-    pub group: String,
-    /// Nominal model.
-    pub before: f64,
-    /// With the effect.
-    pub after: f64,
-}
-
-/// One candidate in the ranking.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RankEntry {
-    /// Effect name, `a+b` for a pair, `none` for the nominal model.
-    pub name: String,
-    /// Fitted magnitudes (full data), in the order of the names.
-    pub magnitudes: Vec<f64>,
-    /// Parameters fitted.
-    pub parameters: usize,
-    /// Held-out log-likelihood (sum over held-out groups).
-    pub held_out_log_likelihood: f64,
-    /// Gain over the nominal model's held-out log-likelihood.
-    pub held_out_gain: f64,
-    /// Held-out RMS standardized error.
-    pub held_out_error: f64,
-    /// AICc of the full-data fit.
-    pub aicc: f64,
-    /// BIC of the full-data fit.
-    pub bic: f64,
-    /// Lack-of-fit p-value of the full-data fit.
-    pub residual_p_value: f64,
-    /// Bootstrap probability of ranking first (among candidates and the nominal).
-    pub p_first: f64,
-    /// Share of the nominal model's excess chi-square (chi2 - dof) the full-data fit removes.
-    pub explained_share: f64,
-    /// Explains the gap: gain > MIN_HELD_OUT_GAIN, residual p-value >= alpha and at least
-    /// [`MIN_EXPLAINED_SHARE`] of the excess removed.
-    pub explains: bool,
-}
-
-/// Fit of the nominal model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct NominalFit {
-    /// Weighted sum of squared standardized residuals.
-    pub chi2: f64,
-    /// Degrees of freedom (weighted observation count).
-    pub dof: f64,
-    /// Lack-of-fit p-value.
-    pub p_value: f64,
-    /// Held-out log-likelihood (no parameter: the plain log-likelihood).
-    pub held_out_log_likelihood: f64,
-    /// RMS standardized error.
-    pub held_out_error: f64,
-}
-
-/// How the predictions were made.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct EmulatorReport {
-    /// Simulated excitation per increment, s.
-    pub window_s: f64,
-    /// Settle, s.
-    pub settle_s: f64,
-    /// Windows simulated.
-    pub simulations: usize,
-    /// Dynamics-effect grid points (positive side).
-    pub grid_points: usize,
-    /// Approximations, in words.
-    pub approximations: Vec<String>,
-}
-
-/// The diagnosis report.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Report {
-    /// Campaign name.
-    pub campaign: String,
-    /// Verdict.
-    pub verdict: Verdict,
-    /// One sentence.
-    pub summary: String,
-    /// The effect (or pair) chosen, when explained.
-    pub best_effect: Option<BestEffect>,
-    /// Other explaining candidates that cannot be told apart from the best.
-    pub indistinguishable: Vec<String>,
-    /// Single effects, best held-out log-likelihood first.
-    pub ranking: Vec<RankEntry>,
-    /// Pairs tried (when no single effect explains).
-    pub pairs: Vec<RankEntry>,
-    /// Where the nominal model misses.
-    #[serde(rename = "where")]
-    pub location: location::Where,
-    /// Nominal fit.
-    pub nominal: NominalFit,
-    /// Uncertainty model.
-    pub noise: noise::NoiseReport,
-    /// Hold-out scheme.
-    pub held_out: String,
-    /// Multiple-comparison correction.
-    pub multiple_comparisons: String,
-    /// Significance level.
-    pub alpha: f64,
-    /// Predictions.
-    pub emulator: EmulatorReport,
-    /// Held-out predictions of every measured mass: the nominal model's and the best-ranked
-    /// single effect's, fitted without the observation's group (what the model, given the
-    /// other tests, says this test should have lost).
-    #[serde(default)]
-    pub held_out_predictions: Vec<HeldOutPrediction>,
-    /// railwear version.
-    pub code_version: String,
-}
-
-/// One measured mass and what the model predicts for it when its group is held out.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct HeldOutPrediction {
-    /// Held-out group (test or increment).
-    pub group: String,
-    /// Test id.
-    pub test: String,
-    /// Increment, from 1.
-    pub increment: usize,
-    /// Quantity (`mass cube`).
-    pub quantity: String,
-    /// Specimens' mean, mg.
-    pub measured_mg: f64,
-    /// Its standard uncertainty about the nominal prediction, mg.
-    pub uncertainty_mg: f64,
-    /// Nominal model, mg.
-    pub nominal_mg: f64,
-    /// Best-ranked single effect (name), fitted on the other groups.
-    pub effect: String,
-    /// Its magnitude fitted without this group.
-    pub magnitude: f64,
-    /// The prediction with it, mg.
-    pub with_effect_mg: f64,
 }
 
 /// Likelihood of one prediction set.
@@ -566,82 +384,6 @@ pub fn diagnose(
     Ok((report, emulator))
 }
 
-/// The diagnosis after up to `options.refine_rounds` rounds of adaptive refinement of the
-/// emulator's dynamics tables ([`Emulator::refine`]): while the contending effects' fits land
-/// between simulated magnitudes, those magnitudes are simulated and the fits repeated, so the
-/// verdict rests on the simulator at the fitted magnitudes rather than on interpolation.
-/// Nothing is refined when the nominal model shows no gap.
-pub fn diagnose_refining(
-    campaign: &Campaign,
-    emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Report, GapError> {
-    // `progress` counts the test simulations of every round: a round's are added to those
-    // done before it, so the count never goes back (the total grows by what a round adds).
-    let mut done_before = 0;
-    for _ in 0..options.refine_rounds {
-        let requests = refinement_requests(campaign, emulator, options);
-        if requests.is_empty() {
-            break;
-        }
-        let offset = done_before;
-        let cumulative = |done: usize, total: usize| progress(offset + done, offset + total);
-        let added = emulator.refine(
-            campaign,
-            configs_dir,
-            &requests,
-            control,
-            cache,
-            &cumulative,
-        )?;
-        done_before = offset + added * campaign.tests.len();
-        if added == 0 {
-            break;
-        }
-    }
-    diagnose_with(campaign, emulator, options)
-}
-
-/// Magnitudes the next refinement round simulates: for the [`REFINE_CONTENDERS`] simulated
-/// effects whose held-out fit beats the nominal, the full-data and every training fold's
-/// fitted magnitude. Empty when the nominal model shows no gap.
-fn refinement_requests(
-    campaign: &Campaign,
-    emulator: &Emulator,
-    options: &DiagnoseOptions,
-) -> Vec<(usize, f64)> {
-    let problem = Problem::new(campaign, emulator, options);
-    if problem.obs.is_empty() {
-        return Vec::new();
-    }
-    let nominal = problem.evaluate(&[], options.alpha);
-    let nominal_p = stats::chi2_sf(nominal.chi2, nominal.dof.round().max(1.0) as usize);
-    if nominal_p >= options.alpha && !location::locate(campaign, &problem).any_flagged() {
-        return Vec::new();
-    }
-    let mut contenders: Vec<Candidate> = (0..emulator.effects.len())
-        .filter(|&e| emulator.effects[e].simulated)
-        .map(|e| problem.evaluate(&[e], options.alpha))
-        .filter(|c| c.held_ll() > nominal.held_ll())
-        .collect();
-    contenders.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
-    contenders
-        .iter()
-        .take(REFINE_CONTENDERS)
-        .flat_map(|c| {
-            let e = c.effects[0];
-            std::iter::once(c.magnitudes[0])
-                .chain(c.fold_magnitudes.iter().map(|m| m[0]))
-                .map(move |m| (e, m))
-        })
-        .filter(|(_, m)| *m != 0.0)
-        .collect()
-}
-
 fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
     let rule = GapError::require;
     rule(
@@ -892,120 +634,4 @@ pub fn diagnose_with(
         held_out_predictions,
         code_version: crate::models::case::code_version().to_string(),
     })
-}
-
-/// Every measured mass with the nominal prediction and `c`'s prediction at the magnitude
-/// fitted without the mass's group.
-fn held_out_predictions(
-    campaign: &Campaign,
-    problem: &Problem,
-    c: &Candidate,
-) -> Vec<HeldOutPrediction> {
-    let nominal = problem.emulator.predict(&[]);
-    let folds: Vec<emulator::TestPredictions> = c
-        .fold_magnitudes
-        .iter()
-        .map(|m| {
-            let spec: Vec<(usize, f64)> =
-                c.effects.iter().copied().zip(m.iter().copied()).collect();
-            problem.emulator.predict(&spec)
-        })
-        .collect();
-    problem
-        .obs
-        .iter()
-        .enumerate()
-        .filter(|(_, o)| matches!(o.quantity, noise::Quantity::Mass(_)))
-        .map(|(i, o)| {
-            let g = problem.group[i];
-            let mu = o.predicted(&nominal);
-            HeldOutPrediction {
-                group: problem.group_labels[g].clone(),
-                test: campaign.tests[o.test].id.clone(),
-                increment: o.increment + 1,
-                quantity: o.quantity.label(),
-                measured_mg: o.value,
-                uncertainty_mg: problem.noise.u(o, mu),
-                nominal_mg: mu,
-                effect: problem.name_of(&c.effects),
-                magnitude: c.fold_magnitudes[g].first().copied().unwrap_or(0.0),
-                with_effect_mg: o.predicted(&folds[g]),
-            }
-        })
-        .collect()
-}
-
-fn best_effect(
-    problem: &Problem,
-    c: &Candidate,
-    nominal: &Candidate,
-    resamples: &[Vec<usize>],
-) -> BestEffect {
-    let before = nominal.held_error();
-    let after = c.held_error();
-    let shrinks: Vec<f64> = resamples
-        .iter()
-        .map(|idx| {
-            let rb: f64 = idx.iter().map(|g| nominal.held_r2[*g]).sum();
-            let ra: f64 = idx.iter().map(|g| c.held_r2[*g]).sum();
-            if rb > 0.0 {
-                1.0 - (ra / rb).sqrt()
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let mut parameters = Vec::new();
-    for (&e, &m) in c.effects.iter().zip(&c.magnitudes) {
-        let info = problem.emulator.effects[e].info;
-        let interval = (c.effects.len() == 1).then(|| profile_interval(problem, e, m));
-        for (pi, p) in info.parameters.iter().enumerate() {
-            parameters.push(FittedParameter {
-                effect: info.name.to_string(),
-                name: p.name.to_string(),
-                unit: p.unit.to_string(),
-                value: if pi == 0 { m } else { p.default },
-                interval: if pi == 0 { interval } else { None },
-                bounds: [p.min, p.max],
-                fitted: pi == 0,
-            });
-        }
-    }
-    BestEffect {
-        name: problem.name_of(&c.effects),
-        parameters,
-        held_out_error_before: before,
-        held_out_error_after: after,
-        shrink: if before > 0.0 {
-            1.0 - after / before
-        } else {
-            0.0
-        },
-        shrink_interval: [
-            stats::quantile(&shrinks, 0.05),
-            stats::quantile(&shrinks, 0.95),
-        ],
-        residual_p_value: c.residual_p,
-        per_group: (0..problem.groups)
-            .map(|g| GroupError {
-                group: problem.group_labels[g].clone(),
-                before: (nominal.held_r2[g] / nominal.held_w[g].max(1e-300)).sqrt(),
-                after: (c.held_r2[g] / c.held_w[g].max(1e-300)).sqrt(),
-            })
-            .collect(),
-    }
-}
-
-/// 95 % profile-likelihood interval of one effect's magnitude around its full-data optimum.
-fn profile_interval(problem: &Problem, e: usize, best: f64) -> [f64; 2] {
-    let nll = |m: f64| problem.nll_of(&[(e, m)], |_| true);
-    let floor = nll(best);
-    let cands = problem.candidates(e);
-    let inside: Vec<f64> = cands
-        .into_iter()
-        .filter(|m| nll(*m) <= floor + PROFILE_95)
-        .collect();
-    let lo = inside.iter().copied().fold(best, f64::min);
-    let hi = inside.iter().copied().fold(best, f64::max);
-    [lo, hi]
 }

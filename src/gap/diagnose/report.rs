@@ -1,0 +1,195 @@
+//! The diagnosis report (`railwear diagnose --json`, the diagnose job's result): verdict, the
+//! chosen effect and how far it closes the gap, the ranking, where the residuals lie, the
+//! nominal fit, the noise model, how the predictions were made and the held-out predictions.
+
+use super::{location, noise};
+use serde::{Deserialize, Serialize};
+
+/// The verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// The nominal model agrees with the measurements within their uncertainty.
+    NoGap,
+    /// An effect (or a pair) explains the gap on held-out tests.
+    Explained,
+    /// There is a gap and no effect of the library explains it.
+    NotExplained,
+}
+
+/// A fitted or fixed parameter of the chosen effect.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedParameter {
+    /// Effect.
+    pub effect: String,
+    /// Parameter name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Value (fitted on all tests, or the library default when not fitted).
+    pub value: f64,
+    /// 95 % profile-likelihood interval (fitted parameters), clipped to the bounds.
+    pub interval: Option<[f64; 2]>,
+    /// Physical bounds.
+    pub bounds: [f64; 2],
+    /// True when fitted; false when held at the library default.
+    pub fitted: bool,
+}
+
+/// The chosen effect and how far it closes the gap.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BestEffect {
+    /// Effect name, or `a+b` for a pair.
+    pub name: String,
+    /// Parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Held-out RMS standardized error of the nominal model.
+    pub held_out_error_before: f64,
+    /// Held-out RMS standardized error with the effect.
+    pub held_out_error_after: f64,
+    /// 1 - after / before.
+    pub shrink: f64,
+    /// 90 % bootstrap interval of the shrink (over held-out groups).
+    pub shrink_interval: [f64; 2],
+    /// Lack-of-fit p-value of the residuals left with the effect (full-data fit).
+    pub residual_p_value: f64,
+    /// Held-out RMS standardized error per held-out group, before and after.
+    pub per_group: Vec<GroupError>,
+}
+
+/// Held-out error of one held-out group.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupError {
+    /// Group (test id, or increment).
+    pub group: String,
+    /// Nominal model.
+    pub before: f64,
+    /// With the effect.
+    pub after: f64,
+}
+
+/// One candidate in the ranking.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RankEntry {
+    /// Effect name, `a+b` for a pair, `none` for the nominal model.
+    pub name: String,
+    /// Fitted magnitudes (full data), in the order of the names.
+    pub magnitudes: Vec<f64>,
+    /// Parameters fitted.
+    pub parameters: usize,
+    /// Held-out log-likelihood (sum over held-out groups).
+    pub held_out_log_likelihood: f64,
+    /// Gain over the nominal model's held-out log-likelihood.
+    pub held_out_gain: f64,
+    /// Held-out RMS standardized error.
+    pub held_out_error: f64,
+    /// AICc of the full-data fit.
+    pub aicc: f64,
+    /// BIC of the full-data fit.
+    pub bic: f64,
+    /// Lack-of-fit p-value of the full-data fit.
+    pub residual_p_value: f64,
+    /// Bootstrap probability of ranking first (among candidates and the nominal).
+    pub p_first: f64,
+    /// Share of the nominal model's excess chi-square (chi2 - dof) the full-data fit removes.
+    pub explained_share: f64,
+    /// Explains the gap: gain > MIN_HELD_OUT_GAIN, residual p-value >= alpha and at least
+    /// [`MIN_EXPLAINED_SHARE`] of the excess removed.
+    pub explains: bool,
+}
+
+/// Fit of the nominal model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NominalFit {
+    /// Weighted sum of squared standardized residuals.
+    pub chi2: f64,
+    /// Degrees of freedom (weighted observation count).
+    pub dof: f64,
+    /// Lack-of-fit p-value.
+    pub p_value: f64,
+    /// Held-out log-likelihood (no parameter: the plain log-likelihood).
+    pub held_out_log_likelihood: f64,
+    /// RMS standardized error.
+    pub held_out_error: f64,
+}
+
+/// How the predictions were made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EmulatorReport {
+    /// Simulated excitation per increment, s.
+    pub window_s: f64,
+    /// Settle, s.
+    pub settle_s: f64,
+    /// Windows simulated.
+    pub simulations: usize,
+    /// Dynamics-effect grid points (positive side).
+    pub grid_points: usize,
+    /// Approximations, in words.
+    pub approximations: Vec<String>,
+}
+
+/// The diagnosis report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Campaign name.
+    pub campaign: String,
+    /// Verdict.
+    pub verdict: Verdict,
+    /// One sentence.
+    pub summary: String,
+    /// The effect (or pair) chosen, when explained.
+    pub best_effect: Option<BestEffect>,
+    /// Other explaining candidates that cannot be told apart from the best.
+    pub indistinguishable: Vec<String>,
+    /// Single effects, best held-out log-likelihood first.
+    pub ranking: Vec<RankEntry>,
+    /// Pairs tried (when no single effect explains).
+    pub pairs: Vec<RankEntry>,
+    /// Where the nominal model misses.
+    #[serde(rename = "where")]
+    pub location: location::Where,
+    /// Nominal fit.
+    pub nominal: NominalFit,
+    /// Uncertainty model.
+    pub noise: noise::NoiseReport,
+    /// Hold-out scheme.
+    pub held_out: String,
+    /// Multiple-comparison correction.
+    pub multiple_comparisons: String,
+    /// Significance level.
+    pub alpha: f64,
+    /// Predictions.
+    pub emulator: EmulatorReport,
+    /// Held-out predictions of every measured mass: the nominal model's and the best-ranked
+    /// single effect's, fitted without the observation's group (what the model, given the
+    /// other tests, says this test should have lost).
+    #[serde(default)]
+    pub held_out_predictions: Vec<HeldOutPrediction>,
+    /// railwear version.
+    pub code_version: String,
+}
+
+/// One measured mass and what the model predicts for it when its group is held out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HeldOutPrediction {
+    /// Held-out group (test or increment).
+    pub group: String,
+    /// Test id.
+    pub test: String,
+    /// Increment, from 1.
+    pub increment: usize,
+    /// Quantity (`mass cube`).
+    pub quantity: String,
+    /// Specimens' mean, mg.
+    pub measured_mg: f64,
+    /// Its standard uncertainty about the nominal prediction, mg.
+    pub uncertainty_mg: f64,
+    /// Nominal model, mg.
+    pub nominal_mg: f64,
+    /// Best-ranked single effect (name), fitted on the other groups.
+    pub effect: String,
+    /// Its magnitude fitted without this group.
+    pub magnitude: f64,
+    /// The prediction with it, mg.
+    pub with_effect_mg: f64,
+}
