@@ -29,7 +29,6 @@ struct HttpHistogram {
     sum_s: f64,
 }
 
-/// A number as Prometheus text, never `-0` (an empty float sum is -0.0 in Rust).
 /// One unlabelled metric: its HELP and TYPE lines and its value.
 fn scalar(out: &mut String, name: &str, kind: &str, help: &str, value: impl std::fmt::Display) {
     let _ = writeln!(out, "# HELP {name} {help}");
@@ -37,6 +36,25 @@ fn scalar(out: &mut String, name: &str, kind: &str, help: &str, value: impl std:
     let _ = writeln!(out, "{name} {value}");
 }
 
+/// One labelled series of a histogram: its cumulative buckets (`le` = each bound, then
+/// `+Inf`), sum and count.
+fn histogram_series(
+    out: &mut String,
+    name: &str,
+    labels: &str,
+    buckets: impl Iterator<Item = (u64, f64)>,
+    count: u64,
+    sum_s: f64,
+) {
+    for (n, bound) in buckets {
+        let _ = writeln!(out, "{name}_bucket{{{labels},le=\"{bound}\"}} {n}");
+    }
+    let _ = writeln!(out, "{name}_bucket{{{labels},le=\"+Inf\"}} {count}");
+    let _ = writeln!(out, "{name}_sum{{{labels}}} {}", num(sum_s));
+    let _ = writeln!(out, "{name}_count{{{labels}}} {count}");
+}
+
+/// A number as Prometheus text, never `-0` (an empty float sum is -0.0 in Rust).
 fn num(x: f64) -> f64 {
     x + 0.0
 }
@@ -204,12 +222,13 @@ impl Metrics {
             .iter()
             .find(|(s, _)| *s == JobStatus::Queued)
             .map_or(0, |(_, n)| *n);
-        let _ = writeln!(
-            out,
-            "# HELP railwear_queue_depth Jobs waiting for a worker."
+        scalar(
+            &mut out,
+            "railwear_queue_depth",
+            "gauge",
+            "Jobs waiting for a worker.",
+            queued,
         );
-        let _ = writeln!(out, "# TYPE railwear_queue_depth gauge");
-        let _ = writeln!(out, "railwear_queue_depth {queued}");
         self.with(|m| {
             let _ = writeln!(
                 out,
@@ -223,23 +242,14 @@ impl Metrics {
                     continue;
                 };
                 let labels = format!("kind=\"{}\",status=\"{}\"", key.0, key.1);
-                for (count, bound) in h.counts.iter().zip(DURATION_BUCKETS_S) {
-                    let _ = writeln!(
-                        out,
-                        "railwear_job_duration_seconds_bucket{{{labels},le=\"{bound}\"}} {count}"
-                    );
-                }
-                let _ = writeln!(
-                    out,
-                    "railwear_job_duration_seconds_bucket{{{labels},le=\"+Inf\"}} {}",
-                    h.count
+                histogram_series(
+                    &mut out,
+                    "railwear_job_duration_seconds",
+                    &labels,
+                    h.counts.iter().copied().zip(DURATION_BUCKETS_S),
+                    h.count,
+                    h.sum_s,
                 );
-                let _ = writeln!(
-                    out,
-                    "railwear_job_duration_seconds_sum{{{labels}}} {}",
-                    num(h.sum_s)
-                );
-                let _ = writeln!(out, "railwear_job_duration_seconds_count{{{labels}}} {}", h.count);
             }
             scalar(
                 &mut out,
@@ -323,26 +333,13 @@ impl Metrics {
                     continue;
                 };
                 let labels = format!("method=\"{}\",route=\"{}\"", key.0, key.1);
-                for (count, bound) in h.counts.iter().zip(HTTP_BUCKETS_S) {
-                    let _ = writeln!(
-                        out,
-                        "railwear_http_request_duration_seconds_bucket{{{labels},le=\"{bound}\"}} {count}"
-                    );
-                }
-                let _ = writeln!(
-                    out,
-                    "railwear_http_request_duration_seconds_bucket{{{labels},le=\"+Inf\"}} {}",
-                    h.count
-                );
-                let _ = writeln!(
-                    out,
-                    "railwear_http_request_duration_seconds_sum{{{labels}}} {}",
-                    num(h.sum_s)
-                );
-                let _ = writeln!(
-                    out,
-                    "railwear_http_request_duration_seconds_count{{{labels}}} {}",
-                    h.count
+                histogram_series(
+                    &mut out,
+                    "railwear_http_request_duration_seconds",
+                    &labels,
+                    h.counts.iter().copied().zip(HTTP_BUCKETS_S),
+                    h.count,
+                    h.sum_s,
                 );
             }
         });
