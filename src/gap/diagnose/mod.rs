@@ -358,6 +358,10 @@ pub fn diagnose(
 ) -> Result<(Report, Emulator), GapError> {
     campaign.validate(configs_dir)?;
     check_options(options)?;
+    // Refused before anything is simulated.
+    if noise::observations(campaign).is_empty() {
+        return Err(no_measurement());
+    }
     let built = std::sync::atomic::AtomicUsize::new(0);
     let mut emulator = Emulator::build(
         campaign,
@@ -446,6 +450,14 @@ fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
     Ok(())
 }
 
+/// A campaign with nothing measured (a skeleton for the rig) cannot be diagnosed.
+fn no_measurement() -> GapError {
+    GapError::field(
+        "tests",
+        "the campaign has no measurement to diagnose (every mass_loss_mg is empty)",
+    )
+}
+
 /// The diagnosis on an emulator already built for `campaign` (the bench reuses one emulator
 /// for many campaigns drawn on the same tests).
 pub fn diagnose_with(
@@ -455,10 +467,7 @@ pub fn diagnose_with(
 ) -> Result<Report, GapError> {
     let problem = Problem::new(campaign, emulator, options);
     if problem.obs.is_empty() {
-        return Err(GapError::field(
-            "tests",
-            "the campaign has no measurement to diagnose (every mass_loss_mg is empty)",
-        ));
+        return Err(no_measurement());
     }
     let alpha = options.alpha;
     let nominal = problem.evaluate(&[], alpha);

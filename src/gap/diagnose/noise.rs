@@ -220,6 +220,27 @@ pub struct NoiseReport {
     pub friction_mass_rel: f64,
 }
 
+/// The model's relative variance of one observation (docs/diagnosis.md, "Uncertainty"): the
+/// numerical spread squared, plus the friction sensitivity squared, plus for masses the wear
+/// coefficient's relative uncertainty squared, for mean squares twice the accelerometer
+/// calibration uncertainty squared (a sensitivity off by a factor 1 + e scales a mean square by
+/// (1 + e)^2, about 1 + 2e).
+fn model_rel_var(
+    quantity: &Quantity,
+    numerical_rel: f64,
+    friction_rel: f64,
+    options: &DiagnoseOptions,
+) -> f64 {
+    let numerical = numerical_rel.powi(2);
+    let friction = friction_rel * friction_rel;
+    match quantity {
+        Quantity::Mass(_) => numerical + options.k_rel_uncertainty.powi(2) + friction,
+        Quantity::Accel(..) => {
+            numerical + friction + (2.0 * options.accelerometer_calibration_rel).powi(2)
+        }
+    }
+}
+
 fn rel_diff(a: f64, b: f64) -> Option<f64> {
     let m = a.abs().max(b.abs());
     (m > 0.0).then(|| (a - b).abs() / m)
@@ -314,19 +335,11 @@ impl NoiseModel {
         for o in obs.iter_mut() {
             let nominal = o.predicted(&emulator.nominal);
             let fr = rel_diff(nominal, o.predicted(&emulator.friction_step)).unwrap_or(0.0);
-            o.model_rel_var = match &o.quantity {
-                Quantity::Mass(_) => {
-                    numerical_mass_rel.powi(2) + options.k_rel_uncertainty.powi(2) + fr * fr
-                }
-                q => {
-                    numerical_accel_rel
-                        .get(&q.label())
-                        .copied()
-                        .unwrap_or(0.0)
-                        .powi(2)
-                        + fr * fr
-                }
+            let numerical = match &o.quantity {
+                Quantity::Mass(_) => numerical_mass_rel,
+                q => numerical_accel_rel.get(&q.label()).copied().unwrap_or(0.0),
             };
+            o.model_rel_var = model_rel_var(&o.quantity, numerical, fr, options);
         }
         Self {
             mass_rel,
@@ -359,5 +372,32 @@ impl NoiseModel {
     /// As reported.
     pub fn report(&self) -> NoiseReport {
         self.report.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mean_squares_carry_twice_the_calibration_uncertainty_masses_the_wear_coefficient() {
+        let options = DiagnoseOptions::default();
+        let accel = Quantity::Accel(AccelLocation::Response, 1);
+        let mass = Quantity::Mass("cube".into());
+        // Nothing but the calibration: a 2 % sensitivity is a 4 % mean square, variance 0.0016.
+        assert!((model_rel_var(&accel, 0.0, 0.0, &options) - 0.0016).abs() < 1e-15);
+        // The wear coefficient's 10 % (an estimate, Table 4.3 has none) enters masses only.
+        assert!((model_rel_var(&mass, 0.0, 0.0, &options) - 0.01).abs() < 1e-15);
+        // Independent terms add in variance: 3-4-5.
+        let five = model_rel_var(
+            &accel,
+            0.03,
+            0.0,
+            &DiagnoseOptions {
+                accelerometer_calibration_rel: 0.02,
+                ..options.clone()
+            },
+        );
+        assert!((five - 0.0025).abs() < 1e-15, "{five}");
     }
 }
