@@ -531,3 +531,49 @@ fn a_campaign_without_measurements_is_refused_naming_the_field() {
         "{text}"
     );
 }
+
+/// Where, by configuration: two of five tests (their own config) read 40 % above the model,
+/// the other three (sharing another) as the model predicts. The pooled group of the two is
+/// flagged, with a mean residual of the sign of the offset; the three's is not; a config
+/// held by every test (the synthetic campaigns' usual case) makes no group.
+#[test]
+fn residuals_pool_by_shared_configuration() {
+    let mut c = campaign(
+        |t, k| {
+            let mut p = truth(t, k, 0.0, 0.0, 0.0);
+            if t < 2 {
+                *p.mass_mg.get_mut("cube").unwrap() *= 1.4;
+            }
+            p
+        },
+        21,
+    );
+    for t in &mut c.tests[..2] {
+        t.config = "rattle-box-d".into();
+    }
+    let report = diagnose_with(&c, &emulator(), &options()).unwrap();
+    let config_groups: Vec<_> = report
+        .location
+        .groups
+        .iter()
+        .filter(|g| g.by == "config")
+        .collect();
+    assert_eq!(config_groups.len(), 2, "{config_groups:#?}");
+    let offset = config_groups
+        .iter()
+        .find(|g| g.label == "rattle-box-d (2 tests)")
+        .unwrap();
+    assert!(offset.flagged && offset.mean_residual > 0.0, "{offset:#?}");
+    let clean = config_groups
+        .iter()
+        .find(|g| g.label == "rattle-box-c (3 tests)")
+        .unwrap();
+    assert!(!clean.flagged, "{clean:#?}");
+    let unchanged = diagnose_with(
+        &campaign(|t, k| truth(t, k, 0.0, 0.0, 0.0), 21),
+        &emulator(),
+        &options(),
+    )
+    .unwrap();
+    assert!(unchanged.location.groups.iter().all(|g| g.by != "config"));
+}

@@ -15,6 +15,7 @@ use crate::analysis::spectra::welch_psd;
 use crate::gap::accel::AccelLocation;
 use crate::gap::Campaign;
 use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Family-wise error rate of the flags.
 pub const FLAG_LEVEL: f64 = 0.05;
@@ -25,7 +26,8 @@ pub const MIN_BAND_SHARE: f64 = 0.05;
 /// One group of residuals.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Group {
-    /// Grouping: `test`, `quantity`, `increment`, `pressure_band`, `slip_band`,
+    /// Grouping: `test`, `config`, `rattle_space`, `drive` (tests sharing that attribute,
+    /// where it takes several values), `quantity`, `increment`, `pressure_band`, `slip_band`,
     /// `frequency_band`.
     pub by: String,
     /// Label, e.g. `C (k_rs 0.64, 15 g at 20 Hz)`.
@@ -118,19 +120,25 @@ impl Acc {
     }
 }
 
-fn test_label(campaign: &Campaign, ti: usize) -> String {
-    let t = &campaign.tests[ti];
-    let mut parts = vec![t.config.clone()];
+/// The configuration attributes a test shares with others: `config`, `rattle_space`, `drive`.
+fn configuration_keys(t: &crate::gap::campaign::CampaignTest) -> Vec<(&'static str, String)> {
+    let mut keys = vec![("config", t.config.clone())];
     if let Some(k) = t.rattle_space {
-        parts.push(format!("k_rs {k}"));
+        keys.push(("rattle_space", format!("k_rs {k}")));
     }
     if let Some(d) = &t.drive {
         if let (Some(g), Some(f)) = (d.level_g, d.frequency_hz) {
-            parts.push(format!("{g} g at {f} Hz"));
+            keys.push(("drive", format!("{g} g at {f} Hz")));
         } else if let Some(p) = &d.profile {
-            parts.push(p.clone());
+            keys.push(("drive", p.clone()));
         }
     }
+    keys
+}
+
+fn test_label(campaign: &Campaign, ti: usize) -> String {
+    let t = &campaign.tests[ti];
+    let parts: Vec<String> = configuration_keys(t).into_iter().map(|(_, v)| v).collect();
     format!("{} ({})", t.id, parts.join(", "))
 }
 
@@ -144,6 +152,9 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
     let mut mass_by_test: Vec<Acc> = (0..ntests).map(|_| Acc::new()).collect();
     let mut by_quantity: Vec<(String, Acc)> = Vec::new();
     let mut by_increment: Vec<Acc> = Vec::new();
+    let configuration: Vec<Vec<(&str, String)>> =
+        campaign.tests.iter().map(configuration_keys).collect();
+    let mut by_configuration: BTreeMap<(&str, String), (Acc, BTreeSet<usize>)> = BTreeMap::new();
     for o in &problem.obs {
         let mu = o.predicted(nominal);
         let u = problem.noise.u(o, mu);
@@ -174,10 +185,26 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
             by_increment.push(Acc::new());
         }
         by_increment[o.increment].push(o.weight, r);
+        for (by, value) in &configuration[o.test] {
+            let (acc, tests) = by_configuration
+                .entry((by, value.clone()))
+                .or_insert_with(|| (Acc::new(), BTreeSet::new()));
+            acc.push(o.weight, r);
+            tests.insert(o.test);
+        }
     }
     let mut groups: Vec<Group> = Vec::new();
     for (ti, a) in by_test.iter().enumerate() {
         groups.extend(a.group("test", test_label(campaign, ti)));
+    }
+    // Configuration: the tests that share a config, a rattle space or a drive, pooled. Only a
+    // value two or more tests share, in a campaign where that attribute takes more than one
+    // value, says more than the test groups or the whole campaign.
+    for ((by, value), (a, tests)) in &by_configuration {
+        let values = by_configuration.keys().filter(|(b, _)| b == by).count();
+        if tests.len() >= 2 && values >= 2 {
+            groups.extend(a.group(by, format!("{value} ({} tests)", tests.len())));
+        }
     }
     for (label, a) in &by_quantity {
         groups.extend(a.group("quantity", label.clone()));
