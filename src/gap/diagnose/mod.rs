@@ -523,12 +523,24 @@ pub fn diagnose_with(
         firsts[best] += 1;
     }
     let p_first = |i: usize| firsts[i] as f64 / resamples.len().max(1) as f64;
+    let gain_interval = |c: &Candidate| -> [f64; 2] {
+        let gains: Vec<f64> = resamples
+            .iter()
+            .map(|idx| {
+                idx.iter()
+                    .map(|g| nominal.held_nll[*g] - c.held_nll[*g])
+                    .sum()
+            })
+            .collect();
+        [stats::quantile(&gains, 0.05), stats::quantile(&gains, 0.95)]
+    };
     let entry = |c: &Candidate, i: usize| RankEntry {
         name: problem.name_of(&c.effects),
         magnitudes: c.magnitudes.clone(),
         parameters: c.effects.len(),
         held_out_log_likelihood: c.held_ll(),
         held_out_gain: c.held_ll() - nominal.held_ll(),
+        held_out_gain_interval: gain_interval(c),
         held_out_error: c.held_error(),
         aicc: c.aicc,
         bic: c.bic,

@@ -12,6 +12,8 @@ struct Bar {
     value: f64,
     /// Second value drawn as a thinner bar below (before/after plots).
     second: Option<f64>,
+    /// Interval drawn as a whisker across the bar (uncertainty of the value).
+    whisker: Option<[f64; 2]>,
     note: String,
     highlight: bool,
 }
@@ -41,7 +43,11 @@ fn bar_chart(
     let height = top + row * bars.len().max(1) as f64 + 60.0;
     let values = bars
         .iter()
-        .flat_map(|b| std::iter::once(b.value).chain(b.second))
+        .flat_map(|b| {
+            std::iter::once(b.value)
+                .chain(b.second)
+                .chain(b.whisker.into_iter().flatten())
+        })
         .chain(guides.iter().copied())
         .chain([0.0])
         .filter(|v| v.is_finite());
@@ -108,6 +114,17 @@ fn bar_chart(
                 (a1 - a0).max(0.5)
             );
         }
+        if let Some([w0, w1]) = b.whisker.filter(|w| w.iter().all(|v| v.is_finite())) {
+            let (a, c, mid) = (x(w0), x(w1), y + 10.0);
+            let _ = write!(
+                s,
+                r##"<path d="M{a:.1} {:.1}V{:.1}M{a:.1} {mid:.1}H{c:.1}M{c:.1} {:.1}V{:.1}" stroke="#222" fill="none"/>"##,
+                mid - 4.0,
+                mid + 4.0,
+                mid - 4.0,
+                mid + 4.0
+            );
+        }
         let _ = write!(
             s,
             r#"<text x="{}" y="{}">{}</text>"#,
@@ -160,6 +177,8 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
             label: format!("{}: {}", g.by, g.label),
             value: g.z,
             second: None,
+            // A bias score is standardized: its standard uncertainty is 1.
+            whisker: g.z.is_finite().then_some([g.z - 1.0, g.z + 1.0]),
             note: format!("p_adj {:.2}", g.p_adjusted),
             highlight: g.flagged,
         })
@@ -169,7 +188,7 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
             "{}: where the nominal model misses (red: flagged, Holm 5 %)",
             report.campaign
         ),
-        "bias score z (measured above the model: > 0); dashed: |z| = 2",
+        "bias score z (measured above the model: > 0; whiskers: +-1, its standard uncertainty); dashed: |z| = 2",
         &residual_bars,
         &[-2.0, 2.0],
         None,
@@ -182,6 +201,7 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
             label: r.name.clone(),
             value: r.held_out_gain,
             second: None,
+            whisker: Some(r.held_out_gain_interval),
             note: format!(
                 "P(first) {:.2}, lack-of-fit p {:.2}",
                 r.p_first, r.residual_p_value
@@ -194,7 +214,7 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
             "{}: effects ranked by held-out log-likelihood gain (red: explains)",
             report.campaign
         ),
-        "held-out log-likelihood gain over the nominal model; dashed: the explaining threshold",
+        "held-out log-likelihood gain over the nominal model (whiskers: 90 % bootstrap interval); dashed: the explaining threshold",
         &rank_bars,
         &[super::MIN_HELD_OUT_GAIN],
         None,
@@ -214,6 +234,7 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
                     label: g.group.clone(),
                     value: g.before,
                     second: Some(g.after),
+                    whisker: None,
                     note: format!("{:.2} -> {:.2}", g.before, g.after),
                     highlight: false,
                 })
@@ -231,6 +252,7 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
                 label: "nominal".into(),
                 value: report.nominal.held_out_error,
                 second: None,
+                whisker: None,
                 note: format!("{:.2}", report.nominal.held_out_error),
                 highlight: false,
             }],
@@ -254,6 +276,7 @@ mod tests {
             label: label.into(),
             value: 1.0,
             second: None,
+            whisker: None,
             note: String::new(),
             highlight: false,
         }
@@ -291,5 +314,30 @@ mod tests {
         let (_, short_width) = label_ends(&short);
         assert!(width > short_width);
         assert_eq!(short_width, 120.0 + 430.0 + 140.0);
+    }
+
+    /// A whisker spans its interval on the bar's axis: from 1 to 3 on an axis from 0 to 3
+    /// (padded 5 %), its ends lie at 1/3 and all of the axis.
+    #[test]
+    fn a_whisker_spans_its_interval() {
+        let mut b = bar("gain");
+        b.value = 2.0;
+        b.whisker = Some([1.0, 3.0]);
+        let svg = bar_chart("t", "x", &[b], &[], None);
+        let path = svg.split("<path d=\"M").nth(1).expect("a whisker path");
+        let xs: Vec<f64> = path
+            .split(['M', 'H', 'V', ' ', '"'])
+            .take(8)
+            .filter_map(|t| t.parse().ok())
+            .collect();
+        let left = (16.0 + LABEL_CHAR_PX * 4.0f64).max(120.0);
+        let (lo, hi) = (-0.15, 3.15);
+        let at = |v: f64| left + (v - lo) / (hi - lo) * 430.0;
+        assert!((xs[0] - at(1.0)).abs() < 0.06, "{xs:?} vs {}", at(1.0));
+        assert!(
+            xs.iter().any(|x| (x - at(3.0)).abs() < 0.06),
+            "{xs:?} vs {}",
+            at(3.0)
+        );
     }
 }

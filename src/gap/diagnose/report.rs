@@ -81,6 +81,10 @@ pub struct RankEntry {
     pub held_out_log_likelihood: f64,
     /// Gain over the nominal model's held-out log-likelihood.
     pub held_out_gain: f64,
+    /// 90 % bootstrap interval of the gain (held-out groups resampled, the resamples of
+    /// `p_first`).
+    #[serde(default)]
+    pub held_out_gain_interval: [f64; 2],
     /// Held-out RMS standardized error.
     pub held_out_error: f64,
     /// AICc of the full-data fit.
