@@ -1,32 +1,40 @@
 //! Calibration of the friction law and of the wear law K(sigma) from persistent-contact fixture
 //! records (thesis chapter 4): eq. 4.1-4.4 for friction, eq. 4.16-4.18 for wear.
 
+use crate::field_error::FieldError;
 use crate::physics::friction::FrictionParams;
 use crate::physics::step::StepKind;
 use crate::wear::WearLaw;
 use nalgebra::{Matrix4, Vector4};
 use serde::{Deserialize, Serialize};
 
-/// Errors of the calibration fits: each names the field (and record) and the rule.
+/// Errors of the calibration fits: each names the field (a path such as `records[3].time_s`
+/// for a record's field, relative to the function's arguments) and the rule.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CalibrationError {
     /// An input value broke a rule.
-    #[error("invalid {field} (record {index}): {rule}")]
-    Invalid {
-        /// Field name.
-        field: &'static str,
-        /// Index of the offending record (0 for scalar parameters).
-        index: usize,
-        /// The rule it broke.
-        rule: &'static str,
-    },
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
     /// The fit could not be carried out.
     #[error("fit failed: {0}")]
     Fit(&'static str),
 }
 
-fn invalid(field: &'static str, index: usize, rule: &'static str) -> CalibrationError {
-    CalibrationError::Invalid { field, index, rule }
+impl CalibrationError {
+    /// As a field error placed under `prefix` (the path of the fit's data, e.g. `friction`):
+    /// a broken rule keeps its field (`friction.records[3].time_s`), a failed fit names
+    /// `prefix` itself.
+    pub fn at(self, prefix: &str) -> FieldError {
+        match self {
+            CalibrationError::Invalid(e) => e.at(prefix),
+            fit @ CalibrationError::Fit(_) => FieldError::new(prefix, fit.to_string()),
+        }
+    }
+}
+
+/// `records[index].field`: the path of a field of the record at `index`.
+fn record_field(index: usize, field: &str) -> String {
+    format!("records[{index}].{field}")
 }
 
 /// One row of a friction test record (thesis 4.3.1: angle, angular velocity, vertical force,
@@ -73,34 +81,44 @@ pub fn friction_samples(
     let j = fixture.polar_inertia_kg_m2;
     let r = fixture.mean_radius_m;
     if !(j.is_finite() && j >= 0.0) {
-        return Err(invalid(
-            "polar_inertia_kg_m2",
-            0,
+        return Err(FieldError::new(
+            "fixture.polar_inertia_kg_m2",
             "must be a finite number >= 0",
-        ));
+        )
+        .into());
     }
     if !(r.is_finite() && r > 0.0) {
-        return Err(invalid("mean_radius_m", 0, "must be a finite number > 0"));
+        return Err(FieldError::new("fixture.mean_radius_m", "must be a finite number > 0").into());
     }
     if records.len() < 3 {
-        return Err(invalid("records", 0, "need at least 3 torque records"));
+        return Err(FieldError::new("records", "need at least 3 torque records").into());
     }
     for (i, rec) in records.iter().enumerate() {
         if !rec.time_s.is_finite() || (i > 0 && rec.time_s <= records[i - 1].time_s) {
-            return Err(invalid(
-                "time_s",
-                i,
+            return Err(FieldError::new(
+                record_field(i, "time_s"),
                 "must be finite and strictly increasing",
-            ));
+            )
+            .into());
         }
         if !rec.angular_velocity_rad_s.is_finite() {
-            return Err(invalid("angular_velocity_rad_s", i, "must be finite"));
+            return Err(FieldError::new(
+                record_field(i, "angular_velocity_rad_s"),
+                "must be finite",
+            )
+            .into());
         }
         if !(rec.normal_load_n.is_finite() && rec.normal_load_n > 0.0) {
-            return Err(invalid("normal_load_n", i, "must be a finite number > 0"));
+            return Err(FieldError::new(
+                record_field(i, "normal_load_n"),
+                "must be a finite number > 0",
+            )
+            .into());
         }
         if !rec.input_torque_n_m.is_finite() {
-            return Err(invalid("input_torque_n_m", i, "must be finite"));
+            return Err(
+                FieldError::new(record_field(i, "input_torque_n_m"), "must be finite").into(),
+            );
         }
     }
     let n = records.len();
@@ -200,15 +218,15 @@ pub fn fit_friction(
     step: StepKind,
 ) -> Result<FrictionFit, CalibrationError> {
     if samples.len() < 8 {
-        return Err(invalid("samples", 0, "need at least 8 friction samples"));
+        return Err(FieldError::new("samples", "need at least 8 friction samples").into());
     }
     for (i, s) in samples.iter().enumerate() {
         if !(s.slip_speed_m_s.is_finite() && s.slip_speed_m_s >= 0.0 && s.coefficient.is_finite()) {
-            return Err(invalid(
-                "samples",
-                i,
+            return Err(FieldError::new(
+                format!("samples[{i}]"),
                 "speed must be finite >= 0 and mu finite",
-            ));
+            )
+            .into());
         }
     }
     let mut p = friction_initial_guess(samples).ok_or(CalibrationError::Fit("no initial guess"))?;
@@ -309,32 +327,37 @@ pub fn lumped_wear_coefficient(
     density_kg_m3: f64,
 ) -> Result<f64, CalibrationError> {
     if !(density_kg_m3.is_finite() && density_kg_m3 > 0.0) {
-        return Err(invalid("density_kg_m3", 0, "must be a finite number > 0"));
+        return Err(FieldError::new("density_kg_m3", "must be a finite number > 0").into());
     }
-    check_wear_record(record, 0)?;
+    check_wear_record(record).map_err(|e| e.at("record"))?;
     Ok(record.wear_mass_kg / density_kg_m3 / (record.normal_load_n * record.sliding_distance_m))
 }
 
-fn check_wear_record(r: &WearTestRecord, i: usize) -> Result<(), CalibrationError> {
+/// The rules of one wear test record; the field is named bare (the caller places it).
+fn check_wear_record(r: &WearTestRecord) -> Result<(), FieldError> {
     if !(r.normal_load_n.is_finite() && r.normal_load_n > 0.0) {
-        return Err(invalid("normal_load_n", i, "must be a finite number > 0"));
+        return Err(FieldError::new(
+            "normal_load_n",
+            "must be a finite number > 0",
+        ));
     }
     if !(r.contact_pressure_pa.is_finite() && r.contact_pressure_pa > 0.0) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "contact_pressure_pa",
-            i,
             "must be a finite number > 0",
         ));
     }
     if !(r.sliding_distance_m.is_finite() && r.sliding_distance_m > 0.0) {
-        return Err(invalid(
+        return Err(FieldError::new(
             "sliding_distance_m",
-            i,
             "must be a finite number > 0",
         ));
     }
     if !(r.wear_mass_kg.is_finite() && r.wear_mass_kg >= 0.0) {
-        return Err(invalid("wear_mass_kg", i, "must be a finite number >= 0"));
+        return Err(FieldError::new(
+            "wear_mass_kg",
+            "must be a finite number >= 0",
+        ));
     }
     Ok(())
 }
@@ -383,18 +406,18 @@ pub fn fit_wear_law(
     cutoff_pressure_pa: f64,
 ) -> Result<WearLawFit, CalibrationError> {
     if cutoff_pressure_pa.is_nan() || cutoff_pressure_pa <= 0.0 {
-        return Err(invalid("cutoff_pressure_pa", 0, "must be > 0 Pa"));
+        return Err(FieldError::new("cutoff_pressure_pa", "must be > 0 Pa").into());
     }
     let mut points = Vec::with_capacity(records.len());
     for (i, r) in records.iter().enumerate() {
-        check_wear_record(r, i)?;
+        check_wear_record(r).map_err(|e| e.at(&format!("records[{i}]")))?;
         let k = lumped_wear_coefficient(r, density_kg_m3)?;
         if k <= 0.0 {
-            return Err(invalid(
-                "wear_mass_kg",
-                i,
+            return Err(FieldError::new(
+                record_field(i, "wear_mass_kg"),
                 "must be > 0 for the relative fit",
-            ));
+            )
+            .into());
         }
         points.push((r.contact_pressure_pa, k));
     }
@@ -402,11 +425,9 @@ pub fn fit_wear_law(
     pressures.sort_by(f64::total_cmp);
     pressures.dedup();
     if pressures.len() < 3 {
-        return Err(invalid(
-            "records",
-            0,
-            "need at least 3 distinct contact pressures",
-        ));
+        return Err(
+            FieldError::new("records", "need at least 3 distinct contact pressures").into(),
+        );
     }
     let cost_at = |lb: f64| wear_linear_solve(&points, lb.exp()).map_or(f64::INFINITY, |s| s.2);
     let (lo, hi) = (0.005f64.ln(), 2.0f64.ln());
@@ -542,11 +563,11 @@ mod tests {
         let bad = friction_samples(&[rec(0.0, 0.0), rec(0.0, 1.0), rec(2.0, 2.0)], &fx);
         assert_eq!(
             bad,
-            Err(invalid(
-                "time_s",
-                1,
+            Err(FieldError::new(
+                "records[1].time_s",
                 "must be finite and strictly increasing"
-            ))
+            )
+            .into())
         );
     }
 
@@ -626,11 +647,7 @@ mod tests {
         let r = wear_records(&[1e6, 2e6], 3, 0.0, 1);
         assert_eq!(
             fit_wear_law(&r, 2810.0, 870e6),
-            Err(invalid(
-                "records",
-                0,
-                "need at least 3 distinct contact pressures"
-            ))
+            Err(FieldError::new("records", "need at least 3 distinct contact pressures").into())
         );
     }
 }

@@ -21,6 +21,7 @@
 //! wear (excitation draws) only, not model error, and assumes `D_j` roughly normal (log rates
 //! are); with one seed there is no interval.
 
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Factor of the first conservative band of Figure 6.68 (10 % below K_SL).
@@ -51,30 +52,17 @@ pub fn t_quantile_95(df: usize) -> f64 {
 /// Why a penalization curve could not be built or evaluated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PenalizationError {
-    /// A sweep point is unusable (non-finite k_rs, k_rs outside (0, 1], rate not finite and > 0).
-    #[error("sweep point {index}: invalid `{field}`: {rule}")]
-    InvalidSweepPoint {
-        /// Index of the point in the given list.
-        index: usize,
-        /// Field name: `rattle_space` or `rail_wear_rate_mg_per_h`.
-        field: &'static str,
-        /// The rule broken, with the value.
-        rule: String,
-    },
     /// Fewer than two distinct rattle spaces: there is no curve to interpolate.
     #[error("the sweep needs at least 2 distinct rattle spaces, got {distinct}")]
     TooFewPoints {
         /// Number of distinct k_rs values given.
         distinct: usize,
     },
-    /// An input to a query is unusable (non-finite, or a non-positive life).
-    #[error("invalid `{field}`: {rule}")]
-    InvalidInput {
-        /// Field name, e.g. `design_rattle_space`, `design_life_h`, `rattle_space`.
-        field: &'static str,
-        /// The rule broken, with the value.
-        rule: String,
-    },
+    /// An input is unusable: a sweep point (non-finite k_rs, k_rs outside (0, 1], rate not
+    /// finite and > 0), named by its path (`points[1].rattle_space`), or a query's argument
+    /// (non-finite, or a non-positive life), e.g. `design_rattle_space`, `design_life_h`.
+    #[error("invalid `{}`: {}", .0.field, .0.rule)]
+    InvalidInput(#[from] FieldError),
     /// The requested rattle space lies outside the swept range: no extrapolation.
     #[error(
         "rattle space {rattle_space} is outside the swept range [{min}, {max}]; \
@@ -208,19 +196,19 @@ impl PenalizationCurve {
     pub fn new(points: &[SweepPoint], design_rattle_space: f64) -> Result<Self, PenalizationError> {
         for (index, p) in points.iter().enumerate() {
             if !(p.rattle_space.is_finite() && p.rattle_space > 0.0 && p.rattle_space <= 1.0) {
-                return Err(PenalizationError::InvalidSweepPoint {
-                    index,
-                    field: "rattle_space",
-                    rule: format!("must be a finite number in (0, 1], got {}", p.rattle_space),
-                });
+                return Err(FieldError::new(
+                    format!("points[{index}].rattle_space"),
+                    format!("must be a finite number in (0, 1], got {}", p.rattle_space),
+                )
+                .into());
             }
             let rate = p.rail_wear_rate_mg_per_h;
             if !(rate.is_finite() && rate > 0.0) {
-                return Err(PenalizationError::InvalidSweepPoint {
-                    index,
-                    field: "rail_wear_rate_mg_per_h",
-                    rule: format!("must be a finite number > 0 mg/h, got {rate}"),
-                });
+                return Err(FieldError::new(
+                    format!("points[{index}].rail_wear_rate_mg_per_h"),
+                    format!("must be a finite number > 0 mg/h, got {rate}"),
+                )
+                .into());
             }
         }
         let mut sorted: Vec<SweepPoint> = points.to_vec();
@@ -248,10 +236,11 @@ impl PenalizationCurve {
             });
         }
         if !design_rattle_space.is_finite() {
-            return Err(PenalizationError::InvalidInput {
-                field: "design_rattle_space",
-                rule: format!("must be a finite number, got {design_rattle_space}"),
-            });
+            return Err(FieldError::new(
+                "design_rattle_space",
+                format!("must be a finite number, got {design_rattle_space}"),
+            )
+            .into());
         }
         let mut curve = Self {
             design_rattle_space,
@@ -263,14 +252,13 @@ impl PenalizationCurve {
             curve
                 .rail_wear_rate_mg_per_h(design_rattle_space)
                 .map_err(|e| match e {
-                    PenalizationError::OutOfRange { min, max, .. } => {
-                        PenalizationError::InvalidInput {
-                            field: "design_rattle_space",
-                            rule: format!(
-                        "{design_rattle_space} must lie inside the swept range [{min}, {max}]"
-                    ),
-                        }
-                    }
+                    PenalizationError::OutOfRange { min, max, .. } => FieldError::new(
+                        "design_rattle_space",
+                        format!(
+                            "{design_rattle_space} must lie inside the swept range [{min}, {max}]"
+                        ),
+                    )
+                    .into(),
                     other => other,
                 })?;
         Ok(curve)
@@ -289,33 +277,34 @@ impl PenalizationCurve {
     ) -> Result<Self, PenalizationError> {
         let n = rates_by_seed.first().map_or(0, Vec::len);
         if rates_by_seed.len() != rattle_spaces.len() {
-            return Err(PenalizationError::InvalidInput {
-                field: "rate_by_seed_mg_per_h",
-                rule: format!(
+            return Err(FieldError::new(
+                "rate_by_seed_mg_per_h",
+                format!(
                     "needs one list of rates per point ({}), got {}",
                     rattle_spaces.len(),
                     rates_by_seed.len()
                 ),
-            });
+            )
+            .into());
         }
         let mut points = Vec::with_capacity(rattle_spaces.len());
         for (index, (k, rates)) in rattle_spaces.iter().zip(rates_by_seed).enumerate() {
             if rates.len() != n || n == 0 {
-                return Err(PenalizationError::InvalidSweepPoint {
-                    index,
-                    field: "rail_wear_rate_mg_per_h",
-                    rule: format!(
+                return Err(FieldError::new(
+                    format!("rate_by_seed_mg_per_h[{index}]"),
+                    format!(
                         "every point needs the same seeds ({n} at the first point), got {}",
                         rates.len()
                     ),
-                });
+                )
+                .into());
             }
             if let Some(bad) = rates.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
-                return Err(PenalizationError::InvalidSweepPoint {
-                    index,
-                    field: "rail_wear_rate_mg_per_h",
-                    rule: format!("must be a finite number > 0 mg/h, got {bad}"),
-                });
+                return Err(FieldError::new(
+                    format!("rate_by_seed_mg_per_h[{index}]"),
+                    format!("must be a finite number > 0 mg/h, got {bad}"),
+                )
+                .into());
             }
             let rate = if n == 1 {
                 rates[0]
@@ -329,10 +318,11 @@ impl PenalizationCurve {
         }
         let mut curve = Self::new(&points, design_rattle_space)?;
         if curve.points.len() != points.len() {
-            return Err(PenalizationError::InvalidInput {
-                field: "rattle_space",
-                rule: "points with seeds need distinct rattle spaces".into(),
-            });
+            return Err(FieldError::new(
+                "rattle_space",
+                "points with seeds need distinct rattle spaces",
+            )
+            .into());
         }
         if n > 1 {
             // Align the seeds' rates with the sorted points.
@@ -421,10 +411,11 @@ impl PenalizationCurve {
     /// an error outside the swept range.
     pub fn rail_wear_rate_mg_per_h(&self, rattle_space: f64) -> Result<f64, PenalizationError> {
         if !rattle_space.is_finite() {
-            return Err(PenalizationError::InvalidInput {
-                field: "rattle_space",
-                rule: format!("must be a finite number, got {rattle_space}"),
-            });
+            return Err(FieldError::new(
+                "rattle_space",
+                format!("must be a finite number, got {rattle_space}"),
+            )
+            .into());
         }
         let (min, max) = self.range();
         if rattle_space < min || rattle_space > max {
@@ -473,10 +464,11 @@ impl PenalizationCurve {
         rattle_space: f64,
     ) -> Result<PenalizedLife, PenalizationError> {
         if !(design_life_h.is_finite() && design_life_h > 0.0) {
-            return Err(PenalizationError::InvalidInput {
-                field: "design_life_h",
-                rule: format!("must be a finite number > 0 h, got {design_life_h}"),
-            });
+            return Err(FieldError::new(
+                "design_life_h",
+                format!("must be a finite number > 0 h, got {design_life_h}"),
+            )
+            .into());
         }
         let factors = self.factors(rattle_space)?;
         Ok(PenalizedLife {
@@ -502,6 +494,13 @@ mod tests {
 
     /// Thesis-shaped sweep (Figure 6.67): loose 0.7684, design 0.7990, tight 0.8317; looser
     /// wears faster. Rates chosen as round numbers so the expected values are by hand.
+    fn field_of(e: &PenalizationError) -> &str {
+        match e {
+            PenalizationError::InvalidInput(e) => &e.field,
+            other => panic!("not an invalid input: {other}"),
+        }
+    }
+
     fn thesis_like() -> PenalizationCurve {
         PenalizationCurve::new(&[pt(0.8317, 1.0), pt(0.7684, 4.0), pt(0.7990, 2.0)], 0.7990)
             .unwrap()
@@ -547,13 +546,11 @@ mod tests {
         assert!((life.life_conservative_80_h - 400.0).abs() < 1e-9);
         assert!((life.factors.k_sl_conservative_90 - 0.45).abs() < 1e-12);
         let err = c.penalized_life(-5.0, 0.79).unwrap_err();
-        assert!(matches!(
-            err,
-            PenalizationError::InvalidInput {
-                field: "design_life_h",
-                ..
-            }
-        ));
+        assert_eq!(field_of(&err), "design_life_h");
+        assert_eq!(
+            err.to_string(),
+            "invalid `design_life_h`: must be a finite number > 0 h, got -5"
+        );
     }
 
     #[test]
@@ -580,37 +577,20 @@ mod tests {
         let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.8, 3.0)], 0.8).unwrap_err();
         assert_eq!(e, PenalizationError::TooFewPoints { distinct: 1 });
         let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.7, 0.0)], 0.75).unwrap_err();
-        assert!(matches!(
-            e,
-            PenalizationError::InvalidSweepPoint {
-                index: 1,
-                field: "rail_wear_rate_mg_per_h",
-                ..
-            }
-        ));
+        assert_eq!(field_of(&e), "points[1].rail_wear_rate_mg_per_h");
+        // The point's index is in the field's path (it read `sweep point 1: invalid
+        // `rail_wear_rate_mg_per_h`: ...` before the one FieldError).
+        assert_eq!(
+            e.to_string(),
+            "invalid `points[1].rail_wear_rate_mg_per_h`: must be a finite number > 0 mg/h, got 0"
+        );
         let e = PenalizationCurve::new(&[pt(f64::NAN, 1.0), pt(0.7, 1.0)], 0.75).unwrap_err();
-        assert!(matches!(
-            e,
-            PenalizationError::InvalidSweepPoint {
-                index: 0,
-                field: "rattle_space",
-                ..
-            }
-        ));
+        assert_eq!(field_of(&e), "points[0].rattle_space");
         let e = PenalizationCurve::new(&[pt(0.8, f64::INFINITY), pt(0.7, 1.0)], 0.75).unwrap_err();
-        assert!(matches!(
-            e,
-            PenalizationError::InvalidSweepPoint { index: 0, .. }
-        ));
+        assert_eq!(field_of(&e), "points[0].rail_wear_rate_mg_per_h");
         // Design outside the sweep.
         let e = PenalizationCurve::new(&[pt(0.8, 1.0), pt(0.7, 2.0)], 0.9).unwrap_err();
-        assert!(matches!(
-            e,
-            PenalizationError::InvalidInput {
-                field: "design_rattle_space",
-                ..
-            }
-        ));
+        assert_eq!(field_of(&e), "design_rattle_space");
     }
 
     #[test]

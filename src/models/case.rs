@@ -134,9 +134,15 @@ pub fn integrator_settings(case: &CaseSpec) -> Result<IntegratorSettings, RunErr
     })
 }
 
-/// Builds the model of a case.
+/// Builds the model of a case (validated first).
 pub fn build(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError> {
     case.validate()?;
+    build_validated(case, configs_dir)
+}
+
+/// [`build`] of a case the caller has just validated ([`CaseSpec::validate`] passed on this
+/// very value), so the rules are not checked twice.
+pub(crate) fn build_validated(case: &CaseSpec, configs_dir: &Path) -> Result<BuiltModel, RunError> {
     let excitation = resolve_excitation(case, configs_dir)?;
     let motion = BaseMotion::from_spec(&excitation)
         .map_err(|e| FieldError::new("excitation", e.to_string()))?;

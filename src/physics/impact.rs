@@ -6,6 +6,7 @@
 //! `wdot` as the penetration rate its sign is reversed (an erratum, see docs/errata.md).
 
 use super::step::StepKind;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// IMPACT parameters in SI (N/m^e, N·s/m, m).
@@ -46,19 +47,25 @@ impl ImpactParams {
         )
     }
 
-    /// Checks the rules on each field; returns (field, rule) for the first violation.
-    pub fn validate(&self) -> Result<(), (&'static str, &'static str)> {
+    /// Checks the rules on each field; the first violation as a [`FieldError`].
+    pub fn validate(&self) -> Result<(), FieldError> {
         if !(self.stiffness.is_finite() && self.stiffness > 0.0) {
-            return Err(("stiffness", "must be a finite number > 0"));
+            return Err(FieldError::new("stiffness", "must be a finite number > 0"));
         }
         if !(self.exponent.is_finite() && self.exponent >= 1.0) {
-            return Err(("exponent", "must be a finite number >= 1"));
+            return Err(FieldError::new("exponent", "must be a finite number >= 1"));
         }
         if !(self.max_damping.is_finite() && self.max_damping >= 0.0) {
-            return Err(("max_damping", "must be a finite number >= 0"));
+            return Err(FieldError::new(
+                "max_damping",
+                "must be a finite number >= 0",
+            ));
         }
         if !(self.full_damping_depth.is_finite() && self.full_damping_depth >= 0.0) {
-            return Err(("full_damping_depth", "must be a finite number >= 0"));
+            return Err(FieldError::new(
+                "full_damping_depth",
+                "must be a finite number >= 0",
+            ));
         }
         Ok(())
     }
@@ -179,6 +186,19 @@ fn power(w: f64, e: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn validate_names_the_field() {
+        assert!(ImpactParams::thesis_table_5_2().validate().is_ok());
+        let p = ImpactParams {
+            exponent: 0.5,
+            ..ImpactParams::thesis_table_5_2()
+        };
+        assert_eq!(
+            p.validate(),
+            Err(FieldError::new("exponent", "must be a finite number >= 1"))
+        );
+    }
 
     #[test]
     fn force_parts_and_unclamped_gradient_are_force_and_force_gradient_bit_for_bit() {

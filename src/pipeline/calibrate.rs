@@ -121,8 +121,7 @@ impl CalibrateParams {
                     )
                     .into());
                 }
-                cal::friction_samples(&records, &fixture)
-                    .map_err(|e| FieldError::new("friction.records", e.to_string()))?;
+                cal::friction_samples(&records, &fixture).map_err(|e| e.at("friction"))?;
                 Some(FrictionData { fixture, records })
             }
         };
@@ -189,10 +188,10 @@ pub fn run_calibration(params: &CalibrateParams) -> Result<serde_json::Value, Ru
     use crate::analysis::calibration as cal;
     let mut out = serde_json::Map::new();
     if let Some(f) = &params.friction {
-        let samples = cal::friction_samples(&f.records, &f.fixture)
-            .map_err(|e| FieldError::new("friction.records", e.to_string()))?;
+        let samples =
+            cal::friction_samples(&f.records, &f.fixture).map_err(|e| e.at("friction"))?;
         let fit = cal::fit_friction(&samples, crate::physics::step::StepKind::Cycloidal)
-            .map_err(|e| FieldError::new("friction", e.to_string()))?;
+            .map_err(|e| e.at("friction"))?;
         out.insert(
             "friction".into(),
             serde_json::to_value(fit).map_err(|e| FieldError::new("friction", e.to_string()))?,
@@ -200,11 +199,41 @@ pub fn run_calibration(params: &CalibrateParams) -> Result<serde_json::Value, Ru
     }
     if let Some(w) = &params.wear_law {
         let fit = cal::fit_wear_law(&w.records, w.density_kg_m3, w.cutoff_pressure_pa)
-            .map_err(|e| FieldError::new("wear_law", e.to_string()))?;
+            .map_err(|e| e.at("wear_law"))?;
         out.insert(
             "wear_law".into(),
             serde_json::to_value(fit).map_err(|e| FieldError::new("wear_law", e.to_string()))?,
         );
     }
     Ok(serde_json::Value::Object(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eight torque records, the fourth going back in time.
+    fn friction_params() -> serde_json::Value {
+        let records: Vec<_> = (0..8)
+            .map(|i| {
+                let t = if i == 3 { 1.0 } else { i as f64 };
+                serde_json::json!({"time_s": t, "angle_rad": 0.0, "angular_velocity_rad_s": 1.0,
+                    "normal_load_n": 10.0, "input_torque_n_m": 0.5})
+            })
+            .collect();
+        serde_json::json!({"friction": {
+            "fixture": {"polar_inertia_kg_m2": 1.0, "mean_radius_m": 0.1},
+            "records": records}})
+    }
+
+    #[test]
+    fn a_record_error_names_the_record_and_its_field() {
+        let Err(RunError::InvalidConfig { field, rule }) =
+            CalibrateParams::parse(&friction_params())
+        else {
+            panic!("a record going back in time is refused");
+        };
+        assert_eq!(field, "friction.records[3].time_s");
+        assert_eq!(rule, "must be finite and strictly increasing");
+    }
 }

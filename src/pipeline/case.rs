@@ -166,7 +166,8 @@ pub fn resolve_case(
     case.validate().map_err(|e| relocate(e.into()))?;
     check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
-    crate::models::case::build(&case, configs_dir).map_err(relocate)?;
+    // Validated above (and not changed since): build without validating again.
+    crate::models::case::build_validated(&case, configs_dir).map_err(relocate)?;
     Ok(case)
 }
 

@@ -74,6 +74,27 @@ where
     for<'q> Option<String>: Encode<'q, DB> + Type<DB>,
     usize: ColumnIndex<DB::Row>,
 {
+    /// Log attempt `attempt` of job `id`, claimed by `worker` at `now_ms`, as running.
+    pub(crate) async fn start_attempt(
+        conn: &mut DB::Connection,
+        id: Uuid,
+        attempt: i64,
+        worker: &str,
+        now_ms: i64,
+    ) -> Result<(), StoreError> {
+        sqlx::query(
+            "INSERT INTO job_attempts (job_id, attempt, worker, started_ms, outcome) \
+             VALUES ($1, $2, $3, $4, 'running')",
+        )
+        .bind(DbUuid(id))
+        .bind(attempt)
+        .bind(worker.to_string())
+        .bind(now_ms)
+        .execute(&mut *conn)
+        .await?;
+        Ok(())
+    }
+
     /// Record how attempt `attempt` of job `id` ended.
     pub(crate) async fn end_attempt(
         conn: &mut DB::Connection,

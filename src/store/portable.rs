@@ -3,7 +3,9 @@
 //! `TRUE`, `ON CONFLICT`, `RETURNING`: all accepted by SQLite and PostgreSQL), the dialect's
 //! statements and locks from [`Dialect`], rows read through [`super::rows`]. `sqlite.rs` and
 //! `postgres.rs` call these from their `Store` impls and keep what really differs: connecting,
-//! migrations, submission with idempotency keys, claiming, and the lease sweeps.
+//! migrations, which queued row a claim takes and how it is locked, and which expired leases
+//! a sweep takes and how (the statements they run on those rows are here: [`Portable::claim`],
+//! [`Portable::expire_lease`], [`Portable::lose_leases`]).
 //!
 //! A generic `QueryResult` has no `rows_affected`, so statements that must say whether they
 //! wrote return a column (`RETURNING seq`).
@@ -16,16 +18,16 @@ use super::dialect::Dialect;
 use super::job_records::{JobProgress, JobRecord, JobStatus};
 use super::rows::{
     child_of, corrupt, cut_page, records, AttemptRow, CampaignContentRow, CampaignRow, ChildRow,
-    CurveRow, DbUuid, HostLeaseRow, JobRow, MeasurementRow, ParentLinkRow, TokenRow,
-    CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
+    CurveRow, DbUuid, HostLeaseRow, JobRow, KeyedJobRow, LostRow, MeasurementRow, ParentLinkRow,
+    TokenRow, CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
 };
 use super::Role;
 use super::{
     publish_refusal, AttemptOutcome, AttemptRecord, CampaignInsert, CampaignRecord,
     CampaignSummary, ChildRecord, CurveFilter, CurveRecord, FanOut, FanOutResult, Finish,
     Heartbeat, HostLease, JobCheckpoint, JobFilter, MeasurementRecord, NewCampaign, NewCheckpoint,
-    NewMeasurement, Page, PageRequest, PublishOutcome, RailRecord, ReleaseOutcome, StoreError,
-    TokenRecord, TrackBlock,
+    NewJob, NewMeasurement, Page, PageRequest, PublishOutcome, RailRecord, ReleaseOutcome,
+    StoreError, Submitted, TokenRecord, TrackBlock, WorkerHost,
 };
 use sqlx::query::QueryAs;
 use sqlx::Type;
@@ -40,6 +42,8 @@ impl<DB> Portable<DB>
 where
     DB: Dialect,
     JobRow: for<'r> FromRow<'r, DB::Row>,
+    KeyedJobRow: for<'r> FromRow<'r, DB::Row>,
+    LostRow: for<'r> FromRow<'r, DB::Row>,
     ParentLinkRow: for<'r> FromRow<'r, DB::Row>,
     ChildRow: for<'r> FromRow<'r, DB::Row>,
     AttemptRow: for<'r> FromRow<'r, DB::Row>,
@@ -128,6 +132,194 @@ where
             .fetch_optional(&mut *conn)
             .await?;
         row.map(JobRecord::try_from).transpose()
+    }
+
+    /// Queue `job`, or, when its Idempotency-Key was seen before, the earlier job: a replay
+    /// when the body hash matches, a conflict otherwise. The key is looked up first, so a
+    /// replay does not consume a `seq` (both engines list jobs in the same order); `ON
+    /// CONFLICT DO NOTHING` makes a concurrent insert of the same key (PostgreSQL; SQLite's
+    /// `BEGIN IMMEDIATE` has one writer) a replay, never a unique-key error.
+    pub(crate) async fn submit_job(pool: &Pool<DB>, job: NewJob) -> Result<Submitted, StoreError> {
+        let (key, sha) = match job.idempotency {
+            Some((k, s)) => (Some(k), Some(s)),
+            None => (None, None),
+        };
+        let mut tx = Self::begin_write(pool).await?;
+        if let Some(found) = Self::keyed_job(&mut tx, key.as_deref(), sha.as_deref()).await? {
+            tx.commit().await?;
+            return Ok(found);
+        }
+        let sql = format!(
+            "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
+             idempotency_key, request_sha256, curve_key, created_ms) \
+             VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7, $8, $9, $10) \
+             ON CONFLICT (idempotency_key) DO NOTHING RETURNING {JOB_COLUMNS}"
+        );
+        let inserted: Option<JobRow> = sqlx::query_as(&sql)
+            .bind(DbUuid(job.id))
+            .bind(job.kind.as_str().to_string())
+            .bind(job.params.to_string())
+            .bind(job.seed as i64)
+            .bind(job.code_version)
+            .bind(job.submitted_by)
+            .bind(key.clone())
+            .bind(sha.clone())
+            .bind(job.curve_key)
+            .bind(job.created_ms)
+            .fetch_optional(&mut *tx)
+            .await?;
+        let submitted = match inserted {
+            Some(row) => Submitted::Created(row.try_into()?),
+            // Lost the race to a concurrent submission with the same key.
+            None => Self::keyed_job(&mut tx, key.as_deref(), sha.as_deref())
+                .await?
+                .ok_or_else(|| corrupt("idempotent job vanished"))?,
+        };
+        tx.commit().await?;
+        Ok(submitted)
+    }
+
+    /// The job submitted earlier with Idempotency-Key `key`: a replay when its body hash is
+    /// `sha`, a conflict otherwise. `None` without a key or when no job has it.
+    async fn keyed_job(
+        conn: &mut DB::Connection,
+        key: Option<&str>,
+        sha: Option<&str>,
+    ) -> Result<Option<Submitted>, StoreError> {
+        let Some(key) = key else {
+            return Ok(None);
+        };
+        let sql =
+            format!("SELECT {JOB_COLUMNS}, request_sha256 FROM jobs WHERE idempotency_key = $1");
+        let row: Option<KeyedJobRow> = sqlx::query_as(&sql)
+            .bind(key.to_string())
+            .fetch_optional(&mut *conn)
+            .await?;
+        let Some(KeyedJobRow {
+            job,
+            request_sha256: stored_sha,
+        }) = row
+        else {
+            return Ok(None);
+        };
+        let record = JobRecord::try_from(job)?;
+        Ok(Some(
+            if stored_sha.is_some() && stored_sha.as_deref() == sha {
+                Submitted::Replayed(record)
+            } else {
+                Submitted::KeyConflict(record.id)
+            },
+        ))
+    }
+
+    /// Hand a queued job to `worker` for `lease_ms` from `now_ms` and log the attempt, inside
+    /// the caller's transaction. `picked` is the `seq` of the queued row the caller chose and
+    /// locked (PostgreSQL); `None` takes the oldest queued row in the same statement (SQLite:
+    /// under its one write lock two workers can never take the same job). A parent queued for
+    /// its assembly keeps the progress of its children. `None` when no row was taken.
+    pub(crate) async fn claim(
+        conn: &mut DB::Connection,
+        picked: Option<i64>,
+        worker: &str,
+        host: Option<&WorkerHost>,
+        now_ms: i64,
+        lease_ms: i64,
+    ) -> Result<Option<JobRecord>, StoreError> {
+        let row = if picked.is_some() {
+            "$7"
+        } else {
+            "(SELECT seq FROM jobs WHERE status = 'queued' ORDER BY seq LIMIT 1)"
+        };
+        let sql = format!(
+            "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $1, \
+             lease_expires_ms = $2 + $3, started_ms = COALESCE(started_ms, $2), \
+             attempt_started_ms = $2, lease_host = $4, lease_pid = $5, lease_instance = $6, \
+             progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
+             progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
+             progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
+             progress_eta_s = NULL \
+             WHERE seq = {row} AND status = 'queued' RETURNING {JOB_COLUMNS}"
+        );
+        let mut query = sqlx::query_as::<_, JobRow>(&sql)
+            .bind(worker.to_string())
+            .bind(now_ms)
+            .bind(lease_ms)
+            .bind(host.map(|h| h.host.clone()))
+            .bind(host.map(|h| i64::from(h.pid)))
+            .bind(host.map(|h| h.instance.clone()));
+        if let Some(seq) = picked {
+            query = query.bind(seq);
+        }
+        let Some(job) = query
+            .fetch_optional(&mut *conn)
+            .await?
+            .map(JobRecord::try_from)
+            .transpose()?
+        else {
+            return Ok(None);
+        };
+        Bookkeeping::<DB>::start_attempt(conn, job.id, job.attempt, worker, now_ms).await?;
+        Ok(Some(job))
+    }
+
+    /// Expire the lease of attempt `attempt` of running job `id` at `now_ms` (the next sweep
+    /// re-queues it); whether it was that attempt's.
+    pub(crate) async fn expire_lease(
+        conn: &mut DB::Connection,
+        id: Uuid,
+        attempt: i64,
+        now_ms: i64,
+    ) -> Result<bool, StoreError> {
+        let row = sqlx::query(
+            "UPDATE jobs SET lease_expires_ms = $3 - 1 \
+             WHERE id = $1 AND attempt = $2 AND status = 'running' RETURNING seq",
+        )
+        .bind(DbUuid(id))
+        .bind(attempt)
+        .bind(now_ms)
+        .fetch_optional(&mut *conn)
+        .await?;
+        Ok(row.is_some())
+    }
+
+    /// End the attempts whose lease expired before `now_ms` (only job `only`'s, which the
+    /// caller found expired and locked, when given): a job that asked to be cancelled is
+    /// cancelled, one at `max_attempts` fails, the others are queued again; then the attempt
+    /// log and the parents' bookkeeping ([`Bookkeeping::lost`]). How many jobs it ended.
+    pub(crate) async fn lose_leases(
+        conn: &mut DB::Connection,
+        only: Option<Uuid>,
+        now_ms: i64,
+        max_attempts: i64,
+    ) -> Result<u64, StoreError> {
+        let rows = if only.is_some() {
+            "id = $3"
+        } else {
+            "status = 'running' AND lease_expires_ms < $1"
+        };
+        let sql = format!(
+            "UPDATE jobs SET \
+             error = CASE WHEN cancel_requested = TRUE THEN error \
+               ELSE 'attempt ' || attempt || ' lost its worker (lease expired)' END, \
+             finished_ms = CASE WHEN cancel_requested = TRUE OR attempt >= $2 THEN $1 \
+               ELSE NULL END, \
+             status = CASE WHEN cancel_requested = TRUE THEN 'cancelled' \
+               WHEN attempt >= $2 THEN 'failed' ELSE 'queued' END, \
+             lease_owner = NULL, lease_expires_ms = NULL \
+             WHERE {rows} RETURNING id, attempt, status, error, parent_id, child_index"
+        );
+        let mut query = sqlx::query_as::<_, LostRow>(&sql)
+            .bind(now_ms)
+            .bind(max_attempts);
+        if let Some(id) = only {
+            query = query.bind(DbUuid(id));
+        }
+        let lost = query.fetch_all(&mut *conn).await?;
+        let changed = lost.len() as u64;
+        for row in lost {
+            Bookkeeping::<DB>::lost(conn, row.try_into()?, now_ms).await?;
+        }
+        Ok(changed)
     }
 
     pub(crate) async fn list_jobs(

@@ -4,18 +4,16 @@
 //! `FOR UPDATE SKIP LOCKED` inside one transaction (concurrent claimers skip each other's row
 //! instead of waiting or taking it twice), every worker write is fenced by the job's attempt, and
 //! expired leases go back to the queue until `max_attempts`. The operations both engines share
-//! are in [`super::portable`]; this file holds the connection, the dialect ([`Dialect`]),
-//! submission, claims and the lease sweeps.
+//! are in [`super::portable`]; this file holds the connection, the dialect ([`Dialect`]), and
+//! how claims and the lease sweeps pick and lock their rows.
 //!
 //! Lock order, to keep concurrent writers free of deadlocks: a transaction that touches a child
 //! job and its parent locks the parent row first ([`Dialect::LOCK_PARENT`]), then the child.
 
-use super::bookkeeping::Bookkeeping;
 use super::delegate::portable_store_methods;
 use super::dialect::Dialect;
 use super::job_records::JobRecord;
 use super::portable::Portable;
-use super::rows::{corrupt, JobRow, LostRow, JOB_COLUMNS};
 use super::{NewJob, Store, StoreError, StoreFuture, Submitted, WorkerHost};
 use sqlx::postgres::{PgConnectOptions, PgPool, PgPoolOptions};
 use sqlx::{Postgres, Row};
@@ -31,9 +29,6 @@ pub struct PgStore {
 
 /// The operations shared with SQLite.
 type Shared = Portable<Postgres>;
-/// Attempt log and fan-out bookkeeping (shared with SQLite), inside a transaction that holds
-/// the parent's row lock.
-type Books = Bookkeeping<Postgres>;
 
 impl Dialect for Postgres {
     const BEGIN_WRITE: Option<&'static str> = None;
@@ -69,14 +64,6 @@ impl Dialect for Postgres {
         "SELECT * FROM api_tokens ORDER BY created_ms, id::TEXT COLLATE \"C\"";
 }
 
-/// A job with the request hash of its idempotency key.
-#[derive(sqlx::FromRow)]
-struct KeyedJobRow {
-    #[sqlx(flatten)]
-    job: JobRow,
-    request_sha256: Option<String>,
-}
-
 impl PgStore {
     /// Connect to `postgres://user@host:port/database` (any URL sqlx accepts).
     pub async fn connect(url: &str) -> Result<Self, StoreError> {
@@ -93,40 +80,6 @@ impl PgStore {
     pub fn pool(&self) -> &PgPool {
         &self.pool
     }
-
-    /// The job submitted earlier with Idempotency-Key `key`: a replay when its body hash is
-    /// `sha`, a conflict otherwise. `None` without a key or when no job has it.
-    async fn keyed_job(
-        &self,
-        tx: &mut sqlx::Transaction<'_, sqlx::Postgres>,
-        key: Option<&str>,
-        sha: Option<&str>,
-    ) -> Result<Option<Submitted>, StoreError> {
-        let Some(key) = key else {
-            return Ok(None);
-        };
-        let sql =
-            format!("SELECT {JOB_COLUMNS}, request_sha256 FROM jobs WHERE idempotency_key = $1");
-        let row: Option<KeyedJobRow> = sqlx::query_as(&sql)
-            .bind(key)
-            .fetch_optional(&mut **tx)
-            .await?;
-        let Some(KeyedJobRow {
-            job,
-            request_sha256: stored_sha,
-        }) = row
-        else {
-            return Ok(None);
-        };
-        let record = JobRecord::try_from(job)?;
-        Ok(Some(
-            if stored_sha.is_some() && stored_sha.as_deref() == sha {
-                Submitted::Replayed(record)
-            } else {
-                Submitted::KeyConflict(record.id)
-            },
-        ))
-    }
 }
 
 impl Store for PgStore {
@@ -141,53 +94,7 @@ impl Store for PgStore {
         })
     }
     fn submit_job(&self, job: NewJob) -> StoreFuture<'_, Submitted> {
-        Box::pin(async move {
-            let (key, sha) = match &job.idempotency {
-                Some((k, s)) => (Some(k.clone()), Some(s.clone())),
-                None => (None, None),
-            };
-            let mut tx = self.pool.begin().await?;
-            // An earlier job with this key: look first, so a replay does not consume a `seq`
-            // (the list order then matches SQLite's exactly).
-            if let Some(found) = self
-                .keyed_job(&mut tx, key.as_deref(), sha.as_deref())
-                .await?
-            {
-                tx.commit().await?;
-                return Ok(found);
-            }
-            // ON CONFLICT DO NOTHING waits for a concurrent insert of the same key to commit,
-            // so two racing submissions yield one job and one replay, never a unique-key error.
-            let sql = format!(
-                "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
-                 idempotency_key, request_sha256, curve_key, created_ms) \
-                 VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7, $8, $9, $10) \
-                 ON CONFLICT (idempotency_key) DO NOTHING RETURNING {JOB_COLUMNS}"
-            );
-            let inserted: Option<JobRow> = sqlx::query_as(&sql)
-                .bind(job.id)
-                .bind(job.kind.as_str())
-                .bind(job.params.to_string())
-                .bind(job.seed as i64)
-                .bind(&job.code_version)
-                .bind(&job.submitted_by)
-                .bind(&key)
-                .bind(&sha)
-                .bind(&job.curve_key)
-                .bind(job.created_ms)
-                .fetch_optional(&mut *tx)
-                .await?;
-            let submitted = match inserted {
-                Some(row) => Submitted::Created(row.try_into()?),
-                // Lost the race to a concurrent submission with the same key.
-                None => self
-                    .keyed_job(&mut tx, key.as_deref(), sha.as_deref())
-                    .await?
-                    .ok_or_else(|| corrupt("idempotent job vanished"))?,
-            };
-            tx.commit().await?;
-            Ok(submitted)
-        })
+        Box::pin(Shared::submit_job(&self.pool, job))
     }
     fn claim_job_on(
         &self,
@@ -212,40 +119,8 @@ impl Store for PgStore {
                 return Ok(None);
             };
             let seq: i64 = picked.try_get("seq")?;
-            // A parent queued for its assembly keeps the progress of its children.
-            let sql = format!(
-                "UPDATE jobs SET status = 'running', attempt = attempt + 1, lease_owner = $2, \
-                 lease_expires_ms = $3 + $4, started_ms = COALESCE(started_ms, $3), \
-                 attempt_started_ms = $3, lease_host = $5, lease_pid = $6, lease_instance = $7, \
-                 progress_simulated_s = CASE WHEN children_total > 0 THEN progress_simulated_s END, \
-                 progress_end_s = CASE WHEN children_total > 0 THEN progress_end_s END, \
-                 progress_fraction = CASE WHEN children_total > 0 THEN progress_fraction END, \
-                 progress_eta_s = NULL \
-                 WHERE seq = $1 AND status = 'queued' RETURNING {JOB_COLUMNS}"
-            );
-            let row: Option<JobRow> = sqlx::query_as(&sql)
-                .bind(seq)
-                .bind(&worker)
-                .bind(now_ms)
-                .bind(lease_ms)
-                .bind(host.as_ref().map(|h| h.host.clone()))
-                .bind(host.as_ref().map(|h| i64::from(h.pid)))
-                .bind(host.as_ref().map(|h| h.instance.clone()))
-                .fetch_optional(&mut *tx)
-                .await?;
-            let record = row.map(JobRecord::try_from).transpose()?;
-            if let Some(job) = &record {
-                sqlx::query(
-                    "INSERT INTO job_attempts (job_id, attempt, worker, started_ms, outcome) \
-                     VALUES ($1, $2, $3, $4, 'running')",
-                )
-                .bind(job.id)
-                .bind(job.attempt)
-                .bind(&worker)
-                .bind(now_ms)
-                .execute(&mut *tx)
-                .await?;
-            }
+            let record =
+                Shared::claim(&mut tx, Some(seq), &worker, host.as_ref(), now_ms, lease_ms).await?;
             tx.commit().await?;
             Ok(record)
         })
@@ -254,17 +129,9 @@ impl Store for PgStore {
         Box::pin(async move {
             let mut n = 0;
             // One statement per job (no other row touched): no lock order to keep.
+            let mut conn = self.pool.acquire().await?;
             for (id, attempt) in attempts {
-                n += sqlx::query(
-                    "UPDATE jobs SET lease_expires_ms = $3 - 1 \
-                     WHERE id = $1 AND attempt = $2 AND status = 'running'",
-                )
-                .bind(id)
-                .bind(attempt)
-                .bind(now_ms)
-                .execute(&self.pool)
-                .await?
-                .rows_affected();
+                n += u64::from(Shared::expire_lease(&mut conn, id, attempt, now_ms).await?);
             }
             Ok(n)
         })
@@ -297,24 +164,8 @@ impl Store for PgStore {
                     tx.rollback().await?;
                     continue;
                 }
-                let lost: LostRow = sqlx::query_as(
-                    "UPDATE jobs SET \
-                     error = CASE WHEN cancel_requested THEN error \
-                       ELSE 'attempt ' || attempt || ' lost its worker (lease expired)' END, \
-                     finished_ms = CASE WHEN cancel_requested OR attempt >= $3 THEN $2 ELSE NULL END, \
-                     status = CASE WHEN cancel_requested THEN 'cancelled' \
-                       WHEN attempt >= $3 THEN 'failed' ELSE 'queued' END, \
-                     lease_owner = NULL, lease_expires_ms = NULL \
-                     WHERE id = $1 RETURNING id, attempt, status, error, parent_id, child_index",
-                )
-                .bind(id)
-                .bind(now_ms)
-                .bind(max_attempts)
-                .fetch_one(&mut *tx)
-                .await?;
-                Books::lost(&mut tx, lost.try_into()?, now_ms).await?;
+                changed += Shared::lose_leases(&mut tx, Some(id), now_ms, max_attempts).await?;
                 tx.commit().await?;
-                changed += 1;
             }
             Ok(changed)
         })

@@ -240,6 +240,15 @@ pub(crate) struct ParentLinkRow {
     pub child_index: Option<i64>,
 }
 
+/// A job with the request hash of its idempotency key (`SELECT <job columns>,
+/// request_sha256`), as a submission with that key reads it.
+#[derive(sqlx::FromRow)]
+pub(crate) struct KeyedJobRow {
+    #[sqlx(flatten)]
+    pub job: JobRow,
+    pub request_sha256: Option<String>,
+}
+
 /// A job whose lease expired, as the re-queue's `RETURNING id, attempt, status, error,
 /// parent_id, child_index` gives it.
 #[derive(sqlx::FromRow)]

@@ -1,6 +1,6 @@
 //! Slow anchors of `railwear validate --slow`: whole-model runs.
 
-use super::Anchor;
+use super::anchor::Anchor;
 use crate::models::case::load_case;
 use crate::physics::control::RunControl;
 use crate::report::run_case;

@@ -27,6 +27,21 @@ fn simulate_with(simulation: serde_json::Value) -> String {
     .to_string()
 }
 
+/// A calibrate request whose eight torque records go back in time at the fourth.
+fn calibrate_back_in_time() -> String {
+    let records: Vec<_> = (0..8)
+        .map(|i| {
+            let t = if i == 3 { 1.0 } else { f64::from(i) };
+            json!({"time_s": t, "angle_rad": 0.0, "angular_velocity_rad_s": 1.0,
+                "normal_load_n": 10.0, "input_torque_n_m": 0.5})
+        })
+        .collect();
+    json!({"kind": "calibrate", "params": {"friction": {
+        "fixture": {"polar_inertia_kg_m2": 1.0, "mean_radius_m": 0.1},
+        "records": records}}})
+    .to_string()
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
     let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
@@ -80,6 +95,9 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
             ("no calibration data", raw(r#"{"kind":"calibrate","params":{}}"#), "params", None),
             ("calibration typo", raw(r#"{"kind":"calibrate","params":{"wear_law":{"records":[],"densty":1}}}"#), "params.wear_law.densty", None),
             ("absurd density", raw(r#"{"kind":"calibrate","params":{"wear_law":{"density_kg_m3":1e9,"records":[]}}}"#), "params.wear_law.density_kg_m3", None),
+            // A record breaking the fit's rule is named by its index and field (the detail no
+            // longer reads `invalid time_s (record 3)` under `params.friction.records`).
+            ("record back in time", calibrate_back_in_time(), "params.friction.records[3].time_s", Some("strictly increasing")),
         ];
         for (case, body, field, word) in &cases {
             let p = api.post(jobs, Some(ENGINEER), body).problem(422);
