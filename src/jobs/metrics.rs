@@ -10,23 +10,64 @@ use uuid::Uuid;
 /// Upper bounds of the job-duration histogram buckets, s.
 const DURATION_BUCKETS_S: [f64; 10] = [0.1, 0.5, 1.0, 5.0, 10.0, 30.0, 60.0, 300.0, 900.0, 3600.0];
 
-#[derive(Default)]
-struct Histogram {
-    counts: [u64; DURATION_BUCKETS_S.len()],
-    count: u64,
-    sum_s: f64,
-}
-
 /// Upper bounds of the HTTP request-latency histogram buckets, s.
 const HTTP_BUCKETS_S: [f64; 12] = [
     0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 10.0,
 ];
 
-#[derive(Default)]
-struct HttpHistogram {
-    counts: [u64; HTTP_BUCKETS_S.len()],
+/// A cumulative histogram over the bucket bounds `N` of its kind.
+struct Histogram<const N: usize> {
+    counts: [u64; N],
     count: u64,
     sum_s: f64,
+}
+
+impl<const N: usize> Default for Histogram<N> {
+    fn default() -> Self {
+        Self {
+            counts: [0; N],
+            count: 0,
+            sum_s: 0.0,
+        }
+    }
+}
+
+impl<const N: usize> Histogram<N> {
+    fn observe(&mut self, bounds: &[f64; N], seconds: f64) {
+        for (slot, bound) in self.counts.iter_mut().zip(bounds) {
+            if seconds <= *bound {
+                *slot += 1;
+            }
+        }
+        self.count += 1;
+        self.sum_s += seconds;
+    }
+}
+
+/// A labelled histogram metric: HELP, TYPE and each label set's series, label sets sorted.
+fn histogram<K: Ord + std::hash::Hash, const N: usize>(
+    out: &mut String,
+    name: &str,
+    help: &str,
+    bounds: &[f64; N],
+    series: &HashMap<K, Histogram<N>>,
+    labels: impl Fn(&K) -> String,
+) {
+    let _ = writeln!(out, "# HELP {name} {help}");
+    let _ = writeln!(out, "# TYPE {name} histogram");
+    let mut keys: Vec<&K> = series.keys().collect();
+    keys.sort();
+    for key in keys {
+        let h = &series[key];
+        histogram_series(
+            out,
+            name,
+            &labels(key),
+            h.counts.iter().copied().zip(bounds.iter().copied()),
+            h.count,
+            h.sum_s,
+        );
+    }
 }
 
 /// One unlabelled metric: its HELP and TYPE lines and its value.
@@ -61,9 +102,9 @@ fn num(x: f64) -> f64 {
 
 #[derive(Default)]
 struct Inner {
-    durations: HashMap<(&'static str, &'static str), Histogram>,
+    durations: HashMap<(&'static str, &'static str), Histogram<{ DURATION_BUCKETS_S.len() }>>,
     /// HTTP requests by (method, route template): latency histogram.
-    http_latency: HashMap<(String, String), HttpHistogram>,
+    http_latency: HashMap<(String, String), Histogram<{ HTTP_BUCKETS_S.len() }>>,
     /// HTTP requests by (method, route template, status code).
     http_requests: HashMap<(String, String, u16), u64>,
     simulated_s_total: f64,
@@ -81,17 +122,10 @@ struct Inner {
 impl Inner {
     /// One job (or attempt) of `kind` that ended with `status` after `seconds`.
     fn observe(&mut self, kind: JobKind, status: JobStatus, seconds: f64) {
-        let h = self
-            .durations
+        self.durations
             .entry((kind.as_str(), status.as_str()))
-            .or_default();
-        for (slot, bound) in h.counts.iter_mut().zip(DURATION_BUCKETS_S) {
-            if seconds <= bound {
-                *slot += 1;
-            }
-        }
-        h.count += 1;
-        h.sum_s += seconds;
+            .or_default()
+            .observe(&DURATION_BUCKETS_S, seconds);
     }
 }
 
@@ -193,17 +227,10 @@ impl Metrics {
             *m.http_requests
                 .entry((method.to_string(), route.to_string(), status))
                 .or_default() += 1;
-            let h = m
-                .http_latency
+            m.http_latency
                 .entry((method.to_string(), route.to_string()))
-                .or_default();
-            for (slot, bound) in h.counts.iter_mut().zip(HTTP_BUCKETS_S) {
-                if seconds <= bound {
-                    *slot += 1;
-                }
-            }
-            h.count += 1;
-            h.sum_s += seconds;
+                .or_default()
+                .observe(&HTTP_BUCKETS_S, seconds);
         });
     }
 
@@ -230,27 +257,14 @@ impl Metrics {
             queued,
         );
         self.with(|m| {
-            let _ = writeln!(
-                out,
-                "# HELP railwear_job_duration_seconds Wall time of jobs ended by this process: an attempt's, or for a job that fanned out (a sweep) the whole job's, from its first claim through its children to its assembly."
+            histogram(
+                &mut out,
+                "railwear_job_duration_seconds",
+                "Wall time of jobs ended by this process: an attempt's, or for a job that fanned out (a sweep) the whole job's, from its first claim through its children to its assembly.",
+                &DURATION_BUCKETS_S,
+                &m.durations,
+                |(kind, status)| format!("kind=\"{kind}\",status=\"{status}\""),
             );
-            let _ = writeln!(out, "# TYPE railwear_job_duration_seconds histogram");
-            let mut keys: Vec<_> = m.durations.keys().copied().collect();
-            keys.sort();
-            for key in keys {
-                let Some(h) = m.durations.get(&key) else {
-                    continue;
-                };
-                let labels = format!("kind=\"{}\",status=\"{}\"", key.0, key.1);
-                histogram_series(
-                    &mut out,
-                    "railwear_job_duration_seconds",
-                    &labels,
-                    h.counts.iter().copied().zip(DURATION_BUCKETS_S),
-                    h.count,
-                    h.sum_s,
-                );
-            }
             scalar(
                 &mut out,
                 "railwear_simulated_seconds_total",
@@ -321,27 +335,14 @@ impl Metrics {
                     key.0, key.1, key.2
                 );
             }
-            let _ = writeln!(
-                out,
-                "# HELP railwear_http_request_duration_seconds Latency of HTTP requests answered by this process, by method and route."
+            histogram(
+                &mut out,
+                "railwear_http_request_duration_seconds",
+                "Latency of HTTP requests answered by this process, by method and route.",
+                &HTTP_BUCKETS_S,
+                &m.http_latency,
+                |(method, route)| format!("method=\"{method}\",route=\"{route}\""),
             );
-            let _ = writeln!(out, "# TYPE railwear_http_request_duration_seconds histogram");
-            let mut keys: Vec<_> = m.http_latency.keys().cloned().collect();
-            keys.sort();
-            for key in keys {
-                let Some(h) = m.http_latency.get(&key) else {
-                    continue;
-                };
-                let labels = format!("method=\"{}\",route=\"{}\"", key.0, key.1);
-                histogram_series(
-                    &mut out,
-                    "railwear_http_request_duration_seconds",
-                    &labels,
-                    h.counts.iter().copied().zip(HTTP_BUCKETS_S),
-                    h.count,
-                    h.sum_s,
-                );
-            }
         });
         out
     }
