@@ -5,7 +5,7 @@
 use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::field_error::FieldError;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
 use std::path::PathBuf;

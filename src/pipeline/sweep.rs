@@ -6,7 +6,7 @@ use super::{
     RunError, SweepRange, SWEEP_KEYS,
 };
 use crate::field_error::FieldError;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;

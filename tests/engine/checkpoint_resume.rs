@@ -7,7 +7,7 @@
 
 use railwear::models::case::{build, code_version, load_case};
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
-use railwear::models::specs::CaseSpec;
+use railwear::models::spec::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
 use railwear::physics::track::TrackSample;
 use railwear::pipeline::{Progress, RunControl, RunError};

@@ -1,6 +1,8 @@
 //! Spec tests: parsing, validation naming the field, derived geometry.
 
 use super::*;
+use crate::analysis::rattle_space::LauncherDimensions;
+use crate::models::launcher::LauncherSpec;
 use std::path::PathBuf;
 
 fn configs_dir() -> PathBuf {
