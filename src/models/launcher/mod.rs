@@ -21,6 +21,8 @@
 
 mod geometry;
 mod spec;
+#[cfg(test)]
+mod tests;
 
 pub use spec::{
     CoilSpringSpec, ConstantForceSpec, LatchJoint, LatchSpec, LauncherContacts, LauncherSpec,

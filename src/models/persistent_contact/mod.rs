@@ -7,6 +7,8 @@
 //! [`build`] refuses it, naming the `model` field.
 
 mod spec;
+#[cfg(test)]
+mod tests;
 
 pub use spec::{PersistentContactSpec, PrescribedRotation};
 

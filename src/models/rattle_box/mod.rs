@@ -4,6 +4,8 @@
 //! it is built as a multibody system is here.
 
 mod spec;
+#[cfg(test)]
+mod tests;
 
 pub use spec::{RattleBoxSpec, TABLE_5_1_TUBE_SIDES_IN};
 

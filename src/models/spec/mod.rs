@@ -107,7 +107,7 @@ pub(in crate::models) fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Resu
 
 mod shared;
 #[cfg(test)]
-mod tests;
+pub(in crate::models) mod tests;
 
 pub use shared::{
     validate_friction, validate_material, ContactSpec, PlanarFace, RoundedBoxSpec, SimulationSpec,
