@@ -19,7 +19,7 @@ fn outcome_hash(o: &CaseOutcome) -> String {
     let mut h = Sha256::new();
     h.update(o.summary.to_string());
     for s in &o.tracks {
-        h.update(railwear::store::tracks::csv_line(s));
+        h.update(s.csv_line());
     }
     for (name, svg) in &o.plots {
         h.update(name);

@@ -54,10 +54,7 @@ pub fn run(
         serde_json::to_string_pretty(&outcome.summary)?,
     )?;
     let mut csv = std::io::BufWriter::new(std::fs::File::create(dir.join("tracks.csv"))?);
-    writeln!(csv, "{}", crate::physics::track::TrackSample::CSV_HEADER)?;
-    for s in &outcome.tracks {
-        writeln!(csv, "{}", crate::store::tracks::csv_line(s))?;
-    }
+    crate::physics::track::TrackSample::write_csv(&outcome.tracks, &mut csv)?;
     csv.flush()?;
     for (name, svg) in &outcome.plots {
         std::fs::write(dir.join(name), svg)?;

@@ -95,10 +95,12 @@ mod tests {
         // Rail wear rate 1 mg/h at the design rattle space 0.05, 2 mg/h at 0.10.
         let points = [
             SweepPoint {
+                offset_mm: None,
                 rattle_space: 0.05,
                 rail_wear_rate_mg_per_h: 1.0,
             },
             SweepPoint {
+                offset_mm: None,
                 rattle_space: 0.10,
                 rail_wear_rate_mg_per_h: 2.0,
             },

@@ -79,10 +79,17 @@ pub enum PenalizationError {
 }
 
 /// One point of a tolerance sweep: a rail configuration's rattle space and its simulated rail
-/// wear rate (thesis Figure 6.67: sum of rail contacts 1, 3 and 5).
+/// wear rate (thesis Figure 6.67: sum of rail contacts 1, 3 and 5), with the material-condition
+/// offset that made the configuration when the point comes from a sweep's run. A curve's points
+/// carry no offset: the curve is a function of the rattle space alone, and
+/// [`PenalizationCurve::new`] drops it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SweepPoint {
+    /// Material-condition offset applied to the launcher dimensions, mm (negative = tighter);
+    /// absent on a curve's points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset_mm: Option<f64>,
     /// Rattle space k_rs of the configuration (eq. 6.3), dimensionless, in (0, 1].
     pub rattle_space: f64,
     /// Rail wear rate at that configuration, mg/h (> 0).
@@ -225,6 +232,7 @@ impl PenalizationCurve {
                 j += 1;
             }
             merged.push(SweepPoint {
+                offset_mm: None,
                 rattle_space: k,
                 rail_wear_rate_mg_per_h: (log_sum / (j - i) as f64).exp(),
             });
@@ -312,6 +320,7 @@ impl PenalizationCurve {
                 (rates.iter().map(|r| r.ln()).sum::<f64>() / n as f64).exp()
             };
             points.push(SweepPoint {
+                offset_mm: None,
                 rattle_space: *k,
                 rail_wear_rate_mg_per_h: rate,
             });
@@ -487,6 +496,7 @@ mod tests {
 
     fn pt(k: f64, rate: f64) -> SweepPoint {
         SweepPoint {
+            offset_mm: None,
             rattle_space: k,
             rail_wear_rate_mg_per_h: rate,
         }

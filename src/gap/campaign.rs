@@ -14,7 +14,7 @@
 use super::accel::{self, AccelRecord, ACCEL_COLUMNS};
 use super::GapError;
 use crate::models::outcome::RunError;
-use crate::models::specs::{CaseSpec, ModelSpecRef};
+use crate::models::spec::{CaseSpec, ModelSpecRef};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Component, Path};

@@ -14,7 +14,7 @@
 use super::tracks::{WearSample, WearTerm};
 use super::GapError;
 use crate::excitation::{Axis, ExcitationSpec, Tone};
-use crate::models::specs::{CaseSpec, ModelKind};
+use crate::models::spec::{CaseSpec, ModelKind};
 use crate::wear::law::WearLaw;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -398,7 +398,7 @@ impl Effect {
         if self.magnitude() == 0.0 || info.acts == Acts::WearLaw {
             return Ok(());
         }
-        let bad = |e: crate::models::specs::FieldError| {
+        let bad = |e: crate::field_error::FieldError| {
             GapError::field(
                 format!("effect.{}", self.name),
                 format!("{}: {}", e.field, e.rule),

@@ -28,7 +28,7 @@ use super::rig_effects::{HiddenEffect, RIG_ONLY};
 use super::tracks::{SlipHistory, WearTerm};
 use super::window::{WindowCache, WindowOptions, WindowRun};
 use super::GapError;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use crate::physics::control::RunControl;
 use crate::sampling::standard_normal;
 use crate::units::S_PER_H;

@@ -8,7 +8,7 @@
 use super::effects::{parse_spec, Acts, EffectInfo, ParameterInfo};
 use super::tracks::{WearSample, WearTerm};
 use super::GapError;
-use crate::models::specs::ModelKind;
+use crate::models::spec::ModelKind;
 use crate::wear::law::WearLaw;
 use std::collections::BTreeMap;
 

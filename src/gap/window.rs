@@ -10,7 +10,7 @@
 
 use super::tracks::{SlipHistory, TrackRecord, WearTerm};
 use super::GapError;
-use crate::models::specs::{CaseSpec, ModelSpecRef};
+use crate::models::spec::{CaseSpec, ModelSpecRef};
 use crate::physics::control::RunControl;
 use crate::units::MG_PER_KG;
 use crate::wear::allocation::VolumeSplit;

@@ -571,32 +571,27 @@ pub async fn get_tracks(
     let job = load_job(&state, &id).await?;
     require_succeeded(&job)?;
     let blocks = state.store.track_blocks(job.id).await?;
-    let body = tokio::task::spawn_blocking(move || -> Result<String, tracks::BlockError> {
-        let mut index: u64 = 0;
-        let mut keep: Vec<TrackSample> = Vec::new();
-        let mut out = String::new();
-        if csv {
-            out.push_str(TrackSample::CSV_HEADER);
-            out.push('\n');
-        }
-        for block in &blocks {
-            for sample in tracks::decode_block(block)? {
-                if index % every == 0 {
-                    if csv {
-                        out.push_str(&tracks::csv_line(&sample));
-                        out.push('\n');
-                    } else {
+    let body = tokio::task::spawn_blocking(
+        move || -> Result<String, Box<dyn std::error::Error + Send + Sync>> {
+            let mut index: u64 = 0;
+            let mut keep: Vec<TrackSample> = Vec::new();
+            for block in &blocks {
+                for sample in tracks::decode_block(block)? {
+                    if index % every == 0 {
                         keep.push(sample);
                     }
+                    index += 1;
                 }
-                index += 1;
             }
-        }
-        if !csv {
-            out = serde_json::to_string(&keep).unwrap_or_else(|_| "[]".into());
-        }
-        Ok(out)
-    })
+            if csv {
+                let mut out = Vec::new();
+                TrackSample::write_csv(&keep, &mut out)?;
+                Ok(String::from_utf8(out)?)
+            } else {
+                Ok(serde_json::to_string(&keep).unwrap_or_else(|_| "[]".into()))
+            }
+        },
+    )
     .await
     .map_err(|e| Problem::internal(&e))?
     .map_err(|e| Problem::internal(&e))?;

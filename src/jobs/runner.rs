@@ -5,9 +5,11 @@
 use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::field_error::FieldError;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use crate::physics::track::TrackSample;
-use crate::pipeline::{CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPoint};
+use crate::pipeline::{
+    CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPointSummary,
+};
 use std::path::PathBuf;
 
 /// What a finished job produces.
@@ -378,8 +380,18 @@ impl CaseRunner for LibraryRunner {
                     control,
                     checkpoint,
                 )?;
+                let summary = SweepPointSummary {
+                    point: index,
+                    replica,
+                    sweep: point,
+                };
+                let summary =
+                    serde_json::to_value(summary).map_err(|e| RunError::InvalidConfig {
+                        field: "summary".into(),
+                        rule: format!("could not be serialized: {e}"),
+                    })?;
                 Ok(JobOutput {
-                    summary: sweep_point_summary(index, replica, &point),
+                    summary,
                     ..JobOutput::default()
                 })
             }
@@ -451,12 +463,12 @@ impl CaseRunner for LibraryRunner {
             .iter()
             .enumerate()
             .map(|(index, summary)| {
-                serde_json::from_value::<SweepPoint>(summary.clone()).map_err(|e| {
-                    RunError::InvalidConfig {
+                serde_json::from_value::<SweepPointSummary>(summary.clone())
+                    .map(|child| child.sweep)
+                    .map_err(|e| RunError::InvalidConfig {
                         field: format!("children[{index}]"),
                         rule: format!("is not a sweep point result: {e}"),
-                    }
-                })
+                    })
             })
             .collect::<Result<Vec<_>, _>>()?;
         sweep_output(&plan, params, &plan.outcome(points)?)
@@ -512,17 +524,6 @@ pub fn run_diagnosis(
         summary,
         plots: crate::gap::diagnose::plots::plots(&report),
         ..JobOutput::default()
-    })
-}
-
-/// Result summary of a `sweep_point` child job: its point and replica indices and the run.
-pub fn sweep_point_summary(index: usize, replica: usize, point: &SweepPoint) -> serde_json::Value {
-    serde_json::json!({
-        "point": index,
-        "replica": replica,
-        "offset_mm": point.offset_mm,
-        "rattle_space": point.rattle_space,
-        "rail_wear_rate_mg_per_h": point.rail_wear_rate_mg_per_h,
     })
 }
 

@@ -3,9 +3,9 @@
 //! packaging the outcome (summary, tracks, plots) is [`crate::report`]'s.
 
 use super::outcome::RunError;
-use super::rattle_box;
 use super::run::{BuiltModel, ModelRunError, RunOptions};
-use super::specs::{CaseSpec, ModelSpecRef};
+use super::spec::{CaseSpec, ModelSpecRef};
+use super::{launcher, persistent_contact, rattle_box};
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
 use crate::field_error::FieldError;
@@ -148,11 +148,8 @@ pub(crate) fn build_validated(case: &CaseSpec, configs_dir: &Path) -> Result<Bui
         .map_err(|e| FieldError::new("excitation", e.to_string()))?;
     match case.model_spec()? {
         ModelSpecRef::RattleBox(spec) => Ok(rattle_box::build(case, spec, motion)),
-        ModelSpecRef::Launcher(spec) => super::launcher::build(case, spec, motion),
-        ModelSpecRef::PersistentContact(_) => Err(FieldError::new(
-            "model",
-            "the persistent-contact fixture runs through `railwear calibrate`, not as a dynamic case in this build",
-        ).into()),
+        ModelSpecRef::Launcher(spec) => launcher::build(case, spec, motion),
+        ModelSpecRef::PersistentContact(spec) => persistent_contact::build(spec),
     }
 }
 

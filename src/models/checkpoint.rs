@@ -17,7 +17,7 @@
 
 use super::case::{code_version, resolve_excitation};
 use super::run::{BuiltModel, ModelCheckpoint};
-use super::specs::CaseSpec;
+use super::spec::CaseSpec;
 use bincode::Options;
 use flate2::read::ZlibDecoder;
 use flate2::write::ZlibEncoder;

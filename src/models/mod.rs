@@ -6,9 +6,10 @@ pub mod checkpoint;
 pub mod launcher;
 pub mod motion;
 pub mod outcome;
+pub mod persistent_contact;
 pub mod rattle_box;
 pub mod reference;
 pub mod run;
-pub mod specs;
+pub mod spec;
 #[cfg(test)]
 mod system_tests;

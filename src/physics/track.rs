@@ -35,4 +35,98 @@ pub struct TrackSample {
 impl TrackSample {
     /// Column names for CSV export, in field order, with units.
     pub const CSV_HEADER: &'static str = "time_s,contact,track,normal_force_n,slip_vx_m_s,slip_vy_m_s,slip_vz_m_s,slip_speed_m_s,penetration_m,penetration_rate_m_s,area_m2,pressure_pa,point_a_x_m,point_a_y_m,point_a_z_m,point_b_x_m,point_b_y_m,point_b_z_m";
+
+    /// One CSV line (no newline) in [`TrackSample::CSV_HEADER`] order. Rust's float formatting
+    /// is the shortest text that parses back to the same f64, so CSV export loses nothing.
+    pub fn csv_line(&self) -> String {
+        let v = self.slip_velocity_m_s;
+        let a = self.point_in_a_m;
+        let b = self.point_in_b_m;
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            self.time_s,
+            self.contact,
+            self.track,
+            self.normal_force_n,
+            v[0],
+            v[1],
+            v[2],
+            self.slip_speed_m_s,
+            self.penetration_m,
+            self.penetration_rate_m_s,
+            self.area_m2,
+            self.pressure_pa,
+            a[0],
+            a[1],
+            a[2],
+            b[0],
+            b[1],
+            b[2]
+        )
+    }
+
+    /// The CSV export of `samples`: [`TrackSample::CSV_HEADER`], then one
+    /// [`TrackSample::csv_line`] per sample, each line ending in `\n`. The one writer of the
+    /// track CSV (`railwear run`'s `tracks.csv` and the service's `GET /v1/jobs/{id}/tracks`).
+    pub fn write_csv<'a>(
+        samples: impl IntoIterator<Item = &'a TrackSample>,
+        mut out: impl std::io::Write,
+    ) -> std::io::Result<()> {
+        writeln!(out, "{}", Self::CSV_HEADER)?;
+        for sample in samples {
+            writeln!(out, "{}", sample.csv_line())?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(i: u32) -> TrackSample {
+        let t = f64::from(i) * 1e-4;
+        TrackSample {
+            time_s: t,
+            contact: i % 5,
+            track: i % 3,
+            normal_force_n: 10.0 + (t * 50.0).sin(),
+            slip_velocity_m_s: [0.01 * t, -0.02, 1.0 / 3.0],
+            slip_speed_m_s: 0.5,
+            penetration_m: 1e-6 * (1.0 + t),
+            penetration_rate_m_s: -1e-4,
+            area_m2: 2.5e-6,
+            pressure_pa: 4.0e6 + t,
+            point_in_a_m: [0.1, 0.2, 0.3],
+            point_in_b_m: [-0.1, f64::MIN_POSITIVE, 1e300],
+        }
+    }
+
+    #[test]
+    fn csv_line_parses_back() {
+        let s = sample(7);
+        let line = s.csv_line();
+        let fields: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+        assert_eq!(fields.len(), TrackSample::CSV_HEADER.split(',').count());
+        assert_eq!(fields[0], s.time_s);
+        assert_eq!(fields[3], s.normal_force_n);
+        assert_eq!(fields[17], s.point_in_b_m[2]);
+    }
+
+    #[test]
+    fn write_csv_is_the_header_then_one_line_per_sample() {
+        let samples = [sample(1), sample(2)];
+        let mut out = Vec::new();
+        TrackSample::write_csv(&samples, &mut out).unwrap();
+        let expected = format!(
+            "{}\n{}\n{}\n",
+            TrackSample::CSV_HEADER,
+            samples[0].csv_line(),
+            samples[1].csv_line()
+        );
+        assert_eq!(String::from_utf8(out).unwrap(), expected);
+        let mut empty = Vec::new();
+        TrackSample::write_csv(&[], &mut empty).unwrap();
+        assert_eq!(empty, format!("{}\n", TrackSample::CSV_HEADER).into_bytes());
+    }
 }

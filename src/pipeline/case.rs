@@ -5,7 +5,7 @@ use super::{
 };
 use crate::field_error::FieldError;
 use crate::models::case::load_case;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use crate::report::run_case;
 use std::path::Path;
 

@@ -5,22 +5,12 @@ use super::{
     check_keys, design_rattle_space, merge_json, replica_seed, resolve_case, Progress, RunControl,
     RunError, SweepRange, SWEEP_KEYS,
 };
+use crate::analysis::penalization::SweepPoint;
 use crate::field_error::FieldError;
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;
-
-/// One point of a tolerance sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct SweepPoint {
-    /// Material-condition offset applied to the launcher dimensions, mm (negative = tighter).
-    pub offset_mm: f64,
-    /// Rattle space k_rs (eq. 6.1-6.3).
-    pub rattle_space: f64,
-    /// Rail wear rate, mg/h.
-    pub rail_wear_rate_mg_per_h: f64,
-}
 
 /// Result of a tolerance sweep.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -404,10 +394,24 @@ pub fn sweep_point_from(
         .map(|b| b.mass_rate_mg_per_h)
         .ok_or_else(|| FieldError::new("config", "the launcher model has no body named `rail`"))?;
     Ok(SweepPoint {
-        offset_mm,
+        offset_mm: Some(offset_mm),
         rattle_space,
         rail_wear_rate_mg_per_h,
     })
+}
+
+/// Result summary of a `sweep_point` child job: its point and replica indices and the run's
+/// point, flattened (`{"point", "replica", "offset_mm", "rattle_space",
+/// "rail_wear_rate_mg_per_h"}`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SweepPointSummary {
+    /// Index of the point in the sweep (tight to loose).
+    pub point: usize,
+    /// Index of the replica (the seed) at that point.
+    pub replica: usize,
+    /// The run's point.
+    #[serde(flatten)]
+    pub sweep: SweepPoint,
 }
 
 /// Params of the child job that runs point `index`, replica `replica` of the sweep with

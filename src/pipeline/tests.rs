@@ -150,3 +150,62 @@ fn replicas_run_their_own_seeds_below_2_pow_53() {
     assert_eq!(plan.runs(), 6);
     assert_eq!(plan.run_index(1, 2), 5);
 }
+
+#[test]
+fn a_point_child_summary_is_its_indices_and_the_flattened_point() {
+    let point = crate::analysis::penalization::SweepPoint {
+        offset_mm: Some(-0.125),
+        rattle_space: 0.8,
+        rail_wear_rate_mg_per_h: 2.5,
+    };
+    let summary = SweepPointSummary {
+        point: 3,
+        replica: 1,
+        sweep: point,
+    };
+    let value = serde_json::to_value(summary).unwrap();
+    assert_eq!(
+        value,
+        serde_json::json!({
+            "point": 3,
+            "replica": 1,
+            "offset_mm": -0.125,
+            "rattle_space": 0.8,
+            "rail_wear_rate_mg_per_h": 2.5,
+        })
+    );
+    assert_eq!(
+        serde_json::from_value::<SweepPointSummary>(value).unwrap(),
+        summary
+    );
+    // A point whose rattle space is unknown (NaN) writes null, as a json! summary did.
+    let unknown = SweepPointSummary {
+        sweep: crate::analysis::penalization::SweepPoint {
+            rattle_space: f64::NAN,
+            ..point
+        },
+        ..summary
+    };
+    assert_eq!(
+        serde_json::to_value(unknown).unwrap()["rattle_space"],
+        serde_json::Value::Null
+    );
+}
+
+#[test]
+fn a_curve_built_from_sweep_points_keeps_no_offsets() {
+    use crate::analysis::penalization::{PenalizationCurve, SweepPoint};
+    let point = |offset_mm, rattle_space, rail_wear_rate_mg_per_h| SweepPoint {
+        offset_mm: Some(offset_mm),
+        rattle_space,
+        rail_wear_rate_mg_per_h,
+    };
+    let curve = PenalizationCurve::new(&[point(-0.1, 0.7, 2.0), point(0.1, 0.8, 1.0)], 0.75)
+        .expect("curve");
+    assert!(curve.points().iter().all(|p| p.offset_mm.is_none()));
+    let value = serde_json::to_value(&curve).unwrap();
+    assert_eq!(
+        value["points"][0],
+        serde_json::json!({"rattle_space": 0.7, "rail_wear_rate_mg_per_h": 2.0})
+    );
+}

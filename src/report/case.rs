@@ -9,7 +9,7 @@ use crate::models::case::{build, code_version, run_options};
 use crate::models::checkpoint::{self, RunIdentity};
 use crate::models::outcome::{CaseOutcome, RunError};
 use crate::models::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
-use crate::models::specs::{CaseSpec, ModelSpecRef};
+use crate::models::spec::{CaseSpec, ModelSpecRef};
 use crate::physics::control::RunControl;
 use crate::physics::simulate::SimError;
 use serde_json::{json, Value};

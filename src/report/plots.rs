@@ -4,7 +4,7 @@
 use super::svg::{AxisSpec, Plot, Series};
 use crate::analysis::penalization::PenalizationCurve;
 use crate::models::run::RunReport;
-use crate::models::specs::{CaseSpec, ModelSpecRef};
+use crate::models::spec::{CaseSpec, ModelSpecRef};
 
 /// The named SVG plots of a finished case: (file name, SVG text).
 pub fn case_plots(

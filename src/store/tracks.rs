@@ -144,35 +144,6 @@ pub fn decode_block(block: &TrackBlock) -> Result<Vec<TrackSample>, BlockError> 
         .collect())
 }
 
-/// One CSV line (no newline) in [`TrackSample::CSV_HEADER`] order. Rust's float formatting is
-/// the shortest text that parses back to the same f64, so CSV export loses nothing.
-pub fn csv_line(s: &TrackSample) -> String {
-    let v = s.slip_velocity_m_s;
-    let a = s.point_in_a_m;
-    let b = s.point_in_b_m;
-    format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-        s.time_s,
-        s.contact,
-        s.track,
-        s.normal_force_n,
-        v[0],
-        v[1],
-        v[2],
-        s.slip_speed_m_s,
-        s.penetration_m,
-        s.penetration_rate_m_s,
-        s.area_m2,
-        s.pressure_pa,
-        a[0],
-        a[1],
-        a[2],
-        b[0],
-        b[1],
-        b[2]
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,16 +192,5 @@ mod tests {
         assert!(decode_block(&block).is_err());
         block.data = vec![1, 2, 3];
         assert!(decode_block(&block).is_err());
-    }
-
-    #[test]
-    fn csv_line_parses_back() {
-        let s = sample(7);
-        let line = csv_line(&s);
-        let fields: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
-        assert_eq!(fields.len(), TrackSample::CSV_HEADER.split(',').count());
-        assert_eq!(fields[0], s.time_s);
-        assert_eq!(fields[3], s.normal_force_n);
-        assert_eq!(fields[17], s.point_in_b_m[2]);
     }
 }

@@ -54,7 +54,7 @@ pub fn motionless_tube(configs_dir: &Path) -> Result<MotionlessTube, RunError> {
     let model = build(&case, configs_dir)?;
     let settings = integrator_settings(&case)?;
     let spec = match case.model_spec() {
-        Ok(crate::models::specs::ModelSpecRef::RattleBox(s)) => s.clone(),
+        Ok(crate::models::spec::ModelSpecRef::RattleBox(s)) => s.clone(),
         _ => {
             return Err(RunError::InvalidConfig {
                 field: "model".into(),

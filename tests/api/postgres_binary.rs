@@ -263,12 +263,12 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     );
     assert_eq!(assembled.points.len(), 12);
     for (a, b) in assembled.points.iter().zip(&outcome.points) {
-        assert_eq!(a.offset_mm.to_bits(), b.offset_mm.to_bits());
+        assert_eq!(a.offset_mm.map(f64::to_bits), b.offset_mm.map(f64::to_bits));
         assert_eq!(a.rattle_space.to_bits(), b.rattle_space.to_bits());
         assert_eq!(
             a.rail_wear_rate_mg_per_h.to_bits(),
             b.rail_wear_rate_mg_per_h.to_bits(),
-            "offset {} mm",
+            "offset {:?} mm",
             b.offset_mm
         );
     }

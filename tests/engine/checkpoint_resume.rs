@@ -7,7 +7,7 @@
 
 use railwear::models::case::{build, code_version, load_case};
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
-use railwear::models::specs::CaseSpec;
+use railwear::models::spec::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
 use railwear::physics::track::TrackSample;
 use railwear::pipeline::{Progress, RunControl, RunError};
@@ -37,13 +37,9 @@ struct Results {
 }
 
 fn csv(tracks: &[TrackSample]) -> String {
-    let mut out = String::from(TrackSample::CSV_HEADER);
-    out.push('\n');
-    for s in tracks {
-        out.push_str(&railwear::store::tracks::csv_line(s));
-        out.push('\n');
-    }
-    out
+    let mut out = Vec::new();
+    TrackSample::write_csv(tracks, &mut out).expect("writing to memory");
+    String::from_utf8(out).expect("the track CSV is ASCII")
 }
 
 /// A control that asks for a checkpoint at the first accepted step at or past simulated time

@@ -4,7 +4,7 @@
 //! of tests/energy_passivity.rs, fixed by physics, not by output).
 
 use railwear::models::case::{integrator_settings, load_case};
-use railwear::models::specs::CaseSpec;
+use railwear::models::spec::CaseSpec;
 use railwear::physics::integrator::{ErrorControl, IntegratorSettings};
 use railwear::physics::simulate::{simulate, DivergenceLimits};
 use railwear::pipeline::RunControl;

@@ -6,7 +6,7 @@ use railwear::gap::effects::{self, Acts, Effect, SpecimenState, LIBRARY};
 use railwear::gap::rig_effects::{HiddenEffect, RIG_ONLY};
 use railwear::gap::tracks::{SlipHistory, TrackPoint, TrackRecord, WearTerm};
 use railwear::models::case::load_case;
-use railwear::models::specs::CaseSpec;
+use railwear::models::spec::CaseSpec;
 use railwear::wear::law::WearLaw;
 use railwear::wear::Material;
 use std::path::{Path, PathBuf};

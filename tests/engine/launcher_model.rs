@@ -3,9 +3,10 @@
 
 use nalgebra::Vector3;
 use railwear::models::case::{build, load_case, run_options};
+use railwear::models::launcher::LauncherSpec;
 use railwear::models::launcher::{CONTACT_NAMES, LEAF_SPRING_FORCE, MISSILE, RAIL};
 use railwear::models::run::{run_model, BuiltModel};
-use railwear::models::specs::{CaseSpec, LauncherSpec, ModelSpecRef};
+use railwear::models::spec::{CaseSpec, ModelSpecRef};
 use railwear::physics::body::BodyKind;
 use railwear::physics::forces::ForceElement;
 use railwear::physics::simulate::{simulate, DivergenceLimits};

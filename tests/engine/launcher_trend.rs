@@ -49,6 +49,7 @@ fn looser_rails_wear_faster_and_k_sl_penalizes_them() {
     let points: Vec<SweepPoint> = [tight, design, loose]
         .iter()
         .map(|&(k, r)| SweepPoint {
+            offset_mm: None,
             rattle_space: k,
             rail_wear_rate_mg_per_h: r,
         })

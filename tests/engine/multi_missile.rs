@@ -6,7 +6,7 @@
 //! closes, and stations whose missiles would overlap are refused.
 
 use railwear::models::case::{build, load_case};
-use railwear::models::specs::{CaseSpec, ModelSpecRef};
+use railwear::models::spec::{CaseSpec, ModelSpecRef};
 use railwear::physics::partition::independent_parts;
 use railwear::pipeline::RunControl;
 use railwear::report::run_case;

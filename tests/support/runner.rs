@@ -238,6 +238,7 @@ pub fn sweep_curve(
 /// design and tight rattle spaces; only their ratios matter to K_SL).
 fn fixed_curve() -> Result<PenalizationCurve, RunError> {
     let point = |rattle_space, rail_wear_rate_mg_per_h| SweepPoint {
+        offset_mm: None,
         rattle_space,
         rail_wear_rate_mg_per_h,
     };

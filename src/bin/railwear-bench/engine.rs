@@ -76,7 +76,8 @@ pub(crate) const SPHERE_DROP_M: f64 = 0.1;
 /// (eq. 2.5-2.10, E = 72 GPa, nu = 0.33 on both sides), e = 1.5, no damping (elastic bounces,
 /// so the time-averaged normal force over whole bounces equals m g).
 pub(crate) fn sphere_impact() -> ImpactParams {
-    let e_star = 1.0 / (2.0 * (1.0 - 0.33f64.powi(2)) / 72e9);
+    use railwear::thesis::{POISSON_RATIO_7075, YOUNGS_MODULUS_7075_PA};
+    let e_star = 1.0 / (2.0 * (1.0 - POISSON_RATIO_7075.powi(2)) / YOUNGS_MODULUS_7075_PA);
     let k_si = 4.0 / 3.0 * e_star * SPHERE_RADIUS_M.sqrt();
     let k_adams = k_si * 1e-3f64.powf(1.5);
     let mut p = ImpactParams::from_adams_units(k_adams, 1.5, 0.0, 0.0);
@@ -272,7 +273,9 @@ pub(crate) fn engine(
         }
     }
     push_with_vdv_ratio(&mut table, sphere_rows);
-    let mass = 2810.0 * 4.0 / 3.0 * std::f64::consts::PI * SPHERE_RADIUS_M.powi(3);
+    let mass = railwear::thesis::DENSITY_7075_KG_PER_M3 * 4.0 / 3.0
+        * std::f64::consts::PI
+        * SPHERE_RADIUS_M.powi(3);
     table.note(
         "rattle box C: configs/rattle-box-c.toml (Table 5.2 contact, 15 g 20 Hz), tracks not \
          recorded; real-time factor = (settle + window) / wall; steps/s = accepted steps / wall; \

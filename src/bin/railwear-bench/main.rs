@@ -10,7 +10,7 @@ use railwear::analysis::rattle_space::LauncherDimensions;
 use railwear::analysis::vdv::vibration_dose_value_uniform;
 use railwear::models::case::{build, load_case, run_options};
 use railwear::models::run::{run_model, BuiltModel, ModelRunError, RunOptions, RunReport};
-use railwear::models::specs::CaseSpec;
+use railwear::models::spec::CaseSpec;
 use railwear::physics::body::write_state;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{

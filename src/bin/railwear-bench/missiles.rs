@@ -46,7 +46,7 @@ pub(crate) fn missiles(
     for name in ["launcher-design", "launcher-m299-2", "launcher-m299-4"] {
         let case = missile_case(configs_dir, name, settle, window)?;
         let n = match case.model_spec() {
-            Ok(railwear::models::specs::ModelSpecRef::Launcher(s)) => s.stations.len(),
+            Ok(railwear::models::spec::ModelSpecRef::Launcher(s)) => s.stations.len(),
             _ => bail!("{name} is not a launcher case"),
         };
         eprintln!("missiles: {name} ({n} missiles), one integrator per missile ...");

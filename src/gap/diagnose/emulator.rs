@@ -23,7 +23,7 @@ use crate::gap::rig::{simulate_test, ModelIncrement, RigOptions};
 use crate::gap::tracks::WearTerm;
 use crate::gap::window::{WindowCache, WindowOptions};
 use crate::gap::{Campaign, GapError};
-use crate::models::specs::CaseSpec;
+use crate::models::spec::CaseSpec;
 use crate::pipeline::RunControl;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -1,27 +1,27 @@
-//! What the three models ARE: typed, documented, validated specifications read from the case
-//! files in `configs/` (thesis chapters 4, 5 and 6). How they move is built elsewhere from these.
+//! What every case shares: the case file itself ([`CaseSpec`]: model kind, name, run control,
+//! the one model table, excitation and wear) and the specs all three models use (contact,
+//! friction and material checks, rounded boxes, planar faces, run control), with the field rules
+//! the models' own specs are validated by. Each model's own spec lives in its folder:
+//! [`crate::models::persistent_contact`] (thesis chapter 4), [`crate::models::rattle_box`]
+//! (chapter 5) and [`crate::models::launcher`] (chapter 6), where it is also built.
 //!
 //! Conventions (SPEC 1, thesis 6.2.2): SI unless a field name says otherwise (`_mm`, `_deg`,
 //! `_n_per_mm_e`); y is vertical (up, towards the vehicle), gravity is standard gravity along -y;
 //! for the launcher the rail frame has its origin at the rail's centre of mass, z longitudinal
 //! (firing direction), x transverse. Contact and friction parameters are written in the thesis'
 //! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`]; friction is the
-//! engine's own [`FrictionParams`], read from and written to mm/s by [`in_mm_per_s`]. Values the thesis does not give are engineering
-//! estimates, flagged `estimate` in `docs/models.md`.
+//! engine's own [`FrictionParams`](crate::physics::friction::FrictionParams), read from and
+//! written to mm/s by [`in_mm_per_s`](crate::physics::friction::in_mm_per_s). Values the thesis
+//! does not give are engineering estimates, flagged `estimate` in `docs/models.md`.
 
-use crate::analysis::rattle_space::{self, LauncherDimensions, RattleSpaceError};
-use crate::physics::friction::{in_mm_per_s, FrictionParams};
-use crate::physics::impact::ImpactParams;
-use crate::physics::step::StepKind;
-use crate::units;
-pub use crate::wear::material::Material;
+use super::launcher::LauncherSpec;
+use super::persistent_contact::PersistentContactSpec;
+use super::rattle_box::RattleBoxSpec;
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
-/// A specification that breaks a rule: `field` is the dotted path of the offending field as it
-/// appears in the case file (e.g. `launcher.rail.lip_thickness_m`).
-pub use crate::field_error::FieldError;
-
-fn path(prefix: &str, name: &str) -> String {
+/// `prefix.name`, or `name` when `prefix` is empty: the dotted path of a field in a case file.
+pub(in crate::models) fn path(prefix: &str, name: &str) -> String {
     if prefix.is_empty() {
         name.to_string()
     } else {
@@ -29,7 +29,7 @@ fn path(prefix: &str, name: &str) -> String {
     }
 }
 
-fn finite(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
+pub(in crate::models) fn finite(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() {
         Ok(())
     } else {
@@ -40,7 +40,7 @@ fn finite(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     }
 }
 
-fn positive(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
+pub(in crate::models) fn positive(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -51,7 +51,7 @@ fn positive(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     }
 }
 
-fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
+pub(in crate::models) fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
@@ -62,7 +62,7 @@ fn non_negative(prefix: &str, name: &str, v: f64) -> Result<(), FieldError> {
     }
 }
 
-fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
+pub(in crate::models) fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
@@ -73,7 +73,7 @@ fn finite3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
     }
 }
 
-fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
+pub(in crate::models) fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
     finite3(prefix, name, v)?;
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if (n - 1.0).abs() > 1e-6 {
@@ -86,7 +86,7 @@ fn unit3(prefix: &str, name: &str, v: [f64; 3]) -> Result<(), FieldError> {
 }
 
 /// Principal moments must be > 0 and satisfy the triangle inequality (a real rigid body).
-fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), FieldError> {
+pub(in crate::models) fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), FieldError> {
     if !i.iter().all(|x| x.is_finite() && *x > 0.0) {
         return Err(FieldError::new(
             path(prefix, name),
@@ -105,17 +105,13 @@ fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Result<(), FieldError> {
     Ok(())
 }
 
-mod launcher;
-mod persistent_contact;
-mod rattle_box;
 mod shared;
 #[cfg(test)]
-mod tests;
+pub(in crate::models) mod tests;
 
-pub use launcher::*;
-pub use persistent_contact::*;
-pub use rattle_box::*;
-pub use shared::*;
+pub use shared::{
+    validate_friction, validate_material, ContactSpec, PlanarFace, RoundedBoxSpec, SimulationSpec,
+};
 
 /// Which model a case file describes (its top-level `model` key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

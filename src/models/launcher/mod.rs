@@ -15,10 +15,23 @@
 //! - the front pad against the rail's bottom face;
 //! - the latch tooth against the floor, roof and chamber walls;
 //! - the mid shoe's front protrusion against the tooth's rear face (a latch half-space).
+//!
+//! What the launcher is ([`LauncherSpec`], the case file's `[launcher]` table) is in `spec.rs`,
+//! the geometry derived from it in `geometry.rs`; how it is built is here.
+
+mod geometry;
+mod spec;
+#[cfg(test)]
+mod tests;
+
+pub use spec::{
+    CoilSpringSpec, ConstantForceSpec, LatchJoint, LatchSpec, LauncherContacts, LauncherSpec,
+    LeafSpringSpec, MissileSpec, RailSpec, ShoeSpec, MAX_STATIONS,
+};
 
 use super::outcome::RunError;
 use super::run::BuiltModel;
-use super::specs::{CaseSpec, LatchJoint, LauncherSpec, PlanarFace, RoundedBoxSpec};
+use super::spec::{CaseSpec, PlanarFace, RoundedBoxSpec};
 use crate::excitation::BaseMotion;
 use crate::field_error::FieldError;
 use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};

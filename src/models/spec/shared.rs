@@ -1,7 +1,12 @@
 //! Specs shared by every model: material, contact and friction (ADAMS units), rounded boxes, the simulation settings.
 
-use super::*;
+use super::{finite3, non_negative, path, positive};
 use crate::field_error::FieldError;
+use crate::physics::friction::FrictionParams;
+use crate::physics::impact::ImpactParams;
+use crate::physics::step::StepKind;
+use crate::wear::material::Material;
+use serde::{Deserialize, Serialize};
 
 /// ADAMS IMPACT contact parameters in ADAMS units (N, mm, s), eq. 2.1-2.3.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -60,8 +65,8 @@ impl ContactSpec {
 }
 
 /// A case's friction (the one [`FrictionParams`] type, written in mm/s in case files through
-/// [`in_mm_per_s`]), checked with its own rules and reported at `prefix`
-/// (e.g. `rattle_box.friction.mu_dynamic`).
+/// [`in_mm_per_s`](crate::physics::friction::in_mm_per_s)), checked with its own rules and
+/// reported at `prefix` (e.g. `rattle_box.friction.mu_dynamic`).
 pub fn validate_friction(friction: &FrictionParams, prefix: &str) -> Result<(), FieldError> {
     friction.validate().map_err(|e| e.at(prefix))
 }
@@ -191,23 +196,23 @@ pub struct SimulationSpec {
     pub contact_points_per_edge: usize,
 }
 
-pub(super) fn default_contact_points_per_edge() -> usize {
+fn default_contact_points_per_edge() -> usize {
     crate::geometry::DEFAULT_POINTS_PER_EDGE
 }
 
-pub(super) fn default_settle_s() -> f64 {
+fn default_settle_s() -> f64 {
     2.0
 }
-pub(super) fn default_integrator() -> String {
+fn default_integrator() -> String {
     "trbdf2".to_string()
 }
-pub(super) fn default_rel_tolerance() -> f64 {
+fn default_rel_tolerance() -> f64 {
     1.0e-4
 }
-pub(super) fn default_abs_tolerance_m() -> f64 {
+fn default_abs_tolerance_m() -> f64 {
     1.0e-9
 }
-pub(super) fn default_record_interval_s() -> f64 {
+fn default_record_interval_s() -> f64 {
     1.0e-4
 }
 

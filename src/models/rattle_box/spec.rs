@@ -1,7 +1,14 @@
 //! Chapter 5: the rattle box.
 
-use super::*;
+use crate::analysis::rattle_space::{self, RattleSpaceError};
 use crate::field_error::FieldError;
+use crate::models::spec::{
+    non_negative, path, positive, validate_friction, validate_material, ContactSpec,
+};
+use crate::physics::friction::{in_mm_per_s, FrictionParams};
+use crate::units;
+use crate::wear::material::Material;
+use serde::{Deserialize, Serialize};
 
 /// Table 5.1 enclosure (tube inner) sides, inches, for cases A-D (1 in cube).
 pub const TABLE_5_1_TUBE_SIDES_IN: [(&str, f64); 4] =
@@ -40,7 +47,7 @@ pub struct RattleBoxSpec {
     pub friction: FrictionParams,
 }
 
-pub(super) fn default_true() -> bool {
+fn default_true() -> bool {
     true
 }
 

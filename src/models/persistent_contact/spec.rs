@@ -1,7 +1,12 @@
 //! Chapter 4: the persistent contact fixture.
 
-use super::*;
 use crate::field_error::FieldError;
+use crate::models::spec::{
+    finite, non_negative, path, positive, validate_friction, validate_material, ContactSpec,
+};
+use crate::physics::friction::{in_mm_per_s, FrictionParams};
+use crate::wear::material::Material;
+use serde::{Deserialize, Serialize};
 
 /// Prescribed rotation of the upper fixture about the vertical axis (thesis 4.3: "an angular
 /// motion was imposed on the cylindrical joint", by an equation or a spline of test data).
