@@ -31,8 +31,8 @@
 //! `methods.rs` (the tableaus and one attempt of each method), `newton.rs` (the stage
 //! equations' Newton iteration), `jacobian.rs` (Newton matrix: finite-difference and
 //! contact-aware parts, factorisation), `diagnostics.rs` (where the steps go), `checkpoint.rs`
-//! (what carries over between steps, for a run's checkpoint); this file holds
-//! the integrator's state and the step control.
+//! (what carries over between steps, for a run's checkpoint), `step_control.rs` (error norms
+//! and step-size factors); this file holds the integrator's state and the step loop.
 
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
@@ -43,6 +43,7 @@ mod jacobian;
 mod methods;
 mod newton;
 mod settings;
+mod step_control;
 
 pub use checkpoint::{IntegratorState, RestoreError};
 pub use diagnostics::{StepDiagnostics, STEP_DECADES};
@@ -56,6 +57,10 @@ use super::contact::GeometryMode;
 use super::newton_matrix::NewtonLu;
 use super::system::{MultibodySystem, Workspace};
 use diagnostics::{contact_change, contact_set_into};
+use step_control::{
+    rejected_step_factor, step_exponent_and_growth, CONTACT_AWARE_NEWTON_CUT,
+    HOLD_STEPS_AFTER_NEWTON_FAILURE,
+};
 
 // TR-BDF2 coefficients (ESDIRK form).
 const SQRT2: f64 = std::f64::consts::SQRT_2;
@@ -72,15 +77,6 @@ const SD_GAMMA: f64 = 1.0 - 1.0 / SQRT2;
 /// (an impact or a stick-slip reversal inside the step), not on the Jacobian: the step is cut
 /// without refreshing it (measured alone on rattle box C: -50 % Jacobians, -20 % rejections).
 const YOUNG_JACOBIAN_STEPS: u32 = 2;
-
-/// Contact-aware Newton: a failed Newton iteration halves the step, and the next
-/// `HOLD_STEPS_AFTER_NEWTON_FAILURE` accepted steps grow by at most `HELD_GROWTH` each, so the
-/// step creeps back instead of jumping straight into the next contact event (measured on the
-/// 2 s windows of rattle box C and the launcher: 0.25 without the hold 84 479 launcher
-/// right-hand sides, 0.5 with a 20-step hold at 1.2 74 064, 7 868 -> 3 756 rejections).
-const CONTACT_AWARE_NEWTON_CUT: f64 = 0.5;
-const HOLD_STEPS_AFTER_NEWTON_FAILURE: u32 = 20;
-const HELD_GROWTH: f64 = 1.2;
 
 /// Contact-aware Newton keeps its LU while every entry of the Newton matrix moved by less than
 /// this fraction of its size since the factorisation.
@@ -270,50 +266,6 @@ impl Integrator {
         self.jac_age = u32::MAX;
     }
 
-    /// Entry `i` of `e` in units of its tolerance between states `y0` and `y1`.
-    #[inline]
-    fn weighted_entry(&self, i: usize, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
-        let rel = self.settings.tolerances.rel;
-        e[i] / (self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs()))
-    }
-
-    fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
-        let mut s = 0.0;
-        for i in 0..self.n {
-            let r = self.weighted_entry(i, e, y0, y1);
-            s += r * r;
-        }
-        (s / self.n.max(1) as f64).sqrt()
-    }
-
-    /// The error norm of an implicit attempt of size `h` over the entries
-    /// [`ErrorControl`] selects; with `diagnose`, counted by the kind of the entry that limits
-    /// it.
-    fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
-        let mut s = 0.0;
-        for &i in &self.error_entries {
-            let r = self.weighted_entry(i, e, y0, &self.ynew);
-            s += r * r;
-        }
-        let norm = (s / self.error_entries.len().max(1) as f64).sqrt();
-        if !self.diagnose {
-            return norm;
-        }
-        // The first entry of largest weighted size.
-        let mut worst = (0.0, 0);
-        for &i in &self.error_entries {
-            let r = self.weighted_entry(i, e, y0, &self.ynew).abs();
-            if r > worst.0 {
-                worst = (r, i);
-            }
-        }
-        if let Some(&kind) = self.state_kind.get(worst.1) {
-            let decade = (-h.log10()).floor().clamp(0.0, (STEP_DECADES - 1) as f64) as usize;
-            self.diagnostics.limiting_kind[decade][usize::from(kind.min(3))] += 1;
-        }
-        norm
-    }
-
     fn rhs(&mut self, sys: &MultibodySystem, ws: &mut Workspace, t: f64, y: &[f64], out_k: usize) {
         let mut out = std::mem::take(&mut self.k[out_k]);
         sys.derivative(t, y, &mut out, ws);
@@ -360,11 +312,7 @@ impl Integrator {
                 return Err(IntegratorError::NonFinite { t, index: i });
             }
         }
-        let (order_exp, facmax) = match self.settings.kind {
-            IntegratorKind::Trbdf2 => (1.0 / 3.0, 4.0),
-            IntegratorKind::Sdirk2 => (0.5, 4.0),
-            IntegratorKind::Dopri5 => (0.2, 5.0),
-        };
+        let (order_exp, facmax) = step_exponent_and_growth(self.settings.kind);
         let classify = self.diagnose && ws.keep_tracks;
         if classify {
             contact_set_into(&ws.tracks, &mut self.start_contacts);
@@ -443,22 +391,7 @@ impl Integrator {
                 }
                 self.jac_fresh = false;
                 self.jac_age = self.jac_age.saturating_add(1);
-                // No growth right after a rejection (Hairer-Wanner II IV.8): growing back
-                // at once re-triggers the same failure (measured: -40 % rejections).
-                let fmax = if self.after_reject {
-                    1.0
-                } else if self.hold_steps > 0 {
-                    HELD_GROWTH
-                } else {
-                    facmax
-                };
-                self.hold_steps = self.hold_steps.saturating_sub(1);
-                self.after_reject = false;
-                let fac = if err == 0.0 {
-                    fmax
-                } else {
-                    (0.9 * err.powf(-order_exp)).clamp(0.2, fmax)
-                };
+                let fac = self.accepted_step_factor(err, order_exp, facmax);
                 // Hold the step (and the LU) when the change would be small.
                 if !(1.0..1.2).contains(&fac) && !last {
                     self.h = h * fac;
@@ -472,12 +405,7 @@ impl Integrator {
             }
             self.stats.rejected += 1;
             self.after_reject = true;
-            let fac = if err.is_finite() {
-                (0.9 * err.powf(-order_exp)).clamp(0.1, 0.9)
-            } else {
-                0.1
-            };
-            self.h = h * fac;
+            self.h = h * rejected_step_factor(err, order_exp);
         }
     }
 }
