@@ -80,26 +80,33 @@ impl TrackSample {
     }
 }
 
+/// A sample with every field set and awkward values (a subnormal, 1e300, 1/3), for tests of
+/// the sample's encodings.
+#[cfg(test)]
+pub(crate) fn example_sample(i: usize) -> TrackSample {
+    let t = i as f64 * 1e-4;
+    TrackSample {
+        time_s: t,
+        contact: (i % 5) as u32,
+        track: (i % 3) as u32,
+        normal_force_n: 10.0 + (t * 50.0).sin(),
+        slip_velocity_m_s: [0.01 * t, -0.02, 1.0 / 3.0],
+        slip_speed_m_s: 0.5,
+        penetration_m: 1e-6 * (1.0 + t),
+        penetration_rate_m_s: -1e-4,
+        area_m2: 2.5e-6,
+        pressure_pa: 4.0e6 + t,
+        point_in_a_m: [0.1, 0.2, 0.3],
+        point_in_b_m: [-0.1, f64::MIN_POSITIVE, 1e300],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn sample(i: u32) -> TrackSample {
-        let t = f64::from(i) * 1e-4;
-        TrackSample {
-            time_s: t,
-            contact: i % 5,
-            track: i % 3,
-            normal_force_n: 10.0 + (t * 50.0).sin(),
-            slip_velocity_m_s: [0.01 * t, -0.02, 1.0 / 3.0],
-            slip_speed_m_s: 0.5,
-            penetration_m: 1e-6 * (1.0 + t),
-            penetration_rate_m_s: -1e-4,
-            area_m2: 2.5e-6,
-            pressure_pa: 4.0e6 + t,
-            point_in_a_m: [0.1, 0.2, 0.3],
-            point_in_b_m: [-0.1, f64::MIN_POSITIVE, 1e300],
-        }
+        example_sample(i as usize)
     }
 
     #[test]

@@ -148,23 +148,7 @@ pub fn decode_block(block: &TrackBlock) -> Result<Vec<TrackSample>, BlockError> 
 mod tests {
     use super::*;
 
-    fn sample(i: usize) -> TrackSample {
-        let t = i as f64 * 1e-4;
-        TrackSample {
-            time_s: t,
-            contact: (i % 5) as u32,
-            track: (i % 3) as u32,
-            normal_force_n: 10.0 + (t * 50.0).sin(),
-            slip_velocity_m_s: [0.01 * t, -0.02, 1.0 / 3.0],
-            slip_speed_m_s: 0.5,
-            penetration_m: 1e-6 * (1.0 + t),
-            penetration_rate_m_s: -1e-4,
-            area_m2: 2.5e-6,
-            pressure_pa: 4.0e6 + t,
-            point_in_a_m: [0.1, 0.2, 0.3],
-            point_in_b_m: [-0.1, f64::MIN_POSITIVE, 1e300],
-        }
-    }
+    use crate::physics::track::example_sample as sample;
 
     #[test]
     fn blocks_round_trip_bit_exact() {
