@@ -295,27 +295,40 @@ fn a_pattern_no_effect_makes_is_not_explained() {
     assert!(test_groups.iter().all(|g| g.mean_residual < 0.0));
 }
 
-/// Case C and D, 0.25 s windows: the simulator path end to end, with physics checks on the
-/// tables (not on the verdict, which needs longer windows to mean anything).
-#[test]
-fn simulated_tables_follow_the_physics_and_the_report_is_written() {
+/// The two-test campaign of the fixture (cases C and D).
+fn small_campaign() -> Campaign {
     let text = include_str!("../fixtures/small-campaign.toml");
-    let c = Campaign::from_toml_str(text, Path::new(".")).unwrap();
+    Campaign::from_toml_str(text, Path::new(".")).unwrap()
+}
+
+/// A real diagnosis on short windows (0.25 s after 0.05 s, two grid points per dynamics
+/// effect), of `effects` or every applicable one.
+fn diagnose_short(
+    campaign: &Campaign,
+    effects: Option<Vec<String>>,
+) -> (railwear::gap::diagnose::Report, Emulator) {
     let mut o = DiagnoseOptions::default();
     o.emulator.window_s = 0.25;
     o.emulator.settle_s = 0.05;
     o.emulator.grid_points = 2;
-    o.emulator.effects = Some(vec!["third_body".into(), "cross_axis".into()]);
-    let cache = WindowCache::new();
-    let (report, em) = diagnose(
-        &c,
+    o.emulator.effects = effects;
+    diagnose(
+        campaign,
         &configs(),
         &o,
         &RunControl::silent(),
-        &cache,
+        &WindowCache::new(),
         &|_, _| {},
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// Case C and D, 0.25 s windows: the simulator path end to end, with physics checks on the
+/// tables (not on the verdict, which needs longer windows to mean anything).
+#[test]
+fn simulated_tables_follow_the_physics_and_the_report_is_written() {
+    let c = small_campaign();
+    let (report, em) = diagnose_short(&c, Some(vec!["third_body".into(), "cross_axis".into()]));
     // Two tests: held out by increment.
     assert!(report.held_out.starts_with("leave-one-increment-out"));
     let third = em
@@ -383,8 +396,7 @@ fn simulated_tables_follow_the_physics_and_the_report_is_written() {
 /// 5 %, the tone's share of a window), at a share no grid point holds.
 #[test]
 fn refinement_simulates_the_requested_magnitude() {
-    let text = include_str!("../fixtures/small-campaign.toml");
-    let c = Campaign::from_toml_str(text, Path::new(".")).unwrap();
+    let c = small_campaign();
     let options = EmulatorOptions {
         window_s: 0.25,
         settle_s: 0.05,
@@ -460,8 +472,7 @@ fn refinement_simulates_the_requested_magnitude() {
 fn a_rig_only_effect_is_reported_not_explained() {
     use railwear::gap::rig::{run, RigOptions};
     use railwear::gap::rig_effects::HiddenEffect;
-    let text = include_str!("../fixtures/small-campaign.toml");
-    let base = Campaign::from_toml_str(text, Path::new(".")).unwrap();
+    let base = small_campaign();
     let rig = RigOptions {
         hidden: vec![HiddenEffect::parse("work_hardening=0.9").unwrap()],
         noise_rel: 0.02,
@@ -481,19 +492,7 @@ fn a_rig_only_effect_is_reported_not_explained() {
         .find("work_hardening")
         .is_none());
     drop(truth);
-    let mut o = DiagnoseOptions::default();
-    o.emulator.window_s = 0.25;
-    o.emulator.settle_s = 0.05;
-    o.emulator.grid_points = 2;
-    let (report, _) = diagnose(
-        &campaign,
-        &configs(),
-        &o,
-        &RunControl::silent(),
-        &WindowCache::new(),
-        &|_, _| {},
-    )
-    .unwrap();
+    let (report, _) = diagnose_short(&campaign, None);
     assert_eq!(
         report.verdict,
         Verdict::NotExplained,
@@ -507,8 +506,7 @@ fn a_rig_only_effect_is_reported_not_explained() {
 /// simulated.
 #[test]
 fn a_campaign_without_measurements_is_refused_naming_the_field() {
-    let text = include_str!("../fixtures/small-campaign.toml");
-    let mut campaign = Campaign::from_toml_str(text, Path::new(".")).unwrap();
+    let mut campaign = small_campaign();
     for test in &mut campaign.tests {
         for specimen in &mut test.specimens {
             for increment in &mut specimen.increments {
