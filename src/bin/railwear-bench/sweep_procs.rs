@@ -79,7 +79,7 @@ pub(crate) fn sweep_procs(
         },
         railwear::jobs::CurveDefaults {
             vehicle_profile: "ah64".into(),
-            environment: "bench".into(),
+            environment: railwear::pipeline::DEFAULT_ENVIRONMENT.into(),
             wear_law: "modified-archard".into(),
         },
     );
@@ -90,6 +90,7 @@ pub(crate) fn sweep_procs(
         &[
             ("worker_processes", "worker processes"),
             ("points", "sweep points"),
+            ("runs", "child jobs (points x seeds)"),
             ("wall_s", "wall s"),
             ("simulations_per_min", "simulations/min"),
             ("ratio", "ratio to 1 process"),
@@ -166,12 +167,15 @@ pub(crate) fn sweep_procs(
             );
         }
         summaries.push(job.result);
-        let per_min = points as f64 / wall * 60.0;
+        // Each point runs once per seed: the child jobs are the simulations.
+        let runs: u64 = per_worker.values().sum();
+        let per_min = runs as f64 / wall * 60.0;
         let ratio = base.map(|b| per_min / b).unwrap_or(1.0);
         base.get_or_insert(per_min);
         t.row(vec![
             Cell::Int(procs as u64),
             Cell::Int(points),
+            Cell::Int(runs),
             Cell::Num(wall),
             Cell::Num(per_min),
             Cell::Num(ratio),
@@ -181,7 +185,7 @@ pub(crate) fn sweep_procs(
     }
     t.note(format!(
         "wall: from starting the worker processes to the sweep's assembled result (fan-out, \
-         {points} child jobs, assembly); the two runs' results are {}",
+         its child jobs, assembly); the two runs' results are {}",
         if summaries.windows(2).all(|w| w[0] == w[1]) {
             "identical"
         } else {
