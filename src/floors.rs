@@ -69,6 +69,15 @@ fn code_only(source: &str) -> String {
         .join("\n")
 }
 
+/// The identifier `s` starts with, if any.
+fn leading_name(s: &str) -> Option<String> {
+    let name: String = s
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect();
+    (!name.is_empty()).then_some(name)
+}
+
 /// Rooms a piece of code imports: `crate::room` and `use crate::{room, ...}`.
 fn imported_rooms(code: &str) -> Vec<String> {
     let mut rooms = Vec::new();
@@ -101,27 +110,14 @@ fn imported_rooms(code: &str) -> Vec<String> {
                     '{' => depth += 1,
                     '}' => depth -= 1,
                     ',' if depth == 0 => {
-                        let item = inner[start..i].trim();
-                        let name: String = item
-                            .chars()
-                            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                            .collect();
-                        if !name.is_empty() {
-                            rooms.push(name);
-                        }
+                        rooms.extend(leading_name(inner[start..i].trim()));
                         start = i + 1;
                     }
                     _ => {}
                 }
             }
         } else {
-            let name: String = rest
-                .chars()
-                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                .collect();
-            if !name.is_empty() {
-                rooms.push(name);
-            }
+            rooms.extend(leading_name(rest));
         }
     }
     rooms
