@@ -136,6 +136,10 @@ enum Command {
         /// Sensor noise of those records, RMS m/s².
         #[arg(long, default_value_t = 0.0)]
         sensor_noise_m_s2: f64,
+        /// Relative sensitivity error of each accelerometer (1 sigma, one draw per location
+        /// and axis for the whole campaign).
+        #[arg(long, default_value_t = 0.0)]
+        calibration_rel: f64,
         /// Directory of reference configs and profiles.
         #[arg(long, default_value = "configs")]
         configs_dir: PathBuf,
@@ -475,6 +479,7 @@ async fn main() -> Result<()> {
             segments_per_increment,
             accelerometer_rate_hz,
             sensor_noise_m_s2,
+            calibration_rel,
             configs_dir,
         } => {
             init_logging(false);
@@ -487,6 +492,7 @@ async fn main() -> Result<()> {
                 segments_per_increment: *segments_per_increment,
                 accelerometer_rate_hz: *accelerometer_rate_hz,
                 sensor_noise_m_s2: *sensor_noise_m_s2,
+                calibration_rel: *calibration_rel,
                 ..Default::default()
             };
             railwear::cli::rig(base, effects, options, out, configs_dir)

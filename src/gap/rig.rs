@@ -15,11 +15,15 @@
 //! - measurement: each weighed mass is `m (1 + noise_rel z)`, clamped at 0 and rounded to the
 //!   test's scale resolution;
 //! - accelerometers (if asked): the window's input (tube / rail) and response (free body)
-//!   acceleration at `accelerometer_rate_hz`, plus N(0, sensor_noise²) per axis and sample.
+//!   acceleration at `accelerometer_rate_hz`, times the sensor's sensitivity error, plus
+//!   N(0, sensor_noise²) per axis and sample. One sensor per location and axis serves the whole
+//!   campaign: its sensitivity is `1 + calibration_rel z`, one `z ~ N(0, 1)` per channel.
 //!
 //! All draws come from one ChaCha20 stream seeded by `seed`, in a fixed order that does not
 //! depend on the effects: the same seed gives the same campaign, and an effect at magnitude 0
-//! gives the control's campaign bit for bit.
+//! gives the control's campaign bit for bit. The sensitivities come from a second stream on the
+//! same seed, so a campaign drawn without calibration error is the one drawn before they
+//! existed.
 
 use super::accel::{AccelLocation, AccelRecord};
 use super::campaign::{Campaign, Increment, Specimen};
@@ -62,6 +66,9 @@ pub struct RigOptions {
     pub accelerometer_rate_hz: Option<f64>,
     /// Sensor noise of the written records, RMS m/s².
     pub sensor_noise_m_s2: f64,
+    /// Relative error of each accelerometer's sensitivity (1 sigma; a mean square carries
+    /// about twice it), >= 0.
+    pub calibration_rel: f64,
 }
 
 impl Default for RigOptions {
@@ -77,6 +84,7 @@ impl Default for RigOptions {
             segments_per_increment: 1,
             accelerometer_rate_hz: None,
             sensor_noise_m_s2: 0.0,
+            calibration_rel: 0.0,
         }
     }
 }
@@ -144,6 +152,12 @@ pub struct Truth {
     pub accelerometer_rate_hz: Option<f64>,
     /// Sensor noise, RMS m/s².
     pub sensor_noise_m_s2: f64,
+    /// Relative sensitivity error drawn per accelerometer (1 sigma).
+    #[serde(default)]
+    pub calibration_rel: f64,
+    /// Sensitivity of each accelerometer: input x, y, z, then response x, y, z (1 = exact).
+    #[serde(default)]
+    pub accelerometer_sensitivity: Vec<f64>,
     /// Per test: the model's masses before scatter and noise.
     pub tests: Vec<TruthTest>,
     /// railwear version.
@@ -210,6 +224,11 @@ fn check_options(o: &RigOptions) -> Result<(), GapError> {
         o.sensor_noise_m_s2.is_finite() && o.sensor_noise_m_s2 >= 0.0,
         "must be a finite number >= 0",
     )?;
+    rule(
+        "calibration_rel",
+        o.calibration_rel.is_finite() && (0.0..=0.2).contains(&o.calibration_rel),
+        "must lie in [0, 0.2]",
+    )?;
     if let Some(r) = o.accelerometer_rate_hz {
         rule(
             "accelerometer_rate_hz",
@@ -243,6 +262,12 @@ pub fn run_cached(
     check_options(options)?;
     base.validate(configs_dir)?;
     let mut rng = ChaCha20Rng::seed_from_u64(options.seed);
+    // Sensitivities: input x, y, z, response x, y, z, from their own stream.
+    let mut cal_rng = ChaCha20Rng::seed_from_u64(options.seed);
+    cal_rng.set_stream(1);
+    let sensitivity: Vec<f64> = (0..6)
+        .map(|_| 1.0 + options.calibration_rel * standard_normal(&mut cal_rng))
+        .collect();
     let mut out = base.clone();
     out.name = format!("{}-rig", base.name);
     out.description = format!("Virtual rig campaign on the tests of `{}`", base.name);
@@ -299,17 +324,18 @@ pub fn run_cached(
             }
             if let Some(rate) = options.accelerometer_rate_hz {
                 for (k, m) in model.iter().take(n).enumerate() {
-                    for (location, series) in [
-                        (AccelLocation::Input, &m.input),
-                        (AccelLocation::Response, &m.response),
+                    for (location, series, gain) in [
+                        (AccelLocation::Input, &m.input, &sensitivity[..3]),
+                        (AccelLocation::Response, &m.response, &sensitivity[3..]),
                     ] {
                         let samples = series
                             .iter()
                             .enumerate()
                             .map(|(i, a)| {
                                 let mut s = [i as f64 / rate, a[0], a[1], a[2]];
-                                for x in s.iter_mut().skip(1) {
-                                    *x += options.sensor_noise_m_s2 * standard_normal(&mut rng);
+                                for (x, g) in s.iter_mut().skip(1).zip(gain) {
+                                    *x = *x * g
+                                        + options.sensor_noise_m_s2 * standard_normal(&mut rng);
                                 }
                                 s
                             })
@@ -358,6 +384,8 @@ pub fn run_cached(
         segments_per_increment: options.segments_per_increment,
         accelerometer_rate_hz: options.accelerometer_rate_hz,
         sensor_noise_m_s2: options.sensor_noise_m_s2,
+        calibration_rel: options.calibration_rel,
+        accelerometer_sensitivity: sensitivity,
         tests: truth_tests,
         code_version: crate::models::case::code_version().to_string(),
     };

@@ -9,6 +9,7 @@
 //!    abrasion only adds wear; cross-axis drive puts response on the other axes), an effect at
 //!    magnitude 0 is the nominal bit for bit, and the CLI writes the report and its plots.
 
+use railwear::gap::accel::AccelLocation;
 use railwear::gap::campaign::{Campaign, Increment, Specimen};
 use railwear::gap::diagnose::emulator::{
     Bands, EffectTable, Emulator, EmulatorOptions, Prediction, TestPredictions,
@@ -266,6 +267,57 @@ fn the_true_effect_is_named_with_its_magnitude() {
             );
         }
     }
+}
+
+/// `c` with every response y sample scaled by `gain` (an accelerometer whose sensitivity is
+/// off by `gain - 1`, the same sensor on every test).
+fn miscalibrated(mut c: Campaign, gain: f64) -> Campaign {
+    for t in &mut c.tests {
+        for s in &mut t.specimens {
+            for r in &mut s.accelerometers {
+                if r.location == AccelLocation::Response {
+                    for x in &mut r.samples {
+                        x[2] *= gain;
+                    }
+                }
+            }
+        }
+    }
+    c
+}
+
+#[test]
+fn a_sensor_calibration_error_is_not_a_gap() {
+    let em = emulator();
+    // A response y sensitivity 4 % high (twice the 2 % calibration uncertainty): every
+    // response y mean square reads 8.2 % above the model, on every test and increment. One
+    // scale shared by the channel explains it at two prior sigmas, which is no gap.
+    for seed in 0..3 {
+        let c = miscalibrated(campaign(|t, k| truth(t, k, 0.0, 0.0, 0.0), seed), 1.04);
+        let r = diagnose_with(&c, &em, &options()).unwrap();
+        assert_eq!(r.verdict, Verdict::NoGap, "seed {seed}: {}", r.summary);
+        // Read as independent errors on each mean square, the same data is a gap: the
+        // structure, not a wider uncertainty, is what keeps the diagnosis quiet.
+        let independent = DiagnoseOptions {
+            accelerometer_calibration_rel: 0.0,
+            ..options()
+        };
+        let r = diagnose_with(&c, &em, &independent).unwrap();
+        assert_ne!(r.verdict, Verdict::NoGap, "seed {seed}: {}", r.summary);
+    }
+    // The same 8 % on one test only is a change between tests, not a sensor: the channel's
+    // shared scale cannot take it, and the test is flagged.
+    let mut c = campaign(|t, k| truth(t, k, 0.0, 0.0, 0.0), 0);
+    let one = miscalibrated(
+        Campaign {
+            tests: vec![c.tests[0].clone()],
+            ..c.clone()
+        },
+        1.04,
+    );
+    c.tests[0] = one.tests[0].clone();
+    let r = diagnose_with(&c, &em, &options()).unwrap();
+    assert_ne!(r.verdict, Verdict::NoGap, "{}", r.summary);
 }
 
 #[test]

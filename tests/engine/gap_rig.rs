@@ -204,3 +204,43 @@ fn wear_law_effects_move_the_model_masses() {
     let s = &control.tests[0].slip_distance_m;
     assert!(s[0] > 0.0 && (s[1] - 2.0 * s[0]).abs() <= 1e-9 * s[1]);
 }
+
+#[test]
+fn each_accelerometer_reads_through_its_own_drawn_sensitivity() {
+    let options = |calibration_rel| RigOptions {
+        seed: 11,
+        window_s: 0.3,
+        settle_s: 0.05,
+        accelerometer_rate_hz: Some(1000.0),
+        calibration_rel,
+        ..RigOptions::default()
+    };
+    let control = RunControl::silent();
+    let (exact, t0) = rig::run(&base(), &configs(), &options(0.0), &control).unwrap();
+    let (off, t1) = rig::run(&base(), &configs(), &options(0.05), &control).unwrap();
+    assert_eq!(t0.accelerometer_sensitivity, vec![1.0; 6]);
+    let g = &t1.accelerometer_sensitivity;
+    assert_eq!(g.len(), 6);
+    // Six draws of 1 + 0.05 z: distinct, and none beyond 5 sigma.
+    assert!(g.iter().all(|x| (x - 1.0).abs() < 0.25 && *x != 1.0), "{g:?}");
+    // The masses do not see the accelerometers.
+    assert_eq!(files(&exact).0, files(&off).0);
+    // Every sample of a channel is the exact one times that channel's sensitivity, on every
+    // increment (one sensor for the campaign).
+    let (a, b) = (&exact.tests[0].specimens[0], &off.tests[0].specimens[0]);
+    assert_eq!(a.accelerometers.len(), 4);
+    for (ra, rb) in a.accelerometers.iter().zip(&b.accelerometers) {
+        let offset = if ra.location == railwear::gap::accel::AccelLocation::Input {
+            0
+        } else {
+            3
+        };
+        for (sa, sb) in ra.samples.iter().zip(&rb.samples) {
+            assert_eq!(sa[0], sb[0]);
+            for axis in 0..3 {
+                let want = sa[1 + axis] * g[offset + axis];
+                assert!((sb[1 + axis] - want).abs() <= 1e-12 * want.abs().max(1e-9));
+            }
+        }
+    }
+}

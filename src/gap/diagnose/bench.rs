@@ -6,16 +6,18 @@
 //! **Detectable.** An effect is detectable in a campaign when its noise-free readings (the rig
 //! with noise, scatter and sensor noise off) differ from the control's noise-free readings by
 //! more than twice the uncertainty the campaign's data carry, RMS over the observations:
-//! `sqrt(mean(((y_effect - y_control) / u)²)) > 2`, with `u` the noise model estimated from the
-//! noisy campaign itself (repeats, quantisation, sensor noise, the simulator's numerical and
-//! parameter uncertainty, accelerometer calibration) at the control's reading. Only detectable in-library effects count in the top-1 score;
+//! `sqrt(d' Σ⁻¹ d / n) > 2` with `d = y_effect - y_control` and `Σ` the noise model estimated
+//! from the noisy campaign itself at the control's readings (repeats, quantisation, sensor
+//! noise, the simulator's numerical and parameter uncertainty, and each accelerometer channel's
+//! calibration as one shared scale: an effect that only rescales a channel by about the
+//! calibration's uncertainty is not detectable). Only detectable in-library effects count in the top-1 score;
 //! undetectable ones are reported apart (the right answer for them is `no_gap`).
 //!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
 
 use super::emulator::{Emulator, EmulatorOptions};
-use super::noise::{observations, NoiseModel, Observation};
+use super::noise::{gaussian, observations, NoiseModel, Observation, Term};
 use super::{diagnose_refining, stats, DiagnoseOptions, Report, Verdict};
 use crate::gap::effects::{Effect, LIBRARY};
 use crate::gap::rig::{run_cached, RigOptions, Truth};
@@ -209,6 +211,11 @@ fn rig_options(s: &Scenario, o: &BenchOptions, noisy: bool) -> Result<RigOptions
         segments_per_increment: 1,
         accelerometer_rate_hz: Some(o.accelerometer_rate_hz),
         sensor_noise_m_s2: if noisy { o.sensor_noise_m_s2 } else { 0.0 },
+        calibration_rel: if noisy {
+            o.diagnose.accelerometer_calibration_rel
+        } else {
+            0.0
+        },
         ..RigOptions::default()
     };
     if s.truth != "control" {
@@ -223,24 +230,24 @@ fn rig_options(s: &Scenario, o: &BenchOptions, noisy: bool) -> Result<RigOptions
 }
 
 /// Noise-free readings' distance from the control's, in units of the uncertainty the noisy
-/// campaign's data carry (its noise model, estimated from its repeats), RMS.
+/// campaign's data carry (its noise model, estimated from its repeats, with each channel's
+/// shared calibration scale), RMS: `sqrt(Mahalanobis² / n)`.
 fn detectability(
     effect: &[Observation],
     control: &[Observation],
     noise: &NoiseModel,
     noisy: &[Observation],
 ) -> f64 {
-    let mut sum = 0.0;
-    let mut n = 0.0;
-    for ((e, c), o) in effect.iter().zip(control).zip(noisy) {
-        let u = noise.u(o, c.value);
-        if u > 0.0 {
-            sum += e.weight * ((e.value - c.value) / u).powi(2);
-            n += e.weight;
-        }
-    }
-    if n > 0.0 {
-        (sum / n).sqrt()
+    let terms = effect
+        .iter()
+        .zip(control)
+        .zip(noisy)
+        .map(|((e, c), o)| (noise.term(o, c.value, 0.0), e.value - c.value))
+        .filter(|(t, _)| t.var > 0.0)
+        .map(|(t, d)| Term { residual: d, ..t });
+    let t = gaussian(terms, noise.scale_var);
+    if t.w > 0.0 {
+        (t.r2 / t.w).sqrt()
     } else {
         0.0
     }

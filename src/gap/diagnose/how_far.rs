@@ -35,7 +35,7 @@ pub(super) fn held_out_predictions(
                 increment: o.increment + 1,
                 quantity: o.quantity.label(),
                 measured_mg: o.value,
-                uncertainty_mg: problem.noise.u(o, mu),
+                uncertainty_mg: problem.noise.u_marginal(o, mu),
                 nominal_mg: mu,
                 effect: problem.name_of(&c.effects),
                 magnitude: c.fold_magnitudes[g].first().copied().unwrap_or(0.0),

@@ -3,13 +3,17 @@
 //! 1/3-octave band of the response spectrum, each group tested for a bias and all tests
 //! corrected together by Holm's method.
 //!
-//! A group's score is `z = Σ w r / sqrt(Σ w²)` (standard normal when the model is right and the
-//! residuals independent). Pressure and slip bands are not measured: a band's score combines
+//! A group's score is `z = Σ w r / sqrt(Var Σ w r)`, standard normal when the model is right.
+//! The residuals are independent but for the mean squares of one channel, which share its
+//! calibration scale: with `a = 2 e_cal μ / u` the correlation of two of them is `a_i a_j`, so
+//! `Var Σ w r = Σ w² + Σ_channels ((Σ w a)² - Σ w² a²)`. A calibration error alone therefore
+//! moves a channel's score by about its own number of sigmas, not by that times `sqrt(n)`. The
+//! frequency bands' log ratios carry the calibration's `(2 e_cal)²` in their variance. Pressure and slip bands are not measured: a band's score combines
 //! the tests' mass scores weighted by the share of each test's friction work (the model's) in
 //! that band, so a band lights up when the tests whose work falls there are the ones that miss.
 
 use super::emulator::{PRESSURE_BANDS, SLIP_BANDS};
-use super::noise::Quantity;
+use super::noise::{Quantity, CHANNELS};
 use super::{stats, Problem};
 use crate::analysis::spectra::welch_psd;
 use crate::gap::accel::AccelLocation;
@@ -86,7 +90,13 @@ struct Acc {
     sum_wr: f64,
     sum_w2: f64,
     sum_w: f64,
+    /// Per calibration channel: Σ w a and Σ w² a².
+    sum_wa: [f64; CHANNELS],
+    sum_w2a2: [f64; CHANNELS],
 }
+
+/// A residual's share of its channel's calibration scale: the channel and `a`.
+type Shared = Option<(usize, f64)>;
 
 impl Acc {
     fn new() -> Self {
@@ -94,18 +104,36 @@ impl Acc {
             sum_wr: 0.0,
             sum_w2: 0.0,
             sum_w: 0.0,
+            sum_wa: [0.0; CHANNELS],
+            sum_w2a2: [0.0; CHANNELS],
         }
     }
 
-    fn push(&mut self, w: f64, r: f64) {
+    fn push(&mut self, w: f64, r: f64, shared: Shared) {
         self.sum_wr += w * r;
         self.sum_w2 += w * w;
         self.sum_w += w;
+        if let Some((c, a)) = shared {
+            self.sum_wa[c] += w * a;
+            self.sum_w2a2[c] += w * w * a * a;
+        }
+    }
+
+    /// Variance of `Σ w r` when the model is right.
+    fn var(&self) -> f64 {
+        let shared: f64 = (0..CHANNELS)
+            .map(|c| self.sum_wa[c].powi(2) - self.sum_w2a2[c])
+            .sum();
+        self.sum_w2 + shared.max(0.0)
+    }
+
+    fn z(&self) -> f64 {
+        self.sum_wr / self.var().sqrt()
     }
 
     fn group(&self, by: &str, label: String) -> Option<Group> {
         (self.sum_w > 0.0).then(|| {
-            let z = self.sum_wr / self.sum_w2.sqrt();
+            let z = self.z();
             Group {
                 by: by.into(),
                 label,
@@ -157,8 +185,12 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
     let mut by_configuration: BTreeMap<(&str, String), (Acc, BTreeSet<usize>)> = BTreeMap::new();
     for o in &problem.obs {
         let mu = o.predicted(nominal);
-        let u = problem.noise.u(o, mu);
+        let u = problem.noise.u_marginal(o, mu);
         let r = (o.value - mu) / u;
+        let shared: Shared = o
+            .quantity
+            .channel()
+            .map(|c| (c, problem.noise.scale_var.sqrt() * mu / u));
         residuals.push(Residual {
             test: campaign.tests[o.test].id.clone(),
             increment: o.increment + 1,
@@ -168,28 +200,28 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
             u,
             residual: r,
         });
-        by_test[o.test].push(o.weight, r);
+        by_test[o.test].push(o.weight, r, shared);
         if matches!(o.quantity, Quantity::Mass(_)) {
-            mass_by_test[o.test].push(o.weight, r);
+            mass_by_test[o.test].push(o.weight, r, shared);
         }
         let label = o.quantity.label();
         match by_quantity.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, a)) => a.push(o.weight, r),
+            Some((_, a)) => a.push(o.weight, r, shared),
             None => {
                 let mut a = Acc::new();
-                a.push(o.weight, r);
+                a.push(o.weight, r, shared);
                 by_quantity.push((label, a));
             }
         }
         while by_increment.len() <= o.increment {
             by_increment.push(Acc::new());
         }
-        by_increment[o.increment].push(o.weight, r);
+        by_increment[o.increment].push(o.weight, r, shared);
         for (by, value) in &configuration[o.test] {
             let (acc, tests) = by_configuration
                 .entry((by, value.clone()))
                 .or_insert_with(|| (Acc::new(), BTreeSet::new()));
-            acc.push(o.weight, r);
+            acc.push(o.weight, r, shared);
             tests.insert(o.test);
         }
     }
@@ -215,7 +247,7 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
     // Bands: tests' mass scores weighted by their work share in the band.
     let test_z: Vec<Option<f64>> = mass_by_test
         .iter()
-        .map(|a| (a.sum_w > 0.0).then(|| a.sum_wr / a.sum_w2.sqrt()))
+        .map(|a| (a.sum_w > 0.0).then(|| a.z()))
         .collect();
     for (by, names, pick) in [
         ("pressure_band", &PRESSURE_BANDS[..], 0usize),
@@ -382,7 +414,11 @@ fn frequency_bands(campaign: &Campaign, problem: &Problem) -> Vec<Group> {
                 .and_then(|p| p.band_mean(lo, hi))
                 .filter(|h| *h > 0.0)
                 .map_or(0.0, |h| (pm / h).ln());
-            let sd = (2.0 / dof_m * noise_gain * noise_gain + 2.0 / dof_p + num * num).sqrt();
+            let sd = (2.0 / dof_m * noise_gain * noise_gain
+                + 2.0 / dof_p
+                + num * num
+                + problem.noise.scale_var)
+                .sqrt();
             let z = log_ratio / sd;
             out.push(Group {
                 by: "frequency_band".into(),
@@ -397,4 +433,33 @@ fn frequency_bands(campaign: &Campaign, problem: &Problem) -> Vec<Group> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shared_calibration_error_moves_a_channel_by_its_own_sigmas_not_root_n_times_more() {
+        // Eight mean squares of one channel whose uncertainty is all calibration (a = 1), each
+        // read two sigmas high: one 2-sigma calibration error, z = 16 / sqrt(8 + 64 - 8) = 2.
+        let mut shared = Acc::new();
+        let mut independent = Acc::new();
+        for _ in 0..8 {
+            shared.push(1.0, 2.0, Some((4, 1.0)));
+            independent.push(1.0, 2.0, None);
+        }
+        assert!((shared.z() - 2.0).abs() < 1e-12, "{}", shared.z());
+        // Independent residuals add up: 16 / sqrt(8).
+        assert!((independent.z() - 16.0 / 8f64.sqrt()).abs() < 1e-12);
+        // Two channels are independent of each other: 4 + 4 readings, each channel's sum has
+        // variance 4 + 16 - 4 = 16, together 32.
+        let mut two = Acc::new();
+        for c in [1, 4] {
+            for _ in 0..4 {
+                two.push(1.0, 1.0, Some((c, 1.0)));
+            }
+        }
+        assert!((two.var() - 32.0).abs() < 1e-12, "{}", two.var());
+    }
 }

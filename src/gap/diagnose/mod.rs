@@ -44,7 +44,7 @@ use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
 use emulator::{Emulator, EmulatorOptions};
 use how_far::{best_effect, held_out_predictions};
-use noise::{NoiseModel, Observation};
+use noise::{NoiseModel, Observation, Totals};
 pub use refine::diagnose_refining;
 pub use report::*;
 use std::path::Path;
@@ -106,16 +106,6 @@ impl Default for DiagnoseOptions {
     }
 }
 
-/// Likelihood of one prediction set.
-struct Score {
-    /// Negative log-likelihood per group.
-    nll: Vec<f64>,
-    /// Weighted squared standardized residuals per group.
-    r2: Vec<f64>,
-    /// Weighted observation count per group.
-    w: Vec<f64>,
-}
-
 /// The data, noise model and folds of one diagnosis.
 pub struct Problem<'a> {
     obs: Vec<Observation>,
@@ -174,37 +164,37 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// Scores the predictions of `spec` (effect table, magnitude).
-    fn score(&self, spec: &[(usize, f64)]) -> Score {
-        let p = self.emulator.predict(spec);
-        let mut s = Score {
-            nll: vec![0.0; self.groups],
-            r2: vec![0.0; self.groups],
-            w: vec![0.0; self.groups],
-        };
-        for (i, o) in self.obs.iter().enumerate() {
-            let mu = o.predicted(&p);
-            let extra: f64 = spec
-                .iter()
-                .filter(|(_, m)| *m != 0.0)
-                .map(|(e, _)| self.roughness[*e][i])
-                .sum();
-            let u = (self.noise.u(o, mu).powi(2) + extra * mu * mu).sqrt();
-            let r = (o.value - mu) / u;
-            let g = self.group[i];
-            s.nll[g] += o.weight * (0.5 * r * r + u.ln());
-            s.r2[g] += o.weight * r * r;
-            s.w[g] += o.weight;
-        }
-        s
+    /// Likelihood of `spec`'s predictions (effect table, magnitude) over the observations of
+    /// the groups `mask` keeps, each channel's calibration scale integrated out
+    /// ([`noise::gaussian`]).
+    fn totals(&self, spec: &[(usize, f64)], mask: &dyn Fn(usize) -> bool) -> Totals {
+        self.totals_of(&self.emulator.predict(spec), spec, mask)
+    }
+
+    fn totals_of(
+        &self,
+        p: &emulator::TestPredictions,
+        spec: &[(usize, f64)],
+        mask: &dyn Fn(usize) -> bool,
+    ) -> Totals {
+        let terms = self
+            .obs
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| mask(self.group[*i]))
+            .map(|(i, o)| {
+                let extra: f64 = spec
+                    .iter()
+                    .filter(|(_, m)| *m != 0.0)
+                    .map(|(e, _)| self.roughness[*e][i])
+                    .sum();
+                self.noise.term(o, o.predicted(p), extra)
+            });
+        noise::gaussian(terms, self.noise.scale_var)
     }
 
     fn nll_of(&self, spec: &[(usize, f64)], mask: impl Fn(usize) -> bool) -> f64 {
-        let s = self.score(spec);
-        (0..self.groups)
-            .filter(|g| mask(*g))
-            .map(|g| s.nll[g])
-            .sum()
+        self.totals(spec, &mask).nll
     }
 
     /// Magnitudes to try for table `e`: the table's points and four between each pair.
@@ -263,17 +253,21 @@ impl<'a> Problem<'a> {
             let (mags, _) = self.fit(effects, &|h| h != g);
             fold_magnitudes.push(mags.clone());
             let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags).collect();
-            let s = self.score(&spec);
-            held_nll.push(s.nll[g]);
-            held_r2.push(s.r2[g]);
-            held_w.push(s.w[g]);
+            // Held out: the joint likelihood less the training groups' alone, i.e. group `g`
+            // given the training groups (their calibration scales carried over).
+            let p = self.emulator.predict(&spec);
+            let held =
+                self.totals_of(&p, &spec, &|_| true) - self.totals_of(&p, &spec, &|h| h != g);
+            held_nll.push(held.nll);
+            held_r2.push(held.r2);
+            held_w.push(held.w);
         }
         let (mags, nll_full) = self.fit(effects, &|_| true);
         let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags.iter().copied()).collect();
-        let full = self.score(&spec);
+        let full = self.totals(&spec, &|_| true);
         let k = effects.len() as f64;
-        let n: f64 = full.w.iter().sum();
-        let chi2: f64 = full.r2.iter().sum();
+        let n = full.w;
+        let chi2 = full.r2;
         let residual_p = stats::chi2_sf(chi2, (n - k).round().max(1.0) as usize);
         Candidate {
             effects: effects.to_vec(),
@@ -471,9 +465,8 @@ pub fn diagnose_with(
     }
     let alpha = options.alpha;
     let nominal = problem.evaluate(&[], alpha);
-    let nominal_score = problem.score(&[]);
-    let chi2: f64 = nominal_score.r2.iter().sum();
-    let dof: f64 = nominal_score.w.iter().sum();
+    let nominal_score = problem.totals(&[], &|_| true);
+    let (chi2, dof) = (nominal_score.r2, nominal_score.w);
     let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
     let location = location::locate(campaign, &problem);
     let any_flag = location.any_flagged();

@@ -1,18 +1,30 @@
 //! Observations of a campaign and the uncertainty of each about a prediction.
 //!
+//! Each observation has an independent variance
 //! `u² = (s²/n + v_model) μ² + v_fixed + v_floor`, where
 //! - `s` is the relative repeatability of one specimen's reading (specimen scatter and
 //!   measurement noise together), pooled over every group of repeats; without repeats an
 //!   assumed value (stated in the report);
 //! - `n` is the number of specimens averaged;
 //! - `v_model` is the model's relative variance: numerical (the pooled relative differences of
-//!   the tolerance-halving and initial-state runs, squared) plus parameters (the wear coefficient's relative
-//!   uncertainty for masses; the friction sensitivity run's relative change for both; twice
-//!   the accelerometer calibration uncertainty for mean squares);
+//!   the tolerance-halving and initial-state runs, squared) plus parameters (the wear
+//!   coefficient's relative uncertainty for masses; the friction sensitivity run's relative
+//!   change for both);
 //! - `v_fixed` is the reading's own absolute variance: the scale's quantisation `res²/12`, or the
 //!   variance of a mean square estimated from `N` samples with sensor noise `σ`
 //!   (`(4 m σ² + 2 σ⁴) / N`);
 //! - `v_floor` keeps `u > 0` where a prediction and its reading are both exactly 0.
+//!
+//! **Calibration is shared, not independent.** An accelerometer whose sensitivity is off by a
+//! factor `1 + e` scales every mean square it records by `(1 + e)² ≈ 1 + 2e`. The campaign's
+//! mean squares of one location and axis (a *channel*) therefore share one unknown scale
+//! `c ~ N(1, (2 e_cal)²)`: the readings of a channel are `y = c μ + ε`, and with `c`
+//! integrated out their covariance is `D + (2 e_cal)² μ μᵀ` (`D` the independent variances
+//! above). [`gaussian`] evaluates that likelihood exactly with the Sherman-Morrison identity;
+//! held out, a test's readings are judged conditional on the training tests' (their joint
+//! likelihood less the training tests' alone), so the scale the training tests show is used and
+//! only what changes between tests counts as a gap. A single reading's marginal uncertainty
+//! ([`NoiseModel::u_marginal`]) is `sqrt(u² + (2 e_cal μ)²)`.
 
 use super::emulator::{mean_square, Emulator, TestPredictions};
 use super::DiagnoseOptions;
@@ -42,6 +54,87 @@ impl Quantity {
     fn is_mass(&self) -> bool {
         matches!(self, Self::Mass(_))
     }
+
+    /// Calibration channel of a mean square (0..[`CHANNELS`]: location and axis); None for a
+    /// mass.
+    pub fn channel(&self) -> Option<usize> {
+        match self {
+            Self::Mass(_) => None,
+            Self::Accel(AccelLocation::Input, a) => Some(*a),
+            Self::Accel(AccelLocation::Response, a) => Some(3 + *a),
+        }
+    }
+}
+
+/// Calibration channels: two locations times three axes.
+pub const CHANNELS: usize = 6;
+
+/// One observation's term of the Gaussian likelihood.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Term {
+    /// Weight (composite likelihood; 1 for mean squares).
+    pub weight: f64,
+    /// Residual `y - μ`.
+    pub residual: f64,
+    /// Independent variance `u²`.
+    pub var: f64,
+    /// Prediction `μ` (the shared scale acts on it).
+    pub predicted: f64,
+    /// Calibration channel (None: no shared scale).
+    pub channel: Option<usize>,
+}
+
+/// Totals of a Gaussian likelihood.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Totals {
+    /// Negative log-likelihood (the constant `n/2 ln 2π` left out).
+    pub nll: f64,
+    /// Squared Mahalanobis distance of the residuals (a chi-square with `w` degrees of freedom
+    /// when the model holds).
+    pub r2: f64,
+    /// Weighted observation count.
+    pub w: f64,
+}
+
+impl std::ops::Sub for Totals {
+    type Output = Totals;
+    fn sub(self, o: Totals) -> Totals {
+        Totals {
+            nll: self.nll - o.nll,
+            r2: (self.r2 - o.r2).max(0.0),
+            w: self.w - o.w,
+        }
+    }
+}
+
+/// Negative log-likelihood and Mahalanobis distance of `terms`: independent Gaussians, except
+/// that the terms of one channel share a scale of variance `scale_var` on their predictions
+/// (covariance `D + scale_var μ μᵀ` per channel). Sherman-Morrison: with `a = Σ μ²/d` and
+/// `b = Σ μ r/d` over a channel, the quadratic form loses `scale_var b² / (1 + scale_var a)`
+/// and the log-determinant gains `ln(1 + scale_var a)`.
+pub fn gaussian(terms: impl IntoIterator<Item = Term>, scale_var: f64) -> Totals {
+    let mut t = Totals::default();
+    let mut a = [0.0; CHANNELS];
+    let mut b = [0.0; CHANNELS];
+    for x in terms {
+        let q = x.weight * x.residual * x.residual / x.var;
+        t.nll += 0.5 * q + 0.5 * x.weight * x.var.ln();
+        t.r2 += q;
+        t.w += x.weight;
+        if let Some(c) = x.channel {
+            a[c] += x.weight * x.predicted * x.predicted / x.var;
+            b[c] += x.weight * x.predicted * x.residual / x.var;
+        }
+    }
+    if scale_var > 0.0 {
+        for c in 0..CHANNELS {
+            let den = 1.0 + scale_var * a[c];
+            let drop = scale_var * b[c] * b[c] / den;
+            t.nll += -0.5 * drop + 0.5 * den.ln();
+            t.r2 -= drop;
+        }
+    }
+    t
 }
 
 /// One observation: a mean over the specimens of a test at one increment.
@@ -193,6 +286,8 @@ pub struct NoiseModel {
     pub mass_rel: f64,
     /// Relative repeatability of one record's mean square.
     pub accel_rel: f64,
+    /// Variance of a channel's shared mean-square scale, `(2 e_cal)²`.
+    pub scale_var: f64,
     report: NoiseReport,
 }
 
@@ -220,11 +315,10 @@ pub struct NoiseReport {
     pub friction_mass_rel: f64,
 }
 
-/// The model's relative variance of one observation (docs/diagnosis.md, "Uncertainty"): the
-/// numerical spread squared, plus the friction sensitivity squared, plus for masses the wear
-/// coefficient's relative uncertainty squared, for mean squares twice the accelerometer
-/// calibration uncertainty squared (a sensitivity off by a factor 1 + e scales a mean square by
-/// (1 + e)^2, about 1 + 2e).
+/// The model's independent relative variance of one observation (docs/diagnosis.md,
+/// "Uncertainty"): the numerical spread squared, plus the friction sensitivity squared, plus for
+/// masses the wear coefficient's relative uncertainty squared. The accelerometer calibration is
+/// not here: it is one scale per channel ([`gaussian`]).
 fn model_rel_var(
     quantity: &Quantity,
     numerical_rel: f64,
@@ -235,9 +329,7 @@ fn model_rel_var(
     let friction = friction_rel * friction_rel;
     match quantity {
         Quantity::Mass(_) => numerical + options.k_rel_uncertainty.powi(2) + friction,
-        Quantity::Accel(..) => {
-            numerical + friction + (2.0 * options.accelerometer_calibration_rel).powi(2)
-        }
+        Quantity::Accel(..) => numerical + friction,
     }
 }
 
@@ -344,6 +436,7 @@ impl NoiseModel {
         Self {
             mass_rel,
             accel_rel,
+            scale_var: (2.0 * options.accelerometer_calibration_rel).powi(2),
             report: NoiseReport {
                 mass_repeatability_rel: mass_rel,
                 mass_repeatability_source: source,
@@ -358,7 +451,8 @@ impl NoiseModel {
         }
     }
 
-    /// Standard uncertainty of observation `o` about the prediction `mu`.
+    /// Independent standard uncertainty of observation `o` about the prediction `mu` (the
+    /// channel's shared calibration scale not included).
     pub fn u(&self, o: &Observation, mu: f64) -> f64 {
         let s = if o.quantity.is_mass() {
             self.mass_rel
@@ -367,6 +461,28 @@ impl NoiseModel {
         };
         let rel = s * s / o.specimens as f64 + o.model_rel_var;
         (rel * mu * mu + o.fixed_var + o.floor_var).sqrt()
+    }
+
+    /// Marginal standard uncertainty of `o` read alone: [`Self::u`] with the calibration.
+    pub fn u_marginal(&self, o: &Observation, mu: f64) -> f64 {
+        let cal = if o.quantity.channel().is_some() {
+            self.scale_var * mu * mu
+        } else {
+            0.0
+        };
+        (self.u(o, mu).powi(2) + cal).sqrt()
+    }
+
+    /// The likelihood term of `o` about the prediction `mu`, with `extra_rel_var` added to its
+    /// independent relative variance.
+    pub fn term(&self, o: &Observation, mu: f64, extra_rel_var: f64) -> Term {
+        Term {
+            weight: o.weight,
+            residual: o.value - mu,
+            var: self.u(o, mu).powi(2) + extra_rel_var * mu * mu,
+            predicted: mu,
+            channel: o.quantity.channel(),
+        }
     }
 
     /// As reported.
@@ -380,24 +496,142 @@ mod tests {
     use super::*;
 
     #[test]
-    fn mean_squares_carry_twice_the_calibration_uncertainty_masses_the_wear_coefficient() {
+    fn independent_variances_add_calibration_is_left_to_the_channel_scale() {
         let options = DiagnoseOptions::default();
         let accel = Quantity::Accel(AccelLocation::Response, 1);
         let mass = Quantity::Mass("cube".into());
-        // Nothing but the calibration: a 2 % sensitivity is a 4 % mean square, variance 0.0016.
-        assert!((model_rel_var(&accel, 0.0, 0.0, &options) - 0.0016).abs() < 1e-15);
+        // The calibration is not an independent variance any more: nothing else, nothing.
+        assert_eq!(model_rel_var(&accel, 0.0, 0.0, &options), 0.0);
         // The wear coefficient's 10 % (an estimate, Table 4.3 has none) enters masses only.
         assert!((model_rel_var(&mass, 0.0, 0.0, &options) - 0.01).abs() < 1e-15);
         // Independent terms add in variance: 3-4-5.
-        let five = model_rel_var(
-            &accel,
-            0.03,
-            0.0,
-            &DiagnoseOptions {
-                accelerometer_calibration_rel: 0.02,
-                ..options.clone()
-            },
-        );
+        let five = model_rel_var(&accel, 0.03, 0.04, &options);
         assert!((five - 0.0025).abs() < 1e-15, "{five}");
+        assert_eq!(mass.channel(), None);
+        assert_eq!(Quantity::Accel(AccelLocation::Input, 2).channel(), Some(2));
+        assert_eq!(accel.channel(), Some(4));
+    }
+
+    fn terms() -> Vec<Term> {
+        // Two readings on channel 1, three on channel 4, one mass of weight 1/2.
+        let raw = [
+            (1.0, 0.3, 0.04, 2.0, Some(1)),
+            (1.0, -0.1, 0.09, 1.5, Some(1)),
+            (1.0, 0.5, 0.25, 4.0, Some(4)),
+            (1.0, 0.2, 0.16, 3.0, Some(4)),
+            (1.0, 0.6, 0.36, 5.0, Some(4)),
+            (0.5, 0.7, 0.49, 9.0, None),
+        ];
+        raw.iter()
+            .map(|&(weight, residual, var, predicted, channel)| Term {
+                weight,
+                residual,
+                var,
+                predicted,
+                channel,
+            })
+            .collect()
+    }
+
+    /// The same likelihood written densely: covariance `D + s μμᵀ` within each channel.
+    fn dense(terms: &[Term], s: f64) -> (f64, f64) {
+        let n = terms.len();
+        let cov = nalgebra::DMatrix::from_fn(n, n, |i, j| {
+            let (a, b) = (terms[i], terms[j]);
+            let shared = match (a.channel, b.channel) {
+                (Some(x), Some(y)) if x == y => s * a.predicted * b.predicted,
+                _ => 0.0,
+            };
+            shared + if i == j { a.var } else { 0.0 }
+        });
+        // A weight scales a term's information; the one weighted term is alone (no channel,
+        // last), so its Cholesky diagonal is its own standard deviation.
+        let r = nalgebra::DVector::from_fn(n, |i, _| terms[i].residual * terms[i].weight.sqrt());
+        let inv = cov.clone().try_inverse().expect("positive definite");
+        let q = (r.transpose() * &inv * &r)[(0, 0)];
+        let logdet: f64 = cov
+            .cholesky()
+            .expect("positive definite")
+            .l()
+            .diagonal()
+            .iter()
+            .zip(terms)
+            .map(|(d, t)| 2.0 * d.ln() * t.weight)
+            .sum();
+        (0.5 * q + 0.5 * logdet, q)
+    }
+
+    #[test]
+    fn the_shared_scale_likelihood_is_the_dense_gaussian() {
+        let t = terms();
+        for s in [0.0, 0.0016, 0.05, 3.0] {
+            let got = gaussian(t.iter().copied(), s);
+            let (nll, q) = dense(&t, s);
+            assert!((got.nll - nll).abs() < 1e-12, "s {s}: {} vs {nll}", got.nll);
+            assert!((got.r2 - q).abs() < 1e-12, "s {s}: {} vs {q}", got.r2);
+            assert!((got.w - 5.5).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn a_vague_scale_removes_the_best_fitting_scale_of_each_channel() {
+        // Readings exactly 1.08 times the prediction: the residuals are all scale, and a
+        // scale with a vague prior leaves nothing of them (least squares through the origin).
+        let t: Vec<Term> = [2.0, 3.0, 5.0]
+            .iter()
+            .map(|&mu: &f64| Term {
+                weight: 1.0,
+                residual: 0.08 * mu,
+                var: 0.01 * mu * mu,
+                predicted: mu,
+                channel: Some(0),
+            })
+            .collect();
+        let independent = gaussian(t.iter().copied(), 0.0).r2;
+        // Independent: three readings, each 0.8 sigma off (8 % against 10 %).
+        assert!((independent - 3.0 * 0.64).abs() < 1e-9, "{independent}");
+        assert!(gaussian(t.iter().copied(), 1e9).r2 < 1e-6);
+        // A 4 % prior on an 8 % offset: the offset is 2 prior sigmas, and with the readings'
+        // own 10 % per reading (3 readings: 5.8 % on their mean) the Mahalanobis distance is
+        // 0.08² / (0.0016 + 0.01 / 3) = 1.30, closed form.
+        let q = gaussian(t.iter().copied(), 0.0016).r2;
+        let expected = 0.0064 / (0.0016 + 0.01 / 3.0);
+        assert!((q - expected).abs() < 1e-9, "{q} vs {expected}");
+    }
+
+    #[test]
+    fn held_out_readings_are_judged_given_the_training_readings() {
+        // The chain rule: the joint likelihood less the training one is the conditional
+        // Gaussian of the held-out readings, written densely.
+        let t = terms();
+        let s = 0.05;
+        let (train, held): (Vec<Term>, Vec<Term>) = (
+            t[..2].iter().chain(&t[3..5]).copied().collect(),
+            vec![t[2], t[5]],
+        );
+        let all: Vec<Term> = train.iter().chain(&held).copied().collect();
+        let cond = gaussian(all.iter().copied(), s) - gaussian(train.iter().copied(), s);
+        // Dense conditional of the channel-4 reading t[2] given the channel-4 training readings.
+        let ch: Vec<Term> = vec![t[3], t[4]];
+        let cov_tt = nalgebra::DMatrix::from_fn(2, 2, |i, j| {
+            s * ch[i].predicted * ch[j].predicted + if i == j { ch[i].var } else { 0.0 }
+        });
+        let cov_ht = nalgebra::DVector::from_fn(2, |i, _| s * t[2].predicted * ch[i].predicted);
+        let r_t = nalgebra::DVector::from_fn(2, |i, _| ch[i].residual);
+        let inv = cov_tt.try_inverse().expect("positive definite");
+        let mean = (cov_ht.transpose() * &inv * &r_t)[(0, 0)];
+        let var =
+            t[2].var + s * t[2].predicted.powi(2) - (cov_ht.transpose() * &inv * &cov_ht)[(0, 0)];
+        let q2 = (t[2].residual - mean).powi(2) / var;
+        // The mass is independent of everything: its own term, weighted.
+        let q5 = t[5].weight * t[5].residual.powi(2) / t[5].var;
+        assert!(
+            (cond.r2 - (q2 + q5)).abs() < 1e-12,
+            "{} vs {}",
+            cond.r2,
+            q2 + q5
+        );
+        let nll = 0.5 * q2 + 0.5 * var.ln() + 0.5 * q5 + 0.5 * t[5].weight * t[5].var.ln();
+        assert!((cond.nll - nll).abs() < 1e-12, "{} vs {nll}", cond.nll);
     }
 }
