@@ -222,7 +222,10 @@ fn each_accelerometer_reads_through_its_own_drawn_sensitivity() {
     let g = &t1.accelerometer_sensitivity;
     assert_eq!(g.len(), 6);
     // Six draws of 1 + 0.05 z: distinct, and none beyond 5 sigma.
-    assert!(g.iter().all(|x| (x - 1.0).abs() < 0.25 && *x != 1.0), "{g:?}");
+    assert!(
+        g.iter().all(|x| (x - 1.0).abs() < 0.25 && *x != 1.0),
+        "{g:?}"
+    );
     // The masses do not see the accelerometers.
     assert_eq!(files(&exact).0, files(&off).0);
     // Every sample of a channel is the exact one times that channel's sensitivity, on every
