@@ -450,7 +450,7 @@ def main():
                     help="skip the mocap-driven MuJoCo variant (run at the first step only)")
     ap.add_argument("--timeconst", type=float, default=0.001, help="MuJoCo solref time constant, s")
     ap.add_argument("--dampratio", type=float, default=1.0, help="MuJoCo solref damping ratio")
-    ap.add_argument("--drake-steps", default="1e-4", help="Drake time steps, comma separated ('' = skip)")
+    ap.add_argument("--drake-steps", default="1e-4", help="Drake time steps, comma separated ('' or none = skip)")
     ap.add_argument("--drake-modulus", type=float, default=1e8, help="hydroelastic modulus of the cube, Pa")
     ap.add_argument("--drake-hc", type=float, default=50.0, help="Hunt-Crossley dissipation, s/m")
     ap.add_argument("--drake-approx", default="lagged", help="discrete contact approximation")
@@ -474,7 +474,8 @@ def main():
         print(json.dumps(run_mujoco(step, args.settle, args.window, "mocap", args.timeconst,
                                     args.dampratio, args.repeats)), flush=True)
 
-    dsteps = [float(s) for s in args.drake_steps.split(",") if s.strip()]
+    skip = args.drake_steps.strip() in ("", "none", "''")
+    dsteps = [] if skip else [float(s) for s in args.drake_steps.split(",") if s.strip()]
     if dsteps:
         try:
             import pydrake  # noqa: F401

@@ -13,7 +13,16 @@ fi
 if ! "$venv/bin/python" -c "import mujoco" 2>/dev/null; then
   "$venv/bin/pip" install -q "mujoco>=4,<5" >&2
 fi
-if ! "$venv/bin/python" -c "import pydrake.multibody.plant" 2>/dev/null; then
+# `--drake-steps none` (or '') skips Drake: nothing to install.
+want_drake=1
+prev=""
+for a in "$@"; do
+  if [ "$prev" = "--drake-steps" ] && { [ -z "$a" ] || [ "$a" = "none" ] || [ "$a" = "''" ]; }; then
+    want_drake=0
+  fi
+  prev="$a"
+done
+if [ "$want_drake" = 1 ] && ! "$venv/bin/python" -c "import pydrake.multibody.plant" 2>/dev/null; then
   if ! "$venv/bin/pip" install -q drake >&2; then
     echo "run_peers: drake did not install; its row will say unavailable" >&2
   elif ! "$venv/bin/python" -c "import pydrake.multibody.plant" 2>/dev/null; then

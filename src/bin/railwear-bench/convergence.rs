@@ -403,3 +403,131 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
     );
     Ok(vec![runs_table, quantity_table, verdict])
 }
+
+/// The tolerance ladder: how loose the case tolerance may be made, with full error control and
+/// the work test, before the quantities users read move by more than the criterion, on halving
+/// or against the tight reference.
+pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) -> Result<Table> {
+    if factors.is_empty() || factors.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
+        bail!("--ladder must list tolerance factors > 0, e.g. 1,4,16,64");
+    }
+    let mut table = Table::new(
+        format!(
+            "Tolerance ladder: full error control with the work test, each factor f on the case tolerance \
+             against f/2 and the reference (criterion |Δ| < {} %)",
+            b.criterion * 100.0
+        ),
+        &[
+            ("case", "case"),
+            ("factor", "tolerance factor f"),
+            ("tolerance", "rel tolerance"),
+            ("accepted", "accepted"),
+            ("rejected", "rejected"),
+            ("cpu_s", "CPU s"),
+            ("real_time_factor_cpu", "real-time factor (CPU)"),
+            ("speedup", "CPU speed-up over f = 1"),
+            ("energy_residual", "energy residual / dissipated"),
+            ("worst_half", "worst |Δ| f/2 vs f"),
+            ("worst_half_q", "at"),
+            ("worst_ref", "worst |Δ| f vs reference"),
+            ("worst_ref_q", "at"),
+            ("pass", "passes"),
+        ],
+    );
+    let full = |factor: f64, label: String| Variant {
+        label,
+        mode: ErrorControl::Full,
+        factor,
+        energy_off: false,
+        nudge_m: 0.0,
+    };
+    for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let settle = if case_name.starts_with("launcher") {
+            b.settle_launcher
+        } else {
+            b.settle_box
+        };
+        let case_tol = load_case(&configs_dir.join(format!("{case_name}.toml")))?
+            .simulation
+            .rel_tolerance;
+        eprintln!("ladder: {case_name} reference ...");
+        let reference = run_variant(
+            configs_dir,
+            case_name,
+            settle,
+            b.window,
+            &full(b.reference_factor, "reference".into()),
+        )?;
+        let mut base_cpu = None;
+        let mut loosest = None;
+        for &f in factors {
+            eprintln!("ladder: {case_name} f = {f} and f/2 ...");
+            let at_f = run_variant(
+                configs_dir,
+                case_name,
+                settle,
+                b.window,
+                &full(f, "f".into()),
+            )?;
+            let half = run_variant(
+                configs_dir,
+                case_name,
+                settle,
+                b.window,
+                &full(0.5 * f, "f/2".into()),
+            )?;
+            let mut worst: [(f64, String); 2] = Default::default();
+            for (i, (name, r, kind)) in reference.quantities.iter().enumerate() {
+                let val = |m: &Measured| m.quantities.get(i).map(|q| q.1).unwrap_or(f64::NAN);
+                let halving = difference(*kind, val(&half), val(&at_f)).abs();
+                let vs_ref = difference(*kind, val(&at_f), *r).abs();
+                for (k, x) in [halving, vs_ref].into_iter().enumerate() {
+                    if worse(x, worst[k].0) {
+                        worst[k] = (x, name.clone());
+                    }
+                }
+            }
+            let passes = worst[0].0 < b.criterion && worst[1].0 < b.criterion;
+            if f == 1.0 {
+                base_cpu = at_f.cpu_s;
+            }
+            if passes {
+                loosest = Some((f, at_f.cpu_s));
+            }
+            table.row(vec![
+                Cell::text(case_name),
+                Cell::Num(f),
+                Cell::Num(case_tol * f),
+                Cell::Int(at_f.accepted),
+                Cell::Int(at_f.rejected),
+                Cell::opt(at_f.cpu_s),
+                Cell::opt(at_f.cpu_s.map(|c| at_f.simulated_s / c.max(1e-9))),
+                Cell::opt(base_cpu.zip(at_f.cpu_s).map(|(a, c)| a / c.max(1e-9))),
+                Cell::opt(at_f.energy_residual_rel),
+                Cell::text(format!("{:.2} %", 100.0 * worst[0].0)),
+                Cell::text(&worst[0].1),
+                Cell::text(format!("{:.2} %", 100.0 * worst[1].0)),
+                Cell::text(&worst[1].1),
+                Cell::text(if passes { "yes" } else { "no" }),
+            ]);
+        }
+        table.note(match loosest {
+            Some((f, cpu)) => format!(
+                "{case_name}: loosest passing factor {f} (rel tolerance {:.1e}), CPU speed-up over f = 1: {}",
+                case_tol * f,
+                base_cpu
+                    .zip(cpu)
+                    .map_or("-".into(), |(a, c)| format!("{:.2}x", a / c.max(1e-9)))
+            ),
+            None => format!("{case_name}: no factor of the ladder passes"),
+        });
+    }
+    table.note(format!(
+        "settle {} s (rattle box) / {} s (launcher), window {} s, no track recording; reference = full \
+         error control at {} × the case tolerance; the work tolerance follows rel (10 × rel); \
+         quantities as in the convergence study",
+        b.settle_box, b.settle_launcher, b.window, b.reference_factor
+    ));
+    table.note(machine_note());
+    Ok(table)
+}

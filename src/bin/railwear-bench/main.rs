@@ -101,6 +101,10 @@ enum Command {
         /// Extra arguments passed to run_peers.sh (e.g. "--drake-steps ''").
         #[arg(long, allow_hyphen_values = true, default_value = "")]
         peer_args: String,
+        /// Also run railwear's default engine at these factors on the case tolerance (comma
+        /// list; 1 is always run), e.g. the loosest converged one of `convergence --ladder`.
+        #[arg(long, default_value = "1")]
+        tolerance_factors: String,
     },
     /// Launcher reference run (launcher-design, AH-64 transverse): real-time factor and the
     /// peak memory of a long run with all contact tracks stored.
@@ -151,6 +155,11 @@ enum Command {
         /// Also run the position-only mode without the energy account's work test.
         #[arg(long)]
         with_energy_off: bool,
+        /// Instead of the mode study, the tolerance ladder: these factors on the case
+        /// tolerance (comma list, e.g. 1,4,16,64), full error control, each against its half
+        /// and the reference.
+        #[arg(long)]
+        ladder: Option<String>,
     },
     /// Cost per missile of a launcher with 1, 2 and 4 missiles (issue 16).
     Missiles {
@@ -265,6 +274,18 @@ const ENGINE_VARIANTS: [EngineVariant; 3] = [
     },
 ];
 
+/// A comma list of numbers (empty items skipped); the error names the option.
+fn parse_list(list: &str, option: &str) -> Result<Vec<f64>> {
+    list.split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            s.parse::<f64>()
+                .with_context(|| format!("{option}: `{s}` is not a number"))
+        })
+        .collect()
+}
+
 fn main() -> Result<()> {
     let cli = Cli::parse();
     let tables = match &cli.command {
@@ -288,6 +309,7 @@ fn main() -> Result<()> {
             settle,
             window,
             peer_args,
+            tolerance_factors,
         } => peers(
             &cli.configs_dir,
             *with_peers,
@@ -295,6 +317,7 @@ fn main() -> Result<()> {
             *settle,
             *window,
             peer_args,
+            &parse_list(tolerance_factors, "--tolerance-factors")?,
         )?,
         Command::Launcher {
             settle,
@@ -312,12 +335,7 @@ fn main() -> Result<()> {
                 *no_mem,
                 *default_only,
             )?;
-            let windows: Vec<f64> = durations
-                .split(',')
-                .map(str::trim)
-                .filter(|s| !s.is_empty())
-                .map(|s| s.parse::<f64>().context("--durations"))
-                .collect::<Result<_>>()?;
+            let windows = parse_list(durations, "--durations")?;
             if !windows.is_empty() {
                 tables.push(launcher_linearity(&cli.configs_dir, *settle, &windows)?);
             }
@@ -331,9 +349,9 @@ fn main() -> Result<()> {
             reference_factor,
             criterion,
             with_energy_off,
-        } => convergence(
-            &cli.configs_dir,
-            &ConvergenceBench {
+            ladder,
+        } => {
+            let bench = ConvergenceBench {
                 cases: cases.clone(),
                 settle_box: *settle_box,
                 settle_launcher: *settle_launcher,
@@ -341,8 +359,16 @@ fn main() -> Result<()> {
                 reference_factor: *reference_factor,
                 criterion: *criterion,
                 with_energy_off: *with_energy_off,
-            },
-        )?,
+            };
+            match ladder {
+                Some(list) => vec![convergence::ladder(
+                    &cli.configs_dir,
+                    &bench,
+                    &parse_list(list, "--ladder")?,
+                )?],
+                None => convergence(&cli.configs_dir, &bench)?,
+            }
+        }
         Command::Missiles {
             settle,
             window,

@@ -9,6 +9,7 @@ pub(crate) fn peers(
     settle: f64,
     window: f64,
     peer_args: &str,
+    tolerance_factors: &[f64],
 ) -> Result<Vec<Table>> {
     let mut peer_rows: Vec<Value> = Vec::new();
     let mut notes = Vec::new();
@@ -45,19 +46,44 @@ pub(crate) fn peers(
         notes.push("no peer rows: pass --with-peers (or --peers-json FILE)".into());
     }
     // railwear in each engine variant (the default first), so the engine changes are measured
-    // in the same run as the peers.
+    // in the same run as the peers; then the default at each further tolerance factor (the
+    // converged tolerances of `convergence --ladder`).
     let mut ours_rows = Vec::new();
-    for variant in ENGINE_VARIANTS {
-        eprintln!("peers: railwear rattle box C ({}) ...", variant.name);
+    let factors = tolerance_factors.iter().copied().filter(|f| *f != 1.0);
+    let runs: Vec<(&EngineVariant, f64)> = ENGINE_VARIANTS
+        .iter()
+        .map(|v| (v, 1.0))
+        .chain(factors.map(|f| (&ENGINE_VARIANTS[0], f)))
+        .collect();
+    for (variant, factor) in runs {
+        eprintln!(
+            "peers: railwear rattle box C ({}, tolerance x {factor}) ...",
+            variant.name
+        );
         let (_, model, mut options) =
             rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
         options.integrator.newton = variant.newton;
         options.integrator.patches = variant.patches;
+        options.integrator.tolerances = options.integrator.tolerances.scaled(factor);
+        let cpu0 = thread_cpu_s();
         let run = run_model(&model, &options, &RunControl::silent())
             .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
-        ours_rows.push((variant, model.end_time_s, options, run));
+        let cpu = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
+        ours_rows.push((variant, factor, model.end_time_s, options, run, cpu));
     }
-    let rw_rtf = ours_rows[0].1 / ours_rows[0].3.wall_s.max(1e-9);
+    let rw_rtf = ours_rows[0].2 / ours_rows[0].4.wall_s.max(1e-9);
+    // Per tolerance factor of the default variant: (factor, wall RTF, CPU RTF).
+    let ours_by_factor: Vec<(f64, f64, Option<f64>)> = ours_rows
+        .iter()
+        .filter(|r| r.0.name == ENGINE_VARIANTS[0].name)
+        .map(|(_, f, end, _, run, cpu)| {
+            (
+                *f,
+                end / run.wall_s.max(1e-9),
+                cpu.map(|c| end / c.max(1e-9)),
+            )
+        })
+        .collect();
     let mut table = Table::new(
         format!("Rattle box case C side by side (settle {settle} s, window {window} s, one run)"),
         &[
@@ -72,7 +98,7 @@ pub(crate) fn peers(
             ("ratio_vs_mujoco", "railwear RTF / this RTF"),
         ],
     );
-    for (variant, end_time_s, options, run) in &ours_rows {
+    for (variant, _, end_time_s, options, run, cpu) in &ours_rows {
         let rtf = end_time_s / run.wall_s.max(1e-9);
         let newton_name = variant.name;
         table.row(vec![
@@ -83,7 +109,7 @@ pub(crate) fn peers(
                 tolerance_text(&options.integrator.tolerances)
             )),
             Cell::Num(rtf),
-            Cell::text("-"),
+            Cell::opt(cpu.map(|c| end_time_s / c.max(1e-9))),
             Cell::Num(run.integrator.accepted as f64 / run.wall_s.max(1e-9)),
             Cell::Num(run.mean_normal_force_n),
             Cell::Num(run.mean_friction_power_w),
@@ -92,6 +118,7 @@ pub(crate) fn peers(
     }
     let mut mujoco_best: Option<f64> = None;
     let mut mujoco_converged: Option<f64> = None;
+    let mut mujoco_converged_cpu: Option<f64> = None;
     for p in &peer_rows {
         let engine = p.get("engine").and_then(Value::as_str).unwrap_or("?");
         let status = p.get("status").and_then(Value::as_str);
@@ -126,6 +153,7 @@ pub(crate) fn peers(
                 // The step at which MuJoCo's friction power has converged (issue 5: 5e-5 s).
                 if f("step_s").is_some_and(|s| (s - 5e-5).abs() < 1e-12) {
                     mujoco_converged = Some(r);
+                    mujoco_converged_cpu = f("real_time_factor_cpu");
                 }
             }
         }
@@ -152,10 +180,17 @@ pub(crate) fn peers(
         table.note(n);
     }
     if let Some(m) = mujoco_converged {
-        table.note(format!(
-            "railwear / MuJoCo at its converged 5e-5 s step, real-time factor: {:.2} (issue 5 target >= 3)",
-            rw_rtf / m
-        ));
+        for (factor, wall, cpu) in &ours_by_factor {
+            let cpu_ratio = cpu
+                .zip(mujoco_converged_cpu)
+                .map_or("-".into(), |(a, b)| format!("{:.2}", a / b.max(1e-9)));
+            table.note(format!(
+                "railwear (case tolerance x {factor}) / MuJoCo at its converged 5e-5 s step, real-time factor: \
+                 {:.2} wall, {cpu_ratio} CPU (issue 16 target >= 3 at a converged tolerance; \
+                 `convergence --ladder` says which are)",
+                wall / m
+            ));
+        }
     }
     if let Some(m) = mujoco_best {
         table.note(format!(
