@@ -69,7 +69,21 @@ pub(crate) fn rattle_box_c(
     window: f64,
     kind: IntegratorKind,
 ) -> Result<(CaseSpec, BuiltModel, RunOptions)> {
+    rattle_box_c_points(configs_dir, settle, window, kind, None)
+}
+
+/// [`rattle_box_c`] with `points` contact points per box edge (None: the case's).
+pub(crate) fn rattle_box_c_points(
+    configs_dir: &Path,
+    settle: f64,
+    window: f64,
+    kind: IntegratorKind,
+    points: Option<usize>,
+) -> Result<(CaseSpec, BuiltModel, RunOptions)> {
     let mut case = load_case(&configs_dir.join("rattle-box-c.toml"))?;
+    if let Some(n) = points {
+        case.simulation.contact_points_per_edge = n;
+    }
     case.simulation.settle_s = settle;
     case.simulation.duration_s = window;
     case.simulation.record_interval_s = case.simulation.record_interval_s.min(window);

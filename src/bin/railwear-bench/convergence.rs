@@ -22,6 +22,8 @@ struct Variant {
     energy_off: bool,
     /// Initial position moved by this much along x, m (chaos floor).
     nudge_m: f64,
+    /// Contact points per box edge (None: the case's).
+    points_per_edge: Option<usize>,
 }
 
 /// What one run measured.
@@ -79,6 +81,9 @@ fn run_variant(
     case.simulation.error_control = v.mode;
     if v.energy_off {
         case.simulation.energy_rel_tolerance = Some(0.0);
+    }
+    if let Some(n) = v.points_per_edge {
+        case.simulation.contact_points_per_edge = n;
     }
     let mut model = build(&case, configs_dir)?;
     model.initial_state[0] += v.nudge_m;
@@ -171,6 +176,10 @@ pub(crate) struct ConvergenceBench {
     pub(crate) reference_factor: f64,
     pub(crate) criterion: f64,
     pub(crate) with_energy_off: bool,
+    /// Ladder: contact points per box edge of the runs (None: the case's).
+    pub(crate) points_per_edge: Option<usize>,
+    /// Ladder: contact points per box edge of the reference (None: the case's).
+    pub(crate) reference_points_per_edge: Option<usize>,
 }
 
 /// An error-control mode of the study: its name, the mode and whether the energy account's
@@ -215,6 +224,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             factor: b.reference_factor,
             energy_off: false,
             nudge_m: 0.0,
+            points_per_edge: None,
         },
         Variant {
             label: "full, tol, start moved 1 nm".into(),
@@ -222,6 +232,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             factor: 1.0,
             energy_off: false,
             nudge_m: 1e-9,
+            points_per_edge: None,
         },
     ];
     for m in &modes {
@@ -232,6 +243,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 factor,
                 energy_off: m.energy_off,
                 nudge_m: 0.0,
+                points_per_edge: None,
             });
         }
     }
@@ -407,7 +419,11 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
 /// The tolerance ladder: how loose the case tolerance may be made, with full error control and
 /// the work test, before the quantities users read move by more than the criterion, on halving
 /// or against the tight reference.
-pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) -> Result<Table> {
+pub(crate) fn ladder(
+    configs_dir: &Path,
+    b: &ConvergenceBench,
+    factors: &[f64],
+) -> Result<Vec<Table>> {
     if factors.is_empty() || factors.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
         bail!("--ladder must list tolerance factors > 0, e.g. 1,4,16,64");
     }
@@ -434,13 +450,27 @@ pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) 
             ("pass", "passes"),
         ],
     );
-    let full = |factor: f64, label: String| Variant {
+    let mut quantities = Table::new(
+        "Tolerance ladder: every quantity against the reference and on halving",
+        &[
+            ("case", "case"),
+            ("quantity", "quantity"),
+            ("reference", "reference"),
+            ("factor", "f"),
+            ("value", "at f"),
+            ("vs_ref", "Δ f vs reference"),
+            ("halving", "Δ f/2 vs f"),
+        ],
+    );
+    let full = |factor: f64, label: String, points_per_edge| Variant {
         label,
         mode: ErrorControl::Full,
         factor,
         energy_off: false,
         nudge_m: 0.0,
+        points_per_edge,
     };
+    let points = b.points_per_edge;
     for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let settle = if case_name.starts_with("launcher") {
             b.settle_launcher
@@ -456,7 +486,11 @@ pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) 
             case_name,
             settle,
             b.window,
-            &full(b.reference_factor, "reference".into()),
+            &full(
+                b.reference_factor,
+                "reference".into(),
+                b.reference_points_per_edge,
+            ),
         )?;
         let mut base_cpu = None;
         let mut loosest = None;
@@ -467,20 +501,33 @@ pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) 
                 case_name,
                 settle,
                 b.window,
-                &full(f, "f".into()),
+                &full(f, "f".into(), points),
             )?;
             let half = run_variant(
                 configs_dir,
                 case_name,
                 settle,
                 b.window,
-                &full(0.5 * f, "f/2".into()),
+                &full(0.5 * f, "f/2".into(), points),
             )?;
             let mut worst: [(f64, String); 2] = Default::default();
             for (i, (name, r, kind)) in reference.quantities.iter().enumerate() {
                 let val = |m: &Measured| m.quantities.get(i).map(|q| q.1).unwrap_or(f64::NAN);
                 let halving = difference(*kind, val(&half), val(&at_f)).abs();
                 let vs_ref = difference(*kind, val(&at_f), *r).abs();
+                let show = |x: f64| match kind {
+                    QuantityKind::Relative => Cell::text(format!("{:.2} %", 100.0 * x)),
+                    QuantityKind::Share => Cell::text(format!("{:.2} pp", 100.0 * x)),
+                };
+                quantities.row(vec![
+                    Cell::text(case_name),
+                    Cell::text(name),
+                    Cell::Num(*r),
+                    Cell::Num(f),
+                    Cell::Num(val(&at_f)),
+                    show(vs_ref),
+                    show(halving),
+                ]);
                 for (k, x) in [halving, vs_ref].into_iter().enumerate() {
                     if worse(x, worst[k].0) {
                         worst[k] = (x, name.clone());
@@ -522,12 +569,19 @@ pub(crate) fn ladder(configs_dir: &Path, b: &ConvergenceBench, factors: &[f64]) 
             None => format!("{case_name}: no factor of the ladder passes"),
         });
     }
+    let pts = |p: Option<usize>| p.map_or("the case's".to_string(), |n| n.to_string());
     table.note(format!(
         "settle {} s (rattle box) / {} s (launcher), window {} s, no track recording; reference = full \
          error control at {} × the case tolerance; the work tolerance follows rel (10 × rel); \
-         quantities as in the convergence study",
-        b.settle_box, b.settle_launcher, b.window, b.reference_factor
+         quantities as in the convergence study; contact points per box edge: {} in the runs, {} in \
+         the reference",
+        b.settle_box,
+        b.settle_launcher,
+        b.window,
+        b.reference_factor,
+        pts(b.points_per_edge),
+        pts(b.reference_points_per_edge)
     ));
     table.note(machine_note());
-    Ok(table)
+    Ok(vec![table, quantities])
 }

@@ -37,6 +37,8 @@ pub(crate) fn launcher_linearity(
             ("vs_shortest", "per simulated s / shortest run"),
             ("real_time_factor_cpu", "real-time factor (CPU)"),
             ("accepted", "accepted"),
+            ("accepted_per_simulated_s", "accepted steps per simulated s"),
+            ("cpu_us_per_step", "CPU µs per accepted step"),
             ("track_samples", "track samples"),
         ],
     );
@@ -62,11 +64,16 @@ pub(crate) fn launcher_linearity(
             Cell::Num(per / base),
             Cell::Num(simulated / cpu.max(1e-9)),
             Cell::Int(report.integrator.accepted),
+            Cell::Num(report.integrator.accepted as f64 / simulated),
+            Cell::Num(1e6 * cpu / (report.integrator.accepted as f64).max(1.0)),
             Cell::Int(outcome.tracks.len() as u64),
         ]);
     }
     t.note(
-        "CPU s = this thread's user + system time of the run (simulation, wear, track recording);          the target is every row's per-second cost within 10 % of the others",
+        "CPU s = this thread's user + system time of the run (simulation, wear, track recording); \
+         the target is every row's per-second cost within 10 % of the others. The cost per accepted \
+         step separates the engine (is each step's cost constant?) from the physics (does the \
+         motion need as many steps per second early in a run as later?)",
     );
     t.note(machine_note());
     Ok(t)

@@ -105,6 +105,10 @@ enum Command {
         /// list; 1 is always run), e.g. the loosest converged one of `convergence --ladder`.
         #[arg(long, default_value = "1")]
         tolerance_factors: String,
+        /// Contact points per box edge of those extra runs (default: the case's; given, the
+        /// factor 1 runs at it too).
+        #[arg(long)]
+        points_per_edge: Option<usize>,
     },
     /// Launcher reference run (launcher-design, AH-64 transverse): real-time factor and the
     /// peak memory of a long run with all contact tracks stored.
@@ -160,6 +164,12 @@ enum Command {
         /// and the reference.
         #[arg(long)]
         ladder: Option<String>,
+        /// Ladder: contact points per box edge of its runs (default: the case's).
+        #[arg(long)]
+        points_per_edge: Option<usize>,
+        /// Ladder: contact points per box edge of the reference (default: the case's).
+        #[arg(long)]
+        reference_points_per_edge: Option<usize>,
     },
     /// Cost per missile of a launcher with 1, 2 and 4 missiles (issue 16).
     Missiles {
@@ -310,6 +320,7 @@ fn main() -> Result<()> {
             window,
             peer_args,
             tolerance_factors,
+            points_per_edge,
         } => peers(
             &cli.configs_dir,
             *with_peers,
@@ -318,6 +329,7 @@ fn main() -> Result<()> {
             *window,
             peer_args,
             &parse_list(tolerance_factors, "--tolerance-factors")?,
+            *points_per_edge,
         )?,
         Command::Launcher {
             settle,
@@ -350,6 +362,8 @@ fn main() -> Result<()> {
             criterion,
             with_energy_off,
             ladder,
+            points_per_edge,
+            reference_points_per_edge,
         } => {
             let bench = ConvergenceBench {
                 cases: cases.clone(),
@@ -359,13 +373,13 @@ fn main() -> Result<()> {
                 reference_factor: *reference_factor,
                 criterion: *criterion,
                 with_energy_off: *with_energy_off,
+                points_per_edge: *points_per_edge,
+                reference_points_per_edge: *reference_points_per_edge,
             };
             match ladder {
-                Some(list) => vec![convergence::ladder(
-                    &cli.configs_dir,
-                    &bench,
-                    &parse_list(list, "--ladder")?,
-                )?],
+                Some(list) => {
+                    convergence::ladder(&cli.configs_dir, &bench, &parse_list(list, "--ladder")?)?
+                }
                 None => convergence(&cli.configs_dir, &bench)?,
             }
         }

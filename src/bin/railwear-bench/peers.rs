@@ -10,6 +10,7 @@ pub(crate) fn peers(
     window: f64,
     peer_args: &str,
     tolerance_factors: &[f64],
+    points_per_edge: Option<usize>,
 ) -> Result<Vec<Table>> {
     let mut peer_rows: Vec<Value> = Vec::new();
     let mut notes = Vec::new();
@@ -46,22 +47,32 @@ pub(crate) fn peers(
         notes.push("no peer rows: pass --with-peers (or --peers-json FILE)".into());
     }
     // railwear in each engine variant (the default first), so the engine changes are measured
-    // in the same run as the peers; then the default at each further tolerance factor (the
-    // converged tolerances of `convergence --ladder`).
+    // in the same run as the peers; then the default at each further tolerance factor and
+    // point count (the converged settings of `convergence --ladder`).
     let mut ours_rows = Vec::new();
-    let factors = tolerance_factors.iter().copied().filter(|f| *f != 1.0);
+    let factors = tolerance_factors
+        .iter()
+        .copied()
+        .filter(|f| *f != 1.0 || points_per_edge.is_some());
     let runs: Vec<(&EngineVariant, f64)> = ENGINE_VARIANTS
         .iter()
         .map(|v| (v, 1.0))
         .chain(factors.map(|f| (&ENGINE_VARIANTS[0], f)))
         .collect();
-    for (variant, factor) in runs {
+    for (i, (variant, factor)) in runs.into_iter().enumerate() {
+        // The engine variants run the case as it is; the extra rows at the asked points.
+        let points = if i < ENGINE_VARIANTS.len() {
+            None
+        } else {
+            points_per_edge
+        };
         eprintln!(
-            "peers: railwear rattle box C ({}, tolerance x {factor}) ...",
+            "peers: railwear rattle box C ({}, tolerance x {factor}, points per edge {points:?}) ...",
             variant.name
         );
-        let (_, model, mut options) =
-            rattle_box_c(configs_dir, settle, window, IntegratorKind::Trbdf2)?;
+        let (case, model, mut options) =
+            rattle_box_c_points(configs_dir, settle, window, IntegratorKind::Trbdf2, points)?;
+        let points = case.simulation.contact_points_per_edge;
         options.integrator.newton = variant.newton;
         options.integrator.patches = variant.patches;
         options.integrator.tolerances = options.integrator.tolerances.scaled(factor);
@@ -69,11 +80,19 @@ pub(crate) fn peers(
         let run = run_model(&model, &options, &RunControl::silent())
             .map_err(|e| anyhow!("railwear rattle box C: {e}"))?;
         let cpu = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
-        ours_rows.push((variant, factor, model.end_time_s, options, run, cpu));
+        ours_rows.push((
+            variant,
+            (factor, points),
+            model.end_time_s,
+            options,
+            run,
+            cpu,
+        ));
     }
     let rw_rtf = ours_rows[0].2 / ours_rows[0].4.wall_s.max(1e-9);
-    // Per tolerance factor of the default variant: (factor, wall RTF, CPU RTF).
-    let ours_by_factor: Vec<(f64, f64, Option<f64>)> = ours_rows
+    // Per tolerance factor and point count of the default variant: ((factor, points), wall
+    // RTF, CPU RTF).
+    let ours_by_factor: Vec<((f64, usize), f64, Option<f64>)> = ours_rows
         .iter()
         .filter(|r| r.0.name == ENGINE_VARIANTS[0].name)
         .map(|(_, f, end, _, run, cpu)| {
@@ -98,15 +117,16 @@ pub(crate) fn peers(
             ("ratio_vs_mujoco", "railwear RTF / this RTF"),
         ],
     );
-    for (variant, _, end_time_s, options, run, cpu) in &ours_rows {
+    for (variant, settings, end_time_s, options, run, cpu) in &ours_rows {
         let rtf = end_time_s / run.wall_s.max(1e-9);
         let newton_name = variant.name;
         table.row(vec![
             Cell::text(format!("railwear {}", env!("CARGO_PKG_VERSION"))),
             Cell::text("IMPACT eq. 2.1-2.3, Table 5.2 (k 1000 N/mm², e 2, c_max 500 N·s/mm, d 0.01 mm); ADAMS friction eq. 4.5"),
             Cell::text(format!(
-                "trbdf2 {}, {newton_name}",
-                tolerance_text(&options.integrator.tolerances)
+                "trbdf2 {}, {newton_name}, {} points per edge",
+                tolerance_text(&options.integrator.tolerances),
+                settings.1
             )),
             Cell::Num(rtf),
             Cell::opt(cpu.map(|c| end_time_s / c.max(1e-9))),
@@ -180,12 +200,12 @@ pub(crate) fn peers(
         table.note(n);
     }
     if let Some(m) = mujoco_converged {
-        for (factor, wall, cpu) in &ours_by_factor {
+        for ((factor, points), wall, cpu) in &ours_by_factor {
             let cpu_ratio = cpu
                 .zip(mujoco_converged_cpu)
                 .map_or("-".into(), |(a, b)| format!("{:.2}", a / b.max(1e-9)));
             table.note(format!(
-                "railwear (case tolerance x {factor}) / MuJoCo at its converged 5e-5 s step, real-time factor: \
+                "railwear (case tolerance x {factor}, {points} points per edge) / MuJoCo at its converged 5e-5 s step, real-time factor: \
                  {:.2} wall, {cpu_ratio} CPU (issue 16 target >= 3 at a converged tolerance; \
                  `convergence --ladder` says which are)",
                 wall / m
