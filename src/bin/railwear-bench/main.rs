@@ -328,8 +328,10 @@ fn main() -> Result<()> {
             *settle,
             *window,
             peer_args,
-            &parse_list(tolerance_factors, "--tolerance-factors")?,
-            *points_per_edge,
+            &ExtraRuns {
+                tolerance_factors: parse_list(tolerance_factors, "--tolerance-factors")?,
+                points_per_edge: *points_per_edge,
+            },
         )?,
         Command::Launcher {
             settle,

@@ -2,6 +2,13 @@
 
 use super::*;
 
+/// railwear's extra rows beside the engine variants: the default engine at these factors on
+/// the case tolerance, at `points_per_edge` contact points per box edge (None: the case's).
+pub(crate) struct ExtraRuns {
+    pub(crate) tolerance_factors: Vec<f64>,
+    pub(crate) points_per_edge: Option<usize>,
+}
+
 pub(crate) fn peers(
     configs_dir: &Path,
     with_peers: bool,
@@ -9,9 +16,9 @@ pub(crate) fn peers(
     settle: f64,
     window: f64,
     peer_args: &str,
-    tolerance_factors: &[f64],
-    points_per_edge: Option<usize>,
+    extra: &ExtraRuns,
 ) -> Result<Vec<Table>> {
+    let points_per_edge = extra.points_per_edge;
     let mut peer_rows: Vec<Value> = Vec::new();
     let mut notes = Vec::new();
     if with_peers {
@@ -50,7 +57,8 @@ pub(crate) fn peers(
     // in the same run as the peers; then the default at each further tolerance factor and
     // point count (the converged settings of `convergence --ladder`).
     let mut ours_rows = Vec::new();
-    let factors = tolerance_factors
+    let factors = extra
+        .tolerance_factors
         .iter()
         .copied()
         .filter(|f| *f != 1.0 || points_per_edge.is_some());
