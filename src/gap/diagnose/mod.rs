@@ -9,16 +9,17 @@
 //!    measurement and specimen scatter from the repeats (pooled relative variance; an assumed
 //!    value, stated, when there are none) and the scale's quantisation; numerical, from a
 //!    tolerance-halving run; parameters, from the wear coefficient's relative uncertainty and a
-//!    friction sensitivity run. Components of one specimen share its scatter, so each of a
-//!    test's `n` components enters the likelihood with weight `1/n` (a composite likelihood,
-//!    conservative when they are fully correlated).
+//!    friction sensitivity run; the accelerometers' calibration as one unknown scale per
+//!    channel (location and axis), integrated out ([`noise::gaussian`]). Components of one
+//!    specimen share its scatter, so each of a test's `n` components enters the likelihood
+//!    with weight `1/n` (a composite likelihood, conservative when they are fully correlated).
 //! 3. **Where** ([`location`]): standardized residuals `(y - μ)/u` of the nominal model, grouped
 //!    by test, component, increment, contact-pressure and slip-speed band (weighted by where the
 //!    model's friction work falls) and 1/3-octave band of the response spectrum; p-values
 //!    adjusted by Holm's method (family-wise error rate 5 %).
 //! 4. **Which**: each effect's magnitude is fitted by maximum likelihood on the training tests
-//!    and judged on the held-out test (leave-one-test-out with three or more tests, otherwise
-//!    leave-one-increment-out); AICc and BIC of the full-data fit; a bootstrap over the held-out
+//!    and judged on the held-out test given the training tests (leave-one-test-out with three
+//!    or more tests, otherwise leave-one-increment-out); AICc and BIC of the full-data fit; a bootstrap over the held-out
 //!    groups gives the probability that each ranks first. An effect *explains* the gap when its
 //!    held-out log-likelihood gain over the nominal exceeds [`MIN_HELD_OUT_GAIN`], it removes
 //!    at least [`MIN_EXPLAINED_SHARE`] of the nominal's excess chi-square, and the residuals
