@@ -182,6 +182,32 @@ pub(crate) struct ConvergenceBench {
     pub(crate) reference_points_per_edge: Option<usize>,
 }
 
+impl ConvergenceBench {
+    /// The case names of `--cases`.
+    fn case_names(&self) -> impl Iterator<Item = &str> {
+        self.cases
+            .split(',')
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+    }
+
+    /// Settle time of a case: the launcher's or the rattle box's.
+    fn settle(&self, case_name: &str) -> f64 {
+        if case_name.starts_with("launcher") {
+            self.settle_launcher
+        } else {
+            self.settle_box
+        }
+    }
+}
+
+/// The case's own relative tolerance (the factors of the studies multiply it).
+fn case_rel_tolerance(configs_dir: &Path, case_name: &str) -> Result<f64> {
+    Ok(load_case(&configs_dir.join(format!("{case_name}.toml")))?
+        .simulation
+        .rel_tolerance)
+}
+
 /// An error-control mode of the study: its name, the mode and whether the energy account's
 /// work test is on.
 struct Mode {
@@ -313,21 +339,15 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             ("pass", "passes"),
         ],
     );
-    for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let settle = if case_name.starts_with("launcher") {
-            b.settle_launcher
-        } else {
-            b.settle_box
-        };
+    for case_name in b.case_names() {
+        let settle = b.settle(case_name);
         let mut measured = Vec::new();
         for v in &variants {
             eprintln!("convergence: {case_name} {} ...", v.label);
             measured.push(run_variant(configs_dir, case_name, settle, b.window, v)?);
         }
         let full_steps = measured[at(0, false)].accepted as f64;
-        let case_tol = load_case(&configs_dir.join(format!("{case_name}.toml")))?
-            .simulation
-            .rel_tolerance;
+        let case_tol = case_rel_tolerance(configs_dir, case_name)?;
         for (v, m) in variants.iter().zip(&measured) {
             runs_table.row(vec![
                 Cell::text(case_name),
@@ -471,15 +491,9 @@ pub(crate) fn ladder(
         points_per_edge,
     };
     let points = b.points_per_edge;
-    for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let settle = if case_name.starts_with("launcher") {
-            b.settle_launcher
-        } else {
-            b.settle_box
-        };
-        let case_tol = load_case(&configs_dir.join(format!("{case_name}.toml")))?
-            .simulation
-            .rel_tolerance;
+    for case_name in b.case_names() {
+        let settle = b.settle(case_name);
+        let case_tol = case_rel_tolerance(configs_dir, case_name)?;
         eprintln!("ladder: {case_name} reference ...");
         let reference = run_variant(
             configs_dir,
