@@ -448,7 +448,8 @@ pub fn diagnose(
             g.by, g.label, g.mean_residual, g.z, g.p_adjusted
         );
     }
-    println!("\nreport and plots in {}", dir.display());
+    println!("\n{}", report.location.energy_budget.table());
+    println!("report and plots in {}", dir.display());
     Ok(())
 }
 

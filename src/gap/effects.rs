@@ -70,7 +70,8 @@ pub struct EffectInfo {
 
 const BOTH: &[ModelKind] = &[ModelKind::RattleBox, ModelKind::Launcher];
 
-/// The library, in issue order (a)-(h).
+/// The library, in issue order: (a)-(h) of issue 14, (i)-(k) of issue 26 (wear mechanisms
+/// beyond sliding Archard at the lumped pressure).
 pub const LIBRARY: &[EffectInfo] = &[
     EffectInfo {
         name: "wear_above_cutoff",
@@ -256,6 +257,77 @@ pub const LIBRARY: &[EffectInfo] = &[
         reason: "thesis 6.3.1: the rear leaf spring may not engage when static; a lost preload lets the missile rattle",
         limitation: None,
     },
+    EffectInfo {
+        name: "impact_wear",
+        letter: 'i',
+        summary: "impact wear: a volume k_E times the energy the contact's normal (IMPACT) damping dissipates, counted while the normal speed is at least a threshold",
+        acts: Acts::WearLaw,
+        models: BOTH,
+        parameters: &[
+            ParameterInfo {
+                name: "k_energy_m3_per_j",
+                unit: "m³/J (wear volume per joule of normal damping work)",
+                min: 0.0,
+                max: 1.0e-11,
+                default: 0.0,
+                reason: "dissipated-energy wear (Fouvry et al., Wear 2003; Huq & Celis, Wear 2002) measures 1e-15 to 1e-13 m³/J for steels and coatings in fretting; an Archard k/(H mu) for aluminium alloys in dry contact, k = 1e-6 (mild, oxidised) to 1e-2 (severe, adhesive) (Archard 1953; Hutchings 1992), H = 1.32 GPa, mu = 0.5, spans 1.5e-15 to 1.5e-11 m³/J; Engel (Impact Wear of Materials, 1976) finds repeated normal impact removes material by the same fatigue and plastic mechanisms, so the sliding range bounds it",
+            },
+            ParameterInfo {
+                name: "min_normal_speed_m_s",
+                unit: "m/s (|penetration rate| below which damping work does not wear)",
+                min: 0.0,
+                max: 0.5,
+                default: 0.0,
+                reason: "Engel's impact wear has a threshold below which impacts only deform elastically; a sliding contact's micro-motion (normal speeds of mm/s) dissipates without removing material; 0.5 m/s is above the rattle boxes' impact speeds (15 g at 20 Hz moves the tube at 1.2 m/s peak)",
+            },
+        ],
+        reason: "the energy account shows the contact's IMPACT damping dissipating 10-100x the friction work (rattle box C: about 1.5 W against 0.02 W); thesis 5.5 and Fig. 5.7 point at impact stresses above yield and plastic flow at the corners",
+        limitation: Some("the damping work is the IMPACT law's (c_max, STEP over the penetration depth d), not a measured restitution: it is as good as Table 5.2's damping"),
+    },
+    EffectInfo {
+        name: "severe_wear",
+        letter: 'j',
+        summary: "severe (plastic) wear: K raised by k_severe/H at contact points whose own pressure exceeds a multiple of the yield strength",
+        acts: Acts::WearLaw,
+        models: BOTH,
+        parameters: &[
+            ParameterInfo {
+                name: "k_severe",
+                unit: "1 (dimensionless Archard k; K_add = k/H)",
+                min: 0.0,
+                max: 1.0e-2,
+                default: 0.0,
+                reason: "severe (adhesive, plastic) wear of aluminium alloys: dimensionless k of 1e-4 to 1e-2 (Archard 1953; Lim & Ashby, Acta Metall. 1987; Hutchings 1992), against 1e-7 to 1e-5 in mild wear",
+            },
+            ParameterInfo {
+                name: "pressure_ratio_to_yield",
+                unit: "1 (local pressure / yield strength Sy where severe wear starts)",
+                min: 0.5,
+                max: 3.0,
+                default: 1.0,
+                reason: "the mild-to-severe transition lies where the local pressure reaches the flow stress: about Sy at first yield, up to the hardness (about 3 Sy, Tabor) at full plasticity (Lim & Ashby 1987); 0.5 Sy allows for the stress concentration of a rough surface",
+            },
+        ],
+        reason: "thesis 5.5 and Fig. 5.7: impact stresses above yield and plastic flow at case A's corners; the lumped pressure N/A of eq. 3.11 averages over the face, the contact points' own pressures (gap::tracks) do not",
+        limitation: Some("local pressures from the contact points' share of the face law (gap::tracks), binned at 1/50 decade; on tracks recorded without points the lumped pressure stands in"),
+    },
+    EffectInfo {
+        name: "local_pressure",
+        letter: 'k',
+        summary: "local-pressure Archard: the case's K(sigma) evaluated at each contact point's own pressure instead of the lumped N/A, for a share of the wear",
+        acts: Acts::WearLaw,
+        models: BOTH,
+        parameters: &[ParameterInfo {
+            name: "share",
+            unit: "1 (0 = lumped N/A as the thesis, 1 = every point at its own pressure)",
+            min: 0.0,
+            max: 1.0,
+            default: 0.0,
+            reason: "eq. 3.11 was written for a face's mean pressure; whether a real contact wears at the mean or at its local pressures is the modelling question, so every share between is allowed",
+        }],
+        reason: "a tilted face or an edge loads its deeper points above the mean; Table 4.3's K rises with pressure and cuts off at 2 Sy, so local pressures can raise the wear, or lower it where points exceed the cutoff",
+        limitation: Some("on tracks recorded without points it changes nothing"),
+    },
 ];
 
 /// Looks an effect up by name.
@@ -374,6 +446,17 @@ impl Effect {
                 k_add_m2_per_n: self.get("k_abrasive") / hardness_pa,
                 min_pressure_pa: self.get("min_pressure_pa"),
                 min_slip_m_s: self.get("min_slip_m_s"),
+            })),
+            "impact_wear" => Some(Box::new(ImpactWear {
+                k_energy_m3_per_j: self.get("k_energy_m3_per_j"),
+                min_normal_speed_m_s: self.get("min_normal_speed_m_s"),
+            })),
+            "severe_wear" => Some(Box::new(SevereWear {
+                k_add_m2_per_n: self.get("k_severe") / hardness_pa,
+                pressure_ratio_to_yield: self.get("pressure_ratio_to_yield"),
+            })),
+            "local_pressure" => Some(Box::new(LocalPressure {
+                share: self.get("share"),
             })),
             _ => None,
         }
@@ -525,6 +608,84 @@ impl WearTerm for ThirdBody {
         } else {
             k
         }
+    }
+}
+
+/// (i) Impact wear: `k_E P_damp` added while `|ẇ| >= v_min` (all of it at `v_min = 0`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImpactWear {
+    /// Wear volume per joule of normal damping work, m³/J.
+    pub k_energy_m3_per_j: f64,
+    /// Normal speed below which damping work does not wear, m/s.
+    pub min_normal_speed_m_s: f64,
+}
+
+impl WearTerm for ImpactWear {
+    fn added_volume_rate_m3_s(&self, _law: &WearLaw, s: &WearSample<'_>) -> f64 {
+        if self.k_energy_m3_per_j != 0.0
+            && s.penetration_rate_m_s.abs() >= self.min_normal_speed_m_s
+        {
+            self.k_energy_m3_per_j * s.damping_power_w
+        } else {
+            0.0
+        }
+    }
+}
+
+/// (j) Severe wear: `K_add Σ N_i |v_i|` over the contact points whose local pressure exceeds
+/// `ratio Sy` (the lumped pressure when the points were not recorded).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SevereWear {
+    /// Added K, m²/N (k_severe / H).
+    pub k_add_m2_per_n: f64,
+    /// Threshold as a multiple of the yield strength.
+    pub pressure_ratio_to_yield: f64,
+}
+
+impl WearTerm for SevereWear {
+    fn added_volume_rate_m3_s(&self, _law: &WearLaw, s: &WearSample<'_>) -> f64 {
+        if self.k_add_m2_per_n == 0.0 {
+            return 0.0;
+        }
+        let threshold = self.pressure_ratio_to_yield * s.yield_strength_pa;
+        let work: f64 = if s.points.is_empty() {
+            if s.pressure_pa > threshold {
+                s.normal_force_n * s.slip_speed_m_s
+            } else {
+                0.0
+            }
+        } else {
+            s.points
+                .iter()
+                .filter(|b| b.pressure_pa > threshold)
+                .map(|b| b.work_rate_w)
+                .sum()
+        };
+        self.k_add_m2_per_n * work
+    }
+}
+
+/// (k) Local-pressure Archard: a share of the lumped `K(N/A) N v` replaced by
+/// `Σ K(p_i) N_i |v_i|` over the contact points (nothing without recorded points).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalPressure {
+    /// Share of the wear at the points' own pressures, 0..1.
+    pub share: f64,
+}
+
+impl WearTerm for LocalPressure {
+    fn added_volume_rate_m3_s(&self, law: &WearLaw, s: &WearSample<'_>) -> f64 {
+        if self.share == 0.0 || s.points.is_empty() {
+            return 0.0;
+        }
+        let k_of = |p: f64| law.coefficient_m2_per_n(p).unwrap_or(0.0);
+        let local: f64 = s
+            .points
+            .iter()
+            .map(|b| k_of(b.pressure_pa) * b.work_rate_w)
+            .sum();
+        let lumped = k_of(s.pressure_pa) * s.normal_force_n * s.slip_speed_m_s;
+        self.share * (local - lumped)
     }
 }
 

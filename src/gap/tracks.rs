@@ -3,17 +3,34 @@
 //!
 //! A run's wear (`models::run`) integrates `K(sigma) N v_slip` per track with the trapezoid rule
 //! over every accepted step, closing a vanished track with a zero sample. [`TrackRecord`] keeps
-//! exactly those steps (time and, per active track, N, v_slip, A), so that
+//! exactly those steps (time and, per active track, N, v_slip, A, the damping and friction
+//! powers, and the distribution of the contact points' own pressures), so that
 //! [`TrackRecord::wear_volumes_m3`] with no terms reproduces the run's wear, and wear-law
 //! effects ([`WearTerm`]) are evaluated on the same tracks without re-simulating.
+//!
+//! **Point pressures.** A track's lumped pressure is the thesis' `sigma = N/A` (A the thesis
+//! 2.5 area). Its contact points (`geometry::lattice`) carry the same face law resolved over
+//! the face: point `i` with stiffness share `β_i` carries `N_i`. Its local pressure is the
+//! lumped pressure scaled by how much more than its share the point carries:
+//! `p_i = (N_i / β_i) (Σ_touching β_j) / A`. So a face pressed uniformly has `p_i = N/A` at
+//! every point, and the share-weighted mean of the `p_i` is `N/A` in every configuration;
+//! a tilted face loads its deeper points above the mean. The record keeps, per track and step,
+//! the friction-work rate over μ, `Σ N_i |v_i|`, in pressure bins of 1/50 decade, each bin at
+//! the work-weighted geometric mean of its points' pressures ([`PressureBin`]). A wear law
+//! `K(p)` evaluated at a bin's mean instead of at each point differs by at most
+//! `a² (ln 10 / 50)² / 8 = 2.6e-4 a²` relative within a bin, for `K ∝ p^a` (second order in
+//! the bin's width; `a <= 2` for Table 4.3 gives <= 0.11 %), and a pressure threshold is
+//! resolved to the bin's width (4.7 %).
 
 use super::GapError;
+use crate::physics::contact::PointLoad;
 use crate::physics::simulate::StepView;
+use crate::physics::system::Workspace;
 use crate::wear::law::WearLaw;
 use std::collections::BTreeMap;
 
 /// One active track at one step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TrackPoint {
     /// Contact index in the model.
     pub contact: u32,
@@ -25,11 +42,35 @@ pub struct TrackPoint {
     pub slip_speed_m_s: f64,
     /// Contact area, m² (thesis 2.5).
     pub area_m2: f64,
+    /// Power dissipated by the IMPACT damping (normal, the impacts), W.
+    pub damping_power_w: f64,
+    /// Power dissipated by friction, W.
+    pub friction_power_w: f64,
+    /// Penetration rate of the deepest point (positive approaching), m/s.
+    pub penetration_rate_m_s: f64,
+    /// The track's point-pressure bins: `bins[first_bin .. first_bin + bin_count]` of the
+    /// record.
+    pub first_bin: u32,
+    /// Number of its point-pressure bins (0 when the points were not recorded).
+    pub bin_count: u32,
 }
+
+/// Contact points of one track at one step whose local pressures fall in one bin of 1/50
+/// decade (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PressureBin {
+    /// Work-weighted geometric mean of the points' local pressures, Pa.
+    pub pressure_pa: f64,
+    /// Their friction-work rate over μ, `Σ N_i |v_i|`, W.
+    pub work_rate_w: f64,
+}
+
+/// Pressure bins per decade of the point-pressure distribution.
+pub const PRESSURE_BINS_PER_DECADE: f64 = 50.0;
 
 /// What a wear-law term sees at one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WearSample {
+pub struct WearSample<'a> {
     /// Mean contact pressure N/A, Pa (infinite for N > 0 on zero area).
     pub pressure_pa: f64,
     /// Normal force, N.
@@ -39,13 +80,31 @@ pub struct WearSample {
     /// Slip distance the specimen has accumulated by this sample, m (see
     /// [`TrackRecord::slip_distance_m`]).
     pub slip_distance_m: f64,
+    /// Power dissipated by the contact's IMPACT damping, W.
+    pub damping_power_w: f64,
+    /// Penetration rate of the deepest point (positive approaching), m/s.
+    pub penetration_rate_m_s: f64,
+    /// Yield strength of the contact's material, Pa (the record's).
+    pub yield_strength_pa: f64,
+    /// The contact points' local-pressure distribution (empty when not recorded).
+    pub points: &'a [PressureBin],
 }
 
-/// A wear-law term: maps the coefficient K (m²/N) at a sample to the effective one. Terms are
-/// applied in order. A term at zero magnitude must return `k` unchanged (bit for bit).
+/// A wear-law term: maps the coefficient K (m²/N) at a sample to the effective one, and may
+/// add a wear rate of its own (a mechanism other than sliding at the lumped pressure). Terms
+/// are applied in order. A term at zero magnitude must return `k` unchanged and add exactly 0
+/// (bit for bit).
 pub trait WearTerm {
     /// Effective K, m²/N, given the K so far and the sample.
-    fn coefficient_m2_per_n(&self, k: f64, law: &WearLaw, sample: &WearSample) -> f64;
+    fn coefficient_m2_per_n(&self, k: f64, _law: &WearLaw, _sample: &WearSample<'_>) -> f64 {
+        k
+    }
+
+    /// Wear volume rate this term adds to `K_eff N v_slip`, m³/s (may be negative when it
+    /// replaces part of the lumped law; the total is clamped at 0).
+    fn added_volume_rate_m3_s(&self, _law: &WearLaw, _sample: &WearSample<'_>) -> f64 {
+        0.0
+    }
 }
 
 /// Where the represented test time sits relative to the simulated window: the window of
@@ -73,7 +132,9 @@ pub struct TrackRecord {
     /// (time s, index of the step's first point in `points`).
     steps: Vec<(f64, usize)>,
     points: Vec<TrackPoint>,
+    bins: Vec<PressureBin>,
     contacts: usize,
+    yield_strength_pa: f64,
 }
 
 impl TrackRecord {
@@ -81,8 +142,21 @@ impl TrackRecord {
     pub fn new(contacts: usize) -> Self {
         Self {
             contacts,
+            yield_strength_pa: f64::INFINITY,
             ..Self::default()
         }
+    }
+
+    /// The contact material's yield strength, Pa, for terms of the plastic regime (default:
+    /// infinite, no point above it).
+    pub fn with_yield_strength(mut self, yield_strength_pa: f64) -> Self {
+        self.yield_strength_pa = yield_strength_pa;
+        self
+    }
+
+    /// Number of contacts of the model.
+    pub fn contacts(&self) -> usize {
+        self.contacts
     }
 
     /// Appends one step (times must not decrease).
@@ -91,7 +165,24 @@ impl TrackRecord {
         self.points.extend(points);
     }
 
-    /// Appends a step handed out by the run loop (`models::run::run_model_observed`).
+    /// Appends one step whose tracks carry their point-pressure bins (hand-made records;
+    /// a run's come from [`TrackRecord::push_view_with_points`]).
+    pub fn push_step_with_bins<'a>(
+        &mut self,
+        time_s: f64,
+        tracks: impl IntoIterator<Item = (TrackPoint, &'a [PressureBin])>,
+    ) {
+        self.steps.push((time_s, self.points.len()));
+        for (mut p, bins) in tracks {
+            p.first_bin = self.bins.len() as u32;
+            p.bin_count = bins.len() as u32;
+            self.bins.extend_from_slice(bins);
+            self.points.push(p);
+        }
+    }
+
+    /// Appends a step handed out by the run loop (`models::run::run_model_observed`), without
+    /// the point-pressure distribution.
     pub fn push_view(&mut self, v: &StepView) {
         self.push_step(
             v.t,
@@ -101,8 +192,45 @@ impl TrackRecord {
                 normal_force_n: t.normal_force,
                 slip_speed_m_s: t.slip_speed,
                 area_m2: t.area,
+                damping_power_w: t.damping_power,
+                friction_power_w: t.friction_power,
+                penetration_rate_m_s: t.penetration_rate,
+                first_bin: 0,
+                bin_count: 0,
             }),
         );
+    }
+
+    /// [`TrackRecord::push_view`] with each track's point-pressure distribution: the contact
+    /// points are evaluated once more at the step's state (`ws` a workspace of the view's
+    /// system, reused between steps; `scratch` reused too).
+    pub fn push_view_with_points(
+        &mut self,
+        v: &StepView,
+        ws: &mut Workspace,
+        scratch: &mut Vec<PointLoad>,
+    ) {
+        scratch.clear();
+        v.system
+            .tracks_with_points(v.t, v.state, ws, &mut |_| {}, &mut |p| scratch.push(*p));
+        let start = self.points.len();
+        self.push_view(v);
+        for i in start..self.points.len() {
+            let tp = self.points[i];
+            let mine = scratch
+                .iter()
+                .filter(|p| p.contact == tp.contact && p.track == tp.track);
+            let first = self.bins.len();
+            push_pressure_bins(&mut self.bins, &tp, mine);
+            self.points[i].first_bin = first as u32;
+            self.points[i].bin_count = (self.bins.len() - first) as u32;
+        }
+    }
+
+    /// The point-pressure bins of `p` (a point of this record).
+    pub fn bins_of(&self, p: &TrackPoint) -> &[PressureBin] {
+        let a = p.first_bin as usize;
+        self.bins.get(a..a + p.bin_count as usize).unwrap_or(&[])
     }
 
     /// Number of steps.
@@ -236,13 +364,7 @@ impl TrackRecord {
         let rate = |i: usize, p: &TrackPoint| -> f64 {
             let n = p.normal_force_n;
             let v = p.slip_speed_m_s;
-            let pressure_pa = if n <= 0.0 {
-                0.0
-            } else if p.area_m2 > 0.0 {
-                n / p.area_m2
-            } else {
-                f64::INFINITY
-            };
+            let pressure_pa = lumped_pressure_pa(p);
             if terms.is_empty() {
                 return law.volume_rate_m3_s(n, v, pressure_pa);
             }
@@ -252,11 +374,17 @@ impl TrackRecord {
                 normal_force_n: n,
                 slip_speed_m_s: v,
                 slip_distance_m: slip_at[i],
+                damping_power_w: p.damping_power_w,
+                penetration_rate_m_s: p.penetration_rate_m_s,
+                yield_strength_pa: self.yield_strength_pa,
+                points: self.bins_of(p),
             };
+            let mut added = 0.0;
             for term in terms {
                 k = term.coefficient_m2_per_n(k, law, &sample);
+                added += term.added_volume_rate_m3_s(law, &sample);
             }
-            k * n * v
+            (k * n * v + added).max(0.0)
         };
         let mut volumes = vec![0.0; self.contacts];
         let mut out_of_range = None;
@@ -274,6 +402,156 @@ impl TrackRecord {
             ));
         }
         Ok(volumes)
+    }
+
+    /// Whether the contact points' pressures were recorded ([`TrackRecord::push_view_with_points`]).
+    pub fn has_point_pressures(&self) -> bool {
+        !self.bins.is_empty()
+    }
+
+    /// Per contact, over the window: the work by kind and what each wear mechanism is driven
+    /// by (the energy budget of the diagnosis' "where"). Trapezoid per track, as the wear.
+    pub fn work_by_contact(&self, law: &WearLaw) -> Vec<ContactWork> {
+        let mut out = vec![ContactWork::default(); self.contacts];
+        let k_of = |pressure: f64| law.coefficient_m2_per_n(pressure).unwrap_or(0.0);
+        let yield_pa = self.yield_strength_pa;
+        let mut add = |value: &dyn Fn(&TrackPoint) -> f64,
+                       slot: fn(&mut ContactWork) -> &mut f64| {
+            self.integrate(
+                |_, p| {
+                    if p.normal_force_n > 0.0 {
+                        value(p)
+                    } else {
+                        0.0
+                    }
+                },
+                &mut |_, c, a| {
+                    if let Some(w) = out.get_mut(c as usize) {
+                        *slot(w) += a;
+                    }
+                },
+            );
+        };
+        add(&|p| p.friction_power_w, |w| &mut w.friction_j);
+        add(&|p| p.damping_power_w, |w| &mut w.damping_j);
+        add(&|p| p.normal_force_n * p.slip_speed_m_s, |w| {
+            &mut w.sliding_n_m
+        });
+        add(
+            &|p| {
+                let bins = self.bins_of(p);
+                if bins.is_empty() {
+                    if lumped_pressure_pa(p) > yield_pa {
+                        p.normal_force_n * p.slip_speed_m_s
+                    } else {
+                        0.0
+                    }
+                } else {
+                    bins.iter()
+                        .filter(|b| b.pressure_pa > yield_pa)
+                        .map(|b| b.work_rate_w)
+                        .sum()
+                }
+            },
+            |w| &mut w.sliding_above_yield_n_m,
+        );
+        add(
+            &|p| k_of(lumped_pressure_pa(p)) * p.normal_force_n * p.slip_speed_m_s,
+            |w| &mut w.lumped_archard_m3,
+        );
+        add(
+            &|p| {
+                let bins = self.bins_of(p);
+                if bins.is_empty() {
+                    k_of(lumped_pressure_pa(p)) * p.normal_force_n * p.slip_speed_m_s
+                } else {
+                    bins.iter()
+                        .map(|b| k_of(b.pressure_pa) * b.work_rate_w)
+                        .sum()
+                }
+            },
+            |w| &mut w.local_archard_m3,
+        );
+        out
+    }
+}
+
+/// One contact's work over a window, by kind, and the integrals the wear mechanisms scale.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct ContactWork {
+    /// Work of friction `∫ Σ μ_i N_i |v_i| dt`, J.
+    pub friction_j: f64,
+    /// Work of the IMPACT damping (normal, the impacts) `∫ P_damp dt`, J.
+    pub damping_j: f64,
+    /// Sliding integral `∫ N v_slip dt` (Archard's load times distance), N·m.
+    pub sliding_n_m: f64,
+    /// The part of it at contact points whose local pressure exceeds the yield strength, N·m.
+    pub sliding_above_yield_n_m: f64,
+    /// Wear volume of the case's law at the lumped pressure `N/A` (the run's own wear), m³.
+    pub lumped_archard_m3: f64,
+    /// Wear volume of the same law at each contact point's own pressure, m³ (equal to the
+    /// lumped one when the points were not recorded).
+    pub local_archard_m3: f64,
+}
+
+/// A track's lumped pressure `N/A`, Pa (0 without load, infinite on zero area).
+fn lumped_pressure_pa(p: &TrackPoint) -> f64 {
+    if p.normal_force_n <= 0.0 {
+        0.0
+    } else if p.area_m2 > 0.0 {
+        p.normal_force_n / p.area_m2
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Appends the point-pressure bins of track `tp` from its touching points `points` (see the
+/// module docs): local pressure `p_i = (N_i / β_i) (Σ β_j) / A`, work rate `N_i |v_i|`, merged
+/// in bins of 1/[`PRESSURE_BINS_PER_DECADE`] decade at the work-weighted geometric mean.
+/// Points without slip carry no work and are left out.
+fn push_pressure_bins<'a>(
+    bins: &mut Vec<PressureBin>,
+    tp: &TrackPoint,
+    points: impl Iterator<Item = &'a PointLoad> + Clone,
+) {
+    let share: f64 = points.clone().map(|p| p.weight).sum();
+    // (bin, Σ w, Σ w ln p), few per track: a linear search.
+    let mut acc: Vec<(i64, f64, f64)> = Vec::new();
+    let mut infinite = 0.0;
+    for p in points {
+        let w = p.normal_force * p.slip_speed;
+        if !(w > 0.0) || !(p.weight > 0.0) {
+            continue;
+        }
+        let pressure = if tp.area_m2 > 0.0 {
+            p.normal_force / p.weight * share / tp.area_m2
+        } else {
+            f64::INFINITY
+        };
+        if !pressure.is_finite() {
+            infinite += w;
+            continue;
+        }
+        let ln_p = pressure.ln();
+        let bin = (ln_p / std::f64::consts::LN_10 * PRESSURE_BINS_PER_DECADE).floor() as i64;
+        match acc.iter_mut().find(|a| a.0 == bin) {
+            Some(a) => {
+                a.1 += w;
+                a.2 += w * ln_p;
+            }
+            None => acc.push((bin, w, w * ln_p)),
+        }
+    }
+    acc.sort_by_key(|a| a.0);
+    bins.extend(acc.into_iter().map(|(_, w, wl)| PressureBin {
+        pressure_pa: (wl / w).exp(),
+        work_rate_w: w,
+    }));
+    if infinite > 0.0 {
+        bins.push(PressureBin {
+            pressure_pa: f64::INFINITY,
+            work_rate_w: infinite,
+        });
     }
 }
 
@@ -297,6 +575,81 @@ mod tests {
             normal_force_n: n,
             slip_speed_m_s: v,
             area_m2: a,
+            damping_power_w: 0.0,
+            friction_power_w: 0.0,
+            penetration_rate_m_s: 0.0,
+            first_bin: 0,
+            bin_count: 0,
+        }
+    }
+
+    /// The point pressures of a real contact: a rounded box (the rattle-box cube's size)
+    /// sliding on a plane. Pressed flat, every point of the face is at the lumped N/A (one
+    /// bin); tilted, the deeper edge carries more, so the bins straddle N/A, and in both the
+    /// bins hold the whole `Σ N_i |v_i| = N v_slip`.
+    #[test]
+    fn point_pressures_of_a_sliding_box() {
+        use crate::geometry::{ConvexShape, HalfSpace};
+        use crate::physics::body::BodyFrame;
+        use crate::physics::contact::Contact;
+        use crate::physics::friction::FrictionParams;
+        use crate::physics::impact::ImpactParams;
+        use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+        let half = 0.0125;
+        let shape = ConvexShape::rounded_box(Vector3::new(half, half, half), 5e-4).unwrap();
+        let contact = Contact::new(
+            "cube-ground",
+            0,
+            vec![(Isometry3::identity(), shape)],
+            1,
+            vec![HalfSpace::new(Vector3::z(), 0.0).unwrap()],
+            ImpactParams::thesis_table_5_2(),
+            Some(FrictionParams::thesis_table_5_2()),
+        );
+        let ground = BodyFrame {
+            position: Vector3::zeros(),
+            rotation: UnitQuaternion::identity(),
+            velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+        };
+        for tilt in [0.0, 2e-4] {
+            let cube = BodyFrame {
+                position: Vector3::new(0.0, 0.0, half - 2e-6),
+                rotation: UnitQuaternion::from_euler_angles(tilt, 0.0, 0.0),
+                velocity: Vector3::new(0.05, 0.0, 0.0),
+                angular_velocity: Vector3::zeros(),
+            };
+            let mut loads = Vec::new();
+            let mut tracks = Vec::new();
+            contact.evaluate_points(0, &[cube, ground], &mut |t| tracks.push(*t), &mut |p| {
+                loads.push(*p)
+            });
+            assert_eq!(tracks.len(), 1, "tilt {tilt}");
+            let t = tracks[0];
+            let tp = TrackPoint {
+                normal_force_n: t.normal_force,
+                slip_speed_m_s: t.slip_speed,
+                area_m2: t.area,
+                ..TrackPoint::default()
+            };
+            let mut bins = Vec::new();
+            push_pressure_bins(&mut bins, &tp, loads.iter());
+            let work: f64 = bins.iter().map(|b| b.work_rate_w).sum();
+            let nv = t.normal_force * t.slip_speed;
+            assert!(
+                (work - nv).abs() <= 1e-12 * nv,
+                "tilt {tilt}: {work} vs {nv}"
+            );
+            let lumped = t.normal_force / t.area;
+            if tilt == 0.0 {
+                assert_eq!(bins.len(), 1);
+                let p = bins[0].pressure_pa;
+                assert!((p - lumped).abs() <= 1e-12 * lumped, "{p} vs {lumped}");
+            } else {
+                let lo = bins.first().unwrap().pressure_pa;
+                let hi = bins.last().unwrap().pressure_pa;
+                assert!(lo < lumped && hi > lumped, "{lo} {lumped} {hi}");
+            }
         }
     }
 

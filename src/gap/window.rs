@@ -48,6 +48,7 @@ impl Default for WindowOptions {
 /// Bodies and materials of one contact, to charge its wear volume.
 #[derive(Debug, Clone)]
 struct ContactBodies {
+    name: String,
     body_a: String,
     body_b: String,
     material_a: Material,
@@ -99,6 +100,30 @@ impl WindowRun {
         Ok(out)
     }
 
+    /// Contact names, in model order.
+    pub fn contact_names(&self) -> Vec<String> {
+        self.contacts.iter().map(|c| c.name.clone()).collect()
+    }
+
+    /// Per contact: the mass charged to each of its bodies per m³ worn there, mg/m³ (the
+    /// case's volume split and the bodies' densities; linear in the volume).
+    pub fn charge_mg_per_m3(&self) -> Result<Vec<BTreeMap<String, f64>>, GapError> {
+        const UNIT_M3: f64 = 1e-9;
+        self.contacts
+            .iter()
+            .map(|c| {
+                let (wa, wb) = self
+                    .split
+                    .split(UNIT_M3, &c.material_a, &c.material_b)
+                    .map_err(|e| GapError::field("wear", e.to_string()))?;
+                let mut out = BTreeMap::new();
+                *out.entry(c.body_a.clone()).or_insert(0.0) += wa.mass_kg * MG_PER_KG / UNIT_M3;
+                *out.entry(c.body_b.clone()).or_insert(0.0) += wb.mass_kg * MG_PER_KG / UNIT_M3;
+                Ok(out)
+            })
+            .collect()
+    }
+
     /// Slip distance over the window, m (see [`TrackRecord::slip_distance_m`]).
     pub fn slip_distance_m(&self) -> f64 {
         self.record.slip_distance_m()
@@ -133,23 +158,27 @@ pub fn simulate_window(
     if let Some(rate) = options.accelerometer_rate_hz {
         run_options.response_rate_hz = rate;
     }
-    let mut record = TrackRecord::new(model.system.contacts.len());
-    tracing::debug!(%what, "simulating a window");
-    let report = crate::models::run::run_model_observed(&model, &run_options, control, &mut |v| {
-        record.push_view(v)
-    })
-    .map_err(|e| sim_err(e.to_string()))?;
     let material = match case.model_spec() {
         Ok(ModelSpecRef::RattleBox(s)) => s.material,
         Ok(ModelSpecRef::Launcher(s)) => s.material,
         _ => Material::default(),
     };
+    let mut record = TrackRecord::new(model.system.contacts.len())
+        .with_yield_strength(material.yield_strength_pa);
+    let mut ws = model.system.workspace();
+    let mut scratch = Vec::new();
+    tracing::debug!(%what, "simulating a window");
+    let report = crate::models::run::run_model_observed(&model, &run_options, control, &mut |v| {
+        record.push_view_with_points(v, &mut ws, &mut scratch)
+    })
+    .map_err(|e| sim_err(e.to_string()))?;
     let contacts = model
         .system
         .contacts
         .iter()
         .zip(&model.contact_materials)
         .map(|(c, (ma, mb))| ContactBodies {
+            name: c.name.clone(),
             body_a: model.system.bodies[c.body_a].name.clone(),
             body_b: model.system.bodies[c.body_b].name.clone(),
             material_a: *ma,

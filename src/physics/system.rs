@@ -2,7 +2,7 @@
 //! motion `dy/dt = f(t, y)` (Newton-Euler per body, quaternion kinematics).
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
-use super::contact::{Contact, GeometryCache, TrackLinearization, TrackState};
+use super::contact::{Contact, GeometryCache, PointLoad, TrackLinearization, TrackState};
 use super::forces::{ForceElement, Wrench};
 use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
 use std::ops::AddAssign;
@@ -222,6 +222,7 @@ impl MultibodySystem {
                     &mut sink,
                     &mut ws.geometry,
                     ws.linearize.then_some(&mut ws.linearizations),
+                    None,
                 );
             }
             power.contact_damping = damping;
@@ -436,6 +437,22 @@ impl MultibodySystem {
         self.frames(t, y, ws);
         for (ci, c) in self.contacts.iter().enumerate() {
             c.evaluate(ci as u32, &ws.frames, None, sink);
+        }
+    }
+
+    /// Active tracks at (t, y) with every touching contact point's load (each track's points
+    /// before the track); no forces accumulated.
+    pub fn tracks_with_points(
+        &self,
+        t: f64,
+        y: &[f64],
+        ws: &mut Workspace,
+        sink: &mut dyn FnMut(&TrackState),
+        points: &mut dyn FnMut(&PointLoad),
+    ) {
+        self.frames(t, y, ws);
+        for (ci, c) in self.contacts.iter().enumerate() {
+            c.evaluate_points(ci as u32, &ws.frames, sink, points);
         }
     }
 

@@ -101,6 +101,7 @@ fn emulator() -> Emulator {
                 Bands {
                     pressure: vec![1.0, 0.0, 0.0, 0.0],
                     slip: vec![0.0, 0.0, 1.0, 0.0],
+                    work: Default::default(),
                 };
                 INCREMENTS
             ];

@@ -4,7 +4,7 @@
 
 use railwear::gap::effects::{self, Acts, Effect, SpecimenState, LIBRARY};
 use railwear::gap::rig_effects::{HiddenEffect, RIG_ONLY};
-use railwear::gap::tracks::{SlipHistory, TrackPoint, TrackRecord, WearTerm};
+use railwear::gap::tracks::{PressureBin, SlipHistory, TrackPoint, TrackRecord, WearTerm};
 use railwear::models::case::load_case;
 use railwear::models::spec::CaseSpec;
 use railwear::wear::law::WearLaw;
@@ -22,7 +22,7 @@ fn case(name: &str) -> CaseSpec {
 #[test]
 fn library_is_complete_and_bounded() {
     let letters: String = LIBRARY.iter().map(|e| e.letter).collect();
-    assert_eq!(letters, "abcdefgh");
+    assert_eq!(letters, "abcdefghijk");
     for e in LIBRARY.iter().chain(RIG_ONLY) {
         assert!(!e.reason.is_empty() && !e.summary.is_empty(), "{}", e.name);
         let magnitude = &e.parameters[0];
@@ -103,6 +103,7 @@ fn track_at(sigma: f64) -> TrackRecord {
                 normal_force_n: 100.0,
                 slip_speed_m_s: 0.1,
                 area_m2: area,
+                ..TrackPoint::default()
             }],
         );
     }
@@ -138,6 +139,9 @@ fn wear_law_effects_at_zero_change_nothing_bit_for_bit() {
             "third_body=0",
             "surface_oxide=0",
             "work_hardening=0",
+            "impact_wear=0",
+            "severe_wear=0",
+            "local_pressure=0",
         ] {
             let t = term(text);
             assert_eq!(
@@ -330,4 +334,117 @@ fn preload_loss_is_a_launcher_effect() {
     let (a, b) = (l0.launcher.unwrap(), l.launcher.unwrap());
     assert!((b.latch_spring.preload_n - 0.6 * a.latch_spring.preload_n).abs() < 1e-12);
     assert!((b.rear_leaf_spring.preload_n - 0.6 * a.rear_leaf_spring.preload_n).abs() < 1e-12);
+}
+
+/// Yield strength of 7075-T73, Pa (the record's, for the plastic-regime terms).
+const SY: f64 = 435.0e6;
+
+/// One track, two steps 1 s apart: N = 100 N, v = 0.1 m/s (10 W of N v) at lumped pressure
+/// 200 MPa, normal damping dissipating `damping_w` at approach rates `rates`, and its contact
+/// points' work split 3 W at 100 MPa, 7 W at 600 MPa (above Sy) in both steps.
+fn impact_track(damping_w: f64, rates: [f64; 2]) -> TrackRecord {
+    let bins = [
+        PressureBin {
+            pressure_pa: 100e6,
+            work_rate_w: 3.0,
+        },
+        PressureBin {
+            pressure_pa: 600e6,
+            work_rate_w: 7.0,
+        },
+    ];
+    let mut r = TrackRecord::new(1).with_yield_strength(SY);
+    for (t, rate) in [0.0, 1.0].into_iter().zip(rates) {
+        r.push_step_with_bins(
+            t,
+            [(
+                TrackPoint {
+                    contact: 0,
+                    track: 0,
+                    normal_force_n: 100.0,
+                    slip_speed_m_s: 0.1,
+                    area_m2: 100.0 / 200e6,
+                    damping_power_w: damping_w,
+                    penetration_rate_m_s: rate,
+                    ..TrackPoint::default()
+                },
+                &bins[..],
+            )],
+        );
+    }
+    r
+}
+
+/// Impact wear adds k_E times the normal damping work (3 W over 1 s = 3 J), and a normal-speed
+/// threshold drops the samples below it (trapezoid: half the interval's work per sample).
+#[test]
+fn impact_wear_is_k_e_times_the_damping_work() {
+    let h = SlipHistory::default();
+    let r = impact_track(3.0, [0.2, -0.05]);
+    let base = wear(&r, &[], h);
+    let t = term("impact_wear=1e-13");
+    let added = wear(&r, &[t.as_ref()], h) - base;
+    assert!((added - 3.0e-13).abs() <= 1e-12 * 3.0e-13, "{added}");
+    // |rate| 0.2 counts, 0.05 does not: half of the trapezoid.
+    let t = term("impact_wear=1e-13,min_normal_speed_m_s=0.1");
+    let added = wear(&r, &[t.as_ref()], h) - base;
+    assert!((added - 1.5e-13).abs() <= 1e-12 * 1.5e-13, "{added}");
+    // The work budget sees the same 3 J.
+    let w = r.work_by_contact(&WearLaw::table_4_3());
+    assert_eq!(w[0].damping_j, 3.0);
+}
+
+/// Severe wear adds k/H times the work of the points above ratio x Sy: at ratio 1 the 7 W at
+/// 600 MPa, at ratio 2 (870 MPa) nothing; without recorded points the lumped pressure decides.
+#[test]
+fn severe_wear_counts_only_points_above_the_yield_ratio() {
+    let h = SlipHistory::default();
+    let hardness = Material::aluminium_7075_t73().hardness_pa();
+    let r = impact_track(0.0, [0.0, 0.0]);
+    let base = wear(&r, &[], h);
+    let t = term("severe_wear=1e-3");
+    let added = wear(&r, &[t.as_ref()], h) - base;
+    let expected = 1e-3 / hardness * 7.0;
+    assert!(
+        (added - expected).abs() <= 1e-9 * expected,
+        "{added} vs {expected}"
+    );
+    let t = term("severe_wear=1e-3,pressure_ratio_to_yield=2");
+    assert_eq!(wear(&r, &[t.as_ref()], h), base);
+    // The budget's share above yield: 7 of 10.
+    let w = r.work_by_contact(&WearLaw::table_4_3());
+    assert!((w[0].sliding_above_yield_n_m / w[0].sliding_n_m - 0.7).abs() < 1e-12);
+    // No points recorded: the lumped 200 MPa is below Sy, so nothing; at 2 GPa all 10 W.
+    let lumped = track_at(2.0e9).with_yield_strength(SY);
+    let base = wear(&lumped, &[], h);
+    let t = term("severe_wear=1e-3");
+    let added = wear(&lumped, &[t.as_ref()], h) - base;
+    let expected = 1e-3 / hardness * 10.0;
+    assert!(
+        (added - expected).abs() <= 1e-9 * expected,
+        "{added} vs {expected}"
+    );
+}
+
+/// Local-pressure Archard at share 1 is Table 4.3's K at each point's pressure times its work
+/// (3 W at 100 MPa, 7 W at 600 MPa), in place of K(200 MPa) x 10 W; share 0.5 is the mean.
+#[test]
+fn local_pressure_evaluates_k_at_each_points_pressure() {
+    let h = SlipHistory::default();
+    let law = WearLaw::table_4_3();
+    let k = |p: f64| law.coefficient_m2_per_n(p).unwrap();
+    let r = impact_track(0.0, [0.0, 0.0]);
+    let lumped = wear(&r, &[], h);
+    assert!((lumped - k(200e6) * 10.0).abs() <= 1e-12 * lumped);
+    let local = k(100e6) * 3.0 + k(600e6) * 7.0;
+    let t = term("local_pressure=1");
+    let v = wear(&r, &[t.as_ref()], h);
+    assert!((v - local).abs() <= 1e-12 * local, "{v} vs {local}");
+    let t = term("local_pressure=0.5");
+    let v = wear(&r, &[t.as_ref()], h);
+    let mean = 0.5 * (lumped + local);
+    assert!((v - mean).abs() <= 1e-12 * mean, "{v} vs {mean}");
+    let w = r.work_by_contact(&law);
+    assert!((w[0].local_archard_m3 - local).abs() <= 1e-12 * local);
+    assert!((w[0].lumped_archard_m3 - lumped).abs() <= 1e-12 * lumped);
 }

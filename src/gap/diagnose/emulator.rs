@@ -106,6 +106,9 @@ pub struct Bands {
     pub pressure: Vec<f64>,
     /// By slip speed (see [`SLIP_BANDS`]).
     pub slip: Vec<f64>,
+    /// Work by kind and the wear mechanisms' drivers per contact (the energy budget).
+    #[serde(default)]
+    pub work: super::budget::IncrementWork,
 }
 
 /// Contact-pressure bands relative to the yield strength Sy: below 0.1 Sy, 0.1-1 Sy, 1-2 Sy
@@ -417,10 +420,11 @@ impl Emulator {
             .iter()
             .map(|t| {
                 t.iter()
-                    .map(|inc| {
+                    .map(|inc| -> Result<Bands, GapError> {
                         let mut b = Bands {
                             pressure: vec![0.0; PRESSURE_BANDS.len()],
                             slip: vec![0.0; SLIP_BANDS.len()],
+                            work: super::budget::IncrementWork::of(&inc.segments)?,
                         };
                         for (run, h) in &inc.segments {
                             let sy = run.yield_strength_pa;
@@ -434,11 +438,11 @@ impl Emulator {
                                 b.slip[i] += s[i] * h.time_scale;
                             }
                         }
-                        b
+                        Ok(b)
                     })
-                    .collect()
+                    .collect::<Result<Vec<_>, _>>()
             })
-            .collect();
+            .collect::<Result<Vec<_>, _>>()?;
         let records = |slot: &Vec<Vec<ModelIncrement>>| -> Vec<(f64, Vec<[f64; 3]>)> {
             slot.iter()
                 .map(|t| {

@@ -77,6 +77,10 @@ pub struct Where {
     pub groups: Vec<Group>,
     /// Every observation.
     pub residuals: Vec<Residual>,
+    /// Work by kind per test and contact, and the coefficient each wear mechanism would need
+    /// for the measured wear (`budget`).
+    #[serde(default)]
+    pub energy_budget: super::budget::EnergyBudget,
 }
 
 impl Where {
@@ -295,7 +299,43 @@ pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
         g.p_adjusted = adj;
         g.flagged = adj < FLAG_LEVEL;
     }
-    Where { groups, residuals }
+    let energy_budget = energy_budget_of(campaign, em, &residuals);
+    Where {
+        groups,
+        residuals,
+        energy_budget,
+    }
+}
+
+/// The energy budget of the nominal model's windows against the measured masses (summed over
+/// each test's weighed increments).
+fn energy_budget_of(
+    campaign: &Campaign,
+    em: &super::emulator::Emulator,
+    residuals: &[Residual],
+) -> super::budget::EnergyBudget {
+    let mut measured: BTreeMap<(String, String), f64> = BTreeMap::new();
+    for r in residuals {
+        if let Some(component) = r.quantity.strip_prefix("mass ") {
+            *measured
+                .entry((r.test.clone(), component.to_string()))
+                .or_insert(0.0) += r.measured;
+        }
+    }
+    let tests: Vec<_> = campaign
+        .tests
+        .iter()
+        .zip(&em.bands)
+        .map(|(t, incs)| {
+            let hours = t.increment_duration_s * incs.len() as f64 / 3600.0;
+            (
+                t.id.clone(),
+                hours,
+                incs.iter().map(|b| b.work.clone()).collect(),
+            )
+        })
+        .collect();
+    super::budget::energy_budget(&tests, &measured)
 }
 
 /// 1/3-octave band centres from 10 Hz to 500 Hz (base-2 series, IEC 61260 nominal spacing).

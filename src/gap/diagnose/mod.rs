@@ -29,6 +29,7 @@
 //!    bootstrap interval, and the fitted magnitude with its profile-likelihood interval.
 
 pub mod bench;
+pub mod budget;
 pub mod emulator;
 mod how_far;
 pub mod location;

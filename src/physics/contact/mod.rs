@@ -153,6 +153,23 @@ impl TrackState {
     }
 }
 
+/// One touching contact point's load at one instant, for what wear needs below the track's
+/// sums (the distribution of point pressures, each point's slip): handed out by
+/// [`Contact::evaluate_points`] before the [`TrackState`] of the point's track.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointLoad {
+    /// Index of the contact in the system.
+    pub contact: u32,
+    /// Track index within the contact (as [`TrackState::track`]).
+    pub track: u32,
+    /// The point's normal force `β max(0, k w^e + c STEP ẇ)`, N.
+    pub normal_force: f64,
+    /// The point's share `β` of the face's stiffness and damping (sums to 1 over a face).
+    pub weight: f64,
+    /// The point's own slip speed, m/s.
+    pub slip_speed: f64,
+}
+
 /// Local derivatives of one contact point's force at one instant, for the contact-aware Newton
 /// matrix ([`MultibodySystem::contact_jacobian`](super::system::MultibodySystem::contact_jacobian)).
 ///
@@ -255,12 +272,33 @@ impl Contact {
             sink,
             &mut GeometryCache::default(),
             None,
+            None,
+        )
+    }
+
+    /// [`Contact::evaluate`] that also hands every touching point's load to `points` (each
+    /// track's points before its [`TrackState`] reaches `sink`).
+    pub fn evaluate_points(
+        &self,
+        index: u32,
+        frames: &[BodyFrame],
+        sink: &mut dyn FnMut(&TrackState),
+        points: &mut dyn FnMut(&PointLoad),
+    ) -> f64 {
+        self.evaluate_with(
+            index,
+            frames,
+            None,
+            sink,
+            &mut GeometryCache::default(),
+            None,
+            Some(points),
         )
     }
 
     /// [`Contact::evaluate`] with the overlap geometry computed, recorded or replayed as
     /// `geometry.mode` says; pushes each active track's force derivatives to `linearizations`
-    /// when given.
+    /// when given, and each touching point's load to `points` when given.
     pub fn evaluate_with(
         &self,
         index: u32,
@@ -269,6 +307,7 @@ impl Contact {
         sink: &mut dyn FnMut(&TrackState),
         geometry: &mut GeometryCache,
         mut linearizations: Option<&mut Vec<TrackLinearization>>,
+        mut points: Option<&mut dyn FnMut(&PointLoad)>,
     ) -> f64 {
         let fa = &frames[self.body_a];
         let fb = &frames[self.body_b];
@@ -387,6 +426,17 @@ impl Contact {
                         }
                     }
                     energy += beta * self.impact.potential(w);
+                    if let Some(out) = points.as_deref_mut() {
+                        if fn_mag > 0.0 {
+                            out(&PointLoad {
+                                contact: index,
+                                track: (ip * nfaces + jf) as u32,
+                                normal_force: fn_mag,
+                                weight: beta,
+                                slip_speed: speed,
+                            });
+                        }
+                    }
                     track.add(&PointForce {
                         point: p,
                         force,
