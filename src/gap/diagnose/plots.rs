@@ -260,11 +260,56 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
             None,
         ),
     };
-    vec![
+    let mut out = vec![
         ("residuals.svg".into(), residuals),
         ("ranking.svg".into(), ranking),
         ("before_after.svg".into(), before_after),
-    ]
+    ];
+    out.extend(energy_budget_plot(report).map(|svg| ("energy_budget.svg".to_string(), svg)));
+    out
+}
+
+/// The energy budget: per test, component and mechanism, how many decades the coefficient
+/// needed for the measured wear lies above the top of its literature range (red: within the
+/// range). None without a budget.
+fn energy_budget_plot(report: &Report) -> Option<String> {
+    let budget = &report.location.energy_budget;
+    let bars: Vec<Bar> = budget
+        .tests
+        .iter()
+        .flat_map(|t| {
+            t.needed.iter().filter_map(move |n| {
+                let v = n.value?;
+                Some(Bar {
+                    label: format!("{} {}: {}", t.test, n.component, n.mechanism),
+                    value: (v / n.range[1]).log10(),
+                    second: None,
+                    whisker: None,
+                    note: format!("{v:.2e} {}", n.unit),
+                    highlight: n.verdict == "within",
+                })
+            })
+        })
+        .collect();
+    if bars.is_empty() {
+        return None;
+    }
+    let low = budget
+        .tests
+        .iter()
+        .flat_map(|t| &t.needed)
+        .map(|n| (n.range[0] / n.range[1]).log10())
+        .fold(0.0f64, f64::min);
+    Some(bar_chart(
+        &format!(
+            "{}: coefficient each wear mechanism needs for the measured wear (red: within its literature range)",
+            report.campaign
+        ),
+        "decades above the top of the mechanism's literature range (dashed: the top, and the widest range's bottom)",
+        &bars,
+        &[low],
+        None,
+    ))
 }
 
 #[cfg(test)]
