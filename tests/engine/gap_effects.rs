@@ -22,7 +22,7 @@ fn case(name: &str) -> CaseSpec {
 #[test]
 fn library_is_complete_and_bounded() {
     let letters: String = LIBRARY.iter().map(|e| e.letter).collect();
-    assert_eq!(letters, "abcdefghijk");
+    assert_eq!(letters, "abcdefghijkl");
     for e in LIBRARY.iter().chain(RIG_ONLY) {
         assert!(!e.reason.is_empty() && !e.summary.is_empty(), "{}", e.name);
         let magnitude = &e.parameters[0];
@@ -142,6 +142,7 @@ fn wear_law_effects_at_zero_change_nothing_bit_for_bit() {
             "impact_wear=0",
             "severe_wear=0",
             "local_pressure=0",
+            "coating_breakthrough=0",
         ] {
             let t = term(text);
             assert_eq!(
@@ -447,4 +448,30 @@ fn local_pressure_evaluates_k_at_each_points_pressure() {
     let w = r.work_by_contact(&law);
     assert!((w[0].local_archard_m3 - local).abs() <= 1e-12 * local);
     assert!((w[0].lumped_archard_m3 - lumped).abs() <= 1e-12 * lumped);
+}
+
+/// Coating breakthrough: K + k/H from the sample at which the slip distance reaches the
+/// breakthrough. Track: 10 W of N v for 1 s (1 m of slip per second at 0.1 m/s over two
+/// samples); history 100 windows after 50 m: the samples sit at 50 m and 60 m of slip.
+#[test]
+fn coating_breakthrough_switches_k_at_the_breakthrough_distance() {
+    let hardness = Material::aluminium_7075_t73().hardness_pa();
+    let h = SlipHistory {
+        slip_start_m: 50.0,
+        time_scale: 100.0,
+    };
+    let r = track_at(2.0e6);
+    let base = wear(&r, &[], h);
+    let add = 1e-3 / hardness;
+    // Breakthrough before the window: both samples, the whole 10 N m.
+    let t = term("coating_breakthrough=1e-3,breakthrough_slip_m=10");
+    let v = wear(&r, &[t.as_ref()], h) - base;
+    assert!((v - add * 10.0).abs() <= 1e-9 * add * 10.0, "{v}");
+    // Between the samples (55 m): only the second, half the trapezoid.
+    let t = term("coating_breakthrough=1e-3,breakthrough_slip_m=55");
+    let v = wear(&r, &[t.as_ref()], h) - base;
+    assert!((v - add * 5.0).abs() <= 1e-9 * add * 5.0, "{v}");
+    // After the window: nothing.
+    let t = term("coating_breakthrough=1e-3,breakthrough_slip_m=100");
+    assert_eq!(wear(&r, &[t.as_ref()], h), base);
 }

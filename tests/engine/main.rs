@@ -8,6 +8,7 @@ mod error_control;
 mod gap_campaign;
 mod gap_diagnose;
 mod gap_effects;
+mod gap_mechanisms;
 mod gap_rig;
 mod launcher_model;
 mod launcher_trend;
