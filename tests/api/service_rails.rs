@@ -477,6 +477,31 @@ async fn curves_are_published_explicitly_with_fidelity_and_an_interval() {
         let v2 = &list["items"][0];
         assert_eq!((v2["version"].as_i64(), v2["published"].as_bool()), (Some(2), Some(false)));
         let v2 = v2["id"].as_i64().unwrap();
+        // Issue 26 item 7: the report compares K_SL under another stored curve, here the
+        // 1-seed trial (unpublished): seed 0's log ratio is -8 (kd - k), so K_SL = e^(-8 d),
+        // and its ratio to the published curve's e^(-8.5 d) is e^(0.5 d).
+        let r = api.get(
+            &format!("/v1/rails/R-7/report?compare={v2}"),
+            Some(PLANNER),
+        );
+        assert_eq!(r.status, 200, "{}", r.body);
+        let rep = r.json();
+        assert_eq!(rep["service_life"], life, "the report's own curve is unchanged");
+        let c = &rep["comparison"];
+        assert_eq!(c["curve_id"], v2);
+        assert_eq!(c["published"], false);
+        assert!(close(&c["k_sl"], (-8.0 * d).exp()), "{c}");
+        assert!(close(&c["penalized_life_h"], 1000.0 * (-8.0 * d).exp()), "{c}");
+        assert!(close(&c["k_sl_ratio"], (0.5 * d).exp()), "{c}");
+        // A curve id that is not stored is a 422 naming `compare`; a malformed one a 400.
+        let p = api
+            .get("/v1/rails/R-7/report?compare=999999", Some(PLANNER))
+            .problem(422);
+        assert_eq!(p["field"], "compare");
+        let p = api
+            .get("/v1/rails/R-7/report?compare=abc", Some(PLANNER))
+            .problem(400);
+        assert_eq!(p["field"], "compare");
         // Publishing it over the 5-point curve is refused without force.
         let p = publish(&api, v2, None).problem(409);
         assert_eq!(p["field"], "force");

@@ -132,6 +132,31 @@ pub struct ReportView {
     pub service_life: Option<ServiceLife>,
     /// Present when no curve covers it.
     pub missing_curve: Option<MissingCurve>,
+    /// K_SL and the penalized life under another stored curve (`?compare=<curve id>`), e.g.
+    /// one swept under another wear mechanism: how much the life depends on it.
+    pub comparison: Option<CurveComparison>,
+}
+
+/// This rail's K_SL and penalized life under a named alternative curve.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct CurveComparison {
+    /// Curve id (`/v1/curves/{id}`).
+    pub curve_id: i64,
+    /// Its key `vehicle_profile/environment/wear_law`: the wear law is its last part.
+    pub curve_key: String,
+    pub version: i64,
+    /// Whether that curve is published (a comparison may use an unpublished one).
+    pub published: bool,
+    /// The sweep job that produced it (its params say how it was made).
+    pub job_id: Uuid,
+    /// K_SL under it (null when it does not cover this rattle space: `detail` says why).
+    pub k_sl: Option<f64>,
+    /// Design life times that K_SL, h.
+    pub penalized_life_h: Option<f64>,
+    /// K_SL under it over K_SL under the report's curve (null without both).
+    pub k_sl_ratio: Option<f64>,
+    /// In words.
+    pub detail: String,
 }
 
 /// Which penalization curve and design life a report uses (defaults from the settings'
@@ -150,6 +175,10 @@ pub struct ReportQuery {
     /// T_SL,design, h (> 0).
     #[param(value_type = Option<f64>, exclusive_minimum = 0)]
     pub design_life_h: Option<String>,
+    /// Id of a stored curve (`/v1/curves`) to compare with: the report adds K_SL and the
+    /// penalized life under it (`comparison`).
+    #[param(value_type = Option<i64>, minimum = 1)]
+    pub compare: Option<String>,
 }
 
 /// The curve labels of a report query, defaults filled in; a label given but unknown is a 422
@@ -211,9 +240,9 @@ fn report_labels(
     params(("serial" = String, Path, pattern = "^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$"), ReportQuery),
     responses(
         (status = 200, description = "Report; `service_life` when a curve covers the rail, otherwise `missing_curve` says which sweep to run", body = ReportView),
-        (status = 400, description = "Malformed serial or design_life_h, unknown or repeated parameter", body = Problem, content_type = "application/problem+json"),
+        (status = 400, description = "Malformed serial, design_life_h or compare, unknown or repeated parameter", body = Problem, content_type = "application/problem+json"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "vehicle_profile, environment or wear_law names nothing a sweep can run; `field` is the parameter", body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "vehicle_profile, environment or wear_law names nothing a sweep can run, or compare names no stored curve; `field` is the parameter", body = Problem, content_type = "application/problem+json"),
     ),
     security(("bearer" = []))
 )]
@@ -240,9 +269,25 @@ pub async fn get_report(
                 Problem::bad_parameter("design_life_h", "must be a positive number of hours")
             })?,
     };
+    let compare_id = match &query.compare {
+        None => None,
+        Some(text) => Some(
+            text.trim()
+                .parse::<i64>()
+                .ok()
+                .filter(|id| *id >= 1)
+                .ok_or_else(|| Problem::bad_parameter("compare", "must be a curve id (>= 1)"))?,
+        ),
+    };
     let (profile, environment, wear_law) =
         report_labels(&query, defaults, &state.config.configs_dir)?;
     load_rail(&state, &serial).await?;
+    let compare_curve = match compare_id {
+        None => None,
+        Some(id) => Some(state.store.get_curve(id).await?.ok_or_else(|| {
+            Problem::invalid_field("compare", format!("curve {id} is not stored"))
+        })?),
+    };
     let measurement = state
         .store
         .latest_measurement(&serial)
@@ -265,6 +310,7 @@ pub async fn get_report(
         k_sl_curve: Vec::new(),
         service_life: None,
         missing_curve: None,
+        comparison: None,
     };
     let read = |c: &CurveRecord| {
         serde_json::from_value::<PenalizationCurve>(c.curve.clone())
@@ -273,6 +319,47 @@ pub async fn get_report(
     };
     let published = state.store.published_curve(&key).await?;
     let published_data = published.as_ref().and_then(read);
+    let base_k_sl = published_data.as_ref().and_then(|d| d.k_sl(k_rs).ok());
+    report.comparison = compare_curve.map(|c| {
+        let under = read(&c)
+            .ok_or("its stored data cannot be read".to_string())
+            .and_then(|d| {
+                crate::service_life::service_life(&d, k_rs, design_life_h)
+                    .map_err(|e| e.to_string())
+            });
+        let (k_sl, life, detail) = match under {
+            Ok(l) => (
+                Some(l.life.factors.k_sl),
+                Some(l.life.life_h),
+                format!(
+                    "K_SL {:.4} under curve {} ({}), penalized life {:.1} h of {design_life_h} h",
+                    l.life.factors.k_sl, c.id, c.key, l.life.life_h
+                ),
+            ),
+            Err(reason) => (
+                None,
+                None,
+                format!(
+                    "curve {} ({}) gives no K_SL at rattle space {k_rs:.4}: {reason}",
+                    c.id, c.key
+                ),
+            ),
+        };
+        CurveComparison {
+            curve_id: c.id,
+            curve_key: c.key.clone(),
+            version: c.version,
+            published: c.published.is_some(),
+            job_id: c.job_id,
+            k_sl,
+            penalized_life_h: life,
+            k_sl_ratio: match (k_sl, base_k_sl) {
+                (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+                _ => None,
+            },
+            detail,
+        }
+    });
     let mut why = format!("no published penalization curve for {key}");
     if let (Some(stored), Some(data)) = (&published, &published_data) {
         let (lo, hi) = data.range();
