@@ -133,6 +133,11 @@ pub struct TrackRecord {
     steps: Vec<(f64, usize)>,
     points: Vec<TrackPoint>,
     bins: Vec<PressureBin>,
+    /// Power the drive delivers at each step, W (the steps' order; empty for hand-made steps).
+    drive_w: Vec<f64>,
+    /// Mechanical energy (kinetic, gravitational, elastic) at the first and the latest step
+    /// recorded with points, J.
+    energy_j: Option<(f64, f64)>,
     contacts: usize,
     yield_strength_pa: f64,
 }
@@ -184,6 +189,7 @@ impl TrackRecord {
     /// Appends a step handed out by the run loop (`models::run::run_model_observed`), without
     /// the point-pressure distribution.
     pub fn push_view(&mut self, v: &StepView) {
+        self.drive_w.push(v.power.drive + v.power.applied);
         self.push_step(
             v.t,
             v.tracks.iter().map(|t| TrackPoint {
@@ -211,6 +217,9 @@ impl TrackRecord {
         scratch: &mut Vec<PointLoad>,
     ) {
         scratch.clear();
+        let motion = v.system.motion_energy(v.t, v.state, ws);
+        let e = motion.kinetic + motion.gravitational + v.power.elastic_energy;
+        self.energy_j = Some((self.energy_j.map_or(e, |(first, _)| first), e));
         v.system
             .tracks_with_points(v.t, v.state, ws, &mut |_| {}, &mut |p| scratch.push(*p));
         let start = self.points.len();
@@ -402,6 +411,24 @@ impl TrackRecord {
             ));
         }
         Ok(volumes)
+    }
+
+    /// Work the drive (and applied loads) delivered over the window, J: trapezoid over the
+    /// steps of the power at each (0 for a record without it).
+    pub fn drive_work_j(&self) -> f64 {
+        if self.drive_w.len() != self.steps.len() {
+            return 0.0;
+        }
+        self.steps
+            .windows(2)
+            .zip(self.drive_w.windows(2))
+            .map(|(t, p)| 0.5 * (p[0] + p[1]) * (t[1].0 - t[0].0))
+            .sum()
+    }
+
+    /// Change of the mechanical energy over the window, J (0 when not recorded).
+    pub fn energy_change_j(&self) -> f64 {
+        self.energy_j.map_or(0.0, |(first, last)| last - first)
     }
 
     /// Whether the contact points' pressures were recorded ([`TrackRecord::push_view_with_points`]).

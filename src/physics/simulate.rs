@@ -13,7 +13,7 @@ use super::integrator::{
     Integrator, IntegratorError, IntegratorSettings, IntegratorState, IntegratorStats,
     InteriorStage,
 };
-use super::system::{MultibodySystem, Workspace};
+use super::system::{MultibodySystem, PowerBalance, Workspace};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -46,6 +46,8 @@ pub struct StepView<'a> {
     pub state: &'a [f64],
     /// Active contact tracks at `t`.
     pub tracks: &'a [TrackState],
+    /// Stored energy and power terms at `t` (the drive's power among them).
+    pub power: PowerBalance,
     /// The system.
     pub system: &'a MultibodySystem,
 }
@@ -200,6 +202,7 @@ pub fn simulate_from(
             t,
             state: y,
             tracks: &tracks,
+            power: ws.power,
             system,
         });
     }
@@ -279,6 +282,7 @@ pub fn simulate_from(
             t,
             state: y,
             tracks: &tracks,
+            power: ws.power,
             system,
         });
         last_good.copy_from_slice(y);

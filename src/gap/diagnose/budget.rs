@@ -33,6 +33,12 @@ pub struct IncrementWork {
     pub yield_strength_pa: f64,
     /// Whether the contact points' pressures were recorded (local pressures available).
     pub point_pressures: bool,
+    /// Work the drive delivered, J.
+    #[serde(default)]
+    pub drive_j: f64,
+    /// Change of the mechanical energy over the windows, scaled like the work, J.
+    #[serde(default)]
+    pub energy_change_j: f64,
 }
 
 impl IncrementWork {
@@ -49,6 +55,8 @@ impl IncrementWork {
                 out.yield_strength_pa = run.yield_strength_pa;
                 out.point_pressures = run.record.has_point_pressures();
             }
+            out.drive_j += h.time_scale * run.record.drive_work_j();
+            out.energy_change_j += h.time_scale * run.record.energy_change_j();
             for (acc, w) in out.contacts.iter_mut().zip(&work) {
                 let s = h.time_scale;
                 acc.friction_j += s * w.friction_j;
@@ -171,6 +179,12 @@ pub struct TestBudget {
     pub test: String,
     /// Test time summed over its increments, h.
     pub hours: f64,
+    /// Work the drive delivered to the model over the test, J (it leaves as the contacts'
+    /// friction and damping work and the force elements' dissipation).
+    pub drive_j: f64,
+    /// Change of the model's mechanical energy over its windows, scaled like the work, J:
+    /// `drive = friction + damping + elements + change` closes the account.
+    pub energy_change_j: f64,
     /// Per contact.
     pub contacts: Vec<ContactBudget>,
     /// Per weighed component and mechanism.
@@ -205,7 +219,7 @@ pub fn energy_budget(
             })
             .collect(),
         notes: vec![
-            "work and drivers are the nominal model's, summed over each test's increments (each increment's window scaled to its duration); the drive's work is not split by window and is not listed".into(),
+            "work and drivers are the nominal model's, summed over each test's increments (each increment's window scaled to its duration); the drive's work is the trapezoid of its power over the window's steps".into(),
             "needed coefficient = measured mass / (Σ over contacts of the mechanism's driver x the mass charged to the component per m³ worn there): each mechanism alone, on the nominal motion".into(),
         ],
         ..EnergyBudget::default()
@@ -278,6 +292,8 @@ pub fn energy_budget(
         out.tests.push(TestBudget {
             test: test.clone(),
             hours: *hours,
+            drive_j: incs.iter().map(|i| i.drive_j).sum(),
+            energy_change_j: incs.iter().map(|i| i.energy_change_j).sum(),
             contacts,
             needed,
         });
@@ -300,6 +316,11 @@ impl EnergyBudget {
             "test", "contact", "friction J", "damping J", "damp/fric", ">Sy share", "Archard mm³", "local mm³"
         );
         for t in &self.tests {
+            let _ = writeln!(
+                s,
+                "  {:<10} {:<16} drive work {:.4e} J",
+                t.test, "(all)", t.drive_j
+            );
             for c in &t.contacts {
                 let _ = writeln!(
                     s,
@@ -373,11 +394,14 @@ mod tests {
             hardness_pa: 1e9,
             yield_strength_pa: 4e8,
             point_pressures: true,
+            drive_j: 150.0,
+            energy_change_j: 0.0,
         };
         let measured: BTreeMap<_, _> = [(("C".to_string(), "cube".to_string()), 4.0)].into();
         let b = energy_budget(&[("C".into(), 8.0, vec![inc.clone(), inc])], &measured);
         let t = &b.tests[0];
         assert_eq!(t.contacts[0].damping_j, 200.0);
+        assert_eq!(t.drive_j, 300.0);
         assert_eq!(t.contacts[0].damping_to_friction, 10.0);
         assert_eq!(t.contacts[0].share_above_yield, 0.1);
         let get = |name: &str| t.needed.iter().find(|n| n.mechanism == name).unwrap();
