@@ -154,7 +154,7 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// Directory for report.json and the plots (residuals.svg, ranking.svg,
-        /// before_after.svg); default: <campaign's directory>/diagnosis.
+        /// before_after.svg, energy_budget.svg); default: <campaign's directory>/diagnosis.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Simulated excitation per increment, s.

@@ -288,7 +288,7 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         );
         assert_eq!(flagged_rows, flagged);
 
-        // The three figures, each decoded by the browser as an image.
+        // The four figures, each decoded by the browser as an image.
         let mut names: Vec<&str> = result["plots"]
             .as_array()
             .unwrap()
@@ -296,7 +296,15 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
             .map(|p| p["name"].as_str().unwrap())
             .collect();
         names.sort_unstable();
-        assert_eq!(names, ["before_after.svg", "ranking.svg", "residuals.svg"]);
+        assert_eq!(
+            names,
+            [
+                "before_after.svg",
+                "energy_budget.svg",
+                "ranking.svg",
+                "residuals.svg"
+            ]
+        );
         let decoded = wait_for(Duration::from_secs(30), "the figures decoded", || {
             let v = driver.script(
                 "const imgs = [...document.querySelectorAll('#diagnosis img[data-plot]')]; \
@@ -305,10 +313,15 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
             );
             (!v.is_null()).then_some(v)
         });
-        // In the report's order: where, which, how far.
+        // In the report's order: where (residuals, energy budget), which, how far.
         assert_eq!(
             decoded,
-            json!(["residuals.svg", "ranking.svg", "before_after.svg"])
+            json!([
+                "residuals.svg",
+                "energy_budget.svg",
+                "ranking.svg",
+                "before_after.svg"
+            ])
         );
     })
     .await
