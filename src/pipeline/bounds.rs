@@ -518,6 +518,100 @@ pub static BOUNDS: &[Bound] = &[
     ),
 ];
 
+/// Bounds on the numbers of a calibration data set (`calibrate` jobs, thesis 4.3-4.4): the
+/// torque records of the rotating-cup test and the wear tests' records.
+pub static CALIBRATION_BOUNDS: &[Bound] = &[
+    b(
+        "polar_inertia_kg_m2",
+        1.0e-9,
+        1.0e3,
+        "kg·m²",
+        "a fixture's rotating parts, from a 1 g cup to a 1 t turntable",
+    ),
+    b(
+        "mean_radius_m",
+        1.0e-5,
+        10.0,
+        "m",
+        "contact radii from 10 µm to 10 m",
+    ),
+    b(
+        "time_s",
+        0.0,
+        limits::MAX_DURATION_S,
+        "s",
+        "a test record within 24 h",
+    ),
+    b(
+        "angle_rad",
+        -1.0e7,
+        1.0e7,
+        "rad",
+        "1.6 million turns: a day at 20 rev/s",
+    ),
+    b(
+        "angular_velocity_rad_s",
+        -1.0e4,
+        1.0e4,
+        "rad/s",
+        "up to 95 000 rpm, past any friction rig's spindle",
+    ),
+    b(
+        "normal_load_n",
+        0.0,
+        1.0e6,
+        "N",
+        "a compressive load up to 1 MN, a large press",
+    ),
+    b(
+        "input_torque_n_m",
+        -1.0e5,
+        1.0e5,
+        "N·m",
+        "torques up to 100 kN·m, past any friction rig's drive",
+    ),
+    b(
+        "contact_pressure_pa",
+        0.0,
+        limits::MAX_CUTOFF_PRESSURE_PA,
+        "Pa",
+        "compressive pressures up to 10 GPa, above any engineering alloy's hardness",
+    ),
+    b(
+        "sliding_distance_m",
+        0.0,
+        1.0e7,
+        "m",
+        "up to 10 000 km of sliding",
+    ),
+    b(
+        "wear_mass_kg",
+        0.0,
+        1.0,
+        "kg",
+        "wear of a test specimen, up to 1 kg",
+    ),
+];
+
+/// Checks every number of a calibration data set (`friction` or `wear_law` of a calibrate
+/// job, at `prefix`) against [`CALIBRATION_BOUNDS`]; fields without a bound there are checked
+/// elsewhere (density, cutoff) or are not numbers.
+pub fn check_calibration_value(value: &Value, prefix: &str) -> Result<(), FieldError> {
+    walk_leaves(value, prefix, &mut |leaf| {
+        let Some(bound) = CALIBRATION_BOUNDS.iter().find(|b| b.key == leaf.key) else {
+            return Ok(());
+        };
+        match leaf.value {
+            Value::Number(n) if bound.admits(n.as_f64().unwrap_or(f64::NAN)) => Ok(()),
+            Value::Null => Ok(()),
+            other => Err(FieldError::new(
+                leaf.path,
+                format!("{}, got {other}", bound.rule()),
+            )),
+        }
+    })
+}
+
 /// Longest text field of a case (names, labels, paths), characters: a name is read on a plot
 /// or in a list; 256 characters hold any path in `configs/`.
 pub const MAX_TEXT_CHARS: usize = 256;

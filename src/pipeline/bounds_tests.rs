@@ -242,3 +242,58 @@ fn the_issue_cases_are_refused_at_their_field() {
         assert!(peak > 0.0 && peak < super::bounds::MAX_WEAR_COEFFICIENT_M2_PER_N / 100.0);
     }
 }
+
+#[test]
+fn every_number_of_a_calibration_data_set_is_bounded() {
+    use super::bounds::CALIBRATION_BOUNDS;
+    use super::CalibrateParams;
+    let records: Vec<Value> = (0..8)
+        .map(|i| {
+            json!({"time_s": f64::from(i), "angle_rad": f64::from(i), "angular_velocity_rad_s": 1.0,
+                "normal_load_n": 10.0, "input_torque_n_m": 0.5})
+        })
+        .collect();
+    let wear: Vec<Value> = (0..4)
+        .map(|i| {
+            json!({"normal_load_n": 10.0, "contact_pressure_pa": 1e6 * f64::from(i + 1),
+                "sliding_distance_m": 100.0, "wear_mass_kg": 1e-6})
+        })
+        .collect();
+    let params = json!({
+        "friction": {"fixture": {"polar_inertia_kg_m2": 1.0, "mean_radius_m": 0.1},
+            "records": records},
+        "wear_law": {"density_kg_m3": 2810.0, "cutoff_pressure_pa": 8.7e8, "records": wear},
+    });
+    let mut leaves = Vec::new();
+    walk_leaves::<()>(&params, "", &mut |leaf| {
+        if leaf.value.is_number() {
+            leaves.push((leaf.path.to_string(), leaf.key.to_string()));
+        }
+        Ok(())
+    })
+    .unwrap();
+    let mut refused = 0;
+    for (path, key) in leaves {
+        if key == "density_kg_m3" || key == "cutoff_pressure_pa" {
+            continue; // bounded by `limits` in the parser itself
+        }
+        let bound = CALIBRATION_BOUNDS
+            .iter()
+            .find(|b| b.key == key)
+            .unwrap_or_else(|| panic!("{path} has no bound"));
+        for bad in [-1e308, 1e308, -1.0] {
+            if bound.admits(bad) {
+                continue;
+            }
+            let mut edited = params.clone();
+            *edited.pointer_mut(&pointer(&path)).unwrap() = json!(bad);
+            match CalibrateParams::parse(&edited) {
+                Err(RunError::InvalidConfig { field, .. }) => assert_eq!(field, path),
+                Err(other) => panic!("{path} = {bad}: {other}"),
+                Ok(_) => panic!("{path} = {bad} accepted"),
+            }
+            refused += 1;
+        }
+    }
+    assert!(refused >= 2 * 13, "{refused}");
+}
