@@ -3,6 +3,7 @@
 
 pub mod auth;
 pub mod campaigns;
+pub mod connection;
 pub mod curves;
 pub mod jobs;
 pub mod openapi;
@@ -196,7 +197,7 @@ pub async fn start(
     let router = app(state.clone());
     let (shutdown, on_shutdown) = tokio::sync::oneshot::channel::<()>();
     let server = tokio::spawn(async move {
-        axum::serve(listener, router)
+        axum::serve(connection::ProblemListener(listener), router)
             .with_graceful_shutdown(async move {
                 let _ = on_shutdown.await;
             })

@@ -173,3 +173,42 @@ async fn unknown_query_parameters_roles_and_cancellation() {
     .unwrap();
     app.stop().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_request_head_hyper_refuses_is_answered_as_problem_json() {
+    use std::io::{Read, Write};
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let addr = app.api.base.trim_start_matches("http://").to_string();
+    tokio::task::spawn_blocking(move || {
+        // A control character (0x01) in Idempotency-Key: hyper refuses the head itself.
+        let mut stream = std::net::TcpStream::connect(&addr).unwrap();
+        stream
+            .write_all(
+                format!(
+                    "POST /v1/jobs HTTP/1.1\r\nHost: {addr}\r\nAuthorization: Bearer {ENGINEER}\r\n\
+                     Idempotency-Key: order\x0142\r\nContent-Type: application/json\r\n\
+                     Content-Length: 2\r\n\r\n{{}}"
+                )
+                .as_bytes(),
+            )
+            .unwrap();
+        let mut reply = String::new();
+        stream.read_to_string(&mut reply).unwrap();
+        let (head, body) = reply.split_once("\r\n\r\n").unwrap();
+        assert!(head.starts_with("HTTP/1.1 400"), "{reply}");
+        assert!(
+            head.to_ascii_lowercase()
+                .contains("content-type: application/problem+json"),
+            "{reply}"
+        );
+        let p: Value = serde_json::from_str(body).unwrap();
+        assert_eq!(p["status"], 400, "{p}");
+        assert!(
+            p["detail"].as_str().unwrap().contains("control character"),
+            "{p}"
+        );
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}
