@@ -410,7 +410,8 @@ pub async fn list_jobs(
     Ok(Json(PageView::from_page(page, JobView::from)))
 }
 
-/// One job with its status and progress.
+/// One job with its status and progress. A sweep waiting for its points shows their
+/// combined progress: the mean of their fractions and an ETA at the rate so far.
 #[utoipa::path(
     get, path = "/v1/jobs/{id}", tag = "jobs",
     params(("id" = Uuid, Path)),
@@ -426,7 +427,15 @@ pub async fn get_job(
     Path(id): Path<String>,
 ) -> Result<Json<JobView>, Problem> {
     caller.require(Area::Jobs, &Method::GET)?;
-    Ok(Json(load_job(&state, &id).await?.into()))
+    let mut job = load_job(&state, &id).await?;
+    // A parent waiting for its children shows their progress, not only their successes.
+    let now_ms = crate::store::clock::now_ms();
+    if let Some(progress) =
+        crate::jobs::family::live_parent_progress(state.store.as_ref(), &job, now_ms).await?
+    {
+        job.progress = Some(progress);
+    }
+    Ok(Json(job.into()))
 }
 
 /// The job's attempt log, oldest first: every claim by a worker and how it ended. A job that

@@ -81,6 +81,7 @@ pub fn app(state: AppState) -> Router {
         .route_layer(middleware::from_fn(query::refuse_unknown_query_parameters))
         .layer(middleware::from_fn_with_state(state.clone(), http_metrics))
         .layer(middleware::map_response(problem::problem_for_bare_errors))
+        .layer(middleware::from_fn(ops::security_headers))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
 }
