@@ -1,4 +1,5 @@
-//! Command-line front ends of the library: `railwear run` and `railwear validate`.
+//! Command-line front ends of the library: `railwear run`, `validate`, `campaign check`,
+//! `rig`, `effects`, `diagnose`.
 //! (anyhow is allowed here: this is the binary edge.)
 
 use crate::models::case::load_case;
@@ -366,7 +367,124 @@ pub fn rig(
          accelerometer records) and truth.json",
         out.join("campaign.toml").display()
     );
+    for warning in resolution_warnings(&result, &truth) {
+        eprintln!("warning: {warning}");
+    }
     Ok(())
+}
+
+/// The 1-2-5 step at or below `x` (`x` > 0): 0.05 for 0.07, 0.2 for 0.2.
+fn step_at_or_below(x: f64) -> f64 {
+    let decade = 10f64.powf(x.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|step| *step <= x * (1.0 + 1e-12))
+        .unwrap_or(decade)
+}
+
+/// One warning per test of a rig campaign where most of the model's masses (before noise and
+/// rounding) are below its scale's resolution, so that most weighed masses read 0.
+pub fn resolution_warnings(
+    campaign: &crate::gap::Campaign,
+    truth: &crate::gap::rig::Truth,
+) -> Vec<String> {
+    campaign
+        .tests
+        .iter()
+        .filter_map(|test| {
+            let t = truth.tests.iter().find(|t| t.id == test.id)?;
+            let masses: Vec<f64> = t
+                .model_mass_loss_mg
+                .iter()
+                .flat_map(|inc| inc.values().copied())
+                .collect();
+            resolution_warning(&test.id, test.scale_resolution_mg, masses)
+        })
+        .collect()
+}
+
+/// The warning for one test whose masses (mg) mostly fall below `resolution` (mg), naming the
+/// 1-2-5 resolution at which nine in ten of them would read at least one step.
+fn resolution_warning(test: &str, resolution: f64, mut masses: Vec<f64>) -> Option<String> {
+    masses.retain(|m| m.is_finite());
+    let below = masses.iter().filter(|m| **m < resolution).count();
+    if masses.is_empty() || 2 * below <= masses.len() {
+        return None;
+    }
+    masses.sort_by(f64::total_cmp);
+    let positive: Vec<f64> = masses.iter().copied().filter(|m| *m > 0.0).collect();
+    let advice = match positive.get(positive.len() / 10) {
+        Some(m) => format!(
+            "a scale resolution of {} mg would show nine in ten of them (or lengthen \
+             increment_duration_s)",
+            step_at_or_below(*m)
+        ),
+        None => "the model predicts no wear at all for this test".to_string(),
+    };
+    Some(format!(
+        "test `{test}`: {below} of {} weighed masses are below the scale resolution \
+         {resolution} mg and read as 0 (largest {:.3e} mg); {advice}",
+        masses.len(),
+        masses.last().copied().unwrap_or(0.0),
+    ))
+}
+
+/// `railwear effects`: the effect library of the gap diagnosis (`gap::effects::LIBRARY`),
+/// each effect with its parameters, units, bounds and reasons; `json` prints it as JSON.
+/// The text is rendered from the entries' serialized form, so every field an entry has is
+/// shown.
+pub fn effects(json: bool) -> Result<()> {
+    let library = serde_json::to_value(crate::gap::effects::LIBRARY)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&library)?);
+        return Ok(());
+    }
+    print!("{}", effects_text(&library));
+    Ok(())
+}
+
+fn plain(value: &serde_json::Value) -> String {
+    match value {
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Array(items) => items.iter().map(plain).collect::<Vec<_>>().join(", "),
+        serde_json::Value::Null => "-".into(),
+        other => other.to_string(),
+    }
+}
+
+/// The library as text: one block per effect, its parameters as `name [min, max] unit
+/// (default d): reason`.
+fn effects_text(library: &serde_json::Value) -> String {
+    let mut text = String::new();
+    let empty = serde_json::Map::new();
+    for effect in library.as_array().into_iter().flatten() {
+        let fields = effect.as_object().unwrap_or(&empty);
+        let name = fields.get("name").map_or("?".into(), plain);
+        text.push_str(&format!("{name}\n"));
+        for (key, value) in fields {
+            if key == "name" || key == "parameters" {
+                continue;
+            }
+            text.push_str(&format!("  {key}: {}\n", plain(value)));
+        }
+        let parameters = fields.get("parameters").and_then(|p| p.as_array());
+        for (i, p) in parameters.into_iter().flatten().enumerate() {
+            let get = |k: &str| p.get(k).map_or("-".into(), plain);
+            let role = if i == 0 { " (magnitude)" } else { "" };
+            text.push_str(&format!(
+                "  parameter {}{role}: [{}, {}] {}, default {}\n    {}\n",
+                get("name"),
+                get("min"),
+                get("max"),
+                get("unit"),
+                get("default"),
+                get("reason"),
+            ));
+        }
+        text.push('\n');
+    }
+    text
 }
 
 /// `railwear diagnose`: the report (summary or JSON) and its plots.
@@ -487,4 +605,49 @@ pub fn diagnose_bench(
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn steps_follow_the_1_2_5_series() {
+        assert_eq!(step_at_or_below(0.07), 0.05);
+        assert_eq!(step_at_or_below(0.2), 0.2);
+        assert_eq!(step_at_or_below(0.0031), 0.002);
+        assert_eq!(step_at_or_below(12.0), 10.0);
+    }
+
+    #[test]
+    fn a_test_whose_masses_mostly_read_zero_is_named_with_a_finer_resolution() {
+        // Ten masses from 0.011 to 0.02 mg on a 0.05 mg scale: all read 0; the tenth
+        // percentile, 0.012 mg, is first shown at a 0.01 mg step.
+        let masses: Vec<f64> = (0..10).map(|i| 0.011 + 0.001 * f64::from(i)).collect();
+        let w = resolution_warning("C", 0.05, masses).unwrap();
+        assert!(w.contains("10 of 10"), "{w}");
+        assert!(w.contains("resolution of 0.01 mg"), "{w}");
+        // Most above the step: no warning.
+        assert!(resolution_warning("C", 0.05, vec![0.01, 0.2, 0.3]).is_none());
+        // No wear at all is said so.
+        let w = resolution_warning("C", 0.05, vec![0.0, 0.0]).unwrap();
+        assert!(w.contains("no wear"), "{w}");
+    }
+
+    #[test]
+    fn the_effect_listing_names_every_effect_and_parameter() {
+        let library = serde_json::to_value(crate::gap::effects::LIBRARY).unwrap();
+        let text = effects_text(&library);
+        for effect in crate::gap::effects::LIBRARY {
+            assert!(text.contains(effect.name), "{}", effect.name);
+            for p in effect.parameters {
+                assert!(
+                    text.contains(&format!("parameter {}", p.name)),
+                    "{}",
+                    p.name
+                );
+                assert!(text.contains(p.reason), "{}", p.name);
+            }
+        }
+    }
 }

@@ -75,7 +75,7 @@ enum Command {
         #[arg(long)]
         settle: Option<f64>,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
     /// Run rattle-box cases A-D and write the comparison page against thesis Tables 5.3/5.4.
@@ -90,7 +90,7 @@ enum Command {
         #[arg(long, default_value = "docs/validation.md")]
         out: PathBuf,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
     /// Test campaigns (measured data for the sim-to-real gap diagnosis).
@@ -141,7 +141,7 @@ enum Command {
         #[arg(long, default_value_t = 0.0)]
         calibration_rel: f64,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
     /// Gap diagnosis of a campaign: where the model misses, which library effect explains it
@@ -173,7 +173,7 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         threads: usize,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
     /// Blind check of the diagnosis: campaigns drawn from the virtual rig (controls, library
@@ -203,8 +203,15 @@ enum Command {
         #[arg(long)]
         emulator_file: Option<PathBuf>,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
+    },
+    /// List the effect library of the gap diagnosis: names, what each models, its parameters
+    /// with units, bounds, defaults and the reasons for them.
+    Effects {
+        /// Print the library as JSON.
+        #[arg(long)]
+        json: bool,
     },
     /// Run the thesis anchors and print expected vs measured vs verdict.
     Validate {
@@ -215,7 +222,7 @@ enum Command {
         #[arg(long)]
         slow: bool,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
 }
@@ -231,7 +238,7 @@ enum CampaignCommand {
         #[arg(long)]
         json: bool,
         /// Directory of reference configs and profiles.
-        #[arg(long, default_value = "configs")]
+        #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
 }
@@ -398,6 +405,7 @@ async fn main() -> Result<()> {
             database_url,
             workers,
         } => worker(load_config(&cli)?, database_url.clone(), *workers).await,
+        Command::Effects { json } => railwear::cli::effects(*json),
         Command::Openapi => {
             print!("{}", railwear::http::openapi::openapi_json());
             Ok(())

@@ -26,6 +26,23 @@ pub const FORMAT_VERSION: u32 = 1;
 /// a month is a typing error.
 pub const MAX_INCREMENT_DURATION_S: f64 = 30.0 * 86_400.0;
 
+/// Largest mass loss of one component over one increment, mg: 100 g. Wear increments remove
+/// micrograms to milligrams (thesis 5.5: tenths of a milligram over 90 min of shaking); 100 g
+/// is twice the whole rattle-box cube. A dynamic component may also not lose more than its own
+/// mass (a kinematic one, the tube or the rail, has no mass in the model).
+pub const MAX_INCREMENT_MASS_LOSS_MG: f64 = 1.0e5;
+/// Finest scale resolution, mg: 0.1 µg, an ultra-microbalance's readability.
+pub const MIN_SCALE_RESOLUTION_MG: f64 = 1.0e-4;
+/// Highest accelerometer sample rate, Hz: 1 MHz, past any vibration accelerometer's band.
+pub const MAX_ACCEL_SAMPLE_RATE_HZ: f64 = 1.0e6;
+/// Largest accelerometer noise, m/s² rms: 1000 m/s² (about 100 g) buries any captive-carry
+/// signal (MIL-STD-810G helicopter levels stay below 10 g).
+pub const MAX_SENSOR_NOISE_M_S2: f64 = 1.0e3;
+/// Longest campaign name, characters (shown in lists and reports).
+pub const MAX_NAME_CHARS: usize = 200;
+/// Longest free text (a description or a source), characters.
+pub const MAX_TEXT_CHARS: usize = 10_000;
+
 /// A test campaign.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -92,7 +109,9 @@ pub struct CampaignTest {
     pub specimens: Vec<Specimen>,
 }
 
-/// One specimen (a repeat) of a test.
+/// One specimen (a repeat) of a test. Its id is unique within its test; two tests may use
+/// the same id (each test is its own configuration, and a specimen is known by test and id:
+/// `A/s1` and `B/s1` are two specimens).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Specimen {
@@ -224,6 +243,11 @@ impl Campaign {
         if self.name.trim().is_empty() {
             return Err(GapError::field("name", "must not be empty"));
         }
+        check_text("name", &self.name, MAX_NAME_CHARS)?;
+        check_text("description", &self.description, MAX_TEXT_CHARS)?;
+        if let Some(source) = &self.source {
+            check_text("source", source, MAX_TEXT_CHARS)?;
+        }
         if self.tests.is_empty() {
             return Err(GapError::field(
                 "tests",
@@ -245,14 +269,22 @@ impl Campaign {
                     format!("`{}` is used twice", test.id),
                 ));
             }
+            check_text(
+                &format!("tests[{ti}].description"),
+                &test.description,
+                MAX_TEXT_CHARS,
+            )?;
             let case = test.case(ti, configs_dir)?;
             let model =
                 crate::models::case::build(&case, configs_dir).map_err(|e| relocate(ti, e))?;
-            let bodies: Vec<&str> = model
+            let bodies: Vec<(&str, Option<f64>)> = model
                 .system
                 .bodies
                 .iter()
-                .map(|b| b.name.as_str())
+                .map(|b| {
+                    let dynamic = matches!(b.kind, crate::physics::body::BodyKind::Dynamic { .. });
+                    (b.name.as_str(), dynamic.then_some(b.mass.mass))
+                })
                 .collect();
             test.validate_measurements(ti, &bodies)?;
         }
@@ -326,6 +358,28 @@ impl Campaign {
         }
         Ok(())
     }
+}
+
+/// A free-text field: at most `max` characters, no control characters but line breaks and
+/// tabs.
+fn check_text(field: &str, text: &str, max: usize) -> Result<(), GapError> {
+    let chars = text.chars().count();
+    if chars > max {
+        return Err(GapError::field(
+            field,
+            format!("has {chars} characters; at most {max}"),
+        ));
+    }
+    if text
+        .chars()
+        .any(|c| c.is_control() && !matches!(c, '\n' | '\t'))
+    {
+        return Err(GapError::field(
+            field,
+            "must not contain control characters",
+        ));
+    }
+    Ok(())
 }
 
 /// Moves a case error's field under `tests[i]`.
@@ -440,10 +494,14 @@ impl CampaignTest {
             tones[0].amplitude_g = g;
         }
         if let Some(hz) = drive.frequency_hz {
-            if !(hz.is_finite() && hz > 0.0 && hz <= 10_000.0) {
+            let (lo, hi) = (0.1, 5000.0);
+            if !(hz.is_finite() && (lo..=hi).contains(&hz)) {
                 return Err(GapError::field(
                     f("drive.frequency_hz"),
-                    format!("must lie in (0, 10000] Hz, got {hz}"),
+                    format!(
+                        "must lie in [{lo}, {hi}] Hz (the bound of every tone: \
+                         pipeline::bounds), got {hz}"
+                    ),
                 ));
             }
             tones[0].frequency_hz = hz;
@@ -459,7 +517,12 @@ impl CampaignTest {
     }
 
     /// Checks durations, resolution, components, specimens, masses and records.
-    fn validate_measurements(&self, ti: usize, bodies: &[&str]) -> Result<(), GapError> {
+    /// `bodies`: the model's body names with the mass of each dynamic one, kg.
+    fn validate_measurements(
+        &self,
+        ti: usize,
+        bodies: &[(&str, Option<f64>)],
+    ) -> Result<(), GapError> {
         let f = |rest: &str| format!("tests[{ti}].{rest}");
         let d = self.increment_duration_s;
         if !(d.is_finite() && d > 0.0 && d <= MAX_INCREMENT_DURATION_S) {
@@ -469,10 +532,13 @@ impl CampaignTest {
             ));
         }
         let r = self.scale_resolution_mg;
-        if !(r.is_finite() && r > 0.0 && r <= 1000.0) {
+        if !(r.is_finite() && (MIN_SCALE_RESOLUTION_MG..=1000.0).contains(&r)) {
             return Err(GapError::field(
                 f("scale_resolution_mg"),
-                format!("must lie in (0, 1000] mg, got {r}"),
+                format!(
+                    "must lie in [{MIN_SCALE_RESOLUTION_MG:e}, 1000] mg (an ultra-microbalance \
+                     to a kitchen scale), got {r}"
+                ),
             ));
         }
         if self.components.is_empty() {
@@ -482,12 +548,13 @@ impl CampaignTest {
             ));
         }
         for (ci, c) in self.components.iter().enumerate() {
-            if !bodies.contains(&c.as_str()) {
+            if !bodies.iter().any(|(name, _)| name == c) {
+                let names: Vec<&str> = bodies.iter().map(|(name, _)| *name).collect();
                 return Err(GapError::field(
                     f(&format!("components[{ci}]")),
                     format!(
                         "`{c}` is not a body of the model (bodies: {})",
-                        bodies.join(", ")
+                        names.join(", ")
                     ),
                 ));
             }
@@ -531,6 +598,28 @@ impl CampaignTest {
                             format!("mass loss must be a finite number >= 0 mg, got {mass}"),
                         ));
                     }
+                    let own_mg = bodies
+                        .iter()
+                        .find(|(name, _)| name == comp)
+                        .and_then(|(_, kg)| *kg)
+                        .map(|kg| kg * crate::units::MG_PER_KG);
+                    let cap = own_mg.map_or(MAX_INCREMENT_MASS_LOSS_MG, |m| {
+                        m.min(MAX_INCREMENT_MASS_LOSS_MG)
+                    });
+                    if *mass > cap {
+                        let why = match own_mg {
+                            Some(m) if m < MAX_INCREMENT_MASS_LOSS_MG => {
+                                format!("the component's own mass in the model, {m:.4e} mg")
+                            }
+                            _ => {
+                                "100 g: wear increments remove micrograms to milligrams".to_string()
+                            }
+                        };
+                        return Err(GapError::field(
+                            field,
+                            format!("mass loss {mass} mg exceeds {why}"),
+                        ));
+                    }
                 }
             }
             for (ri, rec) in spec.accelerometers.iter().enumerate() {
@@ -545,16 +634,28 @@ impl CampaignTest {
                         ),
                     ));
                 }
-                if !(rec.sample_rate_hz.is_finite() && rec.sample_rate_hz > 0.0) {
+                if !(rec.sample_rate_hz.is_finite()
+                    && rec.sample_rate_hz > 0.0
+                    && rec.sample_rate_hz <= MAX_ACCEL_SAMPLE_RATE_HZ)
+                {
                     return Err(GapError::field(
                         fr("sample_rate_hz"),
-                        "must be a finite number > 0 Hz",
+                        format!(
+                            "must lie in (0, {MAX_ACCEL_SAMPLE_RATE_HZ:e}] Hz (past any \
+                             vibration accelerometer's band)"
+                        ),
                     ));
                 }
-                if !(rec.sensor_noise_m_s2.is_finite() && rec.sensor_noise_m_s2 >= 0.0) {
+                if !(rec.sensor_noise_m_s2.is_finite()
+                    && rec.sensor_noise_m_s2 >= 0.0
+                    && rec.sensor_noise_m_s2 <= MAX_SENSOR_NOISE_M_S2)
+                {
                     return Err(GapError::field(
                         fr("sensor_noise_m_s2"),
-                        "must be a finite number >= 0 m/s²",
+                        format!(
+                            "must lie in [0, {MAX_SENSOR_NOISE_M_S2:e}] m/s² (more noise buries \
+                             any captive-carry signal)"
+                        ),
                     ));
                 }
                 if let Err(bad) = rec.check_samples() {

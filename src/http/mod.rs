@@ -3,12 +3,14 @@
 
 pub mod auth;
 pub mod campaigns;
+pub mod connection;
 pub mod curves;
 pub mod jobs;
 pub mod openapi;
 pub mod ops;
 pub mod pagination;
 pub mod problem;
+pub mod query;
 pub mod rails;
 pub mod tokens;
 
@@ -23,7 +25,6 @@ use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::ops::Deref;
 use std::sync::Arc;
-use tower_http::limit::RequestBodyLimitLayer;
 use tower_http::trace::TraceLayer;
 
 /// What every handler shares.
@@ -48,7 +49,11 @@ impl Deref for AppState {
 
 /// The complete router with body limits, problem+json fallbacks and request tracing. Every
 /// route takes bodies up to `body_limit_bytes`, except the campaign upload, which takes up to
-/// `campaign_body_limit_bytes` (accelerometer samples inline).
+/// `campaign_body_limit_bytes` (accelerometer samples inline). The limits apply when a
+/// handler reads the body, which each does after checking the caller's role, so a caller
+/// without the role gets 403 whatever the body's size (issue 29); no layer refuses a body by
+/// its `Content-Length` before that. Query parameters a route does not document are refused
+/// before its handler runs ([`query`]).
 pub fn app(state: AppState) -> Router {
     let limit = state.config.body_limit_bytes;
     let campaign_limit = state.config.campaign_body_limit_bytes;
@@ -59,11 +64,8 @@ pub fn app(state: AppState) -> Router {
         .merge(tokens::router())
         .merge(ops::router())
         .merge(openapi::router())
-        .layer(DefaultBodyLimit::max(limit))
-        .layer(RequestBodyLimitLayer::new(limit));
-    let campaigns = campaigns::router()
-        .layer(DefaultBodyLimit::max(campaign_limit))
-        .layer(RequestBodyLimitLayer::new(campaign_limit));
+        .layer(DefaultBodyLimit::max(limit));
+    let campaigns = campaigns::router().layer(DefaultBodyLimit::max(campaign_limit));
     Router::new()
         .merge(general)
         .merge(campaigns)
@@ -76,8 +78,10 @@ pub fn app(state: AppState) -> Router {
                 "this resource does not support that method",
             )
         })
+        .route_layer(middleware::from_fn(query::refuse_unknown_query_parameters))
         .layer(middleware::from_fn_with_state(state.clone(), http_metrics))
         .layer(middleware::map_response(problem::problem_for_bare_errors))
+        .layer(middleware::from_fn(ops::security_headers))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
 }
@@ -194,7 +198,7 @@ pub async fn start(
     let router = app(state.clone());
     let (shutdown, on_shutdown) = tokio::sync::oneshot::channel::<()>();
     let server = tokio::spawn(async move {
-        axum::serve(listener, router)
+        axum::serve(connection::ProblemListener(listener), router)
             .with_graceful_shutdown(async move {
                 let _ = on_shutdown.await;
             })

@@ -167,6 +167,19 @@ where
             Err(err) => {
                 let path = err.path().to_string();
                 let inner = err.into_inner();
+                // A number past a double's range (1e400) is well-formed JSON that no field
+                // can hold: a 422 naming the field, like any other value out of bounds.
+                if inner.is_syntax() && inner.to_string().starts_with("number out of range") {
+                    let field = if path == "." {
+                        "body".to_string()
+                    } else {
+                        path
+                    };
+                    return Err(Problem::invalid_field(
+                        field,
+                        "is a number beyond the range of a double (about 1.8e308)",
+                    ));
+                }
                 if inner.is_syntax() || inner.is_eof() {
                     Err(Problem::new(
                         StatusCode::BAD_REQUEST,

@@ -2,6 +2,7 @@
 //! heartbeats, fenced completion, cancellation, progress. Computations run on tokio's blocking
 //! threads through the [`CaseRunner`] interface.
 
+pub mod family;
 pub mod host;
 pub mod inputs;
 pub mod metrics;

@@ -89,6 +89,11 @@ impl CalibrateParams {
         if let Some(seed) = map.get("seed") {
             parse_seed(seed)?;
         }
+        for key in ["friction", "wear_law"] {
+            if let Some(data) = map.get(key) {
+                super::bounds::check_calibration_value(data, key)?;
+            }
+        }
         let friction = match map.get("friction") {
             None => None,
             Some(f) => {

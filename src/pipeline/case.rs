@@ -43,11 +43,16 @@ fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
 fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     let s = &case.simulation;
     let bad = |field: &str, rule: String| Err(FieldError::new(field, rule).at("simulation"));
-    if !(s.duration_s.is_finite() && s.duration_s > 0.0 && s.duration_s <= limits::MAX_DURATION_S) {
+    if !(s.duration_s.is_finite()
+        && s.duration_s >= limits::MIN_RECORD_INTERVAL_S
+        && s.duration_s <= limits::MAX_DURATION_S)
+    {
         return bad(
             "duration_s",
             format!(
-                "must be > 0 and <= {} s (24 h of simulated time), got {}",
+                "must be > 0 (at least one record interval, {:e} s) and <= {} s (24 h of \
+                 simulated time), got {}",
+                limits::MIN_RECORD_INTERVAL_S,
                 limits::MAX_DURATION_S,
                 s.duration_s
             ),
@@ -101,12 +106,34 @@ fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     Ok(())
 }
 
+/// Checks every number and text of the case against [`super::bounds`], including the
+/// excitation a profile name stands for.
+fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunError> {
+    let profile = case
+        .excitation
+        .get("kind")
+        .and_then(serde_json::Value::as_str)
+        == Some("profile");
+    let resolved = if profile {
+        let spec = crate::models::case::resolve_excitation(case, configs_dir)?;
+        Some(
+            serde_json::to_value(&spec)
+                .map_err(|e| FieldError::new("excitation", e.to_string()))?,
+        )
+    } else {
+        None
+    };
+    super::bounds::check_case(case, resolved.as_ref())?;
+    Ok(())
+}
+
 /// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
 /// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check). Overrides
 /// deep-merge into the case (e.g. `{"simulation": {"duration_s": 0.5}}`); `seed` sets
 /// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
 /// excitation). The case is checked completely: unknown keys anywhere, the model's own rules,
-/// the bounds of [`limits`], and the model is built once (excitation, geometry, integrator),
+/// the bounds of [`limits`] and
+/// [`super::bounds`], and the model is built once (excitation, geometry, integrator),
 /// so an accepted job does not fail on its configuration later. Errors name the params path
 /// (`config`, `config.<path>` or `overrides.<path>`).
 pub fn resolve_case(
@@ -151,6 +178,10 @@ pub fn resolve_case(
             &serde_json::json!({"simulation": {"seed": seed}}),
         );
     }
+    // Bounds on the JSON first: a value of the wrong type or out of range is named at its
+    // own path, also inside tables serde reads whole (the tagged wear law).
+    super::bounds::check_value(&value, "")
+        .map_err(|e| RunError::from(FieldError::new(locate(&e.field, overrides), e.rule)))?;
     let mut case: CaseSpec = serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
         FieldError::new(locate(&path, overrides), e.into_inner().to_string())
@@ -163,8 +194,12 @@ pub fn resolve_case(
         },
         other => other,
     };
-    case.validate().map_err(|e| relocate(e.into()))?;
+    // The bounds first: a value out of its physical range is named itself, not through a
+    // rule between two fields that it happens to break as well (a cube of 1e308 m is too
+    // large, not a tube too small).
     check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
+    check_physical_bounds(&case, configs_dir).map_err(relocate)?;
+    case.validate().map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
     // Validated above (and not changed since): build without validating again.
     crate::models::case::build_validated(&case, configs_dir).map_err(relocate)?;

@@ -6,8 +6,11 @@
 //! One file per job kind's parameters: [`case`] (simulate jobs: params to a validated case),
 //! [`sweep_range`] (the rattle-space range a sweep covers), [`sweep`] (the planned sweep, its
 //! points, labels and assembly), [`calibrate`] (calibration data sets). The bounds every parser
-//! applies are in [`limits`]; the worker and the submit-time validation call the same parsers.
+//! applies are in [`limits`], the physical range of every case field in [`bounds`]; the worker and the submit-time validation call the same parsers.
 
+pub mod bounds;
+#[cfg(test)]
+mod bounds_tests;
 mod calibrate;
 mod case;
 mod sweep;

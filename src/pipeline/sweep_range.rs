@@ -172,6 +172,7 @@ impl SweepRange {
                     )
                     .into());
                 }
+                super::bounds::check_value(v, "base_dimensions_mm")?;
                 let dims: LauncherDimensions = serde_path_to_error::deserialize(v.clone())
                     .map_err(|e| {
                         let path = e.path().to_string();

@@ -9,6 +9,7 @@ mod helpers;
 mod api_schemathesis;
 mod postgres_binary;
 mod service_binary;
+mod service_bounds;
 mod service_campaigns;
 mod service_dashboard;
 mod service_diagnose;

@@ -160,6 +160,25 @@ async fn dashboard_shows_a_job_reach_success() {
                 .filter(|t| t.contains("force_sum_n"))
                 .map(|_| ())
         });
+        // Issue 29: the page ran above under its policy, which allows no inline script. The
+        // token is in this tab's sessionStorage, not localStorage nor the address bar, and
+        // signing out forgets it.
+        assert_eq!(
+            driver.script("return sessionStorage.getItem('railwear-token');"),
+            ENGINEER
+        );
+        assert!(driver
+            .script("return localStorage.getItem('railwear-token');")
+            .is_null());
+        assert_eq!(driver.script("return location.hash;"), "");
+        driver.script("document.getElementById('sign-out').click(); return null;");
+        assert!(driver
+            .script("return sessionStorage.getItem('railwear-token');")
+            .is_null());
+        assert_eq!(
+            driver.script("return document.getElementById('token').value;"),
+            ""
+        );
     })
     .await
     .unwrap();
@@ -192,7 +211,7 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         let buttons = format!("{row}.querySelectorAll('button.start-diagnosis').length");
 
         // A planner sees the campaign but no way to start a diagnosis (the API would say 403).
-        driver.goto(&api.url(&format!("/?as=planner#token={PLANNER}")));
+        driver.goto(&api.url(&format!("/#token={PLANNER}")));
         wait_for(Duration::from_secs(30), "the campaign listed", || {
             (driver.script(&format!("return {row} !== null;")) == true).then_some(())
         });
@@ -203,7 +222,10 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
         );
 
         // A test engineer does.
-        driver.goto(&api.url(&format!("/?as=lab#token={TEST_ENGINEER}")));
+        // A fresh load (the dashboard takes no query parameters, so a blank page in between
+        // makes the navigation more than a change of fragment).
+        driver.goto("about:blank");
+        driver.goto(&api.url(&format!("/#token={TEST_ENGINEER}")));
         wait_for(Duration::from_secs(30), "the start button", || {
             (driver.script(&format!("return {row} !== null && {buttons} === 1;")) == true)
                 .then_some(())
@@ -322,6 +344,54 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
                 "ranking.svg",
                 "before_after.svg"
             ])
+        );
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}
+
+/// Issue 29: the pages and every answer carry the browser hardening headers, and the pages
+/// hold no inline script or style (their policy would block it).
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn pages_carry_a_strict_policy_and_no_inline_script() {
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        for path in ["/", "/docs", "/dashboard.js", "/v1/jobs"] {
+            let r = api.get(path, Some(ENGINEER));
+            let csp = r.header("content-security-policy").unwrap_or_default();
+            for directive in [
+                "default-src 'none'",
+                "script-src 'self'",
+                "style-src 'self'",
+                "frame-ancestors 'none'",
+            ] {
+                assert!(csp.contains(directive), "{path}: {csp}");
+            }
+            assert!(!csp.contains("unsafe-inline"), "{path}: {csp}");
+            assert_eq!(r.header("x-frame-options"), Some("DENY"), "{path}");
+            assert_eq!(
+                r.header("x-content-type-options"),
+                Some("nosniff"),
+                "{path}"
+            );
+            assert_eq!(r.header("referrer-policy"), Some("no-referrer"), "{path}");
+        }
+        for page in ["/", "/docs"] {
+            let html = api.get(page, None).body;
+            assert!(!html.contains("<script>"), "{page} has an inline script");
+            assert!(!html.contains("<style"), "{page} has an inline style sheet");
+            assert!(!html.contains(" onclick="), "{page} has an inline handler");
+        }
+        let js = api.get("/dashboard.js", None);
+        assert!(js
+            .header("content-type")
+            .unwrap_or_default()
+            .starts_with("text/javascript"));
+        assert!(
+            !js.body.contains("localStorage.setItem"),
+            "the token stays out of localStorage"
         );
     })
     .await

@@ -22,6 +22,7 @@ use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod soundness;
 
 use parts::run_parts;
 
@@ -389,7 +390,9 @@ fn run_whole(
     };
     let law = options.wear_law;
     let history_dt = (model.end_time_s - t0) / 200.0;
+    let mut watch = soundness::Watch::new(model);
     let mut observer = |v: &StepView| {
+        watch.step(v);
         if v.t < t0 {
             return;
         }
@@ -507,12 +510,21 @@ fn run_whole(
         wear_history,
         ..
     } = st;
+    // A broken run fails here rather than report zeros (`soundness`).
+    let energy_controlled = options.integrator.tolerances.energy_rel > 0.0;
+    watch.verdict(
+        sys,
+        stats.energy.as_ref(),
+        energy_controlled,
+        model.end_time_s,
+    )?;
     if let Some(e) = stats.energy.as_ref().filter(|e| !e.balanced) {
         tracing::warn!(
             case = %model.name,
             residual_j = e.residual_j,
             residual_relative = e.residual_relative,
-            "the energy account does not close within its bound: results are suspect"
+            "the energy account does not close within its bound (its work test was off): \
+             results are suspect"
         );
     }
     let window = (model.end_time_s - t0).max(f64::MIN_POSITIVE);

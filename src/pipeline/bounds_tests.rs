@@ -1,0 +1,299 @@
+//! The bad-value table of issue 29: every numeric field of every reference config (and of each
+//! optional table, serialized from its type) has a bound, and a value outside it is refused
+//! naming the field.
+
+use super::bounds::{bound_for, walk_leaves, Bound, BOUNDS};
+use super::{case_from_params, RunError};
+use crate::models::case::{load_case, resolve_excitation};
+use crate::wear::law::WearLaw;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+}
+
+/// Every reference case that runs as a job, as an inline config with its profile resolved,
+/// plus the same cases with each optional table filled from its type's own values.
+fn sample_cases() -> Vec<(String, Value)> {
+    let mut out = Vec::new();
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(configs())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let Ok(case) = load_case(&path) else {
+            continue; // service.toml
+        };
+        if case.model == crate::models::spec::ModelKind::PersistentContact {
+            continue; // not a dynamic case: refused as a job before its fields matter
+        }
+        let mut value = serde_json::to_value(&case).unwrap();
+        let excitation = resolve_excitation(&case, &configs()).unwrap();
+        value["excitation"] = serde_json::to_value(&excitation).unwrap();
+        out.push((case.name.clone(), value));
+    }
+    // Optional tables and other variants, each serialized from the library's own values.
+    let (_, rattle) = out
+        .iter()
+        .find(|(n, _)| n == "rattle-box-c")
+        .cloned()
+        .unwrap();
+    let mut v = rattle.clone();
+    v["rattle_box"]["cube_mass_kg"] = json!(0.046);
+    v["simulation"]["energy_rel_tolerance"] = json!(1e-3);
+    v["wear"]["law"] = serde_json::to_value(WearLaw::legacy_table_4_3()).unwrap();
+    v["wear"]["volume_split"] =
+        serde_json::to_value(crate::wear::allocation::VolumeSplit::Fixed { fraction_to_a: 0.5 })
+            .unwrap();
+    out.push(("rattle-box-c, legacy law, fixed split".into(), v));
+    let mut v = rattle.clone();
+    v["wear"]["law"] = serde_json::to_value(WearLaw::Archard {
+        coefficient_m2_per_n: 1e-14,
+    })
+    .unwrap();
+    v["excitation"] = json!({
+        "kind": "measured", "units": "g", "highpass_hz": 2.0,
+        "samples": [[0.0, 0.0, 0.0, 0.0], [0.01, 1.0, 0.0, 0.0], [0.02, 0.0, 0.0, 0.0]],
+        "ramp": serde_json::to_value(crate::excitation::RampSpec::Seconds(0.5)).unwrap(),
+    });
+    out.push(("rattle-box-c, Archard, measured".into(), v));
+    let (_, launcher) = out
+        .iter()
+        .find(|(n, _)| n == "launcher-design")
+        .cloned()
+        .unwrap();
+    let mut v = launcher;
+    v["launcher"]["missile"]["inertia_kg_m2"] = json!([10.0, 10.0, 0.2]);
+    out.push(("launcher-design, given inertia".into(), v));
+    out
+}
+
+/// `a.b[2].c` as a JSON pointer.
+fn pointer(path: &str) -> String {
+    let mut p = String::new();
+    for part in path.split('.') {
+        let (key, indices) = part.split_once('[').unwrap_or((part, ""));
+        p.push('/');
+        p.push_str(key);
+        for index in indices.split('[').filter(|s| !s.is_empty()) {
+            p.push('/');
+            p.push_str(index.trim_end_matches(']'));
+        }
+    }
+    p
+}
+
+struct NumericLeaf {
+    path: String,
+    bound: Option<&'static Bound>,
+}
+
+fn numeric_leaves(case: &Value) -> Vec<NumericLeaf> {
+    let mut leaves = Vec::new();
+    walk_leaves::<()>(case, "", &mut |leaf| {
+        if leaf.value.is_number() {
+            leaves.push(NumericLeaf {
+                path: leaf.path.to_string(),
+                bound: bound_for(leaf.key, leaf.component, leaf.kind),
+            });
+        }
+        Ok(())
+    })
+    .unwrap();
+    leaves
+}
+
+#[test]
+fn every_numeric_field_has_a_bound_and_every_bound_a_field() {
+    let mut used = vec![false; BOUNDS.len()];
+    let mut missing = Vec::new();
+    for (name, case) in sample_cases() {
+        for leaf in numeric_leaves(&case) {
+            match leaf.bound {
+                Some(bound) => {
+                    let i = BOUNDS.iter().position(|b| std::ptr::eq(b, bound)).unwrap();
+                    used[i] = true;
+                }
+                None => missing.push(format!("{name}: {}", leaf.path)),
+            }
+        }
+    }
+    assert!(missing.is_empty(), "fields without a bound: {missing:#?}");
+    let unused: Vec<_> = BOUNDS
+        .iter()
+        .zip(&used)
+        .filter(|(_, u)| !**u)
+        .map(|(b, _)| (b.key, b.component, b.kind))
+        .collect();
+    assert!(unused.is_empty(), "bounds no field uses: {unused:?}");
+    // The reference configs themselves are inside every bound.
+    for (name, case) in sample_cases() {
+        let params = json!({"config": case});
+        if let Err(e) = case_from_params(&params, &configs()) {
+            // Only the variants may fail later rules (a measured record too short to build).
+            assert!(name.contains(','), "{name}: {e}");
+            if let RunError::InvalidConfig { field, rule } = &e {
+                assert!(!rule.contains("must lie in"), "{name}: {field} {rule}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_value_outside_a_bound_is_refused_naming_the_field() {
+    let bad_values = [-1.0, 0.0, 1e308, -1e308, 1e-300];
+    let mut refused = 0;
+    for (name, case) in sample_cases() {
+        for leaf in numeric_leaves(&case) {
+            let bound = leaf.bound.expect("covered by the test above");
+            let at = pointer(&leaf.path);
+            let mut candidates: Vec<Value> = bad_values
+                .iter()
+                .filter(|v| !bound.admits(**v))
+                .map(|v| json!(v))
+                .collect();
+            candidates.push(json!("NaN"));
+            for bad in candidates {
+                let mut edited = case.clone();
+                *edited.pointer_mut(&at).unwrap() = bad.clone();
+                let params = json!({"config": edited});
+                match case_from_params(&params, &configs()) {
+                    Err(RunError::InvalidConfig { field, rule }) => {
+                        let want = format!("config.{}", leaf.path);
+                        // A field read whole (a vector, a tuple) may be named as a whole.
+                        let whole = want.split('[').next().unwrap_or(&want);
+                        assert!(
+                            field == want || field == whole,
+                            "{name}: {} = {bad}: named `{field}` ({rule})",
+                            leaf.path
+                        );
+                        refused += 1;
+                    }
+                    Err(other) => panic!("{name}: {} = {bad}: {other}", leaf.path),
+                    Ok(_) => panic!("{name}: {} = {bad} was accepted", leaf.path),
+                }
+            }
+        }
+    }
+    assert!(refused > 1000, "only {refused} refusals tried");
+}
+
+#[test]
+fn the_issue_cases_are_refused_at_their_field() {
+    let field = |overrides: Value| match case_from_params(
+        &json!({"config": "rattle-box-c", "overrides": overrides}),
+        &configs(),
+    ) {
+        Err(RunError::InvalidConfig { field, .. }) => field,
+        other => panic!("{:?}", other.map(|_| ())),
+    };
+    assert_eq!(
+        field(
+            json!({"excitation": {"tones": [{"axis": "x", "frequency_hz": 20.0, "amplitude_g": 1e308}]}})
+        ),
+        "overrides.excitation.tones[0].amplitude_g"
+    );
+    assert_eq!(
+        field(json!({"rattle_box": {"friction": {"mu_static": 1e6}}})),
+        "overrides.rattle_box.friction.mu_static"
+    );
+    assert_eq!(
+        field(json!({"rattle_box": {"material": {"density_kg_per_m3": 1e308}}})),
+        "overrides.rattle_box.material.density_kg_per_m3"
+    );
+    assert_eq!(
+        field(json!({"rattle_box": {"contact": {"exponent": 1e308}}})),
+        "overrides.rattle_box.contact.exponent"
+    );
+    assert_eq!(
+        field(
+            json!({"wear": {"law": {"kind": "modified", "c1": 1e308, "c2": 6.3197, "c3": 0.0, "cutoff_pressure_pa": 8.7e8}}})
+        ),
+        "overrides.wear.law.c1"
+    );
+    assert_eq!(
+        field(
+            json!({"wear": {"law": {"kind": "modified", "c1": 2.3685e-15, "c2": 6.3197, "c3": 0.0, "cutoff_pressure_pa": -1.0}}})
+        ),
+        "overrides.wear.law.cutoff_pressure_pa"
+    );
+    // Within every field bound, a peak coefficient beyond severe adhesive wear: C1 at its
+    // bound with C2 = 0.5 gives 1e-10 * (8.7e8)^2 m²/N.
+    assert_eq!(
+        field(
+            json!({"wear": {"law": {"kind": "modified", "c1": 1e-10, "c2": 0.5, "c3": 0.0, "cutoff_pressure_pa": 8.7e8}}})
+        ),
+        "overrides.wear.law.c1"
+    );
+    assert_eq!(field(json!({"name": "x".repeat(10_000)})), "overrides.name");
+    // The Table 4.3 law at its cutoff stays two decades below the ceiling.
+    let table = WearLaw::table_4_3();
+    if let WearLaw::Modified {
+        c1,
+        c2,
+        c3,
+        cutoff_pressure_pa,
+    } = table
+    {
+        let peak = c1 * cutoff_pressure_pa.powf(1.0 / c2) + c3;
+        assert!(peak > 0.0 && peak < super::bounds::MAX_WEAR_COEFFICIENT_M2_PER_N / 100.0);
+    }
+}
+
+#[test]
+fn every_number_of_a_calibration_data_set_is_bounded() {
+    use super::bounds::CALIBRATION_BOUNDS;
+    use super::CalibrateParams;
+    let records: Vec<Value> = (0..8)
+        .map(|i| {
+            json!({"time_s": f64::from(i), "angle_rad": f64::from(i), "angular_velocity_rad_s": 1.0,
+                "normal_load_n": 10.0, "input_torque_n_m": 0.5})
+        })
+        .collect();
+    let wear: Vec<Value> = (0..4)
+        .map(|i| {
+            json!({"normal_load_n": 10.0, "contact_pressure_pa": 1e6 * f64::from(i + 1),
+                "sliding_distance_m": 100.0, "wear_mass_kg": 1e-6})
+        })
+        .collect();
+    let params = json!({
+        "friction": {"fixture": {"polar_inertia_kg_m2": 1.0, "mean_radius_m": 0.1},
+            "records": records},
+        "wear_law": {"density_kg_m3": 2810.0, "cutoff_pressure_pa": 8.7e8, "records": wear},
+    });
+    let mut leaves = Vec::new();
+    walk_leaves::<()>(&params, "", &mut |leaf| {
+        if leaf.value.is_number() {
+            leaves.push((leaf.path.to_string(), leaf.key.to_string()));
+        }
+        Ok(())
+    })
+    .unwrap();
+    let mut refused = 0;
+    for (path, key) in leaves {
+        if key == "density_kg_m3" || key == "cutoff_pressure_pa" {
+            continue; // bounded by `limits` in the parser itself
+        }
+        let bound = CALIBRATION_BOUNDS
+            .iter()
+            .find(|b| b.key == key)
+            .unwrap_or_else(|| panic!("{path} has no bound"));
+        for bad in [-1e308, 1e308, -1.0] {
+            if bound.admits(bad) {
+                continue;
+            }
+            let mut edited = params.clone();
+            *edited.pointer_mut(&pointer(&path)).unwrap() = json!(bad);
+            match CalibrateParams::parse(&edited) {
+                Err(RunError::InvalidConfig { field, .. }) => assert_eq!(field, path),
+                Err(other) => panic!("{path} = {bad}: {other}"),
+                Ok(_) => panic!("{path} = {bad} accepted"),
+            }
+            refused += 1;
+        }
+    }
+    assert!(refused >= 2 * 13, "{refused}");
+}
