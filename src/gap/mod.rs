@@ -17,9 +17,11 @@ pub mod accel;
 pub mod campaign;
 pub mod diagnose;
 pub mod effects;
+pub mod point_pressure;
 pub mod rig;
 pub mod rig_effects;
 pub mod tracks;
+pub mod wear_terms;
 pub mod window;
 
 pub use campaign::Campaign;

@@ -164,7 +164,9 @@ async function loadReport() {
   out.replaceChildren(); plot.replaceChildren();
   if (!serial) { return; }
   try {
-    const r = await api("/v1/rails/" + encodeURIComponent(serial) + "/report");
+    const compare = document.getElementById("compare").value.trim();
+    const r = await api("/v1/rails/" + encodeURIComponent(serial) + "/report" +
+      (compare ? "?compare=" + encodeURIComponent(compare) : ""));
     out.appendChild(text("div", "Rail " + r.serial + ": rattle space k_rs = " + r.rattle_space.toFixed(4) +
       " (measured " + r.measurement.measured_at + " by " + r.measurement.measured_by + " at " + r.measurement.location + ")"));
     if (r.service_life) {
@@ -175,9 +177,22 @@ async function loadReport() {
         s.penalized_life_band_80_h.toFixed(0) + " h conservative)", "status-succeeded"));
     }
     if (r.missing_curve) { out.appendChild(text("div", r.missing_curve.detail, "status-cancelled")); }
+    if (r.comparison) { out.appendChild(comparisonLine(r.comparison)); }
     const svg = curveSvg(r);
     if (svg) { plot.appendChild(svg); }
   } catch (e) { out.appendChild(text("div", String(e), "status-failed")); }
+}
+
+// K_SL and the penalized life under another stored curve (`?compare=<curve id>`, issue 26).
+function comparisonLine(c) {
+  const line = c.k_sl == null ? c.detail :
+    "Under curve " + c.curve_id + " (" + c.curve_key + ", version " + c.version +
+    (c.published ? ", published" : ", not published") + "): K_SL = " + c.k_sl.toFixed(3) +
+    ", service life " + c.penalized_life_h.toFixed(0) + " h" +
+    (c.k_sl_ratio == null ? "" : "; " + c.k_sl_ratio.toFixed(3) + " x the report's K_SL");
+  const div = text("div", line, c.k_sl == null ? "status-cancelled" : "");
+  div.id = "report-comparison";
+  return div;
 }
 
 // ---- Diagnoses (issue 15): campaigns, diagnose jobs, their reports ----
@@ -402,6 +417,35 @@ async function showDiagnosis(job) {
       const whereTable = table(["By", "Group", "Mean residual", "Bias score z", "Adjusted p", "Observations (weighted)"], groups);
       whereTable.id = "diagnosis-where";
       out.appendChild(whereTable);
+    }
+
+    const budget = r.where.energy_budget;
+    if (budget && budget.tests.length > 0) {
+      out.appendChild(text("h4", "Energy budget of the nominal model (work by kind, J) and the coefficient each wear mechanism needs"));
+      const work = [];
+      for (const t of budget.tests) {
+        for (const c of t.contacts) {
+          work.push(row([t.test, c.contact, fmt.num(t.drive_j, 3), fmt.num(c.friction_j, 3), fmt.num(c.damping_j, 3),
+            fmt.num(c.damping_to_friction, 3), fmt.percent(c.share_above_yield),
+            fmt.num(c.lumped_archard_mm3, 3) + " / " + fmt.num(c.local_archard_mm3, 3) + " mm\u00b3"]));
+        }
+      }
+      const workTable = table(["Test", "Contact", "Drive work (test)", "Friction work", "Impact damping work",
+        "Damping / friction", "Sliding above Sy", "Archard wear: lumped / local pressure"], work);
+      workTable.id = "diagnosis-budget";
+      out.appendChild(workTable);
+      const needed = [];
+      for (const t of budget.tests) {
+        for (const n of t.needed) {
+          const tr = row([t.test, n.component, n.mechanism, n.value == null ? "no driver" : fmt.withUnit(n.value, n.unit),
+            interval(n.range, n.unit), n.verdict]);
+          if (n.verdict === "within") { tr.className = "indistinguishable"; }
+          needed.push(tr);
+        }
+      }
+      const neededTable = table(["Test", "Component", "Mechanism", "Needed for the measured wear", "Literature range", ""], needed);
+      neededTable.id = "diagnosis-budget-needed";
+      out.appendChild(neededTable);
     }
 
     // The figures, fetched with the token and shown as images (an <img> runs no script).

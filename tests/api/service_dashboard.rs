@@ -185,6 +185,67 @@ async fn dashboard_shows_a_job_reach_success() {
     app.stop().await;
 }
 
+/// Issue 26 item 7: a planner reads a rail's report with the K_SL under a second stored curve
+/// beside the published one, and the page shows what the API returns.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn dashboard_compares_a_rails_life_under_two_curves() {
+    use crate::service_rails::{measurement, publish, run_sweep};
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let app = TestApp::spawn().await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        let dims = railwear::analysis::rattle_space::LauncherDimensions::design()
+            .with_material_condition(0.1);
+        let r = api.post_rail("R-9", &measurement(dims));
+        assert_eq!(r.status, 201, "{}", r.body);
+        // Two curves of the test runner: three seeds (published) and one seed.
+        let sweep = |seeds: u32| {
+            format!(
+                r#"{{"kind":"sweep","params":{{"steps":1,"step_ms":1,"rattle_space_range":{{"min":0.76,"max":0.84}},"points":3,"seeds":{seeds},"duration_s":1}}}}"#
+            )
+        };
+        run_sweep(&api, &sweep(3));
+        let first = api.get("/v1/curves", Some(PLANNER)).json()["items"][0]["id"]
+            .as_i64()
+            .unwrap();
+        assert_eq!(publish(&api, first, None).status, 200);
+        run_sweep(&api, &sweep(1));
+        let second = api.get("/v1/curves", Some(PLANNER)).json()["items"][0]["id"]
+            .as_i64()
+            .unwrap();
+        assert_ne!(first, second);
+        let expected = api
+            .get(&format!("/v1/rails/R-9/report?compare={second}"), Some(PLANNER))
+            .json();
+        let k_sl = expected["comparison"]["k_sl"].as_f64().expect("a K_SL");
+
+        let driver = Driver::start(&chromium, &chromedriver);
+        driver.goto(&api.url(&format!("/#token={PLANNER}")));
+        fill(&driver, "serial", "R-9");
+        fill(&driver, "compare", &second.to_string());
+        driver.script("document.getElementById('load-report').click(); return null;");
+        let shown = wait_for(Duration::from_secs(30), "the comparison", || {
+            driver
+                .script(
+                    "const c = document.getElementById('report-comparison'); \
+                     return c ? c.textContent : null;",
+                )
+                .as_str()
+                .map(str::to_string)
+        });
+        assert!(
+            shown.contains(&format!("Under curve {second}"))
+                && shown.contains(&format!("K_SL = {k_sl:.3}")),
+            "{shown} (API: {k_sl})"
+        );
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}
+
 /// The smallest campaign that runs a real diagnosis (shared with tests/service_diagnose.rs).
 const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
 
@@ -309,6 +370,30 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
              return t ? t.querySelectorAll('tbody tr').length : 0;",
         );
         assert_eq!(flagged_rows, flagged);
+        // Issue 26: the energy budget, one row per test and contact, one per test, component
+        // and mechanism.
+        let budget = &report["where"]["energy_budget"]["tests"];
+        let contacts: usize = budget
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["contacts"].as_array().unwrap().len())
+            .sum();
+        let needed: usize = budget
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["needed"].as_array().unwrap().len())
+            .sum();
+        assert!(contacts > 0 && needed > 0, "{budget}");
+        let rows = |id: &str| {
+            driver.script(&format!(
+                "const t = document.getElementById('{id}'); \
+                 return t ? t.querySelectorAll('tbody tr').length : 0;"
+            ))
+        };
+        assert_eq!(rows("diagnosis-budget"), contacts);
+        assert_eq!(rows("diagnosis-budget-needed"), needed);
 
         // The four figures, each decoded by the browser as an image.
         let mut names: Vec<&str> = result["plots"]

@@ -11,7 +11,7 @@ use railwear::analysis::rattle_space::LauncherDimensions;
 use serde_json::json;
 use std::time::Duration;
 
-fn measurement(dims: LauncherDimensions) -> String {
+pub(crate) fn measurement(dims: LauncherDimensions) -> String {
     json!({
         "dimensions_mm": dims,
         "measured_by": "J. Doe",
@@ -305,7 +305,7 @@ fn report_of(api: &Api, serial: &str) -> serde_json::Value {
     r.json()
 }
 
-fn run_sweep(api: &Api, body: &str) -> String {
+pub(crate) fn run_sweep(api: &Api, body: &str) -> String {
     let r = api.post("/v1/jobs", Some(ENGINEER), body);
     assert_eq!(r.status, 201, "{}", r.body);
     let id = r.json()["id"].as_str().unwrap().to_string();
@@ -317,7 +317,7 @@ fn run_sweep(api: &Api, body: &str) -> String {
     id
 }
 
-fn publish(api: &Api, id: i64, body: Option<&str>) -> crate::helpers::Reply {
+pub(crate) fn publish(api: &Api, id: i64, body: Option<&str>) -> crate::helpers::Reply {
     api.request(
         "POST",
         &format!("/v1/curves/{id}/publish"),
