@@ -202,17 +202,23 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
         });
         // Issue 29: while its points run, the sweep shows their combined progress (the mean
         // of their fractions) and an ETA, not 0 until the first point succeeds.
-        let waiting = wait_for(Duration::from_secs(20), "progress of running children", || {
-            let j = api.get_job(&id);
-            (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0).then_some(j)
-        });
+        let waiting = wait_for(
+            Duration::from_secs(20),
+            "progress of running children",
+            || {
+                let j = api.get_job(&id);
+                (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0).then_some(j)
+            },
+        );
         assert_eq!(waiting["status"], "waiting");
         assert_eq!(waiting["worker"], Value::Null);
         // Two of five points run and none is done: the fraction is below 2/5.
         let fraction = waiting["progress"]["fraction"].as_f64().unwrap();
         assert!(fraction > 0.0 && fraction < 0.4, "{waiting}");
         assert!(
-            waiting["progress"]["eta_s"].as_f64().is_some_and(|e| e > 0.0),
+            waiting["progress"]["eta_s"]
+                .as_f64()
+                .is_some_and(|e| e > 0.0),
             "{waiting}"
         );
         let r = api.cancel_job(&id);
