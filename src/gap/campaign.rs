@@ -38,6 +38,10 @@ pub const MAX_ACCEL_SAMPLE_RATE_HZ: f64 = 1.0e6;
 /// Largest accelerometer noise, m/s² rms: 1000 m/s² (about 100 g) buries any captive-carry
 /// signal (MIL-STD-810G helicopter levels stay below 10 g).
 pub const MAX_SENSOR_NOISE_M_S2: f64 = 1.0e3;
+/// Largest measured acceleration, m/s²: about 1000 g. Captive-carry profiles stay below 10 g
+/// and shaker tests below 100 g (thesis 5.5: 15 g); beyond it a record is a unit error (mm/s²
+/// for m/s²) or a shock.
+pub const MAX_ACCELERATION_M_S2: f64 = 1.0e4;
 /// Longest campaign name, characters (shown in lists and reports).
 pub const MAX_NAME_CHARS: usize = 200;
 /// Longest free text (a description or a source), characters.
@@ -664,6 +668,18 @@ impl CampaignTest {
                         fr(&format!("samples[{}]", bad.index)),
                         format!("{column}: {}", bad.rule),
                     ));
+                }
+                for (i, sample) in rec.samples.iter().enumerate() {
+                    if let Some(j) = (1..4).find(|&j| sample[j].abs() > MAX_ACCELERATION_M_S2) {
+                        return Err(GapError::field(
+                            fr(&format!("samples[{i}]")),
+                            format!(
+                                "{}: |{}| m/s² exceeds {MAX_ACCELERATION_M_S2:e} m/s² (about \
+                                 1000 g: a unit error or a shock, not captive-carry vibration)",
+                                ACCEL_COLUMNS[j], sample[j]
+                            ),
+                        ));
+                    }
                 }
             }
         }

@@ -406,7 +406,16 @@ pub async fn list_jobs(
         filter.map_err(|_| Problem::bad_parameter("query", "must be status, parent, top_level"))?;
     let filter = filter.to_filter()?;
     let request = page.to_request()?;
-    let page = state.store.list_jobs(request, filter).await?;
+    let mut page = state.store.list_jobs(request, filter).await?;
+    // Sweeps waiting for their points show the points' combined progress (few at a time).
+    let now_ms = crate::store::clock::now_ms();
+    for job in &mut page.items {
+        if let Some(progress) =
+            crate::jobs::family::live_parent_progress(state.store.as_ref(), job, now_ms).await?
+        {
+            job.progress = Some(progress);
+        }
+    }
     Ok(Json(PageView::from_page(page, JobView::from)))
 }
 

@@ -24,8 +24,9 @@ impl Modify for BearerAuth {
 /// The error answers every operation can give, added where an operation does not document
 /// them itself, so the document lists every status the service sends (a property-based run
 /// checks it, `tests/api_schemathesis.rs`): 401 on every operation with a token, 403 on
-/// writes and on token listing (the role is checked before anything else), 400 on operations
-/// with path or query parameters (a malformed or unknown parameter), and on operations with a
+/// writes and on token listing (the role is checked before anything else), 400 on every
+/// operation (a malformed or unknown parameter; every route refuses undocumented query
+/// parameters), and on operations with a
 /// body 400 (malformed JSON), 413 (too large), 415 (not JSON) and 422 (a rule broken).
 struct CommonErrors;
 
@@ -58,12 +59,23 @@ impl CommonErrors {
         if path.contains('{') {
             wanted.push(("404", "No such resource"));
         }
-        if has_params {
-            wanted.push((
-                "400",
-                "Malformed, unknown or repeated path or query parameter; `field` names it",
-            ));
-        }
+        // Every route refuses query parameters it does not document (`http::query`), so
+        // every operation can answer 400.
+        wanted.push((
+            "400",
+            match (has_params, operation.request_body.is_some()) {
+                (true, _) => {
+                    "Malformed, unknown or repeated path or query parameter; `field` names it"
+                }
+                (false, true) => {
+                    "Malformed JSON body, or a query parameter this operation does not take \
+                     (`field` names it)"
+                }
+                (false, false) => {
+                    "A query parameter this operation does not take; `field` names it"
+                }
+            },
+        ));
         if operation.request_body.is_some() {
             wanted.push(("400", "Malformed JSON body"));
             wanted.push(("413", "Request body over the route's limit"));

@@ -297,3 +297,30 @@ fn every_number_of_a_calibration_data_set_is_bounded() {
     }
     assert!(refused >= 2 * 13, "{refused}");
 }
+
+/// A contact exponent at its bound is accepted at submit; its run then either succeeds with a
+/// finite wear and a closed energy account or fails with a diagnostic, never with NaN or zeros
+/// from a broken state.
+#[test]
+fn a_run_at_the_contact_exponent_bound_is_sound_or_fails_loudly() {
+    let exponent = bound_for("exponent", None, None).unwrap().max;
+    let params = json!({"config": "rattle-box-c", "overrides": {
+        "rattle_box": {"contact": {"exponent": exponent}},
+        "simulation": {"settle_s": 0.02, "duration_s": 0.05, "record_interval_s": 0.005}}});
+    let control = super::RunControl::silent();
+    match super::simulate_job(&params, &configs(), &control) {
+        Ok(outcome) => {
+            let energy = &outcome.summary["energy"];
+            assert_eq!(energy["balanced"], true, "{energy}");
+            for t in &outcome.tracks {
+                assert!(t.normal_force_n.is_finite() && t.penetration_m.is_finite());
+            }
+        }
+        Err(RunError::Diverged(diagnostic)) => {
+            for word in ["t =", "body", "contact", "energy"] {
+                assert!(diagnostic.contains(word), "{diagnostic}");
+            }
+        }
+        Err(other) => panic!("{other}"),
+    }
+}

@@ -212,3 +212,41 @@ async fn a_request_head_hyper_refuses_is_answered_as_problem_json() {
     .unwrap();
     app.stop().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn campaign_masses_and_names_are_bounded() {
+    let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        let campaign =
+            railwear::gap::Campaign::from_toml_str(CAMPAIGN, std::path::Path::new(".")).unwrap();
+        let good = serde_json::to_value(&campaign).unwrap();
+        let upload = |v: &Value| api.post("/v1/campaigns", Some(TEST_ENGINEER), &v.to_string());
+        let mass = "/tests/0/specimens/0/increments/0/mass_loss_mg/cube";
+        let mass_field = "tests[0].specimens[0].increments[0].mass_loss_mg.cube";
+        // 1e308 mg; and 50 g from a cube of 2810 kg/m³ x (25.4 mm)³ = 46.05 g.
+        for bad in [1e308, 50_000.0] {
+            let mut v = good.clone();
+            *v.pointer_mut(mass).unwrap() = json!(bad);
+            let p = upload(&v).problem(422);
+            assert_eq!(p["field"], mass_field, "{p}");
+        }
+        let mut v = good.clone();
+        v["name"] = json!("x".repeat(10_000));
+        assert_eq!(upload(&v).problem(422)["field"], "name");
+        let r = api.get("/v1/campaigns", Some(TEST_ENGINEER)).json();
+        assert_eq!(
+            r["items"].as_array().map(Vec::len),
+            Some(0),
+            "nothing stored"
+        );
+        // Two tests may each have a specimen `s1`: a specimen is known by test and id.
+        let mut v = good.clone();
+        v["tests"][0]["specimens"][0]["id"] = json!("s1");
+        v["tests"][1]["specimens"][0]["id"] = json!("s1");
+        assert_eq!(upload(&v).status, 201);
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}

@@ -1,6 +1,6 @@
 //! Fan-out through the embedded workers on SQLite (the same code path as `railwear worker`
 //! processes on PostgreSQL), over HTTP, with the counting test runner: a sweep becomes child
-//! jobs listed under `?parent=`, its progress is the fraction of children done, its result is
+//! jobs listed under `?parent=`, its progress is the mean of its children's, its result is
 //! assembled once from the children's results in index order; a failing child fails the sweep
 //! naming it and cancels the rest; cancelling the sweep cancels its children.
 
@@ -200,10 +200,27 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
             let kids = children(&api, &id);
             (kids.len() == 5 && count(&kids, "running") == 2).then_some(())
         });
-        let waiting = api.get_job(&id);
+        // Issue 29: while its points run, the sweep shows their combined progress (the mean
+        // of their fractions) and an ETA, not 0 until the first point succeeds.
+        let waiting = wait_for(
+            Duration::from_secs(20),
+            "progress of running children",
+            || {
+                let j = api.get_job(&id);
+                (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0).then_some(j)
+            },
+        );
         assert_eq!(waiting["status"], "waiting");
         assert_eq!(waiting["worker"], Value::Null);
-        assert_eq!(waiting["progress"]["fraction"], 0.0);
+        // Two of five points run and none is done: the fraction is below 2/5.
+        let fraction = waiting["progress"]["fraction"].as_f64().unwrap();
+        assert!(fraction > 0.0 && fraction < 0.4, "{waiting}");
+        assert!(
+            waiting["progress"]["eta_s"]
+                .as_f64()
+                .is_some_and(|e| e > 0.0),
+            "{waiting}"
+        );
         let r = api.cancel_job(&id);
         assert_eq!(r.status, 202, "{}", r.body);
         assert_eq!(r.json()["status"], "cancelled");
