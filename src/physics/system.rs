@@ -2,7 +2,9 @@
 //! motion `dy/dt = f(t, y)` (Newton-Euler per body, quaternion kinematics).
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
-use super::contact::{Contact, GeometryCache, PointLoad, TrackLinearization, TrackState};
+use super::contact::{
+    Contact, EvaluationOutputs, GeometryCache, PointLoad, TrackLinearization, TrackState,
+};
 use super::forces::{ForceElement, Wrench};
 use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
 use std::ops::AddAssign;
@@ -221,8 +223,10 @@ impl MultibodySystem {
                     Some(&mut ws.wrenches),
                     &mut sink,
                     &mut ws.geometry,
-                    ws.linearize.then_some(&mut ws.linearizations),
-                    None,
+                    EvaluationOutputs {
+                        linearizations: ws.linearize.then_some(&mut ws.linearizations),
+                        points: None,
+                    },
                 );
             }
             power.contact_damping = damping;

@@ -170,6 +170,16 @@ pub struct PointLoad {
     pub slip_speed: f64,
 }
 
+/// What an evaluation hands out besides forces and tracks (each when given): every active
+/// track's force derivatives, and every touching point's load.
+#[derive(Default)]
+pub struct EvaluationOutputs<'a> {
+    /// Receives each active track's force derivatives.
+    pub linearizations: Option<&'a mut Vec<TrackLinearization>>,
+    /// Receives each touching contact point's load.
+    pub points: Option<&'a mut dyn FnMut(&PointLoad)>,
+}
+
 /// Local derivatives of one contact point's force at one instant, for the contact-aware Newton
 /// matrix ([`MultibodySystem::contact_jacobian`](super::system::MultibodySystem::contact_jacobian)).
 ///
@@ -271,8 +281,7 @@ impl Contact {
             wrenches,
             sink,
             &mut GeometryCache::default(),
-            None,
-            None,
+            EvaluationOutputs::default(),
         )
     }
 
@@ -291,8 +300,10 @@ impl Contact {
             None,
             sink,
             &mut GeometryCache::default(),
-            None,
-            Some(points),
+            EvaluationOutputs {
+                linearizations: None,
+                points: Some(points),
+            },
         )
     }
 
@@ -306,9 +317,12 @@ impl Contact {
         mut wrenches: Option<&mut [Wrench]>,
         sink: &mut dyn FnMut(&TrackState),
         geometry: &mut GeometryCache,
-        mut linearizations: Option<&mut Vec<TrackLinearization>>,
-        mut points: Option<&mut dyn FnMut(&PointLoad)>,
+        outputs: EvaluationOutputs<'_>,
     ) -> f64 {
+        let EvaluationOutputs {
+            mut linearizations,
+            mut points,
+        } = outputs;
         let fa = &frames[self.body_a];
         let fb = &frames[self.body_b];
         let iso_a = fa.isometry();
