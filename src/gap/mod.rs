@@ -16,6 +16,7 @@
 pub mod accel;
 pub mod campaign;
 pub mod diagnose;
+mod drive_edits;
 pub mod effects;
 pub mod point_pressure;
 pub mod rig;
