@@ -119,6 +119,7 @@ fn emulator() -> Emulator {
             table("cross_axis", 2, 41),
         ],
         pairs: Vec::new(),
+        joints: Vec::new(),
         simulations: 0,
         options: EmulatorOptions::default(),
     }

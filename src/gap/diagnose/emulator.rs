@@ -101,10 +101,25 @@ pub struct Emulator {
     /// Exact dynamics + wear-law pairs built so far.
     #[serde(default)]
     pub pairs: Vec<PairTable>,
+    /// Two dynamics effects simulated together at the magnitudes a pair's fits landed on.
+    #[serde(default)]
+    pub joints: Vec<JointPoint>,
     /// Windows simulated to build it.
     pub simulations: usize,
     /// Options used.
     pub options: EmulatorOptions,
+}
+
+/// Two dynamics effects simulated together: `tables` (emulator table indices) at
+/// `magnitudes`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct JointPoint {
+    /// The two tables.
+    pub tables: [usize; 2],
+    /// Their magnitudes.
+    pub magnitudes: [f64; 2],
+    /// The simulated predictions.
+    pub predictions: TestPredictions,
 }
 
 /// Friction work of one increment's window by band, J.
@@ -484,6 +499,7 @@ impl Emulator {
             halving_response_records,
             effects,
             pairs: Vec::new(),
+            joints: Vec::new(),
             simulations: cache.len() - before,
             options: options.clone(),
         })
@@ -505,26 +521,74 @@ impl Emulator {
                     p.at(*mb, *ma)
                 }
             }
-            many => {
-                let mut out = self.nominal.clone();
-                for (e, m) in many {
-                    let p = self.effects[*e].at(*m);
+            [(a, ma), (b, mb)] if self.joint_near(*a, *ma, *b, *mb).is_some() => {
+                let mut out = self.product(effects);
+                if let Some(j) = self.joint_near(*a, *ma, *b, *mb) {
+                    // The product corrected by the simulator at the nearest joint point (exact
+                    // there): joint / product, per quantity.
+                    let at = [
+                        (j.tables[0], j.magnitudes[0]),
+                        (j.tables[1], j.magnitudes[1]),
+                    ];
+                    let base = self.product(&at);
                     for (ti, t) in out.iter_mut().enumerate() {
                         for (k, q) in t.iter_mut().enumerate() {
-                            let nom = &self.nominal[ti][k];
-                            let ratio =
-                                nom.zip(&p[ti][k], |n, x| if n > 0.0 { x / n } else { f64::NAN });
-                            let delta = nom.zip(&p[ti][k], |n, x| x - n);
-                            *q = q.zip(&ratio, |a, r| a * r);
-                            // Where the nominal is 0, add the effect's own amount.
-                            let fixed = q.zip(&delta, |a, d| if a.is_nan() { d } else { a });
-                            *q = fixed;
+                            let (b, e) = (&base[ti][k], &j.predictions[ti][k]);
+                            let ratio = b.zip(e, |b, e| if b > 0.0 { e / b } else { f64::NAN });
+                            // Where the product is 0 at the joint point, add the difference.
+                            let added = q.zip(&b.zip(e, |b, e| e - b), |x, d| x + d);
+                            let scaled = q.zip(&ratio, |x, r| x * r);
+                            *q = scaled.zip(&added, |x, a| if x.is_nan() { a } else { x });
                         }
                     }
                 }
                 out
             }
+            many => self.product(many),
         }
+    }
+
+    /// The nearest joint point of tables `a` and `b` (distance in fractions of each
+    /// magnitude's bound), if any.
+    fn joint_near(&self, a: usize, ma: f64, b: usize, mb: f64) -> Option<&JointPoint> {
+        let scale = |t: usize, m: f64| self.effects[t].bound_for(m).abs().max(1e-300);
+        self.joints
+            .iter()
+            .filter_map(|j| {
+                let (x, y) = if j.tables == [a, b] {
+                    (j.magnitudes[0], j.magnitudes[1])
+                } else if j.tables == [b, a] {
+                    (j.magnitudes[1], j.magnitudes[0])
+                } else {
+                    return None;
+                };
+                Some((
+                    j,
+                    (x - ma).abs() / scale(a, ma) + (y - mb).abs() / scale(b, mb),
+                ))
+            })
+            .min_by(|p, q| p.1.total_cmp(&q.1))
+            .map(|(j, _)| j)
+    }
+
+    /// The nominal times each effect's ratio to the nominal.
+    fn product(&self, effects: &[(usize, f64)]) -> TestPredictions {
+        let mut out = self.nominal.clone();
+        for (e, m) in effects {
+            let p = self.effects[*e].at(*m);
+            for (ti, t) in out.iter_mut().enumerate() {
+                for (k, q) in t.iter_mut().enumerate() {
+                    let nom = &self.nominal[ti][k];
+                    let ratio = nom.zip(&p[ti][k], |n, x| if n > 0.0 { x / n } else { f64::NAN });
+                    let delta = nom.zip(&p[ti][k], |n, x| x - n);
+                    *q = q.zip(&ratio, |a, r| a * r);
+                    // Where the nominal is 0, add the effect's own amount.
+                    let fixed = q.zip(&delta, |a, d| if a.is_nan() { d } else { a });
+                    *q = fixed;
+                }
+            }
+        }
+        out
     }
 }
 
@@ -604,6 +668,43 @@ impl Emulator {
             self.add_pair(campaign, configs_dir, d, w, control, cache)?;
         }
         Ok(targets.len())
+    }
+
+    /// Simulates dynamics tables `a` and `b` together at `ma` and `mb` (held already: nothing
+    /// done). Returns whether a point was added.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_joint(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        (a, ma): (usize, f64),
+        (b, mb): (usize, f64),
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<bool, GapError> {
+        if ma == 0.0 || mb == 0.0 || !ma.is_finite() || !mb.is_finite() {
+            return Ok(false);
+        }
+        let held = self.joints.iter().any(|j| {
+            (j.tables == [a, b] && j.magnitudes == [ma, mb])
+                || (j.tables == [b, a] && j.magnitudes == [mb, ma])
+        });
+        if held {
+            return Ok(false);
+        }
+        let (ta, tb) = (&self.effects[a], &self.effects[b]);
+        let set = vec![
+            effect_with(ta.info, ma, &ta.parameters),
+            effect_with(tb.info, mb, &tb.parameters),
+        ];
+        let mut p = self.simulate_sets(campaign, configs_dir, vec![set], control, cache)?;
+        let predictions = p.pop().unwrap_or_default();
+        self.joints.push(JointPoint {
+            tables: [a, b],
+            magnitudes: [ma, mb],
+            predictions,
+        });
+        Ok(true)
     }
 
     /// Index of the exact pair table of tables `a` and `b` (either order), if built.

@@ -40,6 +40,7 @@ mod report;
 pub mod stats;
 pub mod table;
 
+use crate::gap::effects::Acts;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
@@ -430,15 +431,34 @@ impl<'a> Problem<'a> {
             .take(4)
             .collect();
         let mut out = Vec::new();
+        let mut push = |ta: usize, tb: usize| {
+            let (fa, fb) = (self.family_of(ta), self.family_of(tb));
+            let m = if fa < fb {
+                Model::Pair(ta, tb)
+            } else {
+                Model::Pair(tb, ta)
+            };
+            if fa != fb && !out.contains(&m) {
+                out.push(m);
+            }
+        };
         for (ai, &a) in top.iter().enumerate() {
             for &b in &top[ai + 1..] {
-                let (ta, tb) = (singles[a].table(), singles[b].table());
-                let (fa, fb) = (self.family_of(ta), self.family_of(tb));
-                out.push(if fa < fb {
-                    Model::Pair(ta, tb)
-                } else {
-                    Model::Pair(tb, ta)
-                });
+                push(singles[a].table(), singles[b].table());
+            }
+        }
+        // A wear law may act only on the tracks a dynamics effect brings (wear above the
+        // cutoff under a cross-axis drive), invisible alone on the nominal tracks: the two best
+        // dynamics singles are paired with every wear-law effect.
+        let dynamics = top
+            .iter()
+            .filter(|&&i| self.emulator.effects[singles[i].table()].info.acts == Acts::Dynamics)
+            .take(2);
+        for &d in dynamics {
+            for (f, c) in singles.iter().enumerate() {
+                if self.emulator.effects[self.families[f][0]].info.acts == Acts::WearLaw {
+                    push(singles[d].table(), c.table());
+                }
             }
         }
         out
@@ -492,6 +512,22 @@ impl Candidate {
         } else {
             0.0
         }
+    }
+
+    /// Explains, but fitted at a magnitude bound or with a held-out shrink under
+    /// [`MIN_EXPLAINED_SHRINK`] (what `partly_explained` reports).
+    fn only_partly(&self, nominal: &Candidate, emulator: &Emulator) -> bool {
+        let at_bound = self.spec.iter().any(|&(t, m)| {
+            let b = emulator.effects[t].bound_for(m);
+            m != 0.0 && (m - b).abs() <= 1e-9 * b.abs()
+        });
+        let before = nominal.held_error();
+        let shrink = if before > 0.0 {
+            1.0 - self.held_error() / before
+        } else {
+            0.0
+        };
+        at_bound || !(shrink >= MIN_EXPLAINED_SHRINK)
     }
 
     fn explains(&self, nominal: &Candidate) -> bool {

@@ -165,12 +165,14 @@ fn secondary(
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
         };
-        if singles.iter().any(|c| c.explains(&nominal)) {
+        let cleanly = |c: &Candidate| c.explains(&nominal) && !c.only_partly(&nominal, emulator);
+        if singles.iter().any(cleanly) {
             return Ok(());
         }
         let mut order: Vec<&Candidate> = singles
             .iter()
-            .filter(|c| c.held_ll() > nominal.held_ll() && c.residual_p < options.alpha)
+            .filter(|c| c.held_ll() > nominal.held_ll())
+            .filter(|c| c.residual_p < options.alpha || c.only_partly(&nominal, emulator))
             .filter(|c| emulator.effects[c.table()].info.parameters.len() > 1)
             .filter(|c| c.spec.first().is_some_and(|s| s.1 != 0.0))
             .collect();
@@ -335,16 +337,27 @@ fn exact_pairs(
                 return Ok(());
             }
             let models = problem.pair_models(&singles, &nominal);
-            let requests: Vec<(usize, f64)> = if round == 0 {
-                Vec::new()
-            } else {
-                models
-                    .iter()
-                    .flat_map(|m| requests_of(emulator, &problem.evaluate(*m, options.alpha)))
-                    .collect()
-            };
-            (models, requests)
+            let mut requests: Vec<(usize, f64)> = Vec::new();
+            let mut joints: Vec<[(usize, f64); 2]> = Vec::new();
+            if round > 0 {
+                for m in &models {
+                    let c = problem.evaluate(*m, options.alpha);
+                    requests.extend(requests_of(emulator, &c));
+                    // Two dynamics effects: simulated together where the fits land.
+                    for s in std::iter::once(&c.spec).chain(c.fold_specs.iter()) {
+                        if let [a, b] = s[..] {
+                            let both =
+                                emulator.effects[a.0].simulated && emulator.effects[b.0].simulated;
+                            if both && a.1 != 0.0 && b.1 != 0.0 && !joints.contains(&[a, b]) {
+                                joints.push([a, b]);
+                            }
+                        }
+                    }
+                }
+            }
+            (models, (requests, joints))
         };
+        let (requests, joints) = requests;
         if round == 0 {
             for m in models {
                 if let Model::Pair(a, b) = m {
@@ -364,7 +377,14 @@ fn exact_pairs(
             }
             continue;
         }
-        if emulator.refine(campaign, configs_dir, &requests, control, cache, &|_, _| {})? == 0 {
+        let mut added =
+            emulator.refine(campaign, configs_dir, &requests, control, cache, &|_, _| {})?;
+        for [a, b] in joints {
+            if emulator.add_joint(campaign, configs_dir, a, b, control, cache)? {
+                added += 1;
+            }
+        }
+        if added == 0 {
             break;
         }
     }
