@@ -775,3 +775,78 @@ impl Scores {
         s
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(truth: &str, in_library: bool, verdict: Verdict, chosen: Option<&str>) -> Outcome {
+        Outcome {
+            scenario: Scenario {
+                truth: truth.into(),
+                in_library,
+                magnitude: 1.0,
+                effects: Vec::new(),
+                noise_rel: 0.03,
+                seed: 0,
+            },
+            detectability: 10.0,
+            detectable: true,
+            member_detectability: Vec::new(),
+            verdict,
+            chosen: chosen.map(str::to_string),
+            shrink: chosen.map(|_| 0.9),
+            fitted_magnitude: None,
+            fitted: Vec::new(),
+            nominal_p_value: 0.0,
+            flagged: Vec::new(),
+        }
+    }
+
+    /// A pair is both named whatever the order of its names; naming one member is neither
+    /// both named nor wrong; naming an effect the rig did not inject is wrong, and so is any
+    /// name for a control or a rig-only effect; `partly_explained` is never a confident name.
+    #[test]
+    fn pairs_and_wrong_names_are_scored_by_the_truth() {
+        let s = score(vec![
+            outcome(
+                "third_body+cross_axis",
+                true,
+                Verdict::Explained,
+                Some("cross_axis+third_body"),
+            ),
+            outcome(
+                "third_body+cross_axis",
+                true,
+                Verdict::Explained,
+                Some("cross_axis"),
+            ),
+            outcome(
+                "cross_axis",
+                true,
+                Verdict::Explained,
+                Some("fixture_compliance"),
+            ),
+            outcome("cross_axis", true, Verdict::Explained, Some("cross_axis")),
+            outcome(
+                "work_hardening",
+                false,
+                Verdict::Explained,
+                Some("friction_drift"),
+            ),
+            outcome(
+                "control",
+                true,
+                Verdict::PartlyExplained,
+                Some("sharp_edges"),
+            ),
+        ]);
+        assert_eq!(s.detectable_pairs, 2);
+        assert_eq!(s.pairs_both_named, 0.5);
+        assert_eq!(s.detectable_in_library, 2);
+        assert_eq!(s.top1, 0.5);
+        assert_eq!(s.wrong_names, 2);
+        assert_eq!(s.partly_explained, 1);
+        assert_eq!(s.controls_clean, 0.0);
+    }
+}
