@@ -127,14 +127,34 @@ fn profile_interval(problem: &Problem, spec: &[(usize, f64)], i: usize) -> [f64;
         problem.nll_of(&s, |_| true)
     };
     let floor = nll(best);
-    let inside: Vec<f64> = problem
-        .candidates(t)
-        .into_iter()
+    let cands = problem.candidates(t);
+    let inside: Vec<f64> = cands
+        .iter()
+        .copied()
         .filter(|m| nll(*m) <= floor + PROFILE_95)
         .collect();
     let lo = inside.iter().copied().fold(best, f64::min);
     let hi = inside.iter().copied().fold(best, f64::max);
-    [lo, hi]
+    widen_to_grid(&cands, [lo, hi])
+}
+
+/// `[lo, hi]` widened to the neighbouring grid values outside it (the profile's edge lies
+/// somewhere between the last value inside and the first outside: the conservative side).
+fn widen_to_grid(grid: &[f64], [lo, hi]: [f64; 2]) -> [f64; 2] {
+    let below = grid
+        .iter()
+        .copied()
+        .filter(|v| *v < lo)
+        .fold(f64::NAN, f64::max);
+    let above = grid
+        .iter()
+        .copied()
+        .filter(|v| *v > hi)
+        .fold(f64::NAN, f64::min);
+    [
+        if below.is_nan() { lo } else { below },
+        if above.is_nan() { hi } else { above },
+    ]
 }
 
 /// 95 % profile-likelihood interval of secondary parameter `name` of member `i`, over the
@@ -173,7 +193,8 @@ fn secondary_interval(
         .map(|(v, _)| *v);
     let lo = inside.clone().fold(chosen, f64::min);
     let hi = inside.fold(chosen, f64::max);
-    Some([lo, hi])
+    let grid: Vec<f64> = by_value.iter().map(|v| v.0).collect();
+    Some(widen_to_grid(&grid, [lo, hi]))
 }
 
 /// Why a chosen candidate only partly explains the gap: a magnitude fitted at its physical

@@ -229,10 +229,16 @@ fn profile_secondary(
     let info = emulator.effects[default_table].info;
     let magnitudes: Vec<f64> = match info.acts {
         Acts::WearLaw => Vec::new(),
-        Acts::Dynamics => {
-            let bound = emulator.effects[default_table].bound_for(m);
-            vec![m, bound]
-        }
+        // The default table's grid on the fitted magnitude's side, and the fitted magnitude:
+        // another secondary value may move the magnitude that fits.
+        Acts::Dynamics => emulator.effects[default_table]
+            .magnitudes
+            .iter()
+            .copied()
+            .filter(|g| *g != 0.0 && (*g < 0.0) == (m < 0.0))
+            .filter(|g| g.abs() >= 0.1 * m.abs())
+            .chain([m])
+            .collect(),
     };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
     for p in &info.parameters[1..] {
