@@ -538,6 +538,18 @@ pub fn diagnose(
         return Ok(());
     }
     println!("{}: {}", report.campaign, report.summary);
+    if let Some(b) = &report.best_effect {
+        for p in &b.parameters {
+            let interval = match (p.fitted, p.interval) {
+                (true, Some([lo, hi])) => format!("95 % interval [{lo:.4e}, {hi:.4e}]"),
+                _ => "held at the library default".to_string(),
+            };
+            println!(
+                "  {}.{} = {:.4e} {} ({interval}; bounds [{}, {}])",
+                p.effect, p.name, p.value, p.unit, p.bounds[0], p.bounds[1]
+            );
+        }
+    }
     println!(
         "nominal: chi2 {:.1} on {:.1} dof (p = {:.2e}); held-out {}",
         report.nominal.chi2, report.nominal.dof, report.nominal.p_value, report.held_out

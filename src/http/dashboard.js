@@ -368,7 +368,14 @@ async function showDiagnosis(job) {
 
     if (r.best_effect) {
       const b = r.best_effect;
-      out.appendChild(text("h4", "Best effect: " + b.name));
+      out.appendChild(text("h4", (r.verdict === "partly_explained"
+        ? "Leading candidate (partly explains the gap): " : "Best effect: ") + b.name));
+      if (r.partly_explained) {
+        const p = r.partly_explained;
+        out.appendChild(text("div", "Not explained in full: " + p.reasons.join("; ") + ". It cannot predict " +
+          p.cannot_predict + " (held-out RMS error " + fmt.sigma(p.cannot_predict_error[0]) + " nominal, " +
+          fmt.sigma(p.cannot_predict_error[1]) + " with it).", "partly-explained"));
+      }
       out.appendChild(text("div", "Held-out RMS standardized error: " + fmt.sigma(b.held_out_error_before) +
         " before, " + fmt.sigma(b.held_out_error_after) + " after; the gap shrinks by " + fmt.percent(b.shrink) +
         " (90 % interval " + fmt.percent(b.shrink_interval[0]) + " to " + fmt.percent(b.shrink_interval[1]) +

@@ -1,7 +1,12 @@
 //! The blind check of the diagnosis (`railwear diagnose-bench`): campaigns drawn from the
 //! virtual rig on one skeleton (controls, each library effect from barely to clearly
-//! detectable, the rig-only effects, two noise levels), each diagnosed without its truth, then
-//! scored against the truth.
+//! detectable with its secondary parameters drawn uniformly within their bounds, pairs of a
+//! dynamics effect with a wear-law effect and of two dynamics effects, the rig-only effects,
+//! two noise levels), each diagnosed without its truth, then scored against the truth.
+//!
+//! A **wrong name** is a confident name that is not the truth: an `explained` verdict naming
+//! an effect the rig did not inject (any name, for a control or a rig-only effect). A pair is
+//! **both named** when the verdict is `explained` and names exactly its two effects.
 //!
 //! **Detectable.** An effect is detectable in a campaign when its noise-free readings (the rig
 //! with noise, scatter and sensor noise off) differ from the control's noise-free readings by
@@ -11,22 +16,24 @@
 //! noise, the simulator's numerical and parameter uncertainty, and each accelerometer channel's
 //! calibration as one shared scale: an effect that only rescales a channel by about the
 //! calibration's uncertainty is not detectable). Only detectable in-library effects count in the top-1 score;
-//! undetectable ones are reported apart (the right answer for them is `no_gap`).
+//! undetectable ones are reported apart (the right answer for them is `no_gap`). A pair is
+//! detectable when each member is, given the other: the pair's noise-free readings differ from
+//! those of the other member alone by more than twice the uncertainty.
 //!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
 
-use super::emulator::{Emulator, EmulatorOptions};
+use super::emulator::{effect_with, Emulator, EmulatorOptions};
 use super::noise::{gaussian, observations, NoiseModel, Observation, Term};
 use super::{diagnose_refining, stats, DiagnoseOptions, Report, Verdict};
-use crate::gap::effects::{Effect, LIBRARY};
+use crate::gap::effects::{Acts, Effect, EffectInfo, LIBRARY};
 use crate::gap::rig::{run_cached, RigOptions, Truth};
 use crate::gap::rig_effects::{HiddenEffect, RIG_ONLY};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
 use rand::seq::SliceRandom;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha20Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -54,6 +61,8 @@ pub struct BenchOptions {
     pub sensor_noise_m_s2: f64,
     /// Magnitudes drawn, as fractions of each effect's bound.
     pub fractions: Vec<f64>,
+    /// Pairs drawn per noise level of each kind (dynamics + wear law, dynamics + dynamics).
+    pub pairs_per_kind: usize,
     /// Diagnosis options.
     pub diagnose: DiagnoseOptions,
 }
@@ -70,6 +79,7 @@ impl Default for BenchOptions {
             accelerometer_rate_hz: 2000.0,
             sensor_noise_m_s2: 0.5,
             fractions: vec![0.07, 0.3, 0.8],
+            pairs_per_kind: 4,
             diagnose: DiagnoseOptions {
                 emulator: EmulatorOptions {
                     window_s: 0.5,
@@ -85,12 +95,16 @@ impl Default for BenchOptions {
 /// What the rig put in one campaign.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scenario {
-    /// `control`, a library effect's name or a rig-only effect's name.
+    /// `control`, a library effect's name, `a+b` for a pair (library order) or a rig-only
+    /// effect's name.
     pub truth: String,
     /// In the library.
     pub in_library: bool,
-    /// Magnitude.
+    /// Magnitude (of the first effect).
     pub magnitude: f64,
+    /// The library effects injected, every parameter given (secondary ones drawn).
+    #[serde(default)]
+    pub effects: Vec<Effect>,
     /// Relative measurement noise.
     pub noise_rel: f64,
     /// Rig seed.
@@ -104,8 +118,11 @@ pub struct Outcome {
     pub scenario: Scenario,
     /// Detectability score (see the module documentation).
     pub detectability: f64,
-    /// Detectable (score > 2).
+    /// Detectable (score > 2; a pair: each member's score given the other > 2 too).
     pub detectable: bool,
+    /// A pair's members' detectability, each given the other.
+    #[serde(default)]
+    pub member_detectability: Vec<f64>,
     /// Verdict.
     pub verdict: Verdict,
     /// Best effect's name, if any.
@@ -114,10 +131,26 @@ pub struct Outcome {
     pub shrink: Option<f64>,
     /// Fitted magnitude, if one effect.
     pub fitted_magnitude: Option<f64>,
+    /// Every parameter of the named effect(s): value, interval, fitted or held at default.
+    #[serde(default)]
+    pub fitted: Vec<FittedValue>,
     /// Lack-of-fit p-value of the nominal model.
     pub nominal_p_value: f64,
     /// Groups flagged in `where`.
     pub flagged: Vec<String>,
+}
+
+/// One parameter of a named effect.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedValue {
+    /// `effect.parameter`.
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// 95 % interval, when fitted.
+    pub interval: Option<[f64; 2]>,
+    /// Fitted (false: held at the library default).
+    pub fitted: bool,
 }
 
 /// The bench's scores.
@@ -129,6 +162,21 @@ pub struct Scores {
     pub detectable_in_library: usize,
     /// Of those, the share whose best effect is the true one.
     pub top1: f64,
+    /// Detectable pairs.
+    #[serde(default)]
+    pub detectable_pairs: usize,
+    /// Of those, the share `explained` by exactly their two effects.
+    #[serde(default)]
+    pub pairs_both_named: f64,
+    /// Campaigns `explained` by an effect that is not (part of) the truth.
+    #[serde(default)]
+    pub wrong_names: usize,
+    /// Their share of every campaign.
+    #[serde(default)]
+    pub wrong_name_rate: f64,
+    /// Campaigns reported `partly_explained`.
+    #[serde(default)]
+    pub partly_explained: usize,
     /// Controls.
     pub controls: usize,
     /// Share of controls reported no_gap.
@@ -147,6 +195,14 @@ pub struct Scores {
     pub outcomes: Vec<Outcome>,
 }
 
+/// Secondary parameters of `info` drawn uniformly within their bounds.
+fn draw_secondary(info: &EffectInfo, rng: &mut ChaCha20Rng) -> BTreeMap<String, f64> {
+    info.parameters[1..]
+        .iter()
+        .map(|p| (p.name.to_string(), rng.gen_range(p.min..=p.max)))
+        .collect()
+}
+
 fn scenarios(
     base: &Campaign,
     configs_dir: &Path,
@@ -159,16 +215,35 @@ fn scenarios(
         .map(|(ti, t)| t.case(ti, configs_dir))
         .collect::<Result<_, _>>()?;
     let lib = super::emulator::applicable(&cases, None)?;
-    let mut list = Vec::new();
+    // Secondary parameters and pairs from their own stream.
+    let mut draw = ChaCha20Rng::seed_from_u64(o.seed);
+    draw.set_stream(2);
+    type Drawn = (String, bool, Vec<Effect>, f64, f64);
+    let mut list: Vec<Drawn> = Vec::new();
+    let library_effect = |info: &EffectInfo, f: f64, rng: &mut ChaCha20Rng| {
+        effect_with(info, f * info.parameters[0].max, &draw_secondary(info, rng))
+    };
+    let dynamics: Vec<&EffectInfo> = lib
+        .iter()
+        .copied()
+        .filter(|e| e.acts == Acts::Dynamics)
+        .collect();
+    let wear: Vec<&EffectInfo> = lib
+        .iter()
+        .copied()
+        .filter(|e| e.acts == Acts::WearLaw)
+        .collect();
     for &noise in &o.noise_levels {
         for _ in 0..6 {
-            list.push(("control".to_string(), true, 0.0, noise));
+            list.push(("control".to_string(), true, Vec::new(), 0.0, noise));
         }
         for info in &lib {
             for f in &o.fractions {
+                let e = library_effect(info, *f, &mut draw);
                 list.push((
                     info.name.to_string(),
                     true,
+                    vec![e],
                     f * info.parameters[0].max,
                     noise,
                 ));
@@ -179,9 +254,47 @@ fn scenarios(
                 list.push((
                     info.name.to_string(),
                     false,
+                    Vec::new(),
                     f * info.parameters[0].max,
                     noise,
                 ));
+            }
+        }
+        // Pairs: a dynamics effect with a wear-law effect, and two dynamics effects.
+        for kind in 0..2 {
+            for _ in 0..o.pairs_per_kind {
+                let Some(a) = dynamics.choose(&mut draw).copied() else {
+                    continue;
+                };
+                let pool: Vec<&EffectInfo> = if kind == 0 {
+                    wear.clone()
+                } else {
+                    dynamics
+                        .iter()
+                        .copied()
+                        .filter(|d| d.name != a.name)
+                        .collect()
+                };
+                let Some(b) = pool.choose(&mut draw).copied() else {
+                    continue;
+                };
+                let (fa, fb) = (
+                    *o.fractions.choose(&mut draw).unwrap_or(&0.3),
+                    *o.fractions.choose(&mut draw).unwrap_or(&0.3),
+                );
+                let mut members = vec![
+                    library_effect(a, fa, &mut draw),
+                    library_effect(b, fb, &mut draw),
+                ];
+                let rank = |e: &Effect| LIBRARY.iter().position(|l| l.name == e.name);
+                members.sort_by_key(rank);
+                let name = members
+                    .iter()
+                    .map(|e| e.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join("+");
+                let m = members[0].magnitude();
+                list.push((name, true, members, m, noise));
             }
         }
     }
@@ -191,13 +304,16 @@ fn scenarios(
         .into_iter()
         .take(o.campaigns)
         .enumerate()
-        .map(|(i, (truth, in_library, magnitude, noise_rel))| Scenario {
-            truth,
-            in_library,
-            magnitude,
-            noise_rel,
-            seed: o.seed.wrapping_mul(1000).wrapping_add(i as u64),
-        })
+        .map(
+            |(i, (truth, in_library, effects, magnitude, noise_rel))| Scenario {
+                truth,
+                in_library,
+                magnitude,
+                effects,
+                noise_rel,
+                seed: o.seed.wrapping_mul(1000).wrapping_add(i as u64),
+            },
+        )
         .collect())
 }
 
@@ -219,11 +335,13 @@ fn rig_options(s: &Scenario, o: &BenchOptions, noisy: bool) -> Result<RigOptions
         ..RigOptions::default()
     };
     if s.truth != "control" {
-        let text = format!("{}={}", s.truth, s.magnitude);
         if s.in_library {
-            r.effects.push(Effect::parse(&text)?);
+            r.effects = s.effects.clone();
         } else {
-            r.hidden.push(HiddenEffect::parse(&text)?);
+            r.hidden.push(HiddenEffect::parse(&format!(
+                "{}={}",
+                s.truth, s.magnitude
+            ))?);
         }
     }
     Ok(r)
@@ -307,6 +425,7 @@ pub fn run(
         truth: "control".into(),
         in_library: true,
         magnitude: 0.0,
+        effects: Vec::new(),
         noise_rel: 0.0,
         seed: 0,
     };
@@ -342,13 +461,38 @@ pub fn run(
             control,
             &cache,
         )?;
+        let mut member_detectability = Vec::new();
         let det = if s.truth == "control" {
             0.0
         } else {
             let mut noisy_obs = observations(&noisy);
             let noise = NoiseModel::estimate(&noisy, &mut noisy_obs, &emulator, &o.diagnose);
-            detectability(&observations(&clean), &control_obs, &noise, &noisy_obs)
+            let clean_obs = observations(&clean);
+            if s.effects.len() == 2 {
+                // Each member given the other: the pair against the other member alone.
+                for drop in 0..2 {
+                    let other = Scenario {
+                        effects: vec![s.effects[1 - drop].clone()],
+                        ..s.clone()
+                    };
+                    let (alone, _) = run_cached(
+                        skeleton,
+                        configs_dir,
+                        &rig_options(&other, o, false)?,
+                        control,
+                        &cache,
+                    )?;
+                    member_detectability.push(detectability(
+                        &clean_obs,
+                        &observations(&alone),
+                        &noise,
+                        &noisy_obs,
+                    ));
+                }
+            }
+            detectability(&clean_obs, &control_obs, &noise, &noisy_obs)
         };
+        let detectable = det > 2.0 && member_detectability.iter().all(|d| *d > 2.0);
         // Each campaign refines its own copy, so its diagnosis is the one it would get alone.
         let mut refined = emulator.clone();
         let report: Report = diagnose_refining(
@@ -365,7 +509,8 @@ pub fn run(
         outcomes.push(Outcome {
             scenario: s.clone(),
             detectability: det,
-            detectable: det > 2.0,
+            detectable,
+            member_detectability,
             verdict: report.verdict,
             shrink: report.best_effect.as_ref().map(|b| b.shrink),
             fitted_magnitude: report
@@ -373,6 +518,21 @@ pub fn run(
                 .as_ref()
                 .filter(|b| !b.name.contains('+'))
                 .and_then(|b| b.parameters.first().map(|p| p.value)),
+            fitted: report
+                .best_effect
+                .as_ref()
+                .map(|b| {
+                    b.parameters
+                        .iter()
+                        .map(|p| FittedValue {
+                            name: format!("{}.{}", p.effect, p.name),
+                            value: p.value,
+                            interval: p.interval,
+                            fitted: p.fitted,
+                        })
+                        .collect()
+                })
+                .unwrap_or_default(),
             chosen,
             nominal_p_value: report.nominal.p_value,
             flagged: report
@@ -398,6 +558,9 @@ fn answer(o: &Outcome) -> String {
         Verdict::NoGap => "no_gap".into(),
         Verdict::NotExplained => "not_explained".into(),
         Verdict::Explained => o.chosen.clone().unwrap_or_else(|| "?".into()),
+        Verdict::PartlyExplained => {
+            format!("partly: {}", o.chosen.clone().unwrap_or_else(|| "?".into()))
+        }
     }
 }
 
@@ -409,20 +572,59 @@ fn share(k: usize, n: usize) -> f64 {
     }
 }
 
+/// The effect names of a truth or an answer (`a+b` split; none for a control).
+fn names(text: &str) -> Vec<&str> {
+    if text == "control" {
+        Vec::new()
+    } else {
+        text.split('+').collect()
+    }
+}
+
+/// Explained by exactly the truth's effects.
+fn named_right(o: &Outcome) -> bool {
+    let (mut truth, mut chosen) = (
+        names(&o.scenario.truth),
+        names(o.chosen.as_deref().unwrap_or("")),
+    );
+    truth.sort_unstable();
+    chosen.sort_unstable();
+    o.verdict == Verdict::Explained && o.scenario.in_library && truth == chosen
+}
+
+/// A confident name that is not the truth: explained by an effect the rig did not inject.
+fn named_wrong(o: &Outcome) -> bool {
+    if o.verdict != Verdict::Explained {
+        return false;
+    }
+    let truth = if o.scenario.in_library {
+        names(&o.scenario.truth)
+    } else {
+        Vec::new()
+    };
+    names(o.chosen.as_deref().unwrap_or("?"))
+        .iter()
+        .any(|n| !truth.contains(n))
+}
+
 /// Scores outcomes.
 pub fn score(outcomes: Vec<Outcome>) -> Scores {
     let lib: Vec<&Outcome> = outcomes
         .iter()
         .filter(|o| o.scenario.in_library && o.scenario.truth != "control")
         .collect();
-    let det_lib: Vec<&&Outcome> = lib.iter().filter(|o| o.detectable).collect();
-    let right: Vec<&&&Outcome> = det_lib
+    let singles: Vec<&&Outcome> = lib
         .iter()
-        .filter(|o| {
-            o.verdict == Verdict::Explained && o.chosen.as_deref() == Some(&o.scenario.truth)
-        })
+        .filter(|o| !o.scenario.truth.contains('+'))
         .collect();
-    let undet: Vec<&&Outcome> = lib.iter().filter(|o| !o.detectable).collect();
+    let det_lib: Vec<&&&Outcome> = singles.iter().filter(|o| o.detectable).collect();
+    let right: Vec<&&&&Outcome> = det_lib.iter().filter(|o| named_right(o)).collect();
+    let det_pairs: Vec<&&Outcome> = lib
+        .iter()
+        .filter(|o| o.scenario.truth.contains('+') && o.detectable)
+        .collect();
+    let pairs_right = det_pairs.iter().filter(|o| named_right(o)).count();
+    let undet: Vec<&&&Outcome> = singles.iter().filter(|o| !o.detectable).collect();
     let controls: Vec<&Outcome> = outcomes
         .iter()
         .filter(|o| o.scenario.truth == "control")
@@ -431,6 +633,7 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .iter()
         .filter(|o| !o.scenario.in_library && o.detectable)
         .collect();
+    let wrong = outcomes.iter().filter(|o| named_wrong(o)).count();
     let mut confusion: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
     for o in &outcomes {
         let row = if o.scenario.truth == "control" || o.detectable {
@@ -444,11 +647,24 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             .entry(answer(o))
             .or_insert(0) += 1;
     }
-    let shrinks: Vec<f64> = right.iter().filter_map(|o| o.shrink).collect();
+    let shrinks: Vec<f64> = right
+        .iter()
+        .map(|o| ****o)
+        .chain(det_pairs.iter().map(|o| **o).filter(|o| named_right(o)))
+        .filter_map(|o| o.shrink)
+        .collect();
     Scores {
         campaigns: outcomes.len(),
         detectable_in_library: det_lib.len(),
         top1: share(right.len(), det_lib.len()),
+        detectable_pairs: det_pairs.len(),
+        pairs_both_named: share(pairs_right, det_pairs.len()),
+        wrong_names: wrong,
+        wrong_name_rate: share(wrong, outcomes.len()),
+        partly_explained: outcomes
+            .iter()
+            .filter(|o| o.verdict == Verdict::PartlyExplained)
+            .count(),
         controls: controls.len(),
         controls_clean: share(
             controls
@@ -493,9 +709,24 @@ impl Scores {
         s.push_str("| score | value | target |\n|---|---|---|\n");
         s.push_str(&format!("| campaigns | {} | >= 60 |\n", self.campaigns));
         s.push_str(&format!(
-            "| top-1 on detectable in-library effects ({}) | {} | >= 85 % |\n",
+            "| top-1 on detectable single effects ({}) | {} | >= 85 % |\n",
             self.detectable_in_library,
             pct(self.top1)
+        ));
+        s.push_str(&format!(
+            "| detectable pairs explained by both members ({}) | {} | >= 60 % |\n",
+            self.detectable_pairs,
+            pct(self.pairs_both_named)
+        ));
+        s.push_str(&format!(
+            "| wrong names: explained by an effect not injected ({} of {}) | {} | <= 5 % |\n",
+            self.wrong_names,
+            self.campaigns,
+            pct(self.wrong_name_rate)
+        ));
+        s.push_str(&format!(
+            "| partly_explained (not counted as named) | {} | |\n",
+            self.partly_explained
         ));
         s.push_str(&format!(
             "| controls reported no_gap ({}) | {} | >= 90 % |\n",
@@ -508,7 +739,7 @@ impl Scores {
             pct(self.rig_only_flagged)
         ));
         s.push_str(&format!(
-            "| median held-out shrink where the right effect was found | {} | >= 50 % |\n",
+            "| median held-out shrink where the right effect (or pair) was found | {} | >= 50 % |\n",
             pct(self.median_shrink)
         ));
         s.push_str(&format!(
@@ -542,5 +773,80 @@ impl Scores {
             s.push('\n');
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(truth: &str, in_library: bool, verdict: Verdict, chosen: Option<&str>) -> Outcome {
+        Outcome {
+            scenario: Scenario {
+                truth: truth.into(),
+                in_library,
+                magnitude: 1.0,
+                effects: Vec::new(),
+                noise_rel: 0.03,
+                seed: 0,
+            },
+            detectability: 10.0,
+            detectable: true,
+            member_detectability: Vec::new(),
+            verdict,
+            chosen: chosen.map(str::to_string),
+            shrink: chosen.map(|_| 0.9),
+            fitted_magnitude: None,
+            fitted: Vec::new(),
+            nominal_p_value: 0.0,
+            flagged: Vec::new(),
+        }
+    }
+
+    /// A pair is both named whatever the order of its names; naming one member is neither
+    /// both named nor wrong; naming an effect the rig did not inject is wrong, and so is any
+    /// name for a control or a rig-only effect; `partly_explained` is never a confident name.
+    #[test]
+    fn pairs_and_wrong_names_are_scored_by_the_truth() {
+        let s = score(vec![
+            outcome(
+                "third_body+cross_axis",
+                true,
+                Verdict::Explained,
+                Some("cross_axis+third_body"),
+            ),
+            outcome(
+                "third_body+cross_axis",
+                true,
+                Verdict::Explained,
+                Some("cross_axis"),
+            ),
+            outcome(
+                "cross_axis",
+                true,
+                Verdict::Explained,
+                Some("fixture_compliance"),
+            ),
+            outcome("cross_axis", true, Verdict::Explained, Some("cross_axis")),
+            outcome(
+                "work_hardening",
+                false,
+                Verdict::Explained,
+                Some("friction_drift"),
+            ),
+            outcome(
+                "control",
+                true,
+                Verdict::PartlyExplained,
+                Some("sharp_edges"),
+            ),
+        ]);
+        assert_eq!(s.detectable_pairs, 2);
+        assert_eq!(s.pairs_both_named, 0.5);
+        assert_eq!(s.detectable_in_library, 2);
+        assert_eq!(s.top1, 0.5);
+        assert_eq!(s.wrong_names, 2);
+        assert_eq!(s.partly_explained, 1);
+        assert_eq!(s.controls_clean, 0.0);
     }
 }

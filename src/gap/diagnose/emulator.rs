@@ -13,11 +13,15 @@
 //!   between grid points the prediction is interpolated, log-linearly in each quantity. The
 //!   interpolation is an approximation of the simulator: its error is of the order of the
 //!   chaotic spread the tolerance-halving run measures, which the diagnosis already carries.
-//! - Two effects together: the product of their ratios to the nominal (exact when they act
-//!   independently, an approximation otherwise; stated in the report).
+//! - A dynamics effect with a wear-law effect: exact once the diagnosis has built their
+//!   [`PairTable`] (the wear law on the dynamics effect's own simulated tracks).
+//! - Two effects together otherwise: the product of their ratios to the nominal (exact when
+//!   they act independently, an approximation otherwise; stated in the report).
+//! - Variants: an effect tabulated again at other values of its secondary parameters
+//!   ([`EffectTable::parameters`]), for the diagnosis to profile them.
 
 pub use super::prediction::{mean_square, Prediction, TestPredictions};
-pub use super::table::EffectTable;
+pub use super::table::{EffectTable, PairTable};
 use crate::gap::effects::{Acts, Effect, EffectInfo, LIBRARY};
 use crate::gap::rig::{simulate_test, ModelIncrement, RigOptions};
 use crate::gap::tracks::WearTerm;
@@ -91,12 +95,31 @@ pub struct Emulator {
     pub response_records: Vec<(f64, Vec<[f64; 3]>)>,
     /// The same from the tolerance-halving run.
     pub halving_response_records: Vec<(f64, Vec<[f64; 3]>)>,
-    /// Tabulated effects.
+    /// Tabulated effects (an effect may have several tables: variants at other values of
+    /// its secondary parameters).
     pub effects: Vec<EffectTable>,
+    /// Exact dynamics + wear-law pairs built so far.
+    #[serde(default)]
+    pub pairs: Vec<PairTable>,
+    /// Two dynamics effects simulated together at the magnitudes a pair's fits landed on.
+    #[serde(default)]
+    pub joints: Vec<JointPoint>,
     /// Windows simulated to build it.
     pub simulations: usize,
     /// Options used.
     pub options: EmulatorOptions,
+}
+
+/// Two dynamics effects simulated together: `tables` (emulator table indices) at
+/// `magnitudes`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct JointPoint {
+    /// The two tables.
+    pub tables: [usize; 2],
+    /// Their magnitudes.
+    pub magnitudes: [f64; 2],
+    /// The simulated predictions.
+    pub predictions: TestPredictions,
 }
 
 /// Friction work of one increment's window by band, J.
@@ -180,10 +203,19 @@ pub fn wear_grid(info: &EffectInfo) -> Vec<f64> {
 }
 
 fn effect_at(info: &EffectInfo, magnitude: f64) -> Effect {
+    effect_with(info, magnitude, &BTreeMap::new())
+}
+
+/// The effect at `magnitude` with its other parameters from `secondary` (library defaults for
+/// those not listed).
+pub fn effect_with(info: &EffectInfo, magnitude: f64, secondary: &BTreeMap<String, f64>) -> Effect {
     let mut parameters: BTreeMap<String, f64> = info
         .parameters
         .iter()
-        .map(|p| (p.name.to_string(), p.default))
+        .map(|p| {
+            let v = secondary.get(p.name).copied().unwrap_or(p.default);
+            (p.name.to_string(), v)
+        })
         .collect();
     parameters.insert(info.parameters[0].name.to_string(), magnitude);
     Effect {
@@ -383,6 +415,7 @@ impl Emulator {
                         magnitudes: dynamics_grid(info, options.grid_points),
                         predictions: ids.iter().map(|&s| preds(&by_slot[s])).collect(),
                         simulated: true,
+                        parameters: BTreeMap::new(),
                     });
                 }
                 Acts::WearLaw => {
@@ -412,6 +445,7 @@ impl Emulator {
                         magnitudes,
                         predictions,
                         simulated: false,
+                        parameters: BTreeMap::new(),
                     });
                 }
             }
@@ -468,6 +502,8 @@ impl Emulator {
             response_records,
             halving_response_records,
             effects,
+            pairs: Vec::new(),
+            joints: Vec::new(),
             simulations: cache.len() - before,
             options: options.clone(),
         })
@@ -479,26 +515,84 @@ impl Emulator {
         match effects {
             [] => self.nominal.clone(),
             [(e, m)] => self.effects[*e].at(*m),
-            many => {
-                let mut out = self.nominal.clone();
-                for (e, m) in many {
-                    let p = self.effects[*e].at(*m);
+            // A member at 0 is the other alone, exactly.
+            [(_, z), one] | [one, (_, z)] if *z == 0.0 => self.effects[one.0].at(one.1),
+            [(a, ma), (b, mb)] if self.pair(*a, *b).is_some() => {
+                let p = &self.pairs[self.pair(*a, *b).unwrap_or_default()];
+                if p.dynamics == *a {
+                    p.at(*ma, *mb)
+                } else {
+                    p.at(*mb, *ma)
+                }
+            }
+            [(a, ma), (b, mb)] if self.joint_near(*a, *ma, *b, *mb).is_some() => {
+                let mut out = self.product(effects);
+                if let Some(j) = self.joint_near(*a, *ma, *b, *mb) {
+                    // The product corrected by the simulator at the nearest joint point (exact
+                    // there): joint / product, per quantity.
+                    let at = [
+                        (j.tables[0], j.magnitudes[0]),
+                        (j.tables[1], j.magnitudes[1]),
+                    ];
+                    let base = self.product(&at);
                     for (ti, t) in out.iter_mut().enumerate() {
                         for (k, q) in t.iter_mut().enumerate() {
-                            let nom = &self.nominal[ti][k];
-                            let ratio =
-                                nom.zip(&p[ti][k], |n, x| if n > 0.0 { x / n } else { f64::NAN });
-                            let delta = nom.zip(&p[ti][k], |n, x| x - n);
-                            *q = q.zip(&ratio, |a, r| a * r);
-                            // Where the nominal is 0, add the effect's own amount.
-                            let fixed = q.zip(&delta, |a, d| if a.is_nan() { d } else { a });
-                            *q = fixed;
+                            let (b, e) = (&base[ti][k], &j.predictions[ti][k]);
+                            let ratio = b.zip(e, |b, e| if b > 0.0 { e / b } else { f64::NAN });
+                            // Where the product is 0 at the joint point, add the difference.
+                            let added = q.zip(&b.zip(e, |b, e| e - b), |x, d| x + d);
+                            let scaled = q.zip(&ratio, |x, r| x * r);
+                            *q = scaled.zip(&added, |x, a| if x.is_nan() { a } else { x });
                         }
                     }
                 }
                 out
             }
+            many => self.product(many),
         }
+    }
+
+    /// The nearest joint point of tables `a` and `b` (distance in fractions of each
+    /// magnitude's bound), if any.
+    fn joint_near(&self, a: usize, ma: f64, b: usize, mb: f64) -> Option<&JointPoint> {
+        let scale = |t: usize, m: f64| self.effects[t].bound_for(m).abs().max(1e-300);
+        self.joints
+            .iter()
+            .filter_map(|j| {
+                let (x, y) = if j.tables == [a, b] {
+                    (j.magnitudes[0], j.magnitudes[1])
+                } else if j.tables == [b, a] {
+                    (j.magnitudes[1], j.magnitudes[0])
+                } else {
+                    return None;
+                };
+                Some((
+                    j,
+                    (x - ma).abs() / scale(a, ma) + (y - mb).abs() / scale(b, mb),
+                ))
+            })
+            .min_by(|p, q| p.1.total_cmp(&q.1))
+            .map(|(j, _)| j)
+    }
+
+    /// The nominal times each effect's ratio to the nominal.
+    fn product(&self, effects: &[(usize, f64)]) -> TestPredictions {
+        let mut out = self.nominal.clone();
+        for (e, m) in effects {
+            let p = self.effects[*e].at(*m);
+            for (ti, t) in out.iter_mut().enumerate() {
+                for (k, q) in t.iter_mut().enumerate() {
+                    let nom = &self.nominal[ti][k];
+                    let ratio = nom.zip(&p[ti][k], |n, x| if n > 0.0 { x / n } else { f64::NAN });
+                    let delta = nom.zip(&p[ti][k], |n, x| x - n);
+                    *q = q.zip(&ratio, |a, r| a * r);
+                    // Where the nominal is 0, add the effect's own amount.
+                    let fixed = q.zip(&delta, |a, d| if a.is_nan() { d } else { a });
+                    *q = fixed;
+                }
+            }
+        }
+        out
     }
 }
 
@@ -542,7 +636,10 @@ impl Emulator {
         let (cases, increments) = plan(campaign, configs_dir)?;
         let slots: Vec<Slot> = targets
             .iter()
-            .map(|&(e, m)| (vec![effect_at(self.effects[e].info, m)], 1.0, 0.0, 0.0))
+            .map(|&(e, m)| {
+                let t = &self.effects[e];
+                (vec![effect_with(t.info, m, &t.parameters)], 1.0, 0.0, 0.0)
+            })
             .collect();
         let before = cache.len();
         let total = slots.len() * campaign.tests.len();
@@ -564,7 +661,249 @@ impl Emulator {
             t.predictions.insert(at, predictions_of(slot));
         }
         self.simulations += cache.len() - before;
+        // Exact pairs on a refined dynamics table follow it.
+        let stale: Vec<(usize, usize)> = self
+            .pairs
+            .iter()
+            .filter(|p| targets.iter().any(|(e, _)| *e == p.dynamics))
+            .map(|p| (p.dynamics, p.wear))
+            .collect();
+        for (d, w) in stale {
+            self.add_pair(campaign, configs_dir, d, w, control, cache)?;
+        }
         Ok(targets.len())
+    }
+
+    /// Simulates dynamics tables `a` and `b` together at `ma` and `mb` (held already: nothing
+    /// done). Returns whether a point was added.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_joint(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        (a, ma): (usize, f64),
+        (b, mb): (usize, f64),
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<bool, GapError> {
+        if ma == 0.0 || mb == 0.0 || !ma.is_finite() || !mb.is_finite() {
+            return Ok(false);
+        }
+        let held = self.joints.iter().any(|j| {
+            (j.tables == [a, b] && j.magnitudes == [ma, mb])
+                || (j.tables == [b, a] && j.magnitudes == [mb, ma])
+        });
+        if held {
+            return Ok(false);
+        }
+        let (ta, tb) = (&self.effects[a], &self.effects[b]);
+        let set = vec![
+            effect_with(ta.info, ma, &ta.parameters),
+            effect_with(tb.info, mb, &tb.parameters),
+        ];
+        let mut p = self.simulate_sets(campaign, configs_dir, vec![set], control, cache)?;
+        let predictions = p.pop().unwrap_or_default();
+        self.joints.push(JointPoint {
+            tables: [a, b],
+            magnitudes: [ma, mb],
+            predictions,
+        });
+        Ok(true)
+    }
+
+    /// Index of the exact pair table of tables `a` and `b` (either order), if built.
+    pub fn pair(&self, a: usize, b: usize) -> Option<usize> {
+        self.pairs
+            .iter()
+            .position(|p| (p.dynamics, p.wear) == (a, b) || (p.dynamics, p.wear) == (b, a))
+    }
+
+    /// Predictions `[set][test][increment]` of every test with each set of effects on,
+    /// through the same segment path, tolerance and initial state as the grid (windows already
+    /// simulated come from `cache`; wear-law effects are evaluated on the windows' tracks).
+    fn simulate_sets(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        sets: Vec<Vec<Effect>>,
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<Vec<TestPredictions>, GapError> {
+        let (cases, increments) = plan(campaign, configs_dir)?;
+        let slots: Vec<Slot> = sets.into_iter().map(|e| (e, 1.0, 0.0, 0.0)).collect();
+        let before = cache.len();
+        let total = slots.len() * campaign.tests.len();
+        let by_slot = simulate_slots(
+            &slots,
+            campaign,
+            (&cases, &increments),
+            configs_dir,
+            &self.options,
+            control,
+            cache,
+            &|_, _| {},
+            (0, total),
+        )?;
+        self.simulations += cache.len() - before;
+        Ok(by_slot.iter().map(|s| predictions_of(s)).collect())
+    }
+
+    /// Adds a variant of table `of`: the same effect with its secondary parameters at
+    /// `secondary` (those not listed at the library defaults), simulated at `magnitudes`
+    /// (dynamics; 0 is the nominal and is always included) or evaluated exactly on the nominal
+    /// windows' tracks at the wear-law grid (wear law; `magnitudes` ignored). Returns the new
+    /// table's index; an identical variant already held is returned instead.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_variant(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        of: usize,
+        secondary: BTreeMap<String, f64>,
+        magnitudes: &[f64],
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<usize, GapError> {
+        let info = self.effects[of].info;
+        if let Some(i) = self
+            .effects
+            .iter()
+            .position(|t| t.info.name == info.name && t.parameters == secondary)
+        {
+            return Ok(i);
+        }
+        let mut grid: Vec<f64> = match info.acts {
+            Acts::WearLaw => wear_grid(info),
+            Acts::Dynamics => magnitudes
+                .iter()
+                .copied()
+                .filter(|m| m.is_finite())
+                .chain([0.0])
+                .collect(),
+        };
+        grid.sort_by(f64::total_cmp);
+        grid.dedup();
+        let sets: Vec<Vec<Effect>> = grid
+            .iter()
+            .map(|&m| {
+                if m == 0.0 {
+                    Vec::new()
+                } else {
+                    vec![effect_with(info, m, &secondary)]
+                }
+            })
+            .collect();
+        let predictions = self.simulate_sets(campaign, configs_dir, sets, control, cache)?;
+        self.effects.push(EffectTable {
+            info,
+            magnitudes: grid,
+            predictions,
+            simulated: info.acts == Acts::Dynamics,
+            parameters: secondary,
+        });
+        Ok(self.effects.len() - 1)
+    }
+
+    /// Builds (or rebuilds) the exact pair of dynamics table `dynamics` and wear-law table
+    /// `wear`: the wear law at its bound evaluated on the dynamics effect's own windows at
+    /// every magnitude of its table (the windows come from `cache`, or are simulated again).
+    /// The prediction is linear in the wear magnitude when the wear term is (checked at an
+    /// eighth of the bound on the dynamics effect's first simulated magnitude, to 1e-9
+    /// relative); otherwise slices at nine magnitudes of the wear-law grid are kept. Returns
+    /// the pair table's index.
+    pub fn add_pair(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        dynamics: usize,
+        wear: usize,
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<usize, GapError> {
+        let (d, w) = (self.effects[dynamics].clone(), self.effects[wear].clone());
+        if d.info.acts != Acts::Dynamics || w.info.acts != Acts::WearLaw {
+            return Err(GapError::field(
+                "effects",
+                format!(
+                    "an exact pair is a dynamics effect and a wear-law effect, not `{}` and `{}`",
+                    d.info.name, w.info.name
+                ),
+            ));
+        }
+        let slice_at = |this: &mut Self, wm: f64| -> Result<EffectTable, GapError> {
+            let sets = d
+                .magnitudes
+                .iter()
+                .map(|&m| {
+                    let mut set = Vec::new();
+                    if m != 0.0 {
+                        set.push(effect_with(d.info, m, &d.parameters));
+                    }
+                    if wm != 0.0 {
+                        set.push(effect_with(w.info, wm, &w.parameters));
+                    }
+                    set
+                })
+                .collect();
+            let predictions = this.simulate_sets(campaign, configs_dir, sets, control, cache)?;
+            Ok(EffectTable {
+                predictions,
+                ..d.clone()
+            })
+        };
+        let max = w.info.parameters[0].max;
+        let top = slice_at(self, max)?;
+        // Linearity check on the first simulated magnitude.
+        let probe = d.magnitudes.iter().position(|m| *m != 0.0).unwrap_or(0);
+        let eighth = {
+            let m = d.magnitudes[probe];
+            let mut set = vec![effect_with(w.info, max / 8.0, &w.parameters)];
+            if m != 0.0 {
+                set.push(effect_with(d.info, m, &d.parameters));
+            }
+            self.simulate_sets(campaign, configs_dir, vec![set], control, cache)?
+        };
+        let linear = eighth.first().is_some_and(|e| {
+            e.iter().enumerate().all(|(ti, t)| {
+                t.iter().enumerate().all(|(k, p)| {
+                    let a = d.predictions[probe][ti][k].flat();
+                    let b = top.predictions[probe][ti][k].flat();
+                    p.flat().iter().zip(a.iter().zip(&b)).all(|(x, (u, v))| {
+                        let lin = u + (v - u) / 8.0;
+                        (x - lin).abs() <= 1e-9 * x.abs().max(lin.abs()).max(1e-300)
+                    })
+                })
+            })
+        });
+        let (wear_magnitudes, slices) = if linear {
+            (vec![0.0, max], vec![d.clone(), top])
+        } else {
+            let grid = wear_grid(w.info);
+            let mut ms: Vec<f64> = grid.iter().copied().skip(1).step_by(4).collect();
+            ms.retain(|m| *m != max);
+            let mut slices = vec![d.clone()];
+            let mut mags = vec![0.0];
+            for m in ms {
+                slices.push(slice_at(self, m)?);
+                mags.push(m);
+            }
+            slices.push(top);
+            mags.push(max);
+            (mags, slices)
+        };
+        let table = PairTable {
+            dynamics,
+            wear,
+            wear_magnitudes,
+            slices,
+        };
+        if let Some(i) = self.pair(dynamics, wear) {
+            self.pairs[i] = table;
+            Ok(i)
+        } else {
+            self.pairs.push(table);
+            Ok(self.pairs.len() - 1)
+        }
     }
 }
 

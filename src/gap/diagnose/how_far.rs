@@ -13,13 +13,9 @@ pub(super) fn held_out_predictions(
 ) -> Vec<HeldOutPrediction> {
     let nominal = problem.emulator.predict(&[]);
     let folds: Vec<emulator::TestPredictions> = c
-        .fold_magnitudes
+        .fold_specs
         .iter()
-        .map(|m| {
-            let spec: Vec<(usize, f64)> =
-                c.effects.iter().copied().zip(m.iter().copied()).collect();
-            problem.emulator.predict(&spec)
-        })
+        .map(|spec| problem.emulator.predict(spec))
         .collect();
     problem
         .obs
@@ -37,8 +33,8 @@ pub(super) fn held_out_predictions(
                 measured_mg: o.value,
                 uncertainty_mg: problem.noise.u_marginal(o, mu),
                 nominal_mg: mu,
-                effect: problem.name_of(&c.effects),
-                magnitude: c.fold_magnitudes[g].first().copied().unwrap_or(0.0),
+                effect: problem.name_of(&c.families),
+                magnitude: c.fold_specs[g].first().map_or(0.0, |s| s.1),
                 with_effect_mg: o.predicted(&folds[g]),
             }
         })
@@ -66,23 +62,38 @@ pub(super) fn best_effect(
         })
         .collect();
     let mut parameters = Vec::new();
-    for (&e, &m) in c.effects.iter().zip(&c.magnitudes) {
-        let info = problem.emulator.effects[e].info;
-        let interval = (c.effects.len() == 1).then(|| profile_interval(problem, e, m));
+    for (i, &(t, m)) in c.spec.iter().enumerate() {
+        let table = &problem.emulator.effects[t];
+        let info = table.info;
+        let family = problem.family_of(t);
+        let interval = profile_interval(problem, &c.spec, i);
         for (pi, p) in info.parameters.iter().enumerate() {
+            if pi == 0 {
+                parameters.push(FittedParameter {
+                    effect: info.name.to_string(),
+                    name: p.name.to_string(),
+                    unit: p.unit.to_string(),
+                    value: m,
+                    interval: Some(interval),
+                    bounds: [p.min, p.max],
+                    fitted: true,
+                });
+                continue;
+            }
+            let profiled = secondary_interval(problem, family, &c.spec, i, p.name);
             parameters.push(FittedParameter {
                 effect: info.name.to_string(),
                 name: p.name.to_string(),
                 unit: p.unit.to_string(),
-                value: if pi == 0 { m } else { p.default },
-                interval: if pi == 0 { interval } else { None },
+                value: table.parameter(p.name),
+                interval: profiled,
                 bounds: [p.min, p.max],
-                fitted: pi == 0,
+                fitted: profiled.is_some(),
             });
         }
     }
     BestEffect {
-        name: problem.name_of(&c.effects),
+        name: problem.name_of(&c.families),
         parameters,
         held_out_error_before: before,
         held_out_error_after: after,
@@ -106,16 +117,131 @@ pub(super) fn best_effect(
     }
 }
 
-/// 95 % profile-likelihood interval of one effect's magnitude around its full-data optimum.
-fn profile_interval(problem: &Problem, e: usize, best: f64) -> [f64; 2] {
-    let nll = |m: f64| problem.nll_of(&[(e, m)], |_| true);
+/// 95 % profile-likelihood interval of member `i`'s magnitude around the full-data optimum
+/// `spec` (the other member, for a pair, held at its fitted magnitude: a conditional interval).
+fn profile_interval(problem: &Problem, spec: &[(usize, f64)], i: usize) -> [f64; 2] {
+    let (t, best) = spec[i];
+    let nll = |m: f64| {
+        let mut s = spec.to_vec();
+        s[i].1 = m;
+        problem.nll_of(&s, |_| true)
+    };
     let floor = nll(best);
-    let cands = problem.candidates(e);
+    let cands = problem.candidates(t);
     let inside: Vec<f64> = cands
-        .into_iter()
+        .iter()
+        .copied()
         .filter(|m| nll(*m) <= floor + PROFILE_95)
         .collect();
     let lo = inside.iter().copied().fold(best, f64::min);
     let hi = inside.iter().copied().fold(best, f64::max);
-    [lo, hi]
+    widen_to_grid(&cands, [lo, hi])
+}
+
+/// `[lo, hi]` widened to the neighbouring grid values outside it (the profile's edge lies
+/// somewhere between the last value inside and the first outside: the conservative side).
+fn widen_to_grid(grid: &[f64], [lo, hi]: [f64; 2]) -> [f64; 2] {
+    let below = grid
+        .iter()
+        .copied()
+        .filter(|v| *v < lo)
+        .fold(f64::NAN, f64::max);
+    let above = grid
+        .iter()
+        .copied()
+        .filter(|v| *v > hi)
+        .fold(f64::NAN, f64::min);
+    [
+        if below.is_nan() { lo } else { below },
+        if above.is_nan() { hi } else { above },
+    ]
+}
+
+/// 95 % profile-likelihood interval of secondary parameter `name` of member `i`, over the
+/// values its family's tables hold (each value at its best magnitude, the other member held):
+/// the values within [`PROFILE_95`] of the best, spanned. None when the family holds no
+/// variant in that parameter (it was not fitted). Its resolution is the profile's grid.
+fn secondary_interval(
+    problem: &Problem,
+    family: usize,
+    spec: &[(usize, f64)],
+    i: usize,
+    name: &str,
+) -> Option<[f64; 2]> {
+    let tables = &problem.families[family];
+    if !tables
+        .iter()
+        .any(|t| problem.emulator.effects[*t].parameters.contains_key(name))
+    {
+        return None;
+    }
+    let chosen = problem.emulator.effects[spec[i].0].parameter(name);
+    let mut by_value: Vec<(f64, f64)> = Vec::new();
+    for &t in tables {
+        let mut best = f64::INFINITY;
+        for m in problem.candidates(t) {
+            let mut s = spec.to_vec();
+            s[i] = (t, m);
+            best = best.min(problem.nll_of(&s, |_| true));
+        }
+        by_value.push((problem.emulator.effects[t].parameter(name), best));
+    }
+    let floor = by_value.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
+    let inside = by_value
+        .iter()
+        .filter(|(_, n)| *n <= floor + PROFILE_95)
+        .map(|(v, _)| *v);
+    let lo = inside.clone().fold(chosen, f64::min);
+    let hi = inside.fold(chosen, f64::max);
+    let grid: Vec<f64> = by_value.iter().map(|v| v.0).collect();
+    Some(widen_to_grid(&grid, [lo, hi]))
+}
+
+/// Why a chosen candidate only partly explains the gap: a magnitude fitted at its physical
+/// bound, or a held-out shrink under [`MIN_EXPLAINED_SHRINK`]. None when neither holds.
+pub(super) fn partly_explained(
+    problem: &Problem,
+    c: &Candidate,
+    b: &BestEffect,
+) -> Option<PartlyExplained> {
+    let mut reasons = Vec::new();
+    let mut at_bound = Vec::new();
+    for &(t, m) in &c.spec {
+        let table = &problem.emulator.effects[t];
+        let bound = table.bound_for(m);
+        if m != 0.0 && (m - bound).abs() <= 1e-9 * bound.abs() {
+            let p = &table.info.parameters[0];
+            at_bound.push(format!("{}.{}", table.info.name, p.name));
+            reasons.push(format!(
+                "{} fitted at its bound {} {}",
+                p.name, bound, p.unit
+            ));
+        }
+    }
+    if !(b.shrink >= MIN_EXPLAINED_SHRINK) {
+        reasons.push(format!(
+            "held-out shrink {:.0} % < {:.0} %",
+            100.0 * b.shrink,
+            100.0 * MIN_EXPLAINED_SHRINK
+        ));
+    }
+    if reasons.is_empty() {
+        return None;
+    }
+    let worst = b
+        .per_group
+        .iter()
+        .max_by(|x, y| x.after.total_cmp(&y.after))?;
+    Some(PartlyExplained {
+        candidate: b.name.clone(),
+        reasons,
+        at_bound,
+        held_out_error: [b.held_out_error_before, b.held_out_error_after],
+        shrink: b.shrink,
+        chi2_left: c.chi2,
+        dof: c.dof,
+        residual_p_value: c.residual_p,
+        cannot_predict: worst.group.clone(),
+        cannot_predict_error: [worst.before, worst.after],
+    })
 }

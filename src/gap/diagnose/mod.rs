@@ -41,11 +41,12 @@ mod report;
 pub mod stats;
 pub mod table;
 
+use crate::gap::effects::Acts;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::pipeline::RunControl;
 use emulator::{Emulator, EmulatorOptions};
-use how_far::{best_effect, held_out_predictions};
+use how_far::{best_effect, held_out_predictions, partly_explained};
 use noise::{NoiseModel, Observation, Totals};
 pub use refine::diagnose_refining;
 pub use report::*;
@@ -67,6 +68,14 @@ pub const REFINE_ROUNDS: usize = 3;
 /// Dynamics effects refined per round: those with the best held-out log-likelihood among the
 /// ones that improve on the nominal.
 pub const REFINE_CONTENDERS: usize = 3;
+
+/// Held-out shrink below which a named effect only partly explains the gap
+/// ([`Verdict::PartlyExplained`]): it fits the training tests but predicts the held-out ones
+/// little better than the nominal model.
+pub const MIN_EXPLAINED_SHRINK: f64 = 0.2;
+
+/// Effects whose secondary parameters are fitted when they lead and leave lack-of-fit.
+pub const SECONDARY_CONTENDERS: usize = 2;
 
 /// Profile-likelihood drop of a 95 % interval for one parameter (chi-square 1 dof: 3.84 / 2).
 pub const PROFILE_95: f64 = 1.920_729_410_347_062;
@@ -121,6 +130,21 @@ pub struct Problem<'a> {
     /// Per effect table, per observation: the table's relative roughness², added to the
     /// model's variance wherever the effect is on.
     roughness: Vec<Vec<f64>>,
+    /// The emulator's tables by effect: the first is the effect at its library defaults, the
+    /// others its variants at other values of its secondary parameters.
+    families: Vec<Vec<usize>>,
+}
+
+/// What a candidate fits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Model {
+    /// Nothing: the nominal model.
+    Nominal,
+    /// One effect (family index): its magnitude, and its secondary parameters over the
+    /// family's variant tables.
+    Single(usize),
+    /// Two effects on fixed tables (table indices): both magnitudes.
+    Pair(usize, usize),
 }
 
 impl<'a> Problem<'a> {
@@ -144,16 +168,33 @@ impl<'a> Problem<'a> {
                 "leave-one-increment-out (fewer than 3 tests)".to_string(),
             )
         };
+        // A variant (the effect at other secondary values, a few magnitudes) carries its
+        // effect's roughness from the default table's full grid.
         let roughness = emulator
             .effects
             .iter()
             .map(|t| {
-                let r = t.roughness();
+                let source = emulator
+                    .effects
+                    .iter()
+                    .find(|d| d.info.name == t.info.name && d.parameters.is_empty())
+                    .unwrap_or(t);
+                let r = source.roughness();
                 obs.iter()
                     .map(|o| r.get(&o.quantity.label()).copied().unwrap_or(0.0).powi(2))
                     .collect()
             })
             .collect();
+        let mut families: Vec<Vec<usize>> = Vec::new();
+        for (i, t) in emulator.effects.iter().enumerate() {
+            match families
+                .iter_mut()
+                .find(|f| emulator.effects[f[0]].info.name == t.info.name)
+            {
+                Some(f) => f.push(i),
+                None => families.push(vec![i]),
+            }
+        }
         Self {
             obs,
             noise,
@@ -163,6 +204,7 @@ impl<'a> Problem<'a> {
             groups,
             group_labels,
             held_out,
+            families,
         }
     }
 
@@ -212,49 +254,118 @@ impl<'a> Problem<'a> {
         out
     }
 
-    /// Best magnitudes of `effects` on the groups `mask` keeps: a grid search (one effect: the
-    /// table refined five-fold; two: the tables' own points).
-    fn fit(&self, effects: &[usize], mask: &dyn Fn(usize) -> bool) -> (Vec<f64>, f64) {
-        let mut best = (vec![0.0; effects.len()], f64::INFINITY);
-        let mut try_one = |mags: Vec<f64>| {
-            let spec: Vec<(usize, f64)> =
-                effects.iter().copied().zip(mags.iter().copied()).collect();
-            let nll = self.nll_of(&spec, mask);
+    /// [`Problem::candidates`] of table `e` between the table points either side of its
+    /// point `x`.
+    fn candidates_near(&self, e: usize, x: f64) -> Vec<f64> {
+        let m = &self.emulator.effects[e].magnitudes;
+        let i = m.partition_point(|v| *v < x);
+        let lo = m[i.saturating_sub(1)];
+        let hi = m[(i + 1).min(m.len() - 1)];
+        self.candidates(e)
+            .into_iter()
+            .filter(|c| *c >= lo && *c <= hi)
+            .collect()
+    }
+
+    /// The family (effect) of table `t`.
+    fn family_of(&self, t: usize) -> usize {
+        self.families
+            .iter()
+            .position(|f| f.contains(&t))
+            .unwrap_or(0)
+    }
+
+    /// Best magnitude of table `t` alone on the groups `mask` keeps (a grid search over the
+    /// table refined five-fold): (magnitude, negative log-likelihood).
+    fn fit_table(&self, t: usize, mask: &dyn Fn(usize) -> bool) -> (f64, f64) {
+        let mut best = (0.0, f64::INFINITY);
+        for m in self.candidates(t) {
+            let nll = self.nll_of(&[(t, m)], mask);
             if nll < best.1 {
-                best = (mags, nll);
+                best = (m, nll);
             }
-        };
-        match effects {
-            [] => try_one(Vec::new()),
-            [e] => {
-                for m in self.candidates(*e) {
-                    try_one(vec![m]);
-                }
-            }
-            [a, b] => {
-                let ma = self.emulator.effects[*a].magnitudes.clone();
-                let mb = self.emulator.effects[*b].magnitudes.clone();
-                for x in &ma {
-                    for y in &mb {
-                        try_one(vec![*x, *y]);
-                    }
-                }
-            }
-            _ => {}
         }
         best
     }
 
+    /// Best `(table, magnitude)` of `model` on the groups `mask` keeps, and its negative
+    /// log-likelihood.
+    ///
+    /// - One effect: its magnitude over its default table; a variant table (other values of
+    ///   its secondary parameters) is taken only when it beats the default's best by more than
+    ///   [`PROFILE_95`] (a likelihood-ratio test at 95 %), so noise does not buy parameters.
+    /// - Two effects: every magnitude of each alone (the singles' own candidates, so a pair
+    ///   never fits the training data worse than either member), then both over the tables'
+    ///   points, refined five-fold around the best; both are taken only when they beat the
+    ///   better member alone by more than [`PROFILE_95`].
+    fn fit(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> (Vec<(usize, f64)>, f64) {
+        match model {
+            Model::Nominal => (Vec::new(), self.nll_of(&[], mask)),
+            Model::Single(f) => {
+                let tables = &self.families[f];
+                let (m0, n0) = self.fit_table(tables[0], mask);
+                let mut best = (vec![(tables[0], m0)], n0);
+                let mut variant = (Vec::new(), f64::INFINITY);
+                for &t in &tables[1..] {
+                    let (m, n) = self.fit_table(t, mask);
+                    if n < variant.1 {
+                        variant = (vec![(t, m)], n);
+                    }
+                }
+                if variant.1 < n0 - PROFILE_95 {
+                    best = variant;
+                }
+                best
+            }
+            Model::Pair(a, b) => {
+                let mut member = (vec![(a, 0.0), (b, 0.0)], self.nll_of(&[], mask));
+                let consider = |best: &mut (Vec<(usize, f64)>, f64), x: f64, y: f64| {
+                    let spec = vec![(a, x), (b, y)];
+                    let nll = self.nll_of(&spec, mask);
+                    if nll < best.1 {
+                        *best = (spec, nll);
+                    }
+                };
+                for x in self.candidates(a) {
+                    consider(&mut member, x, 0.0);
+                }
+                for y in self.candidates(b) {
+                    consider(&mut member, 0.0, y);
+                }
+                let mut joint = (Vec::new(), f64::INFINITY);
+                let (ma, mb) = (
+                    &self.emulator.effects[a].magnitudes,
+                    &self.emulator.effects[b].magnitudes,
+                );
+                for &x in ma {
+                    for &y in mb {
+                        consider(&mut joint, x, y);
+                    }
+                }
+                if let [(_, x0), (_, y0)] = joint.0[..] {
+                    for x in self.candidates_near(a, x0) {
+                        for y in self.candidates_near(b, y0) {
+                            consider(&mut joint, x, y);
+                        }
+                    }
+                }
+                if joint.1 < member.1 - PROFILE_95 {
+                    joint
+                } else {
+                    member
+                }
+            }
+        }
+    }
+
     /// Candidate evaluated: held-out per group, full-data fit, criteria.
-    fn evaluate(&self, effects: &[usize], alpha: f64) -> Candidate {
+    fn evaluate(&self, model: Model, alpha: f64) -> Candidate {
         let mut held_nll = Vec::with_capacity(self.groups);
         let mut held_r2 = Vec::with_capacity(self.groups);
         let mut held_w = Vec::with_capacity(self.groups);
-        let mut fold_magnitudes = Vec::with_capacity(self.groups);
+        let mut fold_specs = Vec::with_capacity(self.groups);
         for g in 0..self.groups {
-            let (mags, _) = self.fit(effects, &|h| h != g);
-            fold_magnitudes.push(mags.clone());
-            let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags).collect();
+            let (spec, _) = self.fit(model, &|h| h != g);
             // Held out: the joint likelihood less the training groups' alone, i.e. group `g`
             // given the training groups (their calibration scales carried over).
             let p = self.emulator.predict(&spec);
@@ -263,18 +374,27 @@ impl<'a> Problem<'a> {
             held_nll.push(held.nll);
             held_r2.push(held.r2);
             held_w.push(held.w);
+            fold_specs.push(spec);
         }
-        let (mags, nll_full) = self.fit(effects, &|_| true);
-        let spec: Vec<(usize, f64)> = effects.iter().copied().zip(mags.iter().copied()).collect();
+        let (spec, nll_full) = self.fit(model, &|_| true);
         let full = self.totals(&spec, &|_| true);
-        let k = effects.len() as f64;
+        // Parameters fitted: each magnitude, and the secondary parameters of a variant.
+        let k = spec
+            .iter()
+            .map(|(t, _)| 1 + self.emulator.effects[*t].parameters.len())
+            .sum::<usize>() as f64;
         let n = full.w;
         let chi2 = full.r2;
         let residual_p = stats::chi2_sf(chi2, (n - k).round().max(1.0) as usize);
+        let families = match model {
+            Model::Nominal => Vec::new(),
+            Model::Single(f) => vec![f],
+            Model::Pair(a, b) => vec![self.family_of(a), self.family_of(b)],
+        };
         Candidate {
-            effects: effects.to_vec(),
-            magnitudes: mags,
-            fold_magnitudes,
+            families,
+            spec,
+            fold_specs,
             held_nll,
             held_r2,
             held_w,
@@ -283,29 +403,78 @@ impl<'a> Problem<'a> {
             residual_p,
             chi2,
             dof: n,
+            k,
             alpha,
         }
     }
 
-    fn name_of(&self, effects: &[usize]) -> String {
-        if effects.is_empty() {
+    /// Name of an effect (family) list: `a+b`, `none` when empty.
+    fn name_of(&self, families: &[usize]) -> String {
+        if families.is_empty() {
             return "none".into();
         }
-        effects
+        families
             .iter()
-            .map(|e| self.emulator.effects[*e].info.name)
+            .map(|f| self.emulator.effects[self.families[*f][0]].info.name)
             .collect::<Vec<_>>()
             .join("+")
+    }
+
+    /// The pairs to try given the singles: every two of the four best singles that beat the
+    /// nominal held out, each on the table its full-data fit chose, in library order.
+    fn pair_models(&self, singles: &[Candidate], nominal: &Candidate) -> Vec<Model> {
+        let mut order: Vec<usize> = (0..singles.len()).collect();
+        order.sort_by(|a, b| singles[*b].held_ll().total_cmp(&singles[*a].held_ll()));
+        let top: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| singles[i].held_ll() > nominal.held_ll())
+            .take(4)
+            .collect();
+        let mut out = Vec::new();
+        let mut push = |ta: usize, tb: usize| {
+            let (fa, fb) = (self.family_of(ta), self.family_of(tb));
+            let m = if fa < fb {
+                Model::Pair(ta, tb)
+            } else {
+                Model::Pair(tb, ta)
+            };
+            if fa != fb && !out.contains(&m) {
+                out.push(m);
+            }
+        };
+        for (ai, &a) in top.iter().enumerate() {
+            for &b in &top[ai + 1..] {
+                push(singles[a].table(), singles[b].table());
+            }
+        }
+        // A wear law may act only on the tracks a dynamics effect brings (wear above the
+        // cutoff under a cross-axis drive), invisible alone on the nominal tracks: the two best
+        // dynamics singles are paired with every wear-law effect.
+        let dynamics = top
+            .iter()
+            .filter(|&&i| self.emulator.effects[singles[i].table()].info.acts == Acts::Dynamics)
+            .take(2);
+        for &d in dynamics {
+            for (f, c) in singles.iter().enumerate() {
+                if self.emulator.effects[self.families[f][0]].info.acts == Acts::WearLaw {
+                    push(singles[d].table(), c.table());
+                }
+            }
+        }
+        out
     }
 }
 
 /// One candidate's numbers.
 #[derive(Debug, Clone)]
 struct Candidate {
-    effects: Vec<usize>,
-    magnitudes: Vec<f64>,
-    /// Magnitudes fitted on each training fold (the held-out predictions use them).
-    fold_magnitudes: Vec<Vec<f64>>,
+    /// Effects (family indices), for its name.
+    families: Vec<usize>,
+    /// Full-data fit: (table, magnitude) per effect.
+    spec: Vec<(usize, f64)>,
+    /// The fit on each training fold (the held-out predictions use them).
+    fold_specs: Vec<Vec<(usize, f64)>>,
     held_nll: Vec<f64>,
     held_r2: Vec<f64>,
     held_w: Vec<f64>,
@@ -314,6 +483,8 @@ struct Candidate {
     residual_p: f64,
     chi2: f64,
     dof: f64,
+    /// Parameters fitted (full data).
+    k: f64,
     alpha: f64,
 }
 
@@ -326,6 +497,15 @@ impl Candidate {
         (self.held_r2.iter().sum::<f64>() / self.held_w.iter().sum::<f64>().max(1e-300)).sqrt()
     }
 
+    fn magnitudes(&self) -> Vec<f64> {
+        self.spec.iter().map(|s| s.1).collect()
+    }
+
+    /// The table of a single effect's full-data fit.
+    fn table(&self) -> usize {
+        self.spec.first().map_or(0, |s| s.0)
+    }
+
     fn explained_share(&self, nominal: &Candidate) -> f64 {
         let excess = nominal.chi2 - nominal.dof;
         if excess > 0.0 {
@@ -333,6 +513,22 @@ impl Candidate {
         } else {
             0.0
         }
+    }
+
+    /// Explains, but fitted at a magnitude bound or with a held-out shrink under
+    /// [`MIN_EXPLAINED_SHRINK`] (what `partly_explained` reports).
+    fn only_partly(&self, nominal: &Candidate, emulator: &Emulator) -> bool {
+        let at_bound = self.spec.iter().any(|&(t, m)| {
+            let b = emulator.effects[t].bound_for(m);
+            m != 0.0 && (m - b).abs() <= 1e-9 * b.abs()
+        });
+        let before = nominal.held_error();
+        let shrink = if before > 0.0 {
+            1.0 - self.held_error() / before
+        } else {
+            0.0
+        };
+        at_bound || !(shrink >= MIN_EXPLAINED_SHRINK)
     }
 
     fn explains(&self, nominal: &Candidate) -> bool {
@@ -466,15 +662,15 @@ pub fn diagnose_with(
         return Err(no_measurement());
     }
     let alpha = options.alpha;
-    let nominal = problem.evaluate(&[], alpha);
+    let nominal = problem.evaluate(Model::Nominal, alpha);
     let nominal_score = problem.totals(&[], &|_| true);
     let (chi2, dof) = (nominal_score.r2, nominal_score.w);
     let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
     let location = location::locate(campaign, &problem);
     let any_flag = location.any_flagged();
 
-    let singles: Vec<Candidate> = (0..emulator.effects.len())
-        .map(|e| problem.evaluate(&[e], alpha))
+    let singles: Vec<Candidate> = (0..problem.families.len())
+        .map(|f| problem.evaluate(Model::Single(f), alpha))
         .collect();
     let mut order: Vec<usize> = (0..singles.len()).collect();
     order.sort_by(|a, b| singles[*b].held_ll().total_cmp(&singles[*a].held_ll()));
@@ -487,17 +683,11 @@ pub fn diagnose_with(
         .filter(|&i| singles[i].explains(&nominal))
         .collect();
     if !no_gap && explaining_singles.is_empty() {
-        let top: Vec<usize> = order
-            .iter()
-            .copied()
-            .filter(|&i| singles[i].held_ll() > nominal.held_ll())
-            .take(4)
+        pairs = problem
+            .pair_models(&singles, &nominal)
+            .into_iter()
+            .map(|m| problem.evaluate(m, alpha))
             .collect();
-        for (ai, &a) in top.iter().enumerate() {
-            for &b in &top[ai + 1..] {
-                pairs.push(problem.evaluate(&[a, b], alpha));
-            }
-        }
         pairs.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
     }
 
@@ -530,9 +720,9 @@ pub fn diagnose_with(
         [stats::quantile(&gains, 0.05), stats::quantile(&gains, 0.95)]
     };
     let entry = |c: &Candidate, i: usize| RankEntry {
-        name: problem.name_of(&c.effects),
-        magnitudes: c.magnitudes.clone(),
-        parameters: c.effects.len(),
+        name: problem.name_of(&c.families),
+        magnitudes: c.magnitudes(),
+        parameters: c.k.round() as usize,
         held_out_log_likelihood: c.held_ll(),
         held_out_gain: c.held_ll() - nominal.held_ll(),
         held_out_gain_interval: gain_interval(c),
@@ -564,7 +754,7 @@ pub fn diagnose_with(
             .filter(|&&i| {
                 b.held_ll() - singles[i].held_ll() < MIN_HELD_OUT_GAIN || p_first(1 + i) >= 0.1
             })
-            .map(|&i| problem.name_of(&singles[i].effects))
+            .map(|&i| problem.name_of(&singles[i].families))
             .collect();
         Some((b, others))
     } else {
@@ -579,22 +769,28 @@ pub fn diagnose_with(
                     b.held_ll() - pairs[i].held_ll() < MIN_HELD_OUT_GAIN
                         || p_first(1 + singles.len() + i) >= 0.1
                 })
-                .map(|&i| problem.name_of(&pairs[i].effects))
+                .map(|&i| problem.name_of(&pairs[i].families))
                 .collect();
             (b, others)
         })
     };
 
+    let best_effect = chosen
+        .as_ref()
+        .map(|(c, _)| best_effect(&problem, c, &nominal, &resamples));
+    let partly = chosen
+        .as_ref()
+        .zip(best_effect.as_ref())
+        .and_then(|((c, _), b)| partly_explained(&problem, c, b));
     let verdict = if no_gap {
         Verdict::NoGap
+    } else if partly.is_some() {
+        Verdict::PartlyExplained
     } else if chosen.is_some() {
         Verdict::Explained
     } else {
         Verdict::NotExplained
     };
-    let best_effect = chosen
-        .as_ref()
-        .map(|(c, _)| best_effect(&problem, c, &nominal, &resamples));
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
         Verdict::NoGap => format!(
@@ -610,6 +806,9 @@ pub fn diagnose_with(
                 b.map_or(f64::NAN, |b| 100.0 * b.shrink),
             )
         }
+        Verdict::PartlyExplained => partly
+            .as_ref()
+            .map_or_else(String::new, PartlyExplained::sentence),
         Verdict::NotExplained => format!(
             "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
         ),
@@ -642,12 +841,13 @@ pub fn diagnose_with(
             approximations: vec![
                 "each increment is represented by one simulated window (wear scaled by increment / window); dynamics effects of time or slip see the state at the increment's middle".into(),
                 "dynamics effects are simulated on a grid of magnitudes and interpolated log-linearly between grid points".into(),
-                "pairs combine as the nominal times each effect's ratio to the nominal".into(),
-                "parameters other than each effect's magnitude are held at the library defaults".into(),
+                "a dynamics effect with a wear-law effect is exact once refined (the wear law on the dynamics effect's own tracks); two dynamics effects combine as the nominal times each one's ratio to the nominal".into(),
+                "secondary parameters are fitted only for the leading effects that leave lack-of-fit (profiled over a few values within their bounds); otherwise they are held at the library defaults".into(),
                 "specimen scatter is common to a specimen's increments; that correlation is not modelled".into(),
             ],
         },
         held_out_predictions,
+        partly_explained: partly,
         code_version: crate::models::case::code_version().to_string(),
     })
 }

@@ -1,20 +1,59 @@
-//! Adaptive refinement of the emulator's dynamics tables at the magnitudes the contending
-//! effects' fits land on (docs/diagnosis.md, "Adaptive refinement").
+//! Adaptive refinement of the emulator at what the contending candidates' fits land on
+//! (docs/diagnosis.md, "Adaptive refinement", "Secondary parameters", "Exact pairs"):
+//!
+//! 1. the dynamics tables of the best single effects, at their fitted magnitudes;
+//! 2. when no single effect explains and the leading ones leave lack-of-fit, their secondary
+//!    parameters: each profiled over a few values within its bounds (a variant table per
+//!    value, simulated near the fitted magnitude), then the best value's neighbours, then the
+//!    chosen variant refined at its fitted magnitudes;
+//! 3. when still no single effect explains, the pairs of the best singles: a dynamics effect
+//!    with a wear-law effect made exact ([`Emulator::add_pair`]), and every dynamics member
+//!    refined at the magnitudes the pair's fits land on.
 
 use super::{
-    diagnose_with, location, stats, Candidate, DiagnoseOptions, Problem, Report, REFINE_CONTENDERS,
+    diagnose_with, location, stats, Candidate, DiagnoseOptions, Model, Problem, Report,
+    REFINE_CONTENDERS, SECONDARY_CONTENDERS,
 };
 use crate::gap::diagnose::emulator::Emulator;
+use crate::gap::effects::{Acts, ParameterInfo};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::physics::control::RunControl;
+use std::collections::BTreeMap;
 use std::path::Path;
 
-/// The diagnosis after up to `options.refine_rounds` rounds of adaptive refinement of the
-/// emulator's dynamics tables ([`Emulator::refine`]): while the contending effects' fits land
-/// between simulated magnitudes, those magnitudes are simulated and the fits repeated, so the
-/// verdict rests on the simulator at the fitted magnitudes rather than on interpolation.
-/// Nothing is refined when the nominal model shows no gap.
+/// Rounds of refinement of the pairs' dynamics members.
+const PAIR_ROUNDS: usize = 2;
+
+/// Values of a secondary parameter in the profile's first pass: five, log-spaced when its
+/// bounds are positive and span more than a factor 20, evenly spaced otherwise, bounds
+/// included.
+pub fn profile_values(p: &ParameterInfo) -> Vec<f64> {
+    let n = 5;
+    (0..n)
+        .map(|i| {
+            let t = i as f64 / (n - 1) as f64;
+            if p.min > 0.0 && p.max / p.min > 20.0 {
+                p.min * (p.max / p.min).powf(t)
+            } else {
+                p.min + t * (p.max - p.min)
+            }
+        })
+        .collect()
+}
+
+/// Midpoint of two values of `p` on the profile's scale.
+fn midpoint(p: &ParameterInfo, a: f64, b: f64) -> f64 {
+    if p.min > 0.0 && p.max / p.min > 20.0 {
+        (a * b).sqrt()
+    } else {
+        0.5 * (a + b)
+    }
+}
+
+/// The diagnosis after adaptive refinement of the emulator (module documentation): the
+/// verdict rests on the simulator at the fitted magnitudes and secondary values rather than
+/// on interpolation. Nothing is refined when the nominal model shows no gap.
 pub fn diagnose_refining(
     campaign: &Campaign,
     emulator: &mut Emulator,
@@ -47,7 +86,42 @@ pub fn diagnose_refining(
             break;
         }
     }
+    if options.refine_rounds > 0 {
+        secondary(campaign, emulator, options, configs_dir, control, cache)?;
+        exact_pairs(campaign, emulator, options, configs_dir, control, cache)?;
+    }
     diagnose_with(campaign, emulator, options)
+}
+
+/// The nominal model and every single effect evaluated, when the nominal model shows a gap
+/// (None otherwise).
+fn singles_if_gap(
+    campaign: &Campaign,
+    problem: &Problem,
+    options: &DiagnoseOptions,
+) -> Option<(Candidate, Vec<Candidate>)> {
+    if problem.obs.is_empty() {
+        return None;
+    }
+    let nominal = problem.evaluate(Model::Nominal, options.alpha);
+    let nominal_p = stats::chi2_sf(nominal.chi2, nominal.dof.round().max(1.0) as usize);
+    if nominal_p >= options.alpha && !location::locate(campaign, problem).any_flagged() {
+        return None;
+    }
+    let singles = (0..problem.families.len())
+        .map(|f| problem.evaluate(Model::Single(f), options.alpha))
+        .collect();
+    Some((nominal, singles))
+}
+
+/// Requests `(table, magnitude)` of a candidate's simulated tables at its full-data and every
+/// fold's fitted magnitudes.
+fn requests_of(emulator: &Emulator, c: &Candidate) -> Vec<(usize, f64)> {
+    std::iter::once(&c.spec)
+        .chain(c.fold_specs.iter())
+        .flat_map(|s| s.iter().copied())
+        .filter(|(t, m)| *m != 0.0 && emulator.effects[*t].simulated)
+        .collect()
 }
 
 /// Magnitudes the next refinement round simulates: for the [`REFINE_CONTENDERS`] simulated
@@ -59,29 +133,266 @@ fn refinement_requests(
     options: &DiagnoseOptions,
 ) -> Vec<(usize, f64)> {
     let problem = Problem::new(campaign, emulator, options);
-    if problem.obs.is_empty() {
+    let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
         return Vec::new();
-    }
-    let nominal = problem.evaluate(&[], options.alpha);
-    let nominal_p = stats::chi2_sf(nominal.chi2, nominal.dof.round().max(1.0) as usize);
-    if nominal_p >= options.alpha && !location::locate(campaign, &problem).any_flagged() {
-        return Vec::new();
-    }
-    let mut contenders: Vec<Candidate> = (0..emulator.effects.len())
-        .filter(|&e| emulator.effects[e].simulated)
-        .map(|e| problem.evaluate(&[e], options.alpha))
+    };
+    let mut contenders: Vec<&Candidate> = singles
+        .iter()
+        .filter(|c| emulator.effects[c.table()].simulated)
         .filter(|c| c.held_ll() > nominal.held_ll())
         .collect();
     contenders.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
     contenders
         .iter()
         .take(REFINE_CONTENDERS)
-        .flat_map(|c| {
-            let e = c.effects[0];
-            std::iter::once(c.magnitudes[0])
-                .chain(c.fold_magnitudes.iter().map(|m| m[0]))
-                .map(move |m| (e, m))
-        })
-        .filter(|(_, m)| *m != 0.0)
+        .flat_map(|c| requests_of(emulator, c))
         .collect()
+}
+
+/// Step 2: when no single effect explains, the [`SECONDARY_CONTENDERS`] best singles that
+/// beat the nominal held out but leave lack-of-fit get their secondary parameters profiled
+/// (variant tables), then the chosen variant is refined at its fitted magnitudes.
+fn secondary(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<(), GapError> {
+    let leaders: Vec<(usize, usize, f64)> = {
+        let problem = Problem::new(campaign, emulator, options);
+        let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
+            return Ok(());
+        };
+        let cleanly = |c: &Candidate| c.explains(&nominal) && !c.only_partly(&nominal, emulator);
+        if singles.iter().any(cleanly) {
+            return Ok(());
+        }
+        let mut order: Vec<&Candidate> = singles
+            .iter()
+            .filter(|c| c.held_ll() > nominal.held_ll())
+            .filter(|c| c.residual_p < options.alpha || c.only_partly(&nominal, emulator))
+            .filter(|c| emulator.effects[c.table()].info.parameters.len() > 1)
+            .filter(|c| c.spec.first().is_some_and(|s| s.1 != 0.0))
+            .collect();
+        order.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
+        order
+            .iter()
+            .take(SECONDARY_CONTENDERS)
+            .map(|c| (problem.families[c.families[0]][0], c.spec[0].0, c.spec[0].1))
+            .collect()
+    };
+    for (default_table, _, m) in &leaders {
+        profile_secondary(
+            campaign,
+            emulator,
+            options,
+            configs_dir,
+            control,
+            cache,
+            *default_table,
+            *m,
+        )?;
+    }
+    if leaders.is_empty() {
+        return Ok(());
+    }
+    // The chosen variants at their fitted magnitudes.
+    let requests: Vec<(usize, f64)> = {
+        let problem = Problem::new(campaign, emulator, options);
+        leaders
+            .iter()
+            .map(|(t, _, _)| problem.family_of(*t))
+            .flat_map(|f| requests_of(emulator, &problem.evaluate(Model::Single(f), options.alpha)))
+            .collect()
+    };
+    emulator.refine(campaign, configs_dir, &requests, control, cache, &|_, _| {})?;
+    Ok(())
+}
+
+/// Profiles each secondary parameter of the effect of `default_table` (fitted magnitude `m`
+/// at the defaults): variants at [`profile_values`], then at the midpoints between the best
+/// value and its neighbours; with two or more secondary parameters, a variant at every best
+/// value together.
+#[allow(clippy::too_many_arguments)]
+fn profile_secondary(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+    default_table: usize,
+    m: f64,
+) -> Result<(), GapError> {
+    let info = emulator.effects[default_table].info;
+    let magnitudes: Vec<f64> = match info.acts {
+        Acts::WearLaw => Vec::new(),
+        // The default table's grid on the fitted magnitude's side, and the fitted magnitude:
+        // another secondary value may move the magnitude that fits.
+        Acts::Dynamics => emulator.effects[default_table]
+            .magnitudes
+            .iter()
+            .copied()
+            .filter(|g| *g != 0.0 && (*g < 0.0) == (m < 0.0))
+            .filter(|g| g.abs() >= 0.1 * m.abs())
+            .chain([m])
+            .collect(),
+    };
+    let mut bests: BTreeMap<String, f64> = BTreeMap::new();
+    for p in &info.parameters[1..] {
+        let mut values = profile_values(p);
+        let mut tables = Vec::new();
+        for &v in &values {
+            let t = emulator.add_variant(
+                campaign,
+                configs_dir,
+                default_table,
+                BTreeMap::from([(p.name.to_string(), v)]),
+                &magnitudes,
+                control,
+                cache,
+            )?;
+            tables.push(t);
+        }
+        let best = best_value(campaign, emulator, options, &tables, p.name);
+        // Second pass: midway to the best value's neighbours.
+        if let Some(i) = values.iter().position(|v| *v == best) {
+            let mut more = Vec::new();
+            if i > 0 {
+                more.push(midpoint(p, values[i - 1], best));
+            }
+            if i + 1 < values.len() {
+                more.push(midpoint(p, best, values[i + 1]));
+            }
+            for v in more {
+                let t = emulator.add_variant(
+                    campaign,
+                    configs_dir,
+                    default_table,
+                    BTreeMap::from([(p.name.to_string(), v)]),
+                    &magnitudes,
+                    control,
+                    cache,
+                )?;
+                tables.push(t);
+                values.push(v);
+            }
+        }
+        let best = best_value(campaign, emulator, options, &tables, p.name);
+        bests.insert(p.name.to_string(), best);
+    }
+    let non_default: BTreeMap<String, f64> = bests
+        .into_iter()
+        .filter(|(n, v)| {
+            info.parameters
+                .iter()
+                .find(|p| p.name == n)
+                .is_some_and(|p| p.default != *v)
+        })
+        .collect();
+    if non_default.len() > 1 {
+        emulator.add_variant(
+            campaign,
+            configs_dir,
+            default_table,
+            non_default,
+            &magnitudes,
+            control,
+            cache,
+        )?;
+    }
+    Ok(())
+}
+
+/// The value of parameter `name` among `tables` whose best full-data fit is best.
+fn best_value(
+    campaign: &Campaign,
+    emulator: &Emulator,
+    options: &DiagnoseOptions,
+    tables: &[usize],
+    name: &str,
+) -> f64 {
+    let problem = Problem::new(campaign, emulator, options);
+    tables
+        .iter()
+        .map(|&t| (t, problem.fit_table(t, &|_| true).1))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(f64::NAN, |(t, _)| emulator.effects[t].parameter(name))
+}
+
+/// Step 3: when no single effect explains, the pairs of the best singles: each dynamics +
+/// wear-law pair made exact, and the dynamics members of every pair refined at the
+/// magnitudes the pair's fits land on (the exact pairs follow their refined tables).
+fn exact_pairs(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<(), GapError> {
+    for round in 0..=PAIR_ROUNDS {
+        let (models, requests) = {
+            let problem = Problem::new(campaign, emulator, options);
+            let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
+                return Ok(());
+            };
+            if singles.iter().any(|c| c.explains(&nominal)) {
+                return Ok(());
+            }
+            let models = problem.pair_models(&singles, &nominal);
+            let mut requests: Vec<(usize, f64)> = Vec::new();
+            let mut joints: Vec<[(usize, f64); 2]> = Vec::new();
+            if round > 0 {
+                for m in &models {
+                    let c = problem.evaluate(*m, options.alpha);
+                    requests.extend(requests_of(emulator, &c));
+                    // Two dynamics effects: simulated together where the fits land.
+                    for s in std::iter::once(&c.spec).chain(c.fold_specs.iter()) {
+                        if let [a, b] = s[..] {
+                            let both =
+                                emulator.effects[a.0].simulated && emulator.effects[b.0].simulated;
+                            if both && a.1 != 0.0 && b.1 != 0.0 && !joints.contains(&[a, b]) {
+                                joints.push([a, b]);
+                            }
+                        }
+                    }
+                }
+            }
+            (models, (requests, joints))
+        };
+        let (requests, joints) = requests;
+        if round == 0 {
+            for m in models {
+                if let Model::Pair(a, b) = m {
+                    let (acts_a, acts_b) =
+                        (emulator.effects[a].info.acts, emulator.effects[b].info.acts);
+                    let pair = match (acts_a, acts_b) {
+                        (Acts::Dynamics, Acts::WearLaw) => Some((a, b)),
+                        (Acts::WearLaw, Acts::Dynamics) => Some((b, a)),
+                        _ => None,
+                    };
+                    if let Some((d, w)) = pair {
+                        if emulator.pair(d, w).is_none() {
+                            emulator.add_pair(campaign, configs_dir, d, w, control, cache)?;
+                        }
+                    }
+                }
+            }
+            continue;
+        }
+        let mut added =
+            emulator.refine(campaign, configs_dir, &requests, control, cache, &|_, _| {})?;
+        for [a, b] in joints {
+            if emulator.add_joint(campaign, configs_dir, a, b, control, cache)? {
+                added += 1;
+            }
+        }
+        if added == 0 {
+            break;
+        }
+    }
+    Ok(())
 }

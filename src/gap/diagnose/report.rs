@@ -13,6 +13,10 @@ pub enum Verdict {
     NoGap,
     /// An effect (or a pair) explains the gap on held-out tests.
     Explained,
+    /// An effect (or a pair) passes the explaining rule but is fitted at its physical bound,
+    /// or shrinks the held-out error by less than [`super::MIN_EXPLAINED_SHRINK`]: named, with
+    /// what it leaves and the test it cannot predict ([`Report::partly_explained`]).
+    PartlyExplained,
     /// There is a gap and no effect of the library explains it.
     NotExplained,
 }
@@ -169,8 +173,58 @@ pub struct Report {
     /// other tests, says this test should have lost).
     #[serde(default)]
     pub held_out_predictions: Vec<HeldOutPrediction>,
+    /// Why the verdict is `partly_explained`: the leading candidate, what it leaves, the test
+    /// it cannot predict (None for the other verdicts).
+    #[serde(default)]
+    pub partly_explained: Option<PartlyExplained>,
     /// railwear version.
     pub code_version: String,
+}
+
+/// A candidate that passes the explaining rule but does not carry the gap on held-out data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PartlyExplained {
+    /// The leading candidate (effect, or `a+b`).
+    pub candidate: String,
+    /// Why it is not `explained`, in words (fitted at its bound, held-out shrink under 20 %).
+    pub reasons: Vec<String>,
+    /// Parameters fitted at a physical bound (`effect.parameter`).
+    pub at_bound: Vec<String>,
+    /// Held-out RMS standardized error before (nominal) and after.
+    pub held_out_error: [f64; 2],
+    /// Held-out shrink.
+    pub shrink: f64,
+    /// What it leaves: the full-data fit's chi-square, its degrees of freedom and lack-of-fit
+    /// p-value.
+    pub chi2_left: f64,
+    /// Degrees of freedom of `chi2_left`.
+    pub dof: f64,
+    /// Lack-of-fit p-value of what it leaves.
+    pub residual_p_value: f64,
+    /// The held-out group it predicts worst (largest held-out error with it).
+    pub cannot_predict: String,
+    /// That group's held-out RMS standardized error, nominal and with the candidate.
+    pub cannot_predict_error: [f64; 2],
+}
+
+impl PartlyExplained {
+    /// The report's one-sentence summary.
+    pub fn sentence(&self) -> String {
+        format!(
+            "partly explained by {} ({}): held-out error {:.2} -> {:.2} (shrink {:.0} %); it leaves chi2 {:.1} on {:.1} dof (p = {:.2e}) and cannot predict {} (held-out error {:.2} -> {:.2})",
+            self.candidate,
+            self.reasons.join("; "),
+            self.held_out_error[0],
+            self.held_out_error[1],
+            100.0 * self.shrink,
+            self.chi2_left,
+            self.dof,
+            self.residual_p_value,
+            self.cannot_predict,
+            self.cannot_predict_error[0],
+            self.cannot_predict_error[1],
+        )
+    }
 }
 
 /// One measured mass and what the model predicts for it when its group is held out.

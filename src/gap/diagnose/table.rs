@@ -19,6 +19,11 @@ pub struct EffectTable {
     pub predictions: Vec<TestPredictions>,
     /// True when the table comes from simulations (interpolated between grid points).
     pub simulated: bool,
+    /// Values of the effect's other parameters this table was made at (by name); a parameter
+    /// not listed is at its library default. Tables of one effect that differ here are the
+    /// variants the diagnosis profiles its secondary parameters over.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
 }
 
 impl EffectTable {
@@ -58,6 +63,7 @@ impl EffectTable {
                     .map(|(_, x)| x.clone())
                     .collect(),
                 simulated: self.simulated,
+                parameters: self.parameters.clone(),
             };
             let guess = without.at(m);
             for (t_actual, t_guess) in self.predictions[i].iter().zip(&guess) {
@@ -154,6 +160,77 @@ impl EffectTable {
                             .collect();
                         p0.with_flat(&values)
                     })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+impl EffectTable {
+    /// The value of parameter `name` in this table (its library default when not listed).
+    pub fn parameter(&self, name: &str) -> f64 {
+        self.parameters.get(name).copied().unwrap_or_else(|| {
+            self.info
+                .parameters
+                .iter()
+                .find(|p| p.name == name)
+                .map_or(f64::NAN, |p| p.default)
+        })
+    }
+
+    /// The table's magnitude bound on `m`'s side of 0 (the magnitude parameter's max, or its
+    /// min for negative magnitudes).
+    pub fn bound_for(&self, m: f64) -> f64 {
+        let p = &self.info.parameters[0];
+        if m < 0.0 {
+            p.min
+        } else {
+            p.max
+        }
+    }
+}
+
+/// A dynamics effect and a wear-law effect together, exactly: the wear law evaluated on the
+/// dynamics effect's own simulated tracks (never a product of the two effects' ratios).
+/// `slices[j]` is the dynamics table (its magnitudes) with the wear law at
+/// `wear_magnitudes[j]`; between slices the prediction is linear in the wear magnitude (exact
+/// for a wear term linear in its magnitude, which the emulator checks when it builds the
+/// table; otherwise it keeps more slices).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PairTable {
+    /// Index of the dynamics effect's table in the emulator.
+    pub dynamics: usize,
+    /// Index of the wear-law effect's table in the emulator.
+    pub wear: usize,
+    /// Wear-law magnitudes of the slices, ascending, from 0.
+    pub wear_magnitudes: Vec<f64>,
+    /// The dynamics effect over its magnitudes, one table per wear magnitude.
+    pub slices: Vec<EffectTable>,
+}
+
+impl PairTable {
+    /// Prediction with the dynamics effect at `dynamics` and the wear law at `wear` (clamped
+    /// to the slices' range).
+    pub fn at(&self, dynamics: f64, wear: f64) -> TestPredictions {
+        let w = &self.wear_magnitudes;
+        let n = w.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        let x = wear.clamp(w[0], w[n - 1]);
+        if let Some(j) = w.iter().position(|v| *v == x) {
+            return self.slices[j].at(dynamics);
+        }
+        let j = w.partition_point(|v| *v <= x).clamp(1, n - 1);
+        let t = (x - w[j - 1]) / (w[j] - w[j - 1]);
+        let a = self.slices[j - 1].at(dynamics);
+        let b = self.slices[j].at(dynamics);
+        a.iter()
+            .zip(&b)
+            .map(|(ta, tb)| {
+                ta.iter()
+                    .zip(tb)
+                    .map(|(pa, pb)| pa.zip(pb, |u, v| u + t * (v - u)))
                     .collect()
             })
             .collect()
