@@ -4,6 +4,10 @@
 //! dynamics effect with a wear-law effect and of two dynamics effects, the rig-only effects,
 //! two noise levels), each diagnosed without its truth, then scored against the truth.
 //!
+//! Over 700 lines for now: drawing the scenarios (singles, pairs, secondary parameters) and
+//! scoring them (top-1, pairs, wrong names) are one table; the drawing is the part to move out
+//! next.
+//!
 //! A **wrong name** is a confident name that is not the truth: an `explained` verdict naming
 //! an effect the rig did not inject (any name, for a control or a rig-only effect). A pair is
 //! **both named** when the verdict is `explained` and names exactly its two effects.

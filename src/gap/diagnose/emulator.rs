@@ -1,6 +1,10 @@
 //! The model's predictions for a campaign's tests, nominal and under each library effect,
 //! tabulated over the effect's magnitude so that fitting never waits for a simulation.
 //!
+//! Over 700 lines for now: the nominal tables, the effects' grids, their secondary-parameter
+//! variants and the exact pair tables share one simulation plan and cache; the variants and
+//! pairs are the part to move out next (issue 30's data walk).
+//!
 //! - Nominal: every test simulated through the rig's own segment path
 //!   ([`crate::gap::rig`], no scatter, no noise), once at the configured tolerance and once at
 //!   half of it (the numerical uncertainty), and once with the friction coefficients raised by

@@ -2,6 +2,10 @@
 //! effect of the library causes it, and how far it shrinks once that effect is added, judged on
 //! held-out tests.
 //!
+//! Over 700 lines for now: the problem, the candidates' fits and the verdict rules (with
+//! partly_explained and the pairs) read together; the candidate fitting is the part to move
+//! out next.
+//!
 //! 1. **Observations.** Per test, increment and weighed component: the specimens' mean mass
 //!    loss; per test, increment, accelerometer location and axis: the specimens' mean square
 //!    acceleration less the sensor noise variance.
