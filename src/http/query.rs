@@ -75,7 +75,13 @@ pub async fn refuse_unknown_query_parameters(request: Request, next: Next) -> Re
             .extensions()
             .get::<MatchedPath>()
             .map(|p| p.as_str().to_string());
-        if let Some(template) = template {
+        // A method the document does not list on a documented route is the router's to
+        // answer (405 Method Not Allowed), whatever its query.
+        let undeclared_method = template.as_deref().is_some_and(|t| {
+            !allowed().contains_key(&(request.method().as_str().to_string(), t.to_string()))
+                && allowed().keys().any(|(_, path)| path == t)
+        });
+        if let Some(template) = template.filter(|_| !undeclared_method) {
             let known = documented_query_parameters(request.method().as_str(), &template);
             if let Some(key) = first_unknown(query, known) {
                 let rule = if known.is_empty() {

@@ -124,6 +124,16 @@ async fn unknown_query_parameters_roles_and_cancellation() {
             };
             assert_eq!(p["field"], want, "{path}: {p}");
         }
+        // A method the document does not list on a documented route is 405, whatever its
+        // query (the router's answer, not a parameter error).
+        let r = api.request(
+            "TRACE",
+            "/v1/curves?curve_key=x&limit=1",
+            Some(PLANNER),
+            &[],
+            None,
+        );
+        assert_eq!(r.status, 405, "{}", r.body);
         // Documented ones still work.
         assert_eq!(
             api.get(
