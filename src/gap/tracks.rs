@@ -497,6 +497,18 @@ pub struct ContactWork {
     pub local_archard_m3: f64,
 }
 
+impl ContactWork {
+    /// Adds `scale` times `other` (another window or increment of the same contact).
+    pub fn add_scaled(&mut self, other: &ContactWork, scale: f64) {
+        self.friction_j += scale * other.friction_j;
+        self.damping_j += scale * other.damping_j;
+        self.sliding_n_m += scale * other.sliding_n_m;
+        self.sliding_above_yield_n_m += scale * other.sliding_above_yield_n_m;
+        self.lumped_archard_m3 += scale * other.lumped_archard_m3;
+        self.local_archard_m3 += scale * other.local_archard_m3;
+    }
+}
+
 /// A track's lumped pressure `N/A`, Pa (0 without load, infinite on zero area).
 fn lumped_pressure_pa(p: &TrackPoint) -> f64 {
     if p.normal_force_n <= 0.0 {

@@ -58,13 +58,7 @@ impl IncrementWork {
             out.drive_j += h.time_scale * run.record.drive_work_j();
             out.energy_change_j += h.time_scale * run.record.energy_change_j();
             for (acc, w) in out.contacts.iter_mut().zip(&work) {
-                let s = h.time_scale;
-                acc.friction_j += s * w.friction_j;
-                acc.damping_j += s * w.damping_j;
-                acc.sliding_n_m += s * w.sliding_n_m;
-                acc.sliding_above_yield_n_m += s * w.sliding_above_yield_n_m;
-                acc.lumped_archard_m3 += s * w.lumped_archard_m3;
-                acc.local_archard_m3 += s * w.local_archard_m3;
+                acc.add_scaled(w, h.time_scale);
             }
         }
         Ok(out)
@@ -230,12 +224,7 @@ pub fn energy_budget(
         let mut total = vec![ContactWork::default(); n];
         for inc in incs {
             for (acc, w) in total.iter_mut().zip(&inc.contacts) {
-                acc.friction_j += w.friction_j;
-                acc.damping_j += w.damping_j;
-                acc.sliding_n_m += w.sliding_n_m;
-                acc.sliding_above_yield_n_m += w.sliding_above_yield_n_m;
-                acc.lumped_archard_m3 += w.lumped_archard_m3;
-                acc.local_archard_m3 += w.local_archard_m3;
+                acc.add_scaled(w, 1.0);
             }
         }
         let contacts = total
