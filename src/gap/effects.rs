@@ -16,9 +16,10 @@ use super::drive_edits::{
     add_cross_axis, filter_through_mount, resolved_excitation, set_excitation,
 };
 use super::tracks::WearTerm;
-pub use super::wear_terms::{
+pub use crate::wear::mechanism::{
     AboveCutoff, CoatingBreakthrough, ImpactWear, LocalPressure, SevereWear, ThirdBody,
 };
+use crate::wear::mechanism::WearMechanism;
 use super::GapError;
 use crate::models::spec::{CaseSpec, ModelKind};
 use serde::{Deserialize, Serialize};
@@ -470,32 +471,14 @@ impl Effect {
     /// The wear-law term of a wear-law effect (None for dynamics effects). `hardness_pa` is
     /// the softer body's indentation hardness (135 HB = 1.32 GPa for 7075-T73).
     pub fn wear_term(&self, hardness_pa: f64) -> Option<Box<dyn WearTerm>> {
-        match self.name.as_str() {
-            "wear_above_cutoff" => Some(Box::new(AboveCutoff {
-                ratio: self.get("k_ratio_above_cutoff"),
-            })),
-            "third_body" => Some(Box::new(ThirdBody {
-                k_add_m2_per_n: self.get("k_abrasive") / hardness_pa,
-                min_pressure_pa: self.get("min_pressure_pa"),
-                min_slip_m_s: self.get("min_slip_m_s"),
-            })),
-            "impact_wear" => Some(Box::new(ImpactWear {
-                k_energy_m3_per_j: self.get("k_energy_m3_per_j"),
-                min_normal_speed_m_s: self.get("min_normal_speed_m_s"),
-            })),
-            "severe_wear" => Some(Box::new(SevereWear {
-                k_add_m2_per_n: self.get("k_severe") / hardness_pa,
-                pressure_ratio_to_yield: self.get("pressure_ratio_to_yield"),
-            })),
-            "coating_breakthrough" => Some(Box::new(CoatingBreakthrough {
-                k_add_m2_per_n: self.get("k_bare") / hardness_pa,
-                breakthrough_slip_m: self.get("breakthrough_slip_m"),
-            })),
-            "local_pressure" => Some(Box::new(LocalPressure {
-                share: self.get("share"),
-            })),
-            _ => None,
-        }
+        self.wear_mechanism(hardness_pa)
+            .map(|m| Box::new(m) as Box<dyn WearTerm>)
+    }
+
+    /// The wear mechanism of a wear-law effect at its parameters (None for dynamics effects):
+    /// what a run carries as `wear.mechanism` (see [`crate::wear::mechanism`]).
+    pub fn wear_mechanism(&self, hardness_pa: f64) -> Option<WearMechanism> {
+        WearMechanism::from_effect(&self.name, |p| self.get(p), hardness_pa)
     }
 
     /// Edits `case` for a segment of the specimen in `state`. Magnitude 0 changes nothing.

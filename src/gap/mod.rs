@@ -22,7 +22,6 @@ pub mod point_pressure;
 pub mod rig;
 pub mod rig_effects;
 pub mod tracks;
-pub mod wear_terms;
 pub mod window;
 
 pub use campaign::Campaign;

@@ -18,15 +18,7 @@
 use super::tracks::TrackPoint;
 use crate::physics::contact::PointLoad;
 
-/// Contact points of one track at one step whose local pressures fall in one bin of 1/50
-/// decade (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PressureBin {
-    /// Work-weighted geometric mean of the points' local pressures, Pa.
-    pub pressure_pa: f64,
-    /// Their friction-work rate over μ, `Σ N_i |v_i|`, W.
-    pub work_rate_w: f64,
-}
+pub use crate::wear::mechanism::PressureBin;
 
 /// Pressure bins per decade of the point-pressure distribution.
 pub const PRESSURE_BINS_PER_DECADE: f64 = 50.0;

@@ -44,44 +44,8 @@ pub struct TrackPoint {
     pub bin_count: u32,
 }
 
-/// What a wear-law term sees at one sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WearSample<'a> {
-    /// Mean contact pressure N/A, Pa (infinite for N > 0 on zero area).
-    pub pressure_pa: f64,
-    /// Normal force, N.
-    pub normal_force_n: f64,
-    /// Slip speed, m/s.
-    pub slip_speed_m_s: f64,
-    /// Slip distance the specimen has accumulated by this sample, m (see
-    /// [`TrackRecord::slip_distance_m`]).
-    pub slip_distance_m: f64,
-    /// Power dissipated by the contact's IMPACT damping, W.
-    pub damping_power_w: f64,
-    /// Penetration rate of the deepest point (positive approaching), m/s.
-    pub penetration_rate_m_s: f64,
-    /// Yield strength of the contact's material, Pa (the record's).
-    pub yield_strength_pa: f64,
-    /// The contact points' local-pressure distribution (empty when not recorded).
-    pub points: &'a [PressureBin],
-}
-
-/// A wear-law term: maps the coefficient K (m²/N) at a sample to the effective one, and may
-/// add a wear rate of its own (a mechanism other than sliding at the lumped pressure). Terms
-/// are applied in order. A term at zero magnitude must return `k` unchanged and add exactly 0
-/// (bit for bit).
-pub trait WearTerm {
-    /// Effective K, m²/N, given the K so far and the sample.
-    fn coefficient_m2_per_n(&self, k: f64, _law: &WearLaw, _sample: &WearSample<'_>) -> f64 {
-        k
-    }
-
-    /// Wear volume rate this term adds to `K_eff N v_slip`, m³/s (may be negative when it
-    /// replaces part of the lumped law; the total is clamped at 0).
-    fn added_volume_rate_m3_s(&self, _law: &WearLaw, _sample: &WearSample<'_>) -> f64 {
-        0.0
-    }
-}
+use crate::wear::mechanism::volume_rate_with_terms_m3_s;
+pub use crate::wear::mechanism::{WearSample, WearTerm};
 
 /// Where the represented test time sits relative to the simulated window: the window of
 /// `window_s` stands for `represented_s` of test, which began after `slip_start_m` of slip.
@@ -347,29 +311,17 @@ impl TrackRecord {
             }
         }
         let rate = |i: usize, p: &TrackPoint| -> f64 {
-            let n = p.normal_force_n;
-            let v = p.slip_speed_m_s;
-            let pressure_pa = lumped_pressure_pa(p);
-            if terms.is_empty() {
-                return law.volume_rate_m3_s(n, v, pressure_pa);
-            }
-            let mut k = law.coefficient_m2_per_n(pressure_pa).unwrap_or(0.0);
             let sample = WearSample {
-                pressure_pa,
-                normal_force_n: n,
-                slip_speed_m_s: v,
+                pressure_pa: lumped_pressure_pa(p),
+                normal_force_n: p.normal_force_n,
+                slip_speed_m_s: p.slip_speed_m_s,
                 slip_distance_m: slip_at[i],
                 damping_power_w: p.damping_power_w,
                 penetration_rate_m_s: p.penetration_rate_m_s,
                 yield_strength_pa: self.yield_strength_pa,
                 points: self.bins_of(p),
             };
-            let mut added = 0.0;
-            for term in terms {
-                k = term.coefficient_m2_per_n(k, law, &sample);
-                added += term.added_volume_rate_m3_s(law, &sample);
-            }
-            (k * n * v + added).max(0.0)
+            volume_rate_with_terms_m3_s(law, terms, &sample)
         };
         let mut volumes = vec![0.0; self.contacts];
         let mut out_of_range = None;

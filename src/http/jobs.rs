@@ -47,7 +47,9 @@ pub struct JobRequest {
     /// `sweep` takes the same keys (config default `launcher-design`; it must be a launcher
     /// case) plus `points` (2..=50, default 5), `vehicle_profile` (selects the excitation:
     /// `ah64` or a profile in `configs/profiles`), `environment` (`clean`) and `wear_law`
-    /// (`modified-archard`, `archard` or `legacy-appendix`, matching the config's wear law);
+    /// (`modified-archard`, `archard` or `legacy-appendix`, matching the config's wear law;
+    /// or `{"diagnosis": "<diagnose job id>"}`: the wear-law effect a succeeded diagnosis
+    /// explained the gap with, added to the config's law, curve name `diagnosis-<id>`);
     /// the three default to the service's `[report]` settings and form the penalization-curve
     /// key. A sweep fans out into one `sweep_point` child job per point (`sweep_point` jobs
     /// cannot be submitted). `calibrate`: `{"friction": {"fixture": {...}, "records":
@@ -64,7 +66,8 @@ pub struct JobView {
     pub kind: JobKind,
     pub status: JobStatus,
     /// Parameters as submitted (a sweep's `vehicle_profile`, `environment` and `wear_law`
-    /// filled in from the defaults when absent; a diagnosis adds `campaign_id` and
+    /// filled in from the defaults when absent, and a `wear_law` diagnosis resolved to its
+    /// effect, fitted parameters and verdict; a diagnosis adds `campaign_id` and
     /// `campaign_sha256`, the content it reads from the store when it runs).
     #[schema(value_type = Object)]
     pub params: serde_json::Value,

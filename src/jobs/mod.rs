@@ -248,6 +248,64 @@ impl Jobs {
         })
     }
 
+    /// A sweep's `wear_law = {"diagnosis": "<id>"}` becomes the diagnosis' fitted mechanism
+    /// ([`crate::pipeline::DiagnosedWearLaw`], read from the stored report once, here), so the
+    /// sweep, its points and its curve carry one record. Anything but that bare form of an
+    /// object is refused: the resolved form is the service's to write.
+    async fn resolve_diagnosed_wear_law(
+        &self,
+        params: &mut serde_json::Value,
+    ) -> Result<(), SubmitError> {
+        let Some(serde_json::Value::Object(law)) = params.get("wear_law") else {
+            return Ok(());
+        };
+        let invalid = |field: &str, rule: String| {
+            SubmitError::Invalid(FieldError::new(format!("params.wear_law{field}"), rule))
+        };
+        if let Some(key) = law.keys().find(|k| k.as_str() != "diagnosis") {
+            return Err(invalid(
+                "",
+                format!("`{key}` is not known: give only {{\"diagnosis\": \"<diagnose job id>\"}}"),
+            ));
+        }
+        let id = law
+            .get("diagnosis")
+            .and_then(|v| v.as_str())
+            .and_then(|s| Uuid::parse_str(s).ok())
+            .ok_or_else(|| invalid(".diagnosis", "must be a diagnose job's id (a UUID)".into()))?;
+        let job = self
+            .store
+            .get_job(id)
+            .await
+            .map_err(SubmitError::Store)?
+            .ok_or_else(|| invalid(".diagnosis", format!("names no job ({id})")))?;
+        if job.kind != JobKind::Diagnose {
+            return Err(invalid(
+                ".diagnosis",
+                format!("names a {} job, not a diagnosis", job.kind.as_str()),
+            ));
+        }
+        let result = match (job.status, &job.result) {
+            (JobStatus::Succeeded, Some(result)) => result,
+            (status, _) => {
+                return Err(invalid(
+                    ".diagnosis",
+                    format!(
+                        "names diagnosis {id}, which is {}: wait until it has succeeded",
+                        status.as_str()
+                    ),
+                ))
+            }
+        };
+        let carried = crate::gap::diagnose::carry::carried_wear_law(id, result)
+            .map_err(|e| SubmitError::Invalid(e.at("params")))?;
+        let value = serde_json::to_value(&carried).map_err(|e| invalid("", e.to_string()))?;
+        if let Some(map) = params.as_object_mut() {
+            map.insert("wear_law".into(), value);
+        }
+        Ok(())
+    }
+
     async fn submit_checked(
         &self,
         kind: JobKind,
@@ -289,6 +347,9 @@ impl Jobs {
                 }
             }
         }
+        if kind == JobKind::Sweep {
+            self.resolve_diagnosed_wear_law(&mut params).await?;
+        }
         // The same parse the worker runs (one set of rules); it may build the model, so it
         // runs on a blocking thread.
         let runner = Arc::clone(&self.runner);
@@ -321,11 +382,10 @@ impl Jobs {
                     .unwrap_or_default()
                     .to_string()
             };
-            curve_key(
-                &part("vehicle_profile"),
-                &part("environment"),
-                &part("wear_law"),
-            )
+            let wear_law = crate::pipeline::SweepWearLaw::from_param(params.get("wear_law"), "")
+                .map(|law| law.curve_name())
+                .unwrap_or_default();
+            curve_key(&part("vehicle_profile"), &part("environment"), &wear_law)
         });
         let idempotency = idempotency_key.map(|key| {
             // serde_json maps are sorted, so this text is canonical for equal bodies.

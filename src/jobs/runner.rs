@@ -567,6 +567,7 @@ pub fn sweep_output(
             "vehicle_profile": plan.vehicle_profile,
             "environment": plan.environment,
             "wear_law": plan.wear_law,
+            "diagnosed_wear_law": plan.diagnosed,
             "points": plan.len(),
             "duration_per_point_s": plan.duration_per_point_s(),
             "settle_s": plan.base.simulation.settle_s,

@@ -159,6 +159,7 @@ pub fn run_options(case: &CaseSpec) -> Result<RunOptions, RunError> {
         integrator: integrator_settings(case)?,
         limits: DivergenceLimits::default(),
         wear_law: case.wear.law,
+        wear_mechanism: case.wear.mechanism,
         volume_split: case.wear.volume_split,
         record_interval_s: case.simulation.record_interval_s,
         response_rate_hz: 2000.0,

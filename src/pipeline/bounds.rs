@@ -362,6 +362,82 @@ pub static BOUNDS: &[Bound] = &[
         "Archard's k/H: severe adhesive wear (k about 1e-2) on the softest metals (H about \
          1e8 Pa) gives 1e-10 m²/N",
     ),
+    // Wear mechanisms beside the law (`wear.mechanism`, what a diagnosis fits; the gap
+    // effect library gives each parameter's source).
+    of_kind(
+        b(
+            "ratio",
+            0.0,
+            1000.0,
+            "",
+            "K above the cutoff as a multiple of K at it: up to the thousandfold jump from mild \
+             to severe wear (Archard 1953; the library's wear_above_cutoff bound)",
+        ),
+        "wear_above_cutoff",
+    ),
+    b(
+        "k_add_m2_per_n",
+        0.0,
+        1.0e-10,
+        "m²/N",
+        "an added k/H: severe adhesive wear (k about 1e-2) on the softest metals (H about 1e8 \
+         Pa) gives 1e-10 m²/N, as for the Archard coefficient",
+    ),
+    b(
+        "min_pressure_pa",
+        0.0,
+        limits::MAX_CUTOFF_PRESSURE_PA,
+        "Pa",
+        "a pressure threshold: no contact pressure exceeds 10 GPa, above any alloy's hardness",
+    ),
+    b(
+        "min_slip_m_s",
+        0.0,
+        100.0,
+        "m/s",
+        "a slip-speed threshold: a carried missile's shoes slide at mm/s to m/s",
+    ),
+    b(
+        "k_energy_m3_per_j",
+        0.0,
+        1.0e-11,
+        "m³/J",
+        "wear volume per joule of impact damping: dissipated-energy wear measures 1e-15 to \
+         1e-13 m³/J (Fouvry et al. 2003); Archard's range over H mu bounds it at 1.5e-11",
+    ),
+    b(
+        "min_normal_speed_m_s",
+        0.0,
+        10.0,
+        "m/s",
+        "a normal-speed threshold of impact wear: rattling impacts reach cm/s to m/s",
+    ),
+    b(
+        "pressure_ratio_to_yield",
+        0.1,
+        10.0,
+        "",
+        "a pressure threshold as a multiple of S_y: plastic flow starts near 1 and the \
+         hardness is about 3 S_y (Tabor)",
+    ),
+    of_kind(
+        b(
+            "share",
+            0.0,
+            1.0,
+            "",
+            "a share of the wear evaluated at the points' own pressures, 0 to all of it",
+        ),
+        "local_pressure",
+    ),
+    b(
+        "breakthrough_slip_m",
+        0.0,
+        1.0e9,
+        "m",
+        "the slip distance an anodic coating lasts: from new to beyond a million km of \
+         sliding",
+    ),
     b(
         "speed_unit_m_s",
         1.0e-6,

@@ -68,6 +68,34 @@ fn sample_cases() -> Vec<(String, Value)> {
     let mut v = launcher;
     v["launcher"]["missile"]["inertia_kg_m2"] = json!([10.0, 10.0, 0.2]);
     out.push(("launcher-design, given inertia".into(), v));
+    // Each wear mechanism a case can carry, from the library's own values.
+    use crate::wear::mechanism::*;
+    let mechanisms = [
+        WearMechanism::WearAboveCutoff(AboveCutoff { ratio: 3.0 }),
+        WearMechanism::ThirdBody(ThirdBody {
+            k_add_m2_per_n: 1e-14,
+            min_pressure_pa: 1e4,
+            min_slip_m_s: 1e-3,
+        }),
+        WearMechanism::ImpactWear(ImpactWear {
+            k_energy_m3_per_j: 2.5e-13,
+            min_normal_speed_m_s: 0.01,
+        }),
+        WearMechanism::SevereWear(SevereWear {
+            k_add_m2_per_n: 1e-13,
+            pressure_ratio_to_yield: 1.0,
+        }),
+        WearMechanism::LocalPressure(LocalPressure { share: 0.5 }),
+        WearMechanism::CoatingBreakthrough(CoatingBreakthrough {
+            k_add_m2_per_n: 1e-13,
+            breakthrough_slip_m: 1e3,
+        }),
+    ];
+    for m in mechanisms {
+        let mut v = rattle.clone();
+        v["wear"]["mechanism"] = serde_json::to_value(m).unwrap();
+        out.push((format!("rattle-box-c, {} mechanism", m.name()), v));
+    }
     out
 }
 

@@ -13,6 +13,7 @@ pub mod bounds;
 mod bounds_tests;
 mod calibrate;
 mod case;
+mod diagnosed_wear;
 mod sweep;
 mod sweep_range;
 #[cfg(test)]
@@ -20,6 +21,7 @@ mod tests;
 
 pub use calibrate::*;
 pub use case::*;
+pub use diagnosed_wear::{DiagnosedWearLaw, SweepWearLaw};
 pub use sweep::*;
 pub use sweep_range::*;
 

@@ -166,8 +166,10 @@ pub struct SweepPlan {
     pub vehicle_profile: String,
     /// Environment name (`clean`).
     pub environment: String,
-    /// Wear-law name ([`WEAR_LAWS`]).
+    /// Wear-law name ([`WEAR_LAWS`], or `diagnosis-<id>` for a diagnosed mechanism).
     pub wear_law: String,
+    /// The diagnosis' mechanism the base case carries (`wear_law = {diagnosis = ..}`).
+    pub diagnosed: Option<super::DiagnosedWearLaw>,
     /// `sweep_point` children: the point this child runs.
     pub point: Option<usize>,
     /// `sweep_point` children: the replica (seed index) this child runs.
@@ -194,7 +196,12 @@ impl SweepPlan {
         };
         let vehicle_profile = text("vehicle_profile", DEFAULT_VEHICLE_PROFILE)?;
         let environment = text("environment", DEFAULT_ENVIRONMENT)?;
-        let wear_law = text("wear_law", DEFAULT_WEAR_LAW)?;
+        let law_param = super::SweepWearLaw::from_param(params.get("wear_law"), DEFAULT_WEAR_LAW)?;
+        let wear_law = law_param.curve_name();
+        let diagnosed = match &law_param {
+            super::SweepWearLaw::Diagnosed(d) => Some(d.clone()),
+            super::SweepWearLaw::Named(_) => None,
+        };
         let profile_file = vehicle_profile_file(configs_dir, &vehicle_profile)?;
         if !ENVIRONMENTS.contains(&environment.as_str()) {
             return Err(FieldError::new(
@@ -253,7 +260,21 @@ impl SweepPlan {
                 .into());
             }
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
-            select_wear_law(case, &wear_law)
+            match (&diagnosed, case.launcher.as_ref()) {
+                (Some(d), Some(launcher)) => {
+                    if matches!(case.wear.law, crate::wear::WearLaw::LegacyAppendix { .. }) {
+                        return Err(FieldError::new(
+                            "wear_law",
+                            "a diagnosed mechanism needs a K(sigma) law; the config's is the \
+                             legacy appendix law",
+                        )
+                        .into());
+                    }
+                    case.wear.mechanism = Some(d.mechanism(launcher.material.hardness_pa())?);
+                    Ok(())
+                }
+                _ => select_wear_law(case, &wear_law),
+            }
         })?;
         let design_rattle_space = design_rattle_space();
         let seeds = (0..range.seeds)
@@ -268,6 +289,7 @@ impl SweepPlan {
             vehicle_profile,
             environment,
             wear_law,
+            diagnosed,
             point,
             replica,
         })

@@ -5,6 +5,7 @@
 //! samples cost O(1) memory and `push` does not allocate.
 
 use super::law::{Quadrature, WearLaw};
+use super::mechanism::{volume_rate_with_terms_m3_s, WearMechanism, WearSample};
 use super::pressure_pdf::PressureHistogram;
 use super::WearError;
 use crate::field_error::FieldError;
@@ -36,6 +37,14 @@ pub struct WearTotals {
     pub cutoff_pressure_pa: Option<f64>,
     /// Contact time and friction work per pressure bin (Figure 6.65).
     pub pressure_histogram: PressureHistogram,
+    /// Part of `volume_m3` the case's wear mechanism added to (or, negative, took from) the
+    /// law's own wear, m³ (0 without a mechanism; see [`super::mechanism`]).
+    #[serde(default)]
+    pub mechanism_volume_m3: f64,
+    /// Work of the contact's IMPACT damping ∫ P_damp dt, J (the impacts; what impact wear
+    /// scales; 0 for tracks pushed without it).
+    #[serde(default)]
+    pub damping_work_j: f64,
 }
 
 impl WearTotals {
@@ -53,6 +62,8 @@ impl WearTotals {
             peak_pressure_pa: 0.0,
             cutoff_pressure_pa: cutoff.is_finite().then_some(cutoff),
             pressure_histogram: histogram,
+            mechanism_volume_m3: 0.0,
+            damping_work_j: 0.0,
         }
     }
 
@@ -86,6 +97,8 @@ impl WearTotals {
         }
         self.pressure_histogram.merge(&other.pressure_histogram)?;
         self.volume_m3 += other.volume_m3;
+        self.mechanism_volume_m3 += other.mechanism_volume_m3;
+        self.damping_work_j += other.damping_work_j;
         self.friction_work_j += other.friction_work_j;
         self.work_above_cutoff_j += other.work_above_cutoff_j;
         self.contact_time_s += other.contact_time_s;
@@ -102,6 +115,9 @@ impl WearTotals {
 struct Point {
     time_s: f64,
     rate_m3_s: f64,
+    mechanism_rate_m3_s: f64,
+    damping_power_w: f64,
+    slip_speed_m_s: f64,
     power_w: f64,
     power_above_w: f64,
     pressure_pa: f64,
@@ -117,6 +133,33 @@ pub struct WearAccumulator {
     cutoff_pressure_pa: f64,
     prev: Option<Point>,
     totals: WearTotals,
+    mechanism: Option<MechanismState>,
+}
+
+/// A wear mechanism carried by the accumulator, with what it needs between samples.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct MechanismState {
+    #[serde(with = "mechanism_as_json")]
+    mechanism: WearMechanism,
+    /// Yield strength of the softer body, Pa (severe wear's threshold).
+    yield_strength_pa: f64,
+    /// Slip distance of this track so far, m (trapezoid on the slip speed in contact).
+    slip_distance_m: f64,
+}
+
+/// One sample of a contact track as the run hands it over.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TrackLoad {
+    /// Normal force N, N (>= 0; 0 = not touching).
+    pub normal_force_n: f64,
+    /// Slip speed, m/s (>= 0).
+    pub slip_speed_m_s: f64,
+    /// Contact area (thesis 2.5), m² (>= 0).
+    pub area_m2: f64,
+    /// Power dissipated by the contact's IMPACT damping, W (>= 0).
+    pub damping_power_w: f64,
+    /// Penetration rate of the deepest point (positive approaching), m/s.
+    pub penetration_rate_m_s: f64,
 }
 
 /// The law as its JSON text inside a checkpoint: [`WearLaw`] is an internally tagged enum,
@@ -130,6 +173,21 @@ mod law_as_json {
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WearLaw, D::Error> {
+        let text = String::deserialize(d)?;
+        serde_json::from_str(&text).map_err(D::Error::custom)
+    }
+}
+
+/// The mechanism as its JSON text inside a checkpoint (tagged enum; see `law_as_json`).
+mod mechanism_as_json {
+    use super::WearMechanism;
+    use serde::{de::Error as _, ser::Error as _, Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(m: &WearMechanism, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(m).map_err(S::Error::custom)?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WearMechanism, D::Error> {
         let text = String::deserialize(d)?;
         serde_json::from_str(&text).map_err(D::Error::custom)
     }
@@ -150,7 +208,37 @@ impl WearAccumulator {
             prev: None,
             totals: WearTotals::empty(&law, histogram),
             law,
+            mechanism: None,
         })
+    }
+
+    /// New accumulator that adds `mechanism`'s wear to the law's (see [`super::mechanism`]);
+    /// `yield_strength_pa` is the softer body's. The law must give K(sigma) (not the legacy
+    /// appendix law, which feeds N).
+    pub fn with_mechanism(
+        law: WearLaw,
+        mechanism: WearMechanism,
+        yield_strength_pa: f64,
+    ) -> Result<Self, WearError> {
+        mechanism.validate()?;
+        if matches!(law, WearLaw::LegacyAppendix { .. }) {
+            return Err(FieldError::new(
+                "mechanism",
+                "needs a K(sigma) law (archard or modified); the legacy appendix law feeds N, \
+                 not sigma",
+            )
+            .into());
+        }
+        if !(yield_strength_pa.is_finite() && yield_strength_pa > 0.0) {
+            return Err(FieldError::new("yield_strength_pa", "must be a finite number > 0").into());
+        }
+        let mut acc = Self::new(law)?;
+        acc.mechanism = Some(MechanismState {
+            mechanism,
+            yield_strength_pa,
+            slip_distance_m: 0.0,
+        });
+        Ok(acc)
     }
 
     /// Adds one sample: time (s), normal force N (N, >= 0; 0 = not touching), slip speed
@@ -164,6 +252,34 @@ impl WearAccumulator {
         slip_speed_m_s: f64,
         area_m2: f64,
     ) -> Result<(), WearError> {
+        self.push_track(
+            time_s,
+            &TrackLoad {
+                normal_force_n,
+                slip_speed_m_s,
+                area_m2,
+                ..TrackLoad::default()
+            },
+        )
+    }
+
+    /// [`WearAccumulator::push`] with the damping power and penetration rate a mechanism may
+    /// need (impact wear scales the damping work).
+    #[inline]
+    pub fn push_track(&mut self, time_s: f64, track: &TrackLoad) -> Result<(), WearError> {
+        let TrackLoad {
+            normal_force_n,
+            slip_speed_m_s,
+            area_m2,
+            damping_power_w,
+            penetration_rate_m_s,
+        } = *track;
+        if !(damping_power_w.is_finite() && damping_power_w >= 0.0) {
+            return Err(FieldError::new("damping_power_w", "must be a finite number >= 0").into());
+        }
+        if !penetration_rate_m_s.is_finite() {
+            return Err(FieldError::new("penetration_rate_m_s", "must be finite").into());
+        }
         if !time_s.is_finite() {
             return Err(FieldError::new("time_s", "must be finite").into());
         }
@@ -189,11 +305,36 @@ impl WearAccumulator {
             self.totals.peak_pressure_pa = self.totals.peak_pressure_pa.max(pressure_pa);
         }
         let power_w = normal_force_n * slip_speed_m_s;
+        let law_rate = self
+            .law
+            .volume_rate_m3_s(normal_force_n, slip_speed_m_s, pressure_pa);
+        let slip_in_contact = if in_contact { slip_speed_m_s } else { 0.0 };
+        let rate_m3_s = match &mut self.mechanism {
+            None => law_rate,
+            Some(m) => {
+                if let Some(p) = self.prev {
+                    let dt = (time_s - p.time_s).max(0.0);
+                    m.slip_distance_m += 0.5 * (p.slip_speed_m_s + slip_in_contact) * dt;
+                }
+                let sample = WearSample {
+                    pressure_pa,
+                    normal_force_n,
+                    slip_speed_m_s,
+                    slip_distance_m: m.slip_distance_m,
+                    damping_power_w,
+                    penetration_rate_m_s,
+                    yield_strength_pa: m.yield_strength_pa,
+                    points: &[],
+                };
+                volume_rate_with_terms_m3_s(&self.law, &[&m.mechanism], &sample)
+            }
+        };
         let point = Point {
             time_s,
-            rate_m3_s: self
-                .law
-                .volume_rate_m3_s(normal_force_n, slip_speed_m_s, pressure_pa),
+            rate_m3_s,
+            mechanism_rate_m3_s: rate_m3_s - law_rate,
+            damping_power_w,
+            slip_speed_m_s: slip_in_contact,
             power_w,
             power_above_w: if pressure_pa > self.cutoff_pressure_pa {
                 power_w
@@ -222,6 +363,13 @@ impl WearAccumulator {
                     Quadrature::RightEndpointFromZero => point.rate_m3_s * dt,
                 };
                 t.friction_work_j += 0.5 * (p.power_w + point.power_w) * dt;
+                t.damping_work_j += 0.5 * (p.damping_power_w + point.damping_power_w) * dt;
+                t.mechanism_volume_m3 += match self.quadrature {
+                    Quadrature::Trapezoid => {
+                        0.5 * (p.mechanism_rate_m3_s + point.mechanism_rate_m3_s) * dt
+                    }
+                    Quadrature::RightEndpointFromZero => point.mechanism_rate_m3_s * dt,
+                };
                 t.work_above_cutoff_j += 0.5 * (p.power_above_w + point.power_above_w) * dt;
                 let half = 0.5 * dt;
                 if p.in_contact {
@@ -391,5 +539,53 @@ mod tests {
         assert_eq!(t.volume_m3, 0.0);
         assert_eq!(t.work_share_above_cutoff(), 1.0);
         assert_eq!(t.zero_area_samples, 2);
+    }
+
+    #[test]
+    fn impact_wear_mechanism_adds_k_e_times_damping_work() {
+        use crate::wear::mechanism::{ImpactWear, WearMechanism};
+        // N = 10 N on 1 mm² (10 MPa), 0.1 m/s slip, 2 W of damping for 3 s.
+        let law = WearLaw::table_4_3();
+        let k_e = 2.5e-13;
+        let mechanism = WearMechanism::ImpactWear(ImpactWear {
+            k_energy_m3_per_j: k_e,
+            min_normal_speed_m_s: 0.0,
+        });
+        let mut plain = WearAccumulator::new(law).unwrap();
+        let mut with = WearAccumulator::with_mechanism(law, mechanism, 435.0e6).unwrap();
+        for i in 0..=300 {
+            let t = i as f64 * 0.01;
+            let track = TrackLoad {
+                normal_force_n: 10.0,
+                slip_speed_m_s: 0.1,
+                area_m2: 1.0e-6,
+                damping_power_w: 2.0,
+                penetration_rate_m_s: 0.01,
+            };
+            plain.push_track(t, &track).unwrap();
+            with.push_track(t, &track).unwrap();
+        }
+        let (plain, with) = (plain.finish(), with.finish());
+        // Sliding part: K(10 MPa) x 10 N x 0.1 m/s x 3 s.
+        let sliding = k_by_hand(1.0e7) * 10.0 * 0.1 * 3.0;
+        assert!((plain.volume_m3 - sliding).abs() / sliding < 1e-9);
+        // Impact part: k_E x 2 W x 3 s = 1.5e-12 m³, all of it the mechanism's.
+        let impact = k_e * 2.0 * 3.0;
+        assert!((with.mechanism_volume_m3 - impact).abs() / impact < 1e-9);
+        assert!((with.volume_m3 - (sliding + impact)).abs() / (sliding + impact) < 1e-9);
+        assert!((with.damping_work_j - 6.0).abs() < 1e-9);
+        assert_eq!(plain.mechanism_volume_m3, 0.0);
+    }
+
+    #[test]
+    fn a_mechanism_needs_a_k_sigma_law() {
+        use crate::wear::mechanism::{ImpactWear, WearMechanism};
+        let mechanism = WearMechanism::ImpactWear(ImpactWear {
+            k_energy_m3_per_j: 1e-13,
+            min_normal_speed_m_s: 0.0,
+        });
+        let err = WearAccumulator::with_mechanism(WearLaw::legacy_table_4_3(), mechanism, 435e6)
+            .unwrap_err();
+        assert!(err.to_string().contains("mechanism"), "{err}");
     }
 }

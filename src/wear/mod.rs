@@ -10,12 +10,14 @@ pub mod allocation;
 pub mod integrate;
 pub mod law;
 pub mod material;
+pub mod mechanism;
 pub mod pressure_pdf;
 
 pub use allocation::{mass_rate_mg_per_h, volume_rate_m3_per_h, BodyWear, VolumeSplit};
 pub use integrate::{WearAccumulator, WearTotals};
 pub use law::{Quadrature, WearLaw};
 pub use material::Material;
+pub use mechanism::{WearMechanism, WearSample, WearTerm};
 pub use pressure_pdf::PressureHistogram;
 
 use crate::field_error::FieldError;

@@ -4,7 +4,7 @@
 
 use crate::helpers::Api;
 use crate::support::runner::{start_library, test_config};
-use crate::support::{temp_dir, PLANNER, TEST_ENGINEER};
+use crate::support::{temp_dir, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::gap::Campaign;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -93,10 +93,66 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         assert_eq!(r.status, 200);
         assert_eq!(r.header("content-type"), Some("image/svg+xml"));
         assert!(r.body.contains("<svg"));
+
+        // A sweep may take the diagnosis' wear mechanism as its wear law (issue 26 item 7):
+        // resolved at submission when the diagnosis explained the gap with a wear-law effect
+        // a run can carry, refused naming `params.wear_law...` otherwise.
+        let diagnosis = done["id"].as_str().unwrap();
+        let sweep = |law: Value| {
+            let params = json!({"wear_law": law, "points": 2,
+                "overrides": {"simulation": {"duration_s": 0.05, "settle_s": 0.01}}});
+            api.post(
+                "/v1/jobs",
+                Some(ENGINEER),
+                &json!({"kind": "sweep", "params": params}).to_string(),
+            )
+        };
+        let carried = best_is_carried(report);
+        let r = sweep(json!({ "diagnosis": diagnosis }));
+        if carried {
+            assert_eq!(r.status, 201, "{}", r.body);
+            let job = r.json();
+            let law = &job["params"]["wear_law"];
+            assert_eq!(law["diagnosis"], diagnosis, "{job}");
+            assert_eq!(law["effect"], report["best_effect"]["name"], "{job}");
+            assert_eq!(job["curve_key"], format!("ah64/clean/diagnosis-{diagnosis}"));
+            let url = format!("/v1/jobs/{}/cancel", job["id"].as_str().unwrap());
+            api.post(&url, Some(ENGINEER), "");
+        } else {
+            let p = r.problem(422);
+            assert_eq!(p["field"], "params.wear_law.diagnosis", "{p}");
+        }
+        let unknown = uuid::Uuid::new_v4().to_string();
+        for (law, field, says) in [
+            (json!({ "diagnosis": unknown }), "params.wear_law.diagnosis", "names no job"),
+            (json!({ "diagnosis": "yesterday" }), "params.wear_law.diagnosis", "UUID"),
+            (
+                json!({ "diagnosis": diagnosis, "effect": "impact_wear" }),
+                "params.wear_law",
+                "effect",
+            ),
+            (json!(7), "params.wear_law", "wear-law name"),
+        ] {
+            let p = sweep(law).problem(422);
+            assert_eq!(p["field"], field, "{p}");
+            assert!(p["detail"].as_str().unwrap().contains(says), "{p}");
+        }
     })
     .await
     .unwrap();
     service.stop().await;
+}
+
+/// Whether a report names a single wear-law effect a sweep's run can carry (see
+/// `gap::diagnose::carry`): explained or partly explained, not a pair, not a dynamics effect,
+/// not one acting on point pressures.
+fn best_is_carried(report: &Value) -> bool {
+    let verdict = report["verdict"].as_str().unwrap_or_default();
+    let name = report["best_effect"]["name"].as_str().unwrap_or_default();
+    ["explained", "partly_explained"].contains(&verdict)
+        && railwear::gap::effects::info(name)
+            .is_some_and(|e| e.acts == railwear::gap::effects::Acts::WearLaw)
+        && !["severe_wear", "local_pressure"].contains(&name)
 }
 
 /// The job holds the campaign's id and SHA-256, not its content, and reads the campaign when

@@ -69,6 +69,85 @@ fn assert_recovered(report: &Report, name: &str, truth: f64) {
     );
 }
 
+/// A sweep can carry the recovered mechanism: the record holds the fitted k_E, whose
+/// interval holds the truth; a dynamics effect or a not_explained verdict is refused, naming
+/// `wear_law.diagnosis`.
+fn assert_carried(report: &Report, truth: f64) {
+    use railwear::gap::diagnose::carry::carried_wear_law;
+    use railwear::wear::mechanism::WearMechanism;
+    let id = uuid::Uuid::new_v4();
+    let json = serde_json::to_value(report).unwrap();
+    let carried = carried_wear_law(id, &json).unwrap();
+    assert_eq!(carried.effect, "impact_wear");
+    assert_eq!(carried.curve_name(), format!("diagnosis-{id}"));
+    let best = report.best_effect.as_ref().unwrap();
+    match carried.mechanism(1.32e9).unwrap() {
+        WearMechanism::ImpactWear(m) => {
+            assert_eq!(m.k_energy_m3_per_j, best.parameters[0].value);
+            let [lo, hi] = best.parameters[0].interval.unwrap();
+            assert!(lo <= truth && truth <= hi);
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut dynamics = json.clone();
+    dynamics["best_effect"]["name"] = "cross_axis".into();
+    assert_eq!(
+        carried_wear_law(id, &dynamics).unwrap_err().field,
+        "wear_law.diagnosis"
+    );
+    let mut none = json;
+    none["verdict"] = "not_explained".into();
+    let e = carried_wear_law(id, &none).unwrap_err();
+    assert!(e.rule.contains("not_explained"), "{}", e.rule);
+}
+
+/// A run carrying impact wear as its case's `wear.mechanism` adds exactly k_E times each
+/// contact's IMPACT damping work to the law's wear (the accumulator's trapezoid on the same
+/// accepted steps), and at k_E = 0 its wear is the plain run's, bit for bit.
+#[test]
+fn a_run_carrying_impact_wear_adds_k_e_times_the_damping_work() {
+    use railwear::wear::mechanism::{ImpactWear, WearMechanism};
+    let configs = configs();
+    let text = std::fs::read_to_string(configs.join("rattle-box-c.toml")).unwrap();
+    let mut case = railwear::models::spec::CaseSpec::from_toml_str(&text).unwrap();
+    case.simulation.duration_s = 0.3;
+    let run = |k: Option<f64>| {
+        let mut c = case.clone();
+        c.wear.mechanism = k.map(|k| {
+            WearMechanism::ImpactWear(ImpactWear {
+                k_energy_m3_per_j: k,
+                min_normal_speed_m_s: 0.0,
+            })
+        });
+        railwear::report::run_case(&c, &configs, &RunControl::silent())
+            .unwrap()
+            .0
+    };
+    let plain = run(None);
+    let zero = run(Some(0.0));
+    let k_e = 1e-13;
+    let with = run(Some(k_e));
+    let contacts = |r: &railwear::models::run::RunReport| r.contacts.clone();
+    let mut damping = 0.0;
+    for ((p, z), w) in contacts(&plain)
+        .iter()
+        .zip(contacts(&zero).iter())
+        .zip(contacts(&with).iter())
+    {
+        assert_eq!(p.wear.volume_m3.to_bits(), z.wear.volume_m3.to_bits());
+        let added = w.wear.volume_m3 - p.wear.volume_m3;
+        let expected = k_e * w.wear.damping_work_j;
+        assert!(
+            (added - expected).abs() <= 1e-9 * expected.max(1e-30),
+            "{}: added {added} m³, k_E x damping work {expected} m³",
+            p.name
+        );
+        assert!((w.wear.mechanism_volume_m3 - expected).abs() <= 1e-9 * expected.max(1e-30));
+        damping += w.wear.damping_work_j;
+    }
+    assert!(damping > 0.0, "the rattle box dissipates by impact damping");
+}
+
 /// Impact wear at k_E = 2e-14 m³/J (about 40x the nominal wear on these windows): recovered,
 /// and the budget's needed k_E for each test lies within 10 % of the truth (the 2 % noise,
 /// and the nominal sliding wear the budget also charges to impact); the budget's energy
@@ -78,6 +157,7 @@ fn impact_wear_injected_by_the_rig_is_recovered() {
     let truth = 2e-14;
     let report = inject_and_diagnose(&format!("impact_wear={truth}"), &["impact_wear"]);
     assert_recovered(&report, "impact_wear", truth);
+    assert_carried(&report, truth);
     let budget = &report.location.energy_budget;
     assert_eq!(budget.tests.len(), 2);
     for t in &budget.tests {

@@ -34,6 +34,7 @@
 
 pub mod bench;
 pub mod budget;
+pub mod carry;
 pub mod emulator;
 mod how_far;
 pub mod location;

@@ -170,7 +170,8 @@ pub struct ReportQuery {
     pub vehicle_profile: Option<String>,
     /// Environment of the curve: `clean` (the only one modelled).
     pub environment: Option<String>,
-    /// Wear law of the curve: `modified-archard`, `archard` or `legacy-appendix`.
+    /// Wear law of the curve: `modified-archard`, `archard`, `legacy-appendix`, or
+    /// `diagnosis-<diagnose job id>` for a curve swept with a diagnosis' fitted mechanism.
     pub wear_law: Option<String>,
     /// T_SL,design, h (> 0).
     #[param(value_type = Option<f64>, exclusive_minimum = 0)]
@@ -208,11 +209,14 @@ fn report_labels(
         }
     }
     if let Some(law) = &query.wear_law {
-        if !crate::pipeline::WEAR_LAWS.contains(&law.as_str()) {
+        let diagnosed = law
+            .strip_prefix("diagnosis-")
+            .is_some_and(|id| uuid::Uuid::parse_str(id).is_ok());
+        if !diagnosed && !crate::pipeline::WEAR_LAWS.contains(&law.as_str()) {
             return Err(Problem::invalid_field(
                 "wear_law",
                 format!(
-                    "`{law}` is not a wear law (known: {})",
+                    "`{law}` is not a wear law (known: {}, or diagnosis-<diagnose job id>)",
                     crate::pipeline::WEAR_LAWS.join(", ")
                 ),
             ));

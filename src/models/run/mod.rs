@@ -15,8 +15,9 @@ use crate::physics::system::MultibodySystem;
 use crate::physics::track::TrackSample;
 use crate::units::{MG_PER_KG, S_PER_H};
 use crate::wear::allocation::VolumeSplit;
-use crate::wear::integrate::{WearAccumulator, WearTotals};
+use crate::wear::integrate::{TrackLoad, WearAccumulator, WearTotals};
 use crate::wear::law::WearLaw;
+use crate::wear::mechanism::WearMechanism;
 use crate::wear::material::Material;
 use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,9 @@ pub struct RunOptions {
     pub limits: DivergenceLimits,
     /// Wear law.
     pub wear_law: WearLaw,
+    /// Wear mechanism added to the law's wear on every track (`wear.mechanism`; None: the law
+    /// alone), e.g. the one a gap diagnosis fitted.
+    pub wear_mechanism: Option<WearMechanism>,
     /// Split of each contact's volume between its bodies.
     pub volume_split: VolumeSplit,
     /// Interval between recorded track samples, s (0: every accepted step; negative: none).
@@ -389,6 +393,18 @@ fn run_whole(
         BodyKind::Kinematic(_) => None,
     };
     let law = options.wear_law;
+    // A track's accumulator: the law, plus the case's mechanism at the softer body's yield.
+    let new_accumulator = |contact: usize| -> Result<WearAccumulator, WearError> {
+        match options.wear_mechanism {
+            None => WearAccumulator::new(law),
+            Some(mechanism) => {
+                let yield_pa = model.contact_materials.get(contact).map_or(f64::NAN, |(a, b)| {
+                    a.yield_strength_pa.min(b.yield_strength_pa)
+                });
+                WearAccumulator::with_mechanism(law, mechanism, yield_pa)
+            }
+        }
+    };
     let history_dt = (model.end_time_s - t0) / 200.0;
     let mut watch = soundness::Watch::new(model);
     let mut observer = |v: &StepView| {
@@ -424,7 +440,7 @@ fn run_whole(
             let slot = &mut st.accs[tr.contact as usize][tr.track as usize];
             let entry = match slot {
                 Some(e) => e,
-                None => match WearAccumulator::new(law) {
+                None => match new_accumulator(tr.contact as usize) {
                     Ok(acc) => slot.insert(TrackAcc { acc, open: false }),
                     Err(e) => {
                         wear_error.get_or_insert(e);
@@ -433,7 +449,14 @@ fn run_whole(
                 },
             };
             entry.open = true;
-            if let Err(e) = entry.acc.push(v.t, tr.normal_force, tr.slip_speed, tr.area) {
+            let track = TrackLoad {
+                normal_force_n: tr.normal_force,
+                slip_speed_m_s: tr.slip_speed,
+                area_m2: tr.area,
+                damping_power_w: tr.damping_power.max(0.0),
+                penetration_rate_m_s: tr.penetration_rate,
+            };
+            if let Err(e) = entry.acc.push_track(v.t, &track) {
                 wear_error.get_or_insert(e);
             }
         }

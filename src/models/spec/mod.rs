@@ -176,6 +176,11 @@ pub struct WearSpec {
     /// Volume split between the two bodies of each contact.
     #[serde(default)]
     pub volume_split: crate::wear::allocation::VolumeSplit,
+    /// A wear mechanism added to the law on every track (tagged by `kind`: `impact_wear`,
+    /// `third_body`, ...; see `wear::mechanism`), e.g. the one a gap diagnosis fitted (a
+    /// sweep's `wear_law = {diagnosis = ..}` sets it). Absent: the law alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanism: Option<crate::wear::mechanism::WearMechanism>,
 }
 
 impl Default for WearSpec {
@@ -183,6 +188,7 @@ impl Default for WearSpec {
         Self {
             law: crate::wear::law::WearLaw::table_4_3(),
             volume_split: crate::wear::allocation::VolumeSplit::default(),
+            mechanism: None,
         }
     }
 }
@@ -247,6 +253,20 @@ impl CaseSpec {
             ));
         }
         self.simulation.validate("simulation")?;
+        if let Some(mechanism) = &self.wear.mechanism {
+            mechanism
+                .validate()
+                .map_err(|crate::wear::WearError::Invalid(e)| {
+                    FieldError::new(format!("wear.mechanism.{}", e.field), e.rule)
+                })?;
+            if matches!(self.wear.law, crate::wear::WearLaw::LegacyAppendix { .. }) {
+                return Err(FieldError::new(
+                    "wear.mechanism",
+                    "needs a K(sigma) law (archard or modified); the legacy appendix law feeds \
+                     N, not sigma",
+                ));
+            }
+        }
         match self.model_spec()? {
             ModelSpecRef::PersistentContact(s) => s.validate("persistent_contact")?,
             ModelSpecRef::RattleBox(s) => s.validate("rattle_box")?,
