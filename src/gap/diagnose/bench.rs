@@ -61,6 +61,8 @@ pub struct BenchOptions {
     pub scatter_rel: f64,
     /// Accelerometer rate, Hz.
     pub accelerometer_rate_hz: f64,
+    /// Share of the campaigns drawn with accelerometer records (the rest weigh only).
+    pub records_share: f64,
     /// Sensor noise, RMS m/s².
     pub sensor_noise_m_s2: f64,
     /// Magnitudes drawn, as fractions of each effect's bound.
@@ -81,6 +83,7 @@ impl Default for BenchOptions {
             noise_levels: vec![0.03, 0.10],
             scatter_rel: 0.05,
             accelerometer_rate_hz: 2000.0,
+            records_share: 0.5,
             sensor_noise_m_s2: 0.5,
             fractions: vec![0.07, 0.3, 0.8],
             pairs_per_kind: 4,
@@ -113,6 +116,14 @@ pub struct Scenario {
     pub noise_rel: f64,
     /// Rig seed.
     pub seed: u64,
+    /// Whether the rig writes the input and response accelerometer records (drawn: a real
+    /// campaign may weigh only).
+    #[serde(default = "records_by_default")]
+    pub accelerometers: bool,
+}
+
+fn records_by_default() -> bool {
+    true
 }
 
 /// One campaign's outcome.
@@ -193,6 +204,12 @@ pub struct Scores {
     pub median_shrink: f64,
     /// Undetectable in-library campaigns reported no_gap (share).
     pub undetectable_no_gap: f64,
+    /// Detectable single effects drawn without accelerometer records.
+    #[serde(default)]
+    pub detectable_weighed_only: usize,
+    /// Of those, the share whose best effect is the true one.
+    #[serde(default)]
+    pub top1_weighed_only: f64,
     /// Truth -> answer -> count.
     pub confusion: BTreeMap<String, BTreeMap<String, usize>>,
     /// Every outcome.
@@ -304,6 +321,9 @@ fn scenarios(
     }
     let mut rng = ChaCha20Rng::seed_from_u64(o.seed);
     list.shuffle(&mut rng);
+    // Accelerometer records drawn per campaign after the order (so the order is the one
+    // earlier benches drew): about half the campaigns weigh only.
+    let mut records = ChaCha20Rng::seed_from_u64(o.seed ^ 0xacce1);
     Ok(list
         .into_iter()
         .take(o.campaigns)
@@ -316,6 +336,7 @@ fn scenarios(
                 effects,
                 noise_rel,
                 seed: o.seed.wrapping_mul(1000).wrapping_add(i as u64),
+                accelerometers: records.gen_bool(o.records_share),
             },
         )
         .collect())
@@ -329,7 +350,7 @@ fn rig_options(s: &Scenario, o: &BenchOptions, noisy: bool) -> Result<RigOptions
         window_s: o.rig_window_s,
         settle_s: o.rig_settle_s,
         segments_per_increment: 1,
-        accelerometer_rate_hz: Some(o.accelerometer_rate_hz),
+        accelerometer_rate_hz: s.accelerometers.then_some(o.accelerometer_rate_hz),
         sensor_noise_m_s2: if noisy { o.sensor_noise_m_s2 } else { 0.0 },
         calibration_rel: if noisy {
             o.diagnose.accelerometer_calibration_rel
@@ -432,24 +453,39 @@ pub fn run(
         effects: Vec::new(),
         noise_rel: 0.0,
         seed: 0,
+        accelerometers: true,
     };
-    let (clean_control, _) = run_cached(
-        skeleton,
-        configs_dir,
-        &rig_options(&control_scenario, o, false)?,
-        control,
-        &cache,
-    )?;
-    let control_obs = observations(&clean_control);
+    // The control's readings with and without accelerometer records (a campaign is compared
+    // with the control taken as it was).
+    let mut control_obs_by_records = Vec::new();
+    for accelerometers in [false, true] {
+        let scenario = Scenario {
+            accelerometers,
+            ..control_scenario.clone()
+        };
+        let (clean_control, _) = run_cached(
+            skeleton,
+            configs_dir,
+            &rig_options(&scenario, o, false)?,
+            control,
+            &cache,
+        )?;
+        control_obs_by_records.push(observations(&clean_control));
+    }
     let mut outcomes = Vec::new();
     for (i, s) in list.iter().enumerate() {
         progress(format!(
-            "campaign {}/{}: rig ({} {:.4}, noise {})",
+            "campaign {}/{}: rig ({} {:.4}, noise {}, {})",
             i + 1,
             list.len(),
             s.truth,
             s.magnitude,
-            s.noise_rel
+            s.noise_rel,
+            if s.accelerometers {
+                "with accelerometers"
+            } else {
+                "weighed only"
+            }
         ));
         let (noisy, _truth): (Campaign, Truth) = run_cached(
             skeleton,
@@ -466,6 +502,7 @@ pub fn run(
             &cache,
         )?;
         let mut member_detectability = Vec::new();
+        let control_obs = &control_obs_by_records[usize::from(s.accelerometers)];
         let det = if s.truth == "control" {
             0.0
         } else {
@@ -494,7 +531,7 @@ pub fn run(
                     ));
                 }
             }
-            detectability(&clean_obs, &control_obs, &noise, &noisy_obs)
+            detectability(&clean_obs, control_obs, &noise, &noisy_obs)
         };
         let detectable = det > 2.0 && member_detectability.iter().all(|d| *d > 2.0);
         // Each campaign refines its own copy, so its diagnosis is the one it would get alone.
@@ -623,6 +660,11 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .collect();
     let det_lib: Vec<&&&Outcome> = singles.iter().filter(|o| o.detectable).collect();
     let right: Vec<&&&&Outcome> = det_lib.iter().filter(|o| named_right(o)).collect();
+    let weighed_only: Vec<&&&&Outcome> = det_lib
+        .iter()
+        .filter(|o| !o.scenario.accelerometers)
+        .collect();
+    let weighed_only_right = weighed_only.iter().filter(|o| named_right(o)).count();
     let det_pairs: Vec<&&Outcome> = lib
         .iter()
         .filter(|o| o.scenario.truth.contains('+') && o.detectable)
@@ -694,6 +736,8 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             undet.iter().filter(|o| o.verdict == Verdict::NoGap).count(),
             undet.len(),
         ),
+        detectable_weighed_only: weighed_only.len(),
+        top1_weighed_only: share(weighed_only_right, weighed_only.len()),
         confusion,
         outcomes,
     }
@@ -716,6 +760,11 @@ impl Scores {
             "| top-1 on detectable single effects ({}) | {} | >= 85 % |\n",
             self.detectable_in_library,
             pct(self.top1)
+        ));
+        s.push_str(&format!(
+            "| of them weighed only, without accelerometer records ({}) | {} | |\n",
+            self.detectable_weighed_only,
+            pct(self.top1_weighed_only)
         ));
         s.push_str(&format!(
             "| detectable pairs explained by both members ({}) | {} | >= 60 % |\n",
@@ -793,6 +842,7 @@ mod tests {
                 effects: Vec::new(),
                 noise_rel: 0.03,
                 seed: 0,
+                accelerometers: true,
             },
             detectability: 10.0,
             detectable: true,

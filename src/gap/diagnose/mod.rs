@@ -547,7 +547,7 @@ impl Candidate {
 /// held-out tests better by more than [`MIN_HELD_OUT_GAIN`], the margin by which any
 /// runner-up is told apart from the best (the partly-explained rules then apply to whichever
 /// is chosen).
-pub(super) fn pair_beats(pair: &Candidate, single: &Candidate) -> bool {
+fn pair_beats(pair: &Candidate, single: &Candidate) -> bool {
     pair.held_ll() - single.held_ll() > MIN_HELD_OUT_GAIN
 }
 
