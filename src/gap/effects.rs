@@ -16,12 +16,12 @@ use super::drive_edits::{
     add_cross_axis, filter_through_mount, resolved_excitation, set_excitation,
 };
 use super::tracks::WearTerm;
+use super::GapError;
+use crate::models::spec::{CaseSpec, ModelKind};
+use crate::wear::mechanism::WearMechanism;
 pub use crate::wear::mechanism::{
     AboveCutoff, CoatingBreakthrough, ImpactWear, LocalPressure, SevereWear, ThirdBody,
 };
-use crate::wear::mechanism::WearMechanism;
-use super::GapError;
-use crate::models::spec::{CaseSpec, ModelKind};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;

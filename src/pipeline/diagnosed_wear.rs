@@ -48,8 +48,8 @@ impl DiagnosedWearLaw {
                 f64::NAN
             }
         };
-        let mechanism = WearMechanism::from_effect(&self.effect, get, hardness_pa)
-            .ok_or_else(|| {
+        let mechanism =
+            WearMechanism::from_effect(&self.effect, get, hardness_pa).ok_or_else(|| {
                 FieldError::new(
                     "wear_law.effect",
                     format!("`{}` is not a wear-law effect", self.effect),
@@ -82,7 +82,10 @@ pub enum SweepWearLaw {
 impl SweepWearLaw {
     /// Reads `params.wear_law` (absent: `default`). An object is the resolved form; the bare
     /// `{"diagnosis": "<id>"}` a client sends is resolved by the service before this runs.
-    pub fn from_param(value: Option<&serde_json::Value>, default: &str) -> Result<Self, FieldError> {
+    pub fn from_param(
+        value: Option<&serde_json::Value>,
+        default: &str,
+    ) -> Result<Self, FieldError> {
         match value {
             None => Ok(Self::Named(default.to_string())),
             Some(serde_json::Value::String(s)) => Ok(Self::Named(s.clone())),
@@ -96,7 +99,9 @@ impl SweepWearLaw {
                 }
                 serde_json::from_value(serde_json::Value::Object(map.clone()))
                     .map(Self::Diagnosed)
-                    .map_err(|e| FieldError::new("wear_law", format!("is not a resolved diagnosis: {e}")))
+                    .map_err(|e| {
+                        FieldError::new("wear_law", format!("is not a resolved diagnosis: {e}"))
+                    })
             }
             Some(_) => Err(FieldError::new(
                 "wear_law",

@@ -115,7 +115,10 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
             let law = &job["params"]["wear_law"];
             assert_eq!(law["diagnosis"], diagnosis, "{job}");
             assert_eq!(law["effect"], report["best_effect"]["name"], "{job}");
-            assert_eq!(job["curve_key"], format!("ah64/clean/diagnosis-{diagnosis}"));
+            assert_eq!(
+                job["curve_key"],
+                format!("ah64/clean/diagnosis-{diagnosis}")
+            );
             let url = format!("/v1/jobs/{}/cancel", job["id"].as_str().unwrap());
             api.post(&url, Some(ENGINEER), "");
         } else {
@@ -124,8 +127,16 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         }
         let unknown = uuid::Uuid::new_v4().to_string();
         for (law, field, says) in [
-            (json!({ "diagnosis": unknown }), "params.wear_law.diagnosis", "names no job"),
-            (json!({ "diagnosis": "yesterday" }), "params.wear_law.diagnosis", "UUID"),
+            (
+                json!({ "diagnosis": unknown }),
+                "params.wear_law.diagnosis",
+                "names no job",
+            ),
+            (
+                json!({ "diagnosis": "yesterday" }),
+                "params.wear_law.diagnosis",
+                "UUID",
+            ),
             (
                 json!({ "diagnosis": diagnosis, "effect": "impact_wear" }),
                 "params.wear_law",

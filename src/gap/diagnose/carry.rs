@@ -56,8 +56,12 @@ pub fn carried_wear_law(
             best.name
         )));
     }
-    let effect = info(&best.name)
-        .ok_or_else(|| refuse(format!("names `{}`, not an effect of this library", best.name)))?;
+    let effect = info(&best.name).ok_or_else(|| {
+        refuse(format!(
+            "names `{}`, not an effect of this library",
+            best.name
+        ))
+    })?;
     if effect.acts != Acts::WearLaw {
         return Err(refuse(format!(
             "diagnosis {id} named `{}`, a dynamics effect (it changes the rig or its drive, not \

@@ -17,8 +17,8 @@ use crate::units::{MG_PER_KG, S_PER_H};
 use crate::wear::allocation::VolumeSplit;
 use crate::wear::integrate::{TrackLoad, WearAccumulator, WearTotals};
 use crate::wear::law::WearLaw;
-use crate::wear::mechanism::WearMechanism;
 use crate::wear::material::Material;
+use crate::wear::mechanism::WearMechanism;
 use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
 
@@ -398,9 +398,12 @@ fn run_whole(
         match options.wear_mechanism {
             None => WearAccumulator::new(law),
             Some(mechanism) => {
-                let yield_pa = model.contact_materials.get(contact).map_or(f64::NAN, |(a, b)| {
-                    a.yield_strength_pa.min(b.yield_strength_pa)
-                });
+                let yield_pa = model
+                    .contact_materials
+                    .get(contact)
+                    .map_or(f64::NAN, |(a, b)| {
+                        a.yield_strength_pa.min(b.yield_strength_pa)
+                    });
                 WearAccumulator::with_mechanism(law, mechanism, yield_pa)
             }
         }
