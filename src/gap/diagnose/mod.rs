@@ -543,14 +543,6 @@ impl Candidate {
     }
 }
 
-/// Whether `pair` is chosen over the single `single` (both explaining): it predicts the
-/// held-out tests better by more than [`MIN_HELD_OUT_GAIN`], the margin by which any
-/// runner-up is told apart from the best (the partly-explained rules then apply to whichever
-/// is chosen).
-fn pair_beats(pair: &Candidate, single: &Candidate) -> bool {
-    pair.held_ll() - single.held_ll() > MIN_HELD_OUT_GAIN
-}
-
 /// Runs the diagnosis: builds the emulator (simulations, reported through `progress(done,
 /// total)`), then fits, ranks and locates.
 pub fn diagnose(
@@ -695,10 +687,7 @@ pub fn diagnose_with(
         .copied()
         .filter(|&i| singles[i].explains(&nominal))
         .collect();
-    // Pairs are weighed whenever there is a gap: a pair is chosen over the best explaining
-    // single only when it predicts the held-out tests better by more than
-    // MIN_HELD_OUT_GAIN (the second member must earn its place out of sample).
-    if !no_gap {
+    if !no_gap && explaining_singles.is_empty() {
         pairs = problem
             .pair_models(&singles, &nominal)
             .into_iter()
@@ -761,16 +750,9 @@ pub fn diagnose_with(
         .map(|(j, c)| entry(c, 1 + singles.len() + j))
         .collect();
 
-    let explaining_pairs: Vec<usize> = (0..pairs.len())
-        .filter(|&j| pairs[j].explains(&nominal))
-        .collect();
-    let pair_beats_single = match (explaining_singles.first(), explaining_pairs.first()) {
-        (Some(&i), Some(&j)) => pair_beats(&pairs[j], &singles[i]),
-        _ => false,
-    };
     let chosen: Option<(&Candidate, Vec<String>)> = if no_gap {
         None
-    } else if let (Some(&best), false) = (explaining_singles.first(), pair_beats_single) {
+    } else if let Some(&best) = explaining_singles.first() {
         let b = &singles[best];
         let others = explaining_singles[1..]
             .iter()
@@ -781,7 +763,9 @@ pub fn diagnose_with(
             .collect();
         Some((b, others))
     } else {
-        let explaining = &explaining_pairs;
+        let explaining: Vec<usize> = (0..pairs.len())
+            .filter(|&j| pairs[j].explains(&nominal))
+            .collect();
         explaining.first().map(|&j| {
             let b = &pairs[j];
             let others = explaining[1..]

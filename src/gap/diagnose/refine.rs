@@ -6,8 +6,7 @@
 //!    parameters: each profiled over a few values within its bounds (a variant table per
 //!    value, simulated near the fitted magnitude), then the best value's neighbours, then the
 //!    chosen variant refined at its fitted magnitudes;
-//! 3. when still no single effect explains, or a pair beats the best that does, the pairs of
-//!    the best singles: a dynamics effect
+//! 3. when still no single effect explains, the pairs of the best singles: a dynamics effect
 //!    with a wear-law effect made exact ([`Emulator::add_pair`]), and every dynamics member
 //!    refined at the magnitudes the pair's fits land on.
 
@@ -323,8 +322,7 @@ fn best_value(
         .map_or(f64::NAN, |(t, _)| emulator.effects[t].parameter(name))
 }
 
-/// Step 3: when no single effect explains, or a pair of the best singles beats the best one
-/// that does (as the tables compose it), the pairs of the best singles: each dynamics +
+/// Step 3: when no single effect explains, the pairs of the best singles: each dynamics +
 /// wear-law pair made exact, and the dynamics members of every pair refined at the
 /// magnitudes the pair's fits land on (the exact pairs follow their refined tables).
 fn exact_pairs(
@@ -341,22 +339,10 @@ fn exact_pairs(
             let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
                 return Ok(());
             };
-            let models = problem.pair_models(&singles, &nominal);
-            // With an explaining single, pairs are made exact only when one (as the tables
-            // compose it) beats that single by the margin a chosen pair needs.
-            let best_single = singles
-                .iter()
-                .filter(|c| c.explains(&nominal))
-                .max_by(|a, b| a.held_ll().total_cmp(&b.held_ll()));
-            if let Some(single) = best_single {
-                let contender = models.iter().any(|m| {
-                    let c = problem.evaluate(*m, options.alpha);
-                    c.explains(&nominal) && super::pair_beats(&c, single)
-                });
-                if !contender {
-                    return Ok(());
-                }
+            if singles.iter().any(|c| c.explains(&nominal)) {
+                return Ok(());
             }
+            let models = problem.pair_models(&singles, &nominal);
             let mut requests: Vec<(usize, f64)> = Vec::new();
             let mut joints: Vec<[(usize, f64); 2]> = Vec::new();
             if round > 0 {
