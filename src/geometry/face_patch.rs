@@ -21,9 +21,14 @@
 //! a non-integer exponent it integrates `w^e` to the accuracy of a Gauss rule on a function
 //! `C^⌊e⌋` at the `w = 0` edge (documented, not exact).
 //!
-//! The cut sides (a bounded face's edges crossing the patch) are where the region moves
-//! relative to the material: their nodes ([`FacePatch::for_each_cut_node`]) carry the
-//! boundary term of the energy's gradient (docs/models.md).
+//! Beyond a bounded face's side the face's solid is rounded off: a ball within `r` of the
+//! side's edge still touches it, with `w = r − d` and `d` its distance to the solid (the
+//! lattice's law, [`PlacedFace::signed_distance`]). Those parts of the inner face
+//! ([`FacePatch::beyond_sides`], strips at most `r` wide) carry the rest of the continuum's
+//! energy, which is continuous across the side: the region boundary terms of the two parts'
+//! gradients cancel, so no force acts on the cut line, and a shoe sliding off a lip unloads
+//! continuously even when a whole face crosses the edge at once. `w` is not polynomial there;
+//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/models.md gives the measured error).
 //!
 //! Hot path: fixed-size arrays only, no heap allocation.
 
@@ -33,15 +38,8 @@ use nalgebra::{Point3, Vector3};
 /// Room for the vertices of a clipped face: the square's 4, one more per clipping line (the
 /// `w = 0` line and up to four sides of a bounded face), with margin for repeated vertices.
 const MAX_VERTICES: usize = 16;
-/// Most cut sides: a rectangular face extent has four.
-const MAX_CUTS: usize = 4;
-/// Edge label of the square's own sides (material boundary: no boundary term).
-const LABEL_SQUARE: u8 = 0;
-/// Edge label of the `w = 0` line (the density vanishes there: no boundary term).
-const LABEL_SURFACE: u8 = 1;
-/// Edge label of cut `k`: `LABEL_CUT + k`.
-const LABEL_CUT: u8 = 2;
-
+/// Most sides of a face's extent (a rectangle).
+const MAX_SIDES: usize = 4;
 /// Gauss–Legendre abscissae on [-1, 1] for 1 to 5 nodes.
 const GL_NODES: [&[f64]; 5] = [
     &[0.0],
@@ -91,6 +89,13 @@ pub struct QuadratureOrder {
 }
 
 impl QuadratureOrder {
+    /// The rule on the strips beyond a bounded face's sides (`w` not polynomial): the most
+    /// nodes of the table, 5 × 5 per slice.
+    pub const ROUNDED_EDGE: Self = Self {
+        across: 5,
+        along: 5,
+    };
+
     /// The smallest rule exact for the stored energy and the torque of the IMPACT law with
     /// exponent `e` (densities of degree `D = ⌈e⌉ + 1` in `ξ`): `m_v = ⌈(D + 1)/2⌉`,
     /// `m_u = ⌈(D + 2)/2⌉`, each at most 5 (exact up to `e = 7`). `e = 2`: 2 × 3 nodes.
@@ -117,28 +122,6 @@ impl Line {
     }
 }
 
-/// A side of a bounded face that cuts the patch.
-#[derive(Debug, Clone, Copy)]
-struct Cut {
-    line: Line,
-    /// World unit direction out of the face's extent across this side.
-    outward: Vector3<f64>,
-}
-
-/// A node on a cut side, carrying the boundary term of the energy's gradient.
-#[derive(Debug, Clone, Copy)]
-pub struct CutNode {
-    /// The material point (a ball centre on the inner face), world, m.
-    pub centre: Point3<f64>,
-    /// Its penetration `w`, m.
-    pub penetration: f64,
-    /// Line weight `L_ξ ω / (4 |∇_ξ g|)`, m: the generalized force on the piece is
-    /// `weight · U'(w) · outward` with `U'(w) = k w^(e+1)/(e+1)` the energy per unit share.
-    pub weight: f64,
-    /// World unit direction out of the face's extent (the force's direction on the piece).
-    pub outward: Vector3<f64>,
-}
-
 /// The pressed part of one inner-box face against one (possibly bounded) face.
 #[derive(Debug, Clone, Copy)]
 pub struct FacePatch {
@@ -147,16 +130,13 @@ pub struct FacePatch {
     axis_v: Vector3<f64>,
     depth: Line,
     verts: [[f64; 2]; MAX_VERTICES],
-    labels: [u8; MAX_VERTICES],
     len: usize,
-    cuts: [Option<Cut>; MAX_CUTS],
 }
 
 impl FacePatch {
-    /// The part of the inner face `centre + u axis_u + v axis_v` (`|u|, |v| <= 1`, world, m)
-    /// whose balls of `radius` penetrate `face`'s plane and lie over its extent; `None` when
-    /// that part is empty.
-    pub fn new(
+    /// The whole inner face `centre + u axis_u + v axis_v` (`|u|, |v| <= 1`, world, m), its
+    /// balls of `radius` against `face`'s plane.
+    fn square(
         centre: Point3<f64>,
         axis_u: Vector3<f64>,
         axis_v: Vector3<f64>,
@@ -178,36 +158,127 @@ impl FacePatch {
             axis_v,
             depth,
             verts: [[0.0; 2]; MAX_VERTICES],
-            labels: [LABEL_SQUARE; MAX_VERTICES],
             len: 4,
-            cuts: [None; MAX_CUTS],
         };
         patch.verts[..4].copy_from_slice(&[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]);
-        if !patch.clip(&depth, LABEL_SURFACE) {
-            return None;
+        patch.clip(&depth).then_some(patch)
+    }
+
+    /// The line `g >= 0` of a side `(d, o, b)` of `face`'s extent ([`PlacedFace::sides`]):
+    /// `g(x) = b − d·(x − o)`, positive over the extent, in this face's `ξ`.
+    fn side_line(&self, side: &(Vector3<f64>, Point3<f64>, f64)) -> Line {
+        let (d, o, b) = side;
+        Line {
+            alpha: b - d.dot(&(self.centre - o)),
+            beta: [-d.dot(&self.axis_u), -d.dot(&self.axis_v)],
         }
-        for (k, (outward, origin, bound)) in face.sides().enumerate().take(MAX_CUTS) {
-            // g(x) = bound − outward·(x − origin) >= 0 over the extent.
-            let line = Line {
-                alpha: bound - outward.dot(&(centre - origin)),
-                beta: [-outward.dot(&axis_u), -outward.dot(&axis_v)],
-            };
-            if patch.verts[..patch.len].iter().all(|&p| line.at(p) >= 0.0) {
-                continue;
-            }
-            if !patch.clip(&line, LABEL_CUT + k as u8) {
+    }
+
+    /// The part of the inner face `centre + u axis_u + v axis_v` (`|u|, |v| <= 1`, world, m)
+    /// whose balls of `radius` penetrate `face`'s plane with their centres over its extent;
+    /// `None` when that part is empty. There `w = radius − (n·x − offset)` is linear.
+    pub fn new(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+    ) -> Option<Self> {
+        let mut patch = Self::square(centre, axis_u, axis_v, radius, face)?;
+        for side in face.sides() {
+            let line = patch.side_line(&side);
+            if !patch.clip(&line) {
                 return None;
             }
-            patch.cuts[k] = Some(Cut { line, outward });
         }
         Some(patch)
     }
 
-    /// Sutherland–Hodgman clip of the polygon by `line` (keeping `line >= 0`), labelling the
-    /// new side `label`; false when nothing of positive area is left.
-    fn clip(&mut self, line: &Line, label: u8) -> bool {
+    /// The parts of the same inner face whose ball centres lie beyond a side of `face`'s
+    /// extent by less than `radius` (and below `radius` above its plane): where a ball can
+    /// touch the face's rounded-off edge, its penetration `radius − d` with `d` the distance
+    /// to the face's solid ([`PlacedFace::signed_distance`]), not linear. One part per side,
+    /// a point beyond several sides counted with the first: together with [`FacePatch::new`]
+    /// they cover every ball that touches the solid, each once.
+    pub fn beyond_sides(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+    ) -> [Option<Self>; MAX_SIDES] {
+        let mut out = [None; MAX_SIDES];
+        let sides: [_; MAX_SIDES] = {
+            let mut all = [None; MAX_SIDES];
+            for (slot, side) in all.iter_mut().zip(face.sides()) {
+                *slot = Some(side);
+            }
+            all
+        };
+        for (k, side) in sides.iter().enumerate() {
+            let Some(side) = side else { continue };
+            // Slice across the side's edge (`u` the face axis most nearly across it): the
+            // integrand's kink at `w = 0` then lies in few slices.
+            let across_v = side.0.dot(&axis_v).abs() > side.0.dot(&axis_u).abs();
+            let (au, av) = if across_v {
+                (axis_v, axis_u)
+            } else {
+                (axis_u, axis_v)
+            };
+            let Some(mut patch) = Self::square(centre, au, av, radius, face) else {
+                return out;
+            };
+            let g = patch.side_line(side);
+            let beyond = Line {
+                alpha: -g.alpha,
+                beta: [-g.beta[0], -g.beta[1]],
+            };
+            let within = |reach: f64| Line {
+                alpha: g.alpha + reach,
+                ..g
+            };
+            let mut keep = patch.clip(&beyond) && patch.clip(&within(radius));
+            for (j, other) in sides.iter().enumerate() {
+                let Some(other) = other else { continue };
+                if !keep || j == k {
+                    continue;
+                }
+                let h = patch.side_line(other);
+                keep = if j < k {
+                    patch.clip(&h)
+                } else {
+                    patch.clip(&Line {
+                        alpha: h.alpha + radius,
+                        ..h
+                    })
+                };
+            }
+            if keep {
+                // No ball farther beyond the edge than sqrt(r² − u²) touches it, u >= 0 the
+                // lowest height of a centre over the plane: for a face parallel to the plane
+                // this is exactly the `w = 0` curve, and the integrand is smooth inside.
+                let lowest = patch.verts[..patch.len]
+                    .iter()
+                    .map(|&p| radius - patch.depth.at(p))
+                    .fold(f64::INFINITY, f64::min)
+                    .max(0.0);
+                let reach = (radius * radius - lowest * lowest).max(0.0).sqrt();
+                keep = patch.clip(&within(reach));
+            }
+            if keep {
+                out[k] = Some(patch);
+            }
+        }
+        out
+    }
+
+    /// Sutherland–Hodgman clip of the polygon by `line` (keeping `line >= 0`); false when
+    /// nothing of positive area is left.
+    fn clip(&mut self, line: &Line) -> bool {
+        if self.verts[..self.len].iter().all(|&p| line.at(p) >= 0.0) {
+            return true;
+        }
         let mut out = [[0.0; 2]; MAX_VERTICES];
-        let mut out_labels = [0u8; MAX_VERTICES];
         let mut m = 0;
         for i in 0..self.len {
             let p = self.verts[i];
@@ -217,26 +288,22 @@ impl FacePatch {
                 let t = gp / (gp - gq);
                 [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
             };
-            // (vertex, label of the side leaving it) to append, at most two.
             let (first, second) = match (gp >= 0.0, gq >= 0.0) {
-                (true, true) => (Some((p, self.labels[i])), None),
-                // p on the line: the side from p runs along it.
-                (true, false) if gp == 0.0 => (Some((p, label)), None),
-                (true, false) => (Some((p, self.labels[i])), Some((crossing(), label))),
+                (true, true) => (Some(p), None),
+                (true, false) if gp == 0.0 => (Some(p), None),
+                (true, false) => (Some(p), Some(crossing())),
                 // q on the line is appended as the next p.
-                (false, true) if gq > 0.0 => (Some((crossing(), self.labels[i])), None),
+                (false, true) if gq > 0.0 => (Some(crossing()), None),
                 (false, _) => (None, None),
             };
-            for (v, l) in [first, second].into_iter().flatten() {
+            for v in [first, second].into_iter().flatten() {
                 if m < MAX_VERTICES {
                     out[m] = v;
-                    out_labels[m] = l;
                     m += 1;
                 }
             }
         }
         self.verts = out;
-        self.labels = out_labels;
         self.len = m;
         m >= 3 && self.area_xi() > 0.0
     }
@@ -279,6 +346,17 @@ impl FacePatch {
     /// and its share of the face's stiffness (the rule's weight in `ξ` over the square's area
     /// 4, so a fully pressed face's weights sum to 1).
     pub fn for_each_node(&self, order: QuadratureOrder, visit: &mut impl FnMut(Point3<f64>, f64)) {
+        self.for_each_node_sliced(order, 1, visit);
+    }
+
+    /// [`FacePatch::for_each_node`] with each slice between vertices cut into `parts` equal
+    /// slices (for an integrand with a kink inside the patch).
+    pub fn for_each_node_sliced(
+        &self,
+        order: QuadratureOrder,
+        parts: usize,
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
         let mut us = [0.0; MAX_VERTICES];
         for (u, p) in us.iter_mut().zip(&self.verts[..self.len]) {
             *u = p[0];
@@ -287,27 +365,57 @@ impl FacePatch {
         us.sort_unstable_by(f64::total_cmp);
         let (xs_u, ws_u) = rule(order.along);
         let (xs_v, ws_v) = rule(order.across);
+        let parts = parts.max(1);
         for k in 1..us.len() {
-            let (u0, u1) = (us[k - 1], us[k]);
-            if u1 <= u0 {
+            let (ua, ub) = (us[k - 1], us[k]);
+            if ub <= ua {
                 continue;
             }
-            let mid = 0.5 * (u0 + u1);
-            let Some((lower, upper)) = self.chains_at(mid) else {
+            let Some((lower, upper)) = self.chains_at(0.5 * (ua + ub)) else {
                 continue;
             };
-            let half_u = 0.5 * (u1 - u0);
-            for (xu, wu) in xs_u.iter().zip(ws_u) {
-                let u = mid + half_u * xu;
-                let (lo, hi) = (lower.0 + lower.1 * (u - mid), upper.0 + upper.1 * (u - mid));
-                if hi <= lo {
-                    continue;
-                }
-                let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-                for (xv, wv) in xs_v.iter().zip(ws_v) {
-                    let v = vm + half_v * xv;
-                    visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
-                }
+            let (lower, upper) = (
+                (lower.0 - lower.1 * 0.5 * (ua + ub), lower.1),
+                (upper.0 - upper.1 * 0.5 * (ua + ub), upper.1),
+            );
+            for part in 0..parts {
+                let u0 = ua + (ub - ua) * part as f64 / parts as f64;
+                let u1 = ua + (ub - ua) * (part + 1) as f64 / parts as f64;
+                let mid = 0.5 * (u0 + u1);
+                let half_u = 0.5 * (u1 - u0);
+                let lower = (lower.0 + lower.1 * mid, lower.1);
+                let upper = (upper.0 + upper.1 * mid, upper.1);
+                self.slice_nodes(mid, half_u, lower, upper, xs_u, ws_u, xs_v, ws_v, visit);
+            }
+        }
+    }
+
+    /// The nodes of one slice `[mid − half_u, mid + half_u]` whose lower and upper sides are
+    /// (value at `mid`, slope).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn slice_nodes(
+        &self,
+        mid: f64,
+        half_u: f64,
+        lower: (f64, f64),
+        upper: (f64, f64),
+        xs_u: &[f64],
+        ws_u: &[f64],
+        xs_v: &[f64],
+        ws_v: &[f64],
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
+        for (xu, wu) in xs_u.iter().zip(ws_u) {
+            let u = mid + half_u * xu;
+            let (lo, hi) = (lower.0 + lower.1 * (u - mid), upper.0 + upper.1 * (u - mid));
+            if hi <= lo {
+                continue;
+            }
+            let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+            for (xv, wv) in xs_v.iter().zip(ws_v) {
+                let v = vm + half_v * xv;
+                visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
             }
         }
     }
@@ -333,39 +441,6 @@ impl FacePatch {
             }
         }
         Some((lower?, upper?))
-    }
-
-    /// Calls `visit` for every node of the cut sides (the bounded face's edges crossing the
-    /// patch), `order.along` Gauss–Legendre nodes per side: exact for a line density of
-    /// degree `2 m_u − 1` (`w^(e+1)` and its lever: degree `e + 2`).
-    pub fn for_each_cut_node(&self, order: QuadratureOrder, visit: &mut impl FnMut(&CutNode)) {
-        let (xs, ws) = rule(order.along);
-        for i in 0..self.len {
-            let label = self.labels[i];
-            if label < LABEL_CUT {
-                continue;
-            }
-            let Some(cut) = self.cuts[(label - LABEL_CUT) as usize] else {
-                continue;
-            };
-            let p = self.verts[i];
-            let q = self.verts[(i + 1) % self.len];
-            let length = (q[0] - p[0]).hypot(q[1] - p[1]);
-            let grad = cut.line.beta[0].hypot(cut.line.beta[1]);
-            if !(length > 0.0 && grad > 0.0) {
-                continue;
-            }
-            for (x, w) in xs.iter().zip(ws) {
-                let t = 0.5 * (1.0 + x);
-                let xi = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
-                visit(&CutNode {
-                    centre: self.point(xi),
-                    penetration: self.depth.at(xi),
-                    weight: 0.5 * w * length / (4.0 * grad),
-                    outward: cut.outward,
-                });
-            }
-        }
     }
 }
 

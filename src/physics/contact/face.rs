@@ -7,11 +7,12 @@
 //! ([`Contact::evaluate_point`](super::Contact::evaluate_point)) with the plane's normal and
 //! the node's share of the face: its force, damping and friction act at the node with the
 //! node's own rates, so damping and friction do non-positive work node by node, and the
-//! elastic resultants (force, torque, stored energy) are the exact integrals. Where a bounded
-//! face's side cuts the patch, the region moves relative to the material and the energy's
-//! gradient has a boundary term: a force `U'(w)` per unit length along the cut, pointing out
-//! of the face's extent ([`Contact::evaluate_faces`]). With it the elastic force is the exact
-//! gradient of the stored energy, and a shoe sliding off a lip unloads continuously.
+//! elastic resultants (force, torque, stored energy) over the face's extent are the exact
+//! integrals. Beyond a bounded face's side, within the roundover radius, balls touch the
+//! face's rounded-off edge ([`FacePatch::beyond_sides`]): the energy is continuous across the
+//! side, so the region boundary terms of its gradient cancel and the elastic force is the
+//! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
+//! unloads continuously.
 
 use super::point::PointOutputs;
 use super::Contact;
@@ -28,11 +29,15 @@ pub enum FaceContact {
     #[default]
     Lattice,
     /// Each face integrated over its pressed polygon with a Gauss rule exact for the IMPACT
-    /// law's force, torque and stored energy (integer exponent), plus the boundary force of a
-    /// bounded face's cut sides: the lattice's limit of infinitely many points, up to the
-    /// rounded strip beyond a bounded face's edge (docs/models.md "Exact face contact").
+    /// law's force, torque and stored energy (integer exponent), and over the strips beyond a
+    /// bounded face's sides with a 5 × 5 rule: the lattice's limit of infinitely many points
+    /// (docs/models.md "Exact face contact").
     Exact,
 }
+
+/// Slices per strip beyond a bounded face's side (each with the 5 × 5 rule): the strip's
+/// integrand has a kink where `w = 0` crosses it on a tilted face.
+const ROUNDED_EDGE_SLICES: usize = 2;
 
 impl Contact {
     /// Evaluates the six faces of the inner box `inner` (half extents, m) of a rounded box of
@@ -53,23 +58,29 @@ impl Contact {
         let order = QuadratureOrder::for_exponent(self.impact.exponent);
         let mut deepest: Option<(f64, Point3<f64>)> = None;
         for (centre, axis_u, axis_v) in inner_box_faces(inner, pose) {
-            let Some(patch) = FacePatch::new(centre, axis_u, axis_v, radius, face) else {
-                continue;
-            };
-            let d = patch.deepest();
-            if deepest.is_none_or(|best| d.0 > best.0) {
-                deepest = Some(d);
-            }
-            patch.for_each_node(order, &mut |x, share| {
-                let distance = normal.dot(&x.coords) - offset;
-                self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
-            });
-            patch.for_each_cut_node(order, &mut |node| {
-                if node.penetration > 0.0 {
-                    let force = node.outward * (node.weight * self.impact.potential(node.penetration));
-                    out.sum.add_boundary_force(&node.centre, &force, fa, fb);
+            if let Some(patch) = FacePatch::new(centre, axis_u, axis_v, radius, face) {
+                let d = patch.deepest();
+                if deepest.is_none_or(|best| d.0 > best.0) {
+                    deepest = Some(d);
                 }
-            });
+                patch.for_each_node(order, &mut |x, share| {
+                    let distance = normal.dot(&x.coords) - offset;
+                    self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
+                });
+            }
+            if !face.is_bounded() {
+                continue;
+            }
+            for strip in FacePatch::beyond_sides(centre, axis_u, axis_v, radius, face)
+                .iter()
+                .flatten()
+            {
+                let order = QuadratureOrder::ROUNDED_EDGE;
+                strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
+                    let (distance, normal) = face.signed_distance(&x);
+                    self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
+                });
+            }
         }
         // The track's penetration is the patch's deepest vertex (the exact maximum of the
         // linear `w`), not the deepest node.

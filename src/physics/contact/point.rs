@@ -211,21 +211,3 @@ pub(super) fn friction_derivatives(
     }
 }
 
-
-impl TrackSum {
-    /// Adds a conservative force `force` (N, world) on body a at its material point `at`
-    /// (−force on b at the same point): the boundary term of an exactly integrated face's
-    /// energy gradient ([`super::face`]). Not a normal force: no share in N, slip or power.
-    #[inline]
-    pub(super) fn add_boundary_force(
-        &mut self,
-        at: &Point3<f64>,
-        force: &Vector3<f64>,
-        fa: &BodyFrame,
-        fb: &BodyFrame,
-    ) {
-        self.force += force;
-        self.torque_a += (at.coords - fa.position).cross(force);
-        self.torque_b += (at.coords - fb.position).cross(force);
-    }
-}
