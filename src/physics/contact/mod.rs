@@ -391,7 +391,7 @@ impl Contact {
                     track: (ip * nfaces + jf) as u32,
                     linearizations: linearizations.as_deref_mut(),
                     points: points.as_deref_mut(),
-                    energy: 0.0,
+                    energy: &mut energy,
                     sum: TrackSum::default(),
                 };
                 match (self.face_contact, shape) {
@@ -433,7 +433,6 @@ impl Contact {
                         }
                     }
                 }
-                energy += out.energy;
                 let track = out.sum;
                 if !track.touching {
                     continue;

@@ -18,8 +18,9 @@ pub(super) struct PointOutputs<'s, 'p> {
     pub(super) linearizations: Option<&'s mut Vec<TrackLinearization>>,
     /// Receives each loaded point's load.
     pub(super) points: Option<&'s mut (dyn FnMut(&PointLoad) + 'p)>,
-    /// Elastic energy stored in the pair's points, J.
-    pub(super) energy: f64,
+    /// The contact's stored elastic energy, J: each point adds its own (in the points' order,
+    /// so the sum is the lattice's bit for bit).
+    pub(super) energy: &'s mut f64,
     /// The track's sums.
     pub(super) sum: TrackSum,
 }
@@ -88,7 +89,7 @@ impl super::Contact {
                 });
             }
         }
-        out.energy += beta * self.impact.potential(w);
+        *out.energy += beta * self.impact.potential(w);
         if let Some(sink) = out.points.as_deref_mut() {
             if fn_mag > 0.0 {
                 sink(&PointLoad {
