@@ -457,7 +457,11 @@ pub fn inner_box_faces(
     pose: &nalgebra::Isometry3<f64>,
 ) -> [(Point3<f64>, Vector3<f64>, Vector3<f64>); 6] {
     let r = pose.rotation.to_rotation_matrix();
-    let axes = [r.matrix().column(0), r.matrix().column(1), r.matrix().column(2)];
+    let axes = [
+        r.matrix().column(0),
+        r.matrix().column(1),
+        r.matrix().column(2),
+    ];
     let c = Point3::from(pose.translation.vector);
     let mut out = [(c, Vector3::zeros(), Vector3::zeros()); 6];
     for k in 0..3 {

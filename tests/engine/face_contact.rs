@@ -110,8 +110,8 @@ fn a_uniformly_pressed_face_carries_k_w_e_times_its_pressed_share() {
             t_range_m: (f64::NEG_INFINITY, f64::INFINITY),
         });
         let face = PlacedFace::new(plane, extent.as_ref(), &Isometry3::identity());
-        let patch = FacePatch::new(centre, Vector3::x() * a, Vector3::z() * b, r, &face)
-            .expect("pressed");
+        let patch =
+            FacePatch::new(centre, Vector3::x() * a, Vector3::z() * b, r, &face).expect("pressed");
         let (mut share, mut force) = (0.0, 0.0);
         patch.for_each_node(order, &mut |x, beta| {
             share += beta;
@@ -134,8 +134,12 @@ fn a_uniformly_pressed_face_carries_k_w_e_times_its_pressed_share() {
     let contact = lip_contact(false, false);
     let inner_height = 2.0 * (HALF[1] - ROUNDOVER);
     for w in [1e-6, 5e-5, 2e-4, 4e-4] {
-        let (energy, force, torque, tracks) =
-            evaluate(&contact, &level(0.003, w), Vector3::zeros(), Vector3::zeros());
+        let (energy, force, torque, tracks) = evaluate(
+            &contact,
+            &level(0.003, w),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        );
         let e = impact.exponent;
         let k = impact.stiffness;
         let expected = k * w.powf(e) * (1.0 + 4.0 * w / ((e + 1.0) * inner_height));
@@ -149,7 +153,10 @@ fn a_uniformly_pressed_face_carries_k_w_e_times_its_pressed_share() {
         // Stored energy: k w^(e+1)/(e+1) on the bottom, k w^(e+2)/((e+1)(e+2) H) per side.
         let stored = k * w.powf(e + 1.0) / (e + 1.0)
             + 4.0 * k * w.powf(e + 2.0) / ((e + 1.0) * (e + 2.0) * inner_height);
-        assert!((energy - stored).abs() < 1e-12 * stored, "{energy} vs {stored}");
+        assert!(
+            (energy - stored).abs() < 1e-12 * stored,
+            "{energy} vs {stored}"
+        );
         // The track: normal force the sum, penetration the exact depth w.
         assert_eq!(tracks.len(), 1);
         assert!((tracks[0].normal_force - expected).abs() < 1e-12 * expected);
@@ -217,8 +224,14 @@ fn the_elastic_force_is_minus_the_gradient_of_the_stored_energy_across_a_lip_edg
         let h = (1e-3 * depth).min(1e-8);
         for i in 0..3 {
             let e = Vector3::ith(i, h);
-            let plus = Isometry3::from_parts(Translation3::from(pose.translation.vector + e), pose.rotation);
-            let minus = Isometry3::from_parts(Translation3::from(pose.translation.vector - e), pose.rotation);
+            let plus = Isometry3::from_parts(
+                Translation3::from(pose.translation.vector + e),
+                pose.rotation,
+            );
+            let minus = Isometry3::from_parts(
+                Translation3::from(pose.translation.vector - e),
+                pose.rotation,
+            );
             let grad = (stored(&contact, &plus) - stored(&contact, &minus)) / (2.0 * h);
             worst = worst.max((force[i] + grad).abs() / scale);
             assert!(
@@ -323,7 +336,10 @@ fn a_head_sliding_off_a_lip_unloads_continuously_and_its_work_is_the_energy_drop
                 "jump at x = {x}: {} of the law",
                 (force.y - fy_prev).abs() / full
             );
-            assert!(force.y <= fy_prev + 1e-12 * full, "loads while sliding off at {x}");
+            assert!(
+                force.y <= fy_prev + 1e-12 * full,
+                "loads while sliding off at {x}"
+            );
         }
         prev = Some((force.x, force.y));
         e_end = e;
@@ -435,7 +451,10 @@ fn the_exact_face_jacobian_equals_central_differences() {
 
 /// Sum of the contact forces and torques (about each body's centre) on body 0 (the missile)
 /// of `sys` at `y`, and the tracks.
-fn missile_resultant(sys: &MultibodySystem, y: &[f64]) -> (Vector3<f64>, Vector3<f64>, Vec<TrackState>) {
+fn missile_resultant(
+    sys: &MultibodySystem,
+    y: &[f64],
+) -> (Vector3<f64>, Vector3<f64>, Vec<TrackState>) {
     let mut ws = sys.workspace();
     let mut tracks = Vec::new();
     sys.tracks(0.0, y, &mut ws, &mut |t| tracks.push(*t));
@@ -466,11 +485,15 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     };
     let fine = model_at(33, FaceContact::Lattice);
     let settings = railwear::models::case::integrator_settings(&case).expect("settings");
-    let y = railwear::validation::energy::energy_run(&fine.system, &fine.initial_state, settings, 1.0)
-        .expect("settles")
-        .state;
+    let y =
+        railwear::validation::energy::energy_run(&fine.system, &fine.initial_state, settings, 1.0)
+            .expect("settles")
+            .state;
     let (f_e, t_e, tracks_e) = missile_resultant(&model_at(33, FaceContact::Exact).system, &y);
-    assert!(f_e.norm() > 100.0, "the missile must rest on its shoes: {f_e:?}");
+    assert!(
+        f_e.norm() > 100.0,
+        "the missile must rest on its shoes: {f_e:?}"
+    );
     let mut previous = f64::INFINITY;
     for n in [9, 17, 33] {
         let (f_l, t_l, tracks_l) = missile_resultant(&model_at(n, FaceContact::Lattice).system, &y);

@@ -17,7 +17,7 @@ pub(crate) fn extrapolate(pairs: [(f64, f64); 3]) -> Option<(f64, f64)> {
         return Some((q3, f64::NAN));
     }
     let target = d12 / d23;
-    if !(target > 0.0) {
+    if target.is_nan() || target <= 0.0 {
         return None;
     }
     let ratio = |p: f64| (h1.powf(p) - h2.powf(p)) / (h2.powf(p) - h3.powf(p));
@@ -111,9 +111,10 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
             let val = |m: &Measured| m.quantities.get(i).map_or(f64::NAN, |q| q.1);
             let rel = |a: f64, r: f64| (a - r) / r.abs().max(f64::MIN_POSITIVE);
             let pct = |x: Option<f64>| {
-                Cell::text(x.filter(|x| x.is_finite()).map_or("-".into(), |x| {
-                    format!("{:+.2} %", 100.0 * x)
-                }))
+                Cell::text(
+                    x.filter(|x| x.is_finite())
+                        .map_or("-".into(), |x| format!("{:+.2} %", 100.0 * x)),
+                )
             };
             let values: Vec<String> = ladder
                 .iter()
@@ -126,7 +127,10 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
                 extrapolate([pair(k - 3), pair(k - 2), pair(k - 1)])
             });
             let reference = fit.flatten().map(|f| f.0);
-            let at9 = ladder.iter().position(|&n| n == 9).map(|j| val(&lattice[j].1));
+            let at9 = ladder
+                .iter()
+                .position(|&n| n == 9)
+                .map(|j| val(&lattice[j].1));
             quantities.row(vec![
                 Cell::text(case_name),
                 Cell::text(name),

@@ -211,4 +211,3 @@ pub(super) fn friction_derivatives(
         )
     }
 }
-
