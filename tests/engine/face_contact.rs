@@ -518,3 +518,60 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     }
     eprintln!("exact: F {f_e:?} τ {t_e:?}");
 }
+
+#[test]
+fn random_missile_states_never_gain_energy_with_the_exact_face_contact() {
+    // As the lattice's test in `energy_passivity`: launcher-design without excitation, in the
+    // exact face contact, settled, then 20 random missile states (shifted within the
+    // clearances, turned, moving) run for 10 ms: the mechanical energy never rises above its
+    // running minimum by more than PASSIVITY_TOLERANCE of what was available, and the energy
+    // account closes within BALANCE_TOLERANCE of the dissipated work (SPEC §2).
+    use railwear::validation::energy::{energy_run, BALANCE_TOLERANCE, PASSIVITY_TOLERANCE};
+    let mut case =
+        railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
+    case.excitation = serde_json::json!({ "kind": "none" });
+    case.simulation.face_contact = FaceContact::Exact;
+    let model = railwear::models::case::build(&case, configs()).expect("model");
+    let settings = railwear::models::case::integrator_settings(&case).expect("settings");
+    let sys = &model.system;
+    let rest = energy_run(sys, &model.initial_state, settings, 1.0)
+        .expect("settles")
+        .state;
+    let mut ws = sys.workspace();
+    let rest_energy = sys.energy(0.0, &rest, &mut ws).total();
+    let mut rng = ChaCha8Rng::seed_from_u64(127);
+    for _ in 0..20 {
+        let mut y = rest.clone();
+        y[0] += rng.gen_range(-2e-4..2e-4);
+        y[1] += rng.gen_range(-1e-4..1e-4);
+        y[2] += rng.gen_range(-1e-4..1e-4);
+        let turn = UnitQuaternion::from_euler_angles(
+            rng.gen_range(-5e-4..5e-4),
+            rng.gen_range(-5e-4..5e-4),
+            rng.gen_range(-5e-3..5e-3),
+        );
+        let q = turn
+            * UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[3], y[4], y[5], y[6]));
+        y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        for v in y[7..10].iter_mut() {
+            *v = rng.gen_range(-0.02..0.02);
+        }
+        for w in y[10..13].iter_mut() {
+            *w = rng.gen_range(-0.2..0.2);
+        }
+        let available = sys.energy(0.0, &y, &mut ws).total() - rest_energy;
+        let run = energy_run(sys, &y, settings, 0.01).expect("runs");
+        let a = &run.audit;
+        assert!(
+            a.max_rise_without_drive_j <= PASSIVITY_TOLERANCE * available.abs() + 1e-12,
+            "energy rose by {:.3e} J of {available:.3e} J",
+            a.max_rise_without_drive_j
+        );
+        assert!(
+            a.residual_j.abs() <= BALANCE_TOLERANCE * a.dissipated_j + 1e-12,
+            "residual {:.3e} J of {:.3e} J dissipated",
+            a.residual_j,
+            a.dissipated_j
+        );
+    }
+}
