@@ -14,6 +14,10 @@
 //!   friction `−μ N |v_slip| <= 0`: the contact is passive by construction;
 //! - a face pressed uniformly by `w` gives `Σ β k w^e = k w^e`, the thesis' law for the face.
 //!
+//! With [`FaceContact::Exact`] a rounded box's faces are instead integrated over their pressed
+//! polygons (the lattice's limit; `face.rs`, docs/models.md "Exact face contact"): its
+//! quadrature nodes are points of the same law (`point.rs`).
+//!
 //! Each touching (piece, face) pair is one track: its normal force is the points' sum, its
 //! contact point their centre of pressure, its slip the force-weighted mean slip (and the
 //! force-weighted mean slip speed, so `N · slip_speed` is the friction work rate over μ), its
