@@ -111,6 +111,21 @@ impl PlacedFace {
         }
     }
 
+    /// The extent's finite sides, each as (outward unit direction `d`, a point `o` of the
+    /// face, bound `b`): the extent is `d·(x − o) <= b` on every side (none when unbounded).
+    pub fn sides(&self) -> impl Iterator<Item = (Vector3<f64>, Point3<f64>, f64)> + '_ {
+        let sides = [
+            (self.tangent, self.s_range.1),
+            (-self.tangent, -self.s_range.0),
+            (self.bitangent, self.t_range.1),
+            (-self.bitangent, -self.t_range.0),
+        ];
+        sides
+            .into_iter()
+            .filter(move |(_, b)| self.bounded && b.is_finite())
+            .map(move |(d, b)| (d, self.origin, b))
+    }
+
     /// Share of `shape` (placed by `pose`) whose extent along the face's bounded in-plane
     /// directions lies within the face, 0..1 (1 for an unbounded face). It scales the thesis
     /// 2.5 area (overlap volume / depth against the face's plane) to the face's extent: exact

@@ -21,6 +21,7 @@
 
 pub mod bounded_face;
 mod disk_polygon;
+pub mod face_patch;
 pub mod halfspace_overlap;
 pub mod lattice;
 mod polytope_clip;
@@ -33,6 +34,7 @@ mod steiner_pieces;
 mod tests;
 
 pub use bounded_face::{FaceExtent, PlacedFace};
+pub use face_patch::{inner_box_faces, FacePatch, QuadratureOrder};
 pub use halfspace_overlap::{shape_halfspace_depth, shape_halfspace_overlap, PlaneOverlap};
 pub use lattice::{contact_points, ContactPoint, DEFAULT_POINTS_PER_EDGE};
 pub use shapes::{ConvexShape, GeometryError, HalfSpace};

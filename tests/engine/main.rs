@@ -5,6 +5,7 @@ mod checkpoint_resume;
 mod energy_passivity;
 mod engine_closed_forms;
 mod error_control;
+mod face_contact;
 mod gap_campaign;
 mod gap_diagnose;
 mod gap_effects;

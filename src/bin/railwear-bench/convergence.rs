@@ -8,39 +8,57 @@
 
 use super::*;
 use railwear::analysis::spectra::welch_psd;
+use railwear::physics::contact::FaceContact;
 use railwear::physics::integrator::ErrorControl;
 
 /// One run of the convergence study.
 #[derive(Clone)]
-struct Variant {
-    label: String,
-    mode: ErrorControl,
+pub(crate) struct Variant {
+    pub(crate) label: String,
+    pub(crate) mode: ErrorControl,
     /// Tolerance factor applied to the case's `rel_tolerance` and `abs_tolerance_m` (and so to
     /// the energy tolerance, which follows `rel_tolerance`).
-    factor: f64,
+    pub(crate) factor: f64,
     /// Energy account's work test off (the account is still kept).
-    energy_off: bool,
+    pub(crate) energy_off: bool,
     /// Initial position moved by this much along x, m (chaos floor).
-    nudge_m: f64,
+    pub(crate) nudge_m: f64,
     /// Contact points per box edge (None: the case's).
-    points_per_edge: Option<usize>,
+    pub(crate) points_per_edge: Option<usize>,
+    /// Face resolution (None: the case's).
+    pub(crate) face_contact: Option<FaceContact>,
+}
+
+impl Variant {
+    /// Full error control at the case tolerance, from the case's initial state.
+    pub(crate) fn plain(label: String) -> Self {
+        Self {
+            label,
+            mode: ErrorControl::Full,
+            factor: 1.0,
+            energy_off: false,
+            nudge_m: 0.0,
+            points_per_edge: None,
+            face_contact: None,
+        }
+    }
 }
 
 /// What one run measured.
-struct Measured {
-    accepted: u64,
+pub(crate) struct Measured {
+    pub(crate) accepted: u64,
     rejected: u64,
     rhs: u64,
     wall_s: f64,
-    cpu_s: Option<f64>,
-    simulated_s: f64,
-    energy_residual_rel: Option<f64>,
+    pub(crate) cpu_s: Option<f64>,
+    pub(crate) simulated_s: f64,
+    pub(crate) energy_residual_rel: Option<f64>,
     /// (name, value, kind) of every user quantity.
-    quantities: Vec<(String, f64, QuantityKind)>,
+    pub(crate) quantities: Vec<(String, f64, QuantityKind)>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
-enum QuantityKind {
+pub(crate) enum QuantityKind {
     /// Compared by relative difference.
     Relative,
     /// A share in 0..1: compared by its absolute difference (percentage points).
@@ -65,7 +83,7 @@ pub(crate) fn thread_cpu_s() -> Option<f64> {
     Some((utime + stime) / 100.0)
 }
 
-fn run_variant(
+pub(crate) fn run_variant(
     configs_dir: &Path,
     case_name: &str,
     settle: f64,
@@ -84,6 +102,9 @@ fn run_variant(
     }
     if let Some(n) = v.points_per_edge {
         case.simulation.contact_points_per_edge = n;
+    }
+    if let Some(f) = v.face_contact {
+        case.simulation.face_contact = f;
     }
     let mut model = build(&case, configs_dir)?;
     model.initial_state[0] += v.nudge_m;
@@ -169,6 +190,9 @@ fn difference(kind: QuantityKind, a: f64, b: f64) -> f64 {
 }
 
 pub(crate) struct ConvergenceBench {
+    /// Face study: lattice points per edge whose runs are extrapolated to the reference
+    /// (empty: no face study).
+    pub(crate) faces: Vec<usize>,
     pub(crate) cases: String,
     pub(crate) settle_box: f64,
     pub(crate) settle_launcher: f64,
@@ -184,7 +208,7 @@ pub(crate) struct ConvergenceBench {
 
 impl ConvergenceBench {
     /// The case names of `--cases`.
-    fn case_names(&self) -> impl Iterator<Item = &str> {
+    pub(crate) fn case_names(&self) -> impl Iterator<Item = &str> {
         self.cases
             .split(',')
             .map(str::trim)
@@ -192,7 +216,7 @@ impl ConvergenceBench {
     }
 
     /// Settle time of a case: the launcher's or the rattle box's.
-    fn settle(&self, case_name: &str) -> f64 {
+    pub(crate) fn settle(&self, case_name: &str) -> f64 {
         if case_name.starts_with("launcher") {
             self.settle_launcher
         } else {
@@ -251,6 +275,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             energy_off: false,
             nudge_m: 0.0,
             points_per_edge: None,
+            face_contact: None,
         },
         Variant {
             label: "full, tol, start moved 1 nm".into(),
@@ -259,6 +284,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             energy_off: false,
             nudge_m: 1e-9,
             points_per_edge: None,
+            face_contact: None,
         },
     ];
     for m in &modes {
@@ -270,6 +296,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 energy_off: m.energy_off,
                 nudge_m: 0.0,
                 points_per_edge: None,
+                face_contact: None,
             });
         }
     }
@@ -489,6 +516,7 @@ pub(crate) fn ladder(
         energy_off: false,
         nudge_m: 0.0,
         points_per_edge,
+        face_contact: None,
     };
     let points = b.points_per_edge;
     for case_name in b.case_names() {

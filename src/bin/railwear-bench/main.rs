@@ -28,6 +28,7 @@ use std::time::{Duration, Instant};
 mod budget;
 mod convergence;
 mod engine;
+mod faces;
 mod launcher;
 mod load;
 mod missiles;
@@ -170,6 +171,11 @@ enum Command {
         /// Ladder: contact points per box edge of the reference (default: the case's).
         #[arg(long)]
         reference_points_per_edge: Option<usize>,
+        /// Instead of the mode study, issue 27's face study: the lattice at these points per
+        /// edge (comma list, e.g. 5,9,13,17; the last three extrapolated to the reference) and
+        /// the exact face contact, each at the case tolerance.
+        #[arg(long)]
+        faces: Option<String>,
     },
     /// Cost per missile of a launcher with 1, 2 and 4 missiles (issue 16).
     Missiles {
@@ -366,8 +372,16 @@ fn main() -> Result<()> {
             ladder,
             points_per_edge,
             reference_points_per_edge,
+            faces,
         } => {
             let bench = ConvergenceBench {
+                faces: match faces {
+                    Some(list) => parse_list(list, "--faces")?
+                        .into_iter()
+                        .map(|n: f64| n as usize)
+                        .collect(),
+                    None => Vec::new(),
+                },
                 cases: cases.clone(),
                 settle_box: *settle_box,
                 settle_launcher: *settle_launcher,
@@ -379,6 +393,7 @@ fn main() -> Result<()> {
                 reference_points_per_edge: *reference_points_per_edge,
             };
             match ladder {
+                _ if !bench.faces.is_empty() => faces::faces(&cli.configs_dir, &bench)?,
                 Some(list) => {
                     convergence::ladder(&cli.configs_dir, &bench, &parse_list(list, "--ladder")?)?
                 }

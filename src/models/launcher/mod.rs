@@ -547,7 +547,10 @@ pub fn build(
 
     let contacts: Vec<Contact> = contacts
         .into_iter()
-        .map(|c| c.with_points_per_edge(case.simulation.contact_points_per_edge))
+        .map(|c| {
+            c.with_points_per_edge(case.simulation.contact_points_per_edge)
+                .with_face_contact(case.simulation.face_contact)
+        })
         .collect();
     // Stations: the first is the rail above (bodies 0-2, the thesis' names); each further one
     // a copy with its own missile, latch and rail body (placed at its offset, driven by the

@@ -109,7 +109,8 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         Some(spec.friction),
     )
     .with_face_extents(extents)
-    .with_points_per_edge(case.simulation.contact_points_per_edge);
+    .with_points_per_edge(case.simulation.contact_points_per_edge)
+    .with_face_contact(case.simulation.face_contact);
     let system = MultibodySystem::new(
         vec![cube, tube],
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),

@@ -194,6 +194,12 @@ pub struct SimulationSpec {
     /// at a proportional cost in contact evaluation; range 2 (corners only) to 33.
     #[serde(default = "default_contact_points_per_edge")]
     pub contact_points_per_edge: usize,
+    /// How rounded boxes' faces are resolved (docs/models.md "Exact face contact"): `lattice`
+    /// (default; `contact_points_per_edge` points per edge) or `exact` (each face integrated
+    /// over its pressed polygon, exact for the IMPACT force, torque and stored energy at an
+    /// integer exponent; `contact_points_per_edge` then unused by boxes).
+    #[serde(default)]
+    pub face_contact: crate::physics::contact::FaceContact,
 }
 
 fn default_contact_points_per_edge() -> usize {

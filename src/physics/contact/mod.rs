@@ -14,6 +14,10 @@
 //!   friction `−μ N |v_slip| <= 0`: the contact is passive by construction;
 //! - a face pressed uniformly by `w` gives `Σ β k w^e = k w^e`, the thesis' law for the face.
 //!
+//! With [`FaceContact::Exact`] a rounded box's faces are instead integrated over their pressed
+//! polygons (the lattice's limit; `face.rs`, docs/models.md "Exact face contact"): its
+//! quadrature nodes are points of the same law (`point.rs`).
+//!
 //! Each touching (piece, face) pair is one track: its normal force is the points' sum, its
 //! contact point their centre of pressure, its slip the force-weighted mean slip (and the
 //! force-weighted mean slip speed, so `N · slip_speed` is the friction work rate over μ), its
@@ -30,9 +34,13 @@ use crate::geometry::{
 };
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
+mod face;
 mod geometry_cache;
+mod point;
 
+pub use face::FaceContact;
 pub use geometry_cache::{GeometryCache, GeometryMode, PATCH_REUSE};
+use point::{PointOutputs, TrackSum};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
 #[derive(Debug, Clone)]
@@ -53,6 +61,8 @@ pub struct Contact {
     pub impact: ImpactParams,
     /// Friction law (None: frictionless).
     pub friction: Option<FrictionParams>,
+    /// How the rounded boxes' faces are resolved (contact points or exact integration).
+    pub face_contact: FaceContact,
     /// Contact points of each piece, in the piece's frame.
     points: Vec<Vec<ContactPoint>>,
 }
@@ -78,6 +88,7 @@ impl Contact {
             face_extents: Vec::new(),
             impact,
             friction,
+            face_contact: FaceContact::default(),
             points: Vec::new(),
         };
         c.set_points_per_edge(DEFAULT_POINTS_PER_EDGE);
@@ -93,6 +104,12 @@ impl Contact {
     /// Contact points per box edge (see [`crate::geometry::lattice`]).
     pub fn with_points_per_edge(mut self, n: usize) -> Self {
         self.set_points_per_edge(n);
+        self
+    }
+
+    /// How the rounded boxes' faces are resolved (see [`FaceContact`]).
+    pub fn with_face_contact(mut self, face_contact: FaceContact) -> Self {
+        self.face_contact = face_contact;
         self
     }
 
@@ -373,99 +390,54 @@ impl Contact {
                     self.face_extents.get(jf).and_then(Option::as_ref),
                     &iso_b,
                 );
-                let mut track = TrackSum::default();
-                // Narrow-phase cull: a point whose ball centre lies farther above the face's
-                // plane than its radius cannot touch the face's solid (the distance to the
-                // solid is at least the distance to its plane). The test runs in the piece's
-                // frame (three multiply-adds instead of placing the point in the world);
-                // `cull_margin` covers the rounding between the two frames, so only points
-                // whose world evaluation gives `w <= 0` are skipped: no result changes.
-                let cull = PlaneCull::new(&pose, &hs);
-                for point in &self.points[ip] {
-                    if cull.misses(point) {
-                        continue;
+                let mut out = PointOutputs {
+                    index,
+                    track: (ip * nfaces + jf) as u32,
+                    linearizations: linearizations.as_deref_mut(),
+                    points: points.as_deref_mut(),
+                    energy: &mut energy,
+                    sum: TrackSum::default(),
+                };
+                match (self.face_contact, shape) {
+                    (
+                        FaceContact::Exact,
+                        ConvexShape::RoundedBox {
+                            half_extents,
+                            roundover,
+                        },
+                    ) => {
+                        let inner = half_extents.map(|h| (h - roundover).max(0.0));
+                        self.evaluate_faces(fa, fb, &pose, &inner, *roundover, &placed, &mut out);
                     }
-                    let centre = pose * point.local;
-                    let (distance, normal) = placed.signed_distance(&centre);
-                    let w = point.radius - distance;
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    let p = centre - normal * point.radius;
-                    let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
-                    let wdot = -v_rel.dot(&normal);
-                    let beta = point.weight;
-                    // The force's parts once (each STEP evaluated once per point): the same
-                    // numbers as `ImpactParams::force`, `elastic_force` and `force_gradient`.
-                    let (spring, damping) = self.impact.force_parts(w);
-                    let fn_mag = beta * (spring + damping * wdot).max(0.0);
-                    let elastic = beta * spring;
-                    let slip = v_rel - normal * v_rel.dot(&normal);
-                    let speed = slip.norm();
-                    let mut ft = 0.0;
-                    let mut mu = None;
-                    let mut force = normal * fn_mag;
-                    if let Some(fr) = &self.friction {
-                        if speed > 0.0 && fn_mag > 0.0 {
-                            let m = fr.coefficient(speed);
-                            mu = Some(m);
-                            ft = m * fn_mag;
-                            force -= slip * (ft / speed);
-                        }
-                    }
-                    if let Some(lin) = linearizations.as_deref_mut() {
-                        if fn_mag > 0.0 {
-                            let (dfn_dw, dfn_dwdot) =
-                                self.impact.unclamped_gradient(w, wdot, damping);
-                            let (dforce_dfn, dforce_dslip) = friction_derivatives(
-                                self.friction.as_ref(),
+                    _ => {
+                        // Narrow-phase cull: a point whose ball centre lies farther above the
+                        // face's plane than its radius cannot touch the face's solid (the
+                        // distance to the solid is at least the distance to its plane). The
+                        // test runs in the piece's frame (three multiply-adds instead of
+                        // placing the point in the world); `cull_margin` covers the rounding
+                        // between the two frames, so only points whose world evaluation gives
+                        // `w <= 0` are skipped: no result changes.
+                        let cull = PlaneCull::new(&pose, &hs);
+                        for point in &self.points[ip] {
+                            if cull.misses(point) {
+                                continue;
+                            }
+                            let centre = pose * point.local;
+                            let (distance, normal) = placed.signed_distance(&centre);
+                            self.evaluate_point(
+                                fa,
+                                fb,
+                                &centre,
+                                point.radius,
+                                point.weight,
+                                distance,
                                 &normal,
-                                &slip,
-                                fn_mag,
-                                mu,
+                                &mut out,
                             );
-                            lin.push(TrackLinearization {
-                                body_a: self.body_a,
-                                body_b: self.body_b,
-                                deepest_point: p,
-                                point: p,
-                                centre,
-                                force,
-                                normal,
-                                dfn_dw: beta * dfn_dw,
-                                dfn_dwdot: beta * dfn_dwdot,
-                                dforce_dfn,
-                                dforce_dslip,
-                            });
                         }
                     }
-                    energy += beta * self.impact.potential(w);
-                    if let Some(out) = points.as_deref_mut() {
-                        if fn_mag > 0.0 {
-                            out(&PointLoad {
-                                contact: index,
-                                track: (ip * nfaces + jf) as u32,
-                                normal_force: fn_mag,
-                                weight: beta,
-                                slip_speed: speed,
-                            });
-                        }
-                    }
-                    track.add(&PointForce {
-                        point: p,
-                        force,
-                        normal,
-                        normal_force: fn_mag,
-                        penetration: w,
-                        penetration_rate: wdot,
-                        slip,
-                        speed,
-                        friction_force: ft,
-                        damping_power: (fn_mag - elastic) * wdot,
-                        lever_a: p.coords - fa.position,
-                        lever_b: p.coords - fb.position,
-                    });
                 }
+                let track = out.sum;
                 if !track.touching {
                     continue;
                 }
@@ -503,100 +475,6 @@ impl Contact {
             }
         }
         energy
-    }
-}
-
-/// One contact point's force and rates (an input of [`TrackSum::add`]).
-struct PointForce {
-    point: Point3<f64>,
-    force: Vector3<f64>,
-    normal: Vector3<f64>,
-    normal_force: f64,
-    penetration: f64,
-    penetration_rate: f64,
-    slip: Vector3<f64>,
-    speed: f64,
-    friction_force: f64,
-    damping_power: f64,
-    lever_a: Vector3<f64>,
-    lever_b: Vector3<f64>,
-}
-
-/// A track's sums over its contact points. Points arrive in mirror pairs
-/// ([`crate::geometry::lattice`]), so in a configuration symmetric about a piece's mid-plane
-/// the out-of-plane sums cancel pair by pair, exactly.
-#[derive(Default)]
-struct TrackSum {
-    touching: bool,
-    force: Vector3<f64>,
-    torque_a: Vector3<f64>,
-    torque_b: Vector3<f64>,
-    normal_force: f64,
-    weighted_slip: Vector3<f64>,
-    weighted_speed: f64,
-    weighted_point: Vector3<f64>,
-    friction_force: f64,
-    damping_power: f64,
-    friction_power: f64,
-    penetration: f64,
-    penetration_rate: f64,
-    deepest_point: Point3<f64>,
-    normal: Vector3<f64>,
-}
-
-impl TrackSum {
-    #[inline]
-    fn add(&mut self, p: &PointForce) {
-        self.touching = true;
-        self.force += p.force;
-        self.torque_a += p.lever_a.cross(&p.force);
-        self.torque_b += p.lever_b.cross(&p.force);
-        self.normal_force += p.normal_force;
-        self.weighted_slip += p.slip * p.normal_force;
-        self.weighted_speed += p.speed * p.normal_force;
-        self.weighted_point += p.point.coords * p.normal_force;
-        self.friction_force += p.friction_force;
-        self.damping_power += p.damping_power;
-        self.friction_power += p.friction_force * p.speed;
-        if p.penetration > self.penetration {
-            self.penetration = p.penetration;
-            self.penetration_rate = p.penetration_rate;
-            self.deepest_point = p.point;
-            self.normal = p.normal;
-        }
-    }
-}
-
-/// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
-/// and slip `slip` (tangential; `mu` = μ(|s|) when already known): `∂F/∂f_n = n − μ ŝ` and
-/// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
-/// `μ/|s| → μ'(0)` is used.
-fn friction_derivatives(
-    friction: Option<&FrictionParams>,
-    normal: &Vector3<f64>,
-    slip: &Vector3<f64>,
-    fn_mag: f64,
-    mu: Option<f64>,
-) -> (Vector3<f64>, Matrix3<f64>) {
-    let Some(fr) = friction else {
-        return (*normal, Matrix3::zeros());
-    };
-    let tangent = Matrix3::identity() - normal * normal.transpose();
-    let speed = slip.norm();
-    if speed > 0.0 {
-        let dir = slip / speed;
-        let along = dir * dir.transpose();
-        let mu = mu.unwrap_or_else(|| fr.coefficient(speed));
-        let dmu = fr.coefficient_derivative(speed);
-        (
-            normal - dir * mu,
-            -(along * dmu + (tangent - along) * (mu / speed)) * fn_mag,
-        )
-    } else {
-        (
-            *normal,
-            -tangent * (fr.coefficient_derivative(0.0) * fn_mag),
-        )
     }
 }
 

@@ -1,0 +1,476 @@
+//! The exactly integrated face contact (issue 27; docs/models.md "Exact face contact"): the
+//! part of one face of a rounded box's inner box that presses into a (possibly bounded) face,
+//! and a quadrature over it that is exact for the IMPACT law's polynomial densities.
+//!
+//! A rounded box is its inner box ⊕ ball(r). The contact-point lattice
+//! ([`super::lattice`]) puts balls of radius `r` on the inner box's faces with a stiffness
+//! share `dA / A` per face (A the inner face's area); its limit of infinitely many points is
+//! the continuum this module integrates: on an inner face with material coordinates
+//! `ξ = (u, v) ∈ [−1, 1]²`, `x(ξ) = c + u a_u + v a_v`, the ball at `x` penetrates the face's
+//! plane by `w(ξ) = r − (n·x − offset)`, which is **linear** in `ξ`. The pressed part of the
+//! face is the convex polygon `P = square ∩ {w > 0} ∩ {x over the face's extent}`: every
+//! boundary is a straight line in `ξ` (a bounded face's sides are lines `g(x) = 0`, `g` affine).
+//!
+//! Quadrature: `P` is sliced at its vertices' `u`; on each slice its lower and upper
+//! boundaries are straight, so a polynomial density of degree `D` in `ξ` integrates over `v`
+//! to a polynomial of degree `D + 1` in `u`. Gauss–Legendre with `m_v` nodes in `v` and `m_u`
+//! in `u` is exact when `2 m_v − 1 >= D` and `2 m_u − 1 >= D + 1`. For the exponent `e = 2`
+//! of every reference model the densities are `k w²` (force, `D = 2`), `x × n k w²` (torque)
+//! and `k w³/3` (stored energy, both `D = 3`): `m_v = 2`, `m_u = 3` integrate all three to
+//! round-off. The rule's degree follows the exponent ([`QuadratureOrder::for_exponent`]); for
+//! a non-integer exponent it integrates `w^e` to the accuracy of a Gauss rule on a function
+//! `C^⌊e⌋` at the `w = 0` edge (documented, not exact).
+//!
+//! Beyond a bounded face's side the face's solid is rounded off: a ball within `r` of the
+//! side's edge still touches it, with `w = r − d` and `d` its distance to the solid (the
+//! lattice's law, [`PlacedFace::signed_distance`]). Those parts of the inner face
+//! ([`FacePatch::beyond_sides`], strips at most `r` wide) carry the rest of the continuum's
+//! energy, which is continuous across the side: the region boundary terms of the two parts'
+//! gradients cancel, so no force acts on the cut line, and a shoe sliding off a lip unloads
+//! continuously even when a whole face crosses the edge at once. `w` is not polynomial there;
+//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/models.md gives the measured error).
+//!
+//! Hot path: fixed-size arrays only, no heap allocation.
+
+use super::bounded_face::PlacedFace;
+use nalgebra::{Point3, Vector3};
+
+/// Room for the vertices of a clipped face: the square's 4, one more per clipping line (the
+/// `w = 0` line and up to four sides of a bounded face), with margin for repeated vertices.
+const MAX_VERTICES: usize = 16;
+/// Most sides of a face's extent (a rectangle).
+const MAX_SIDES: usize = 4;
+/// Gauss–Legendre abscissae on [-1, 1] for 1 to 5 nodes.
+const GL_NODES: [&[f64]; 5] = [
+    &[0.0],
+    &[-0.577_350_269_189_625_8, 0.577_350_269_189_625_8],
+    &[-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4],
+    &[
+        -0.861_136_311_594_052_6,
+        -0.339_981_043_584_856_3,
+        0.339_981_043_584_856_3,
+        0.861_136_311_594_052_6,
+    ],
+    &[
+        -0.906_179_845_938_664,
+        -0.538_469_310_105_683_1,
+        0.0,
+        0.538_469_310_105_683_1,
+        0.906_179_845_938_664,
+    ],
+];
+/// Matching weights (sum 2).
+const GL_WEIGHTS: [&[f64]; 5] = [
+    &[2.0],
+    &[1.0, 1.0],
+    &[5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0],
+    &[
+        0.347_854_845_137_453_9,
+        0.652_145_154_862_546_1,
+        0.652_145_154_862_546_1,
+        0.347_854_845_137_453_9,
+    ],
+    &[
+        0.236_926_885_056_189_1,
+        0.478_628_670_499_366_5,
+        0.568_888_888_888_888_9,
+        0.478_628_670_499_366_5,
+        0.236_926_885_056_189_1,
+    ],
+];
+
+/// Gauss–Legendre nodes per direction of the patch rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct QuadratureOrder {
+    /// Nodes across a slice (`v`): exact to degree `2 m_v − 1`.
+    pub across: usize,
+    /// Nodes along the slices (`u`), and along a cut side: exact to degree `2 m_u − 1`.
+    pub along: usize,
+}
+
+impl QuadratureOrder {
+    /// The rule on the strips beyond a bounded face's sides (`w` not polynomial): the most
+    /// nodes of the table, 5 × 5 per slice.
+    pub const ROUNDED_EDGE: Self = Self {
+        across: 5,
+        along: 5,
+    };
+
+    /// The smallest rule exact for the stored energy and the torque of the IMPACT law with
+    /// exponent `e` (densities of degree `D = ⌈e⌉ + 1` in `ξ`): `m_v = ⌈(D + 1)/2⌉`,
+    /// `m_u = ⌈(D + 2)/2⌉`, each at most 5 (exact up to `e = 7`). `e = 2`: 2 × 3 nodes.
+    pub fn for_exponent(e: f64) -> Self {
+        let degree = (e.max(0.0).ceil() as usize).min(8) + 1;
+        Self {
+            across: (degree + 1).div_ceil(2).min(5),
+            along: (degree + 2).div_ceil(2).min(5),
+        }
+    }
+}
+
+/// `alpha + beta · ξ >= 0` on the kept side.
+#[derive(Debug, Clone, Copy)]
+struct Line {
+    alpha: f64,
+    beta: [f64; 2],
+}
+
+impl Line {
+    #[inline]
+    fn at(&self, p: [f64; 2]) -> f64 {
+        self.alpha + self.beta[0] * p[0] + self.beta[1] * p[1]
+    }
+}
+
+/// The pressed part of one inner-box face against one (possibly bounded) face.
+#[derive(Debug, Clone, Copy)]
+pub struct FacePatch {
+    centre: Point3<f64>,
+    axis_u: Vector3<f64>,
+    axis_v: Vector3<f64>,
+    depth: Line,
+    verts: [[f64; 2]; MAX_VERTICES],
+    len: usize,
+}
+
+impl FacePatch {
+    /// The whole inner face `centre + u axis_u + v axis_v` (`|u|, |v| <= 1`, world, m), its
+    /// balls of `radius` against `face`'s plane.
+    fn square(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+    ) -> Option<Self> {
+        let n = face.plane.normal.into_inner();
+        let depth = Line {
+            alpha: radius - (n.dot(&centre.coords) - face.plane.offset),
+            beta: [-n.dot(&axis_u), -n.dot(&axis_v)],
+        };
+        // Cull: w is largest at a corner.
+        if depth.alpha + depth.beta[0].abs() + depth.beta[1].abs() <= 0.0 {
+            return None;
+        }
+        let mut patch = Self {
+            centre,
+            axis_u,
+            axis_v,
+            depth,
+            verts: [[0.0; 2]; MAX_VERTICES],
+            len: 4,
+        };
+        patch.verts[..4].copy_from_slice(&[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]);
+        patch.clip(&depth).then_some(patch)
+    }
+
+    /// The line `g >= 0` of a side `(d, o, b)` of `face`'s extent ([`PlacedFace::sides`]):
+    /// `g(x) = b − d·(x − o)`, positive over the extent, in this face's `ξ`.
+    fn side_line(&self, side: &(Vector3<f64>, Point3<f64>, f64)) -> Line {
+        let (d, o, b) = side;
+        Line {
+            alpha: b - d.dot(&(self.centre - o)),
+            beta: [-d.dot(&self.axis_u), -d.dot(&self.axis_v)],
+        }
+    }
+
+    /// The part of the inner face `centre + u axis_u + v axis_v` (`|u|, |v| <= 1`, world, m)
+    /// whose balls of `radius` penetrate `face`'s plane with their centres over its extent;
+    /// `None` when that part is empty. There `w = radius − (n·x − offset)` is linear.
+    pub fn new(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+    ) -> Option<Self> {
+        let mut patch = Self::square(centre, axis_u, axis_v, radius, face)?;
+        for side in face.sides() {
+            let line = patch.side_line(&side);
+            if !patch.clip(&line) {
+                return None;
+            }
+        }
+        Some(patch)
+    }
+
+    /// The parts of the same inner face whose ball centres lie beyond a side of `face`'s
+    /// extent by less than `radius` (and below `radius` above its plane): where a ball can
+    /// touch the face's rounded-off edge, its penetration `radius − d` with `d` the distance
+    /// to the face's solid ([`PlacedFace::signed_distance`]), not linear. One part per side,
+    /// a point beyond several sides counted with the first: together with [`FacePatch::new`]
+    /// they cover every ball that touches the solid, each once.
+    pub fn beyond_sides(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+    ) -> [Option<Self>; MAX_SIDES] {
+        let mut out = [None; MAX_SIDES];
+        let sides: [_; MAX_SIDES] = {
+            let mut all = [None; MAX_SIDES];
+            for (slot, side) in all.iter_mut().zip(face.sides()) {
+                *slot = Some(side);
+            }
+            all
+        };
+        for (k, side) in sides.iter().enumerate() {
+            let Some(side) = side else { continue };
+            // Slice across the side's edge (`u` the face axis most nearly across it): the
+            // integrand's kink at `w = 0` then lies in few slices.
+            let across_v = side.0.dot(&axis_v).abs() > side.0.dot(&axis_u).abs();
+            let (au, av) = if across_v {
+                (axis_v, axis_u)
+            } else {
+                (axis_u, axis_v)
+            };
+            let Some(mut patch) = Self::square(centre, au, av, radius, face) else {
+                return out;
+            };
+            let g = patch.side_line(side);
+            let beyond = Line {
+                alpha: -g.alpha,
+                beta: [-g.beta[0], -g.beta[1]],
+            };
+            let within = |reach: f64| Line {
+                alpha: g.alpha + reach,
+                ..g
+            };
+            let mut keep = patch.clip(&beyond) && patch.clip(&within(radius));
+            for (j, other) in sides.iter().enumerate() {
+                let Some(other) = other else { continue };
+                if !keep || j == k {
+                    continue;
+                }
+                let h = patch.side_line(other);
+                keep = if j < k {
+                    patch.clip(&h)
+                } else {
+                    patch.clip(&Line {
+                        alpha: h.alpha + radius,
+                        ..h
+                    })
+                };
+            }
+            if keep {
+                // No ball farther beyond the edge than sqrt(r² − u²) touches it, u >= 0 the
+                // lowest height of a centre over the plane: for a face parallel to the plane
+                // this is exactly the `w = 0` curve, and the integrand is smooth inside.
+                let lowest = patch.verts[..patch.len]
+                    .iter()
+                    .map(|&p| radius - patch.depth.at(p))
+                    .fold(f64::INFINITY, f64::min)
+                    .max(0.0);
+                let reach = (radius * radius - lowest * lowest).max(0.0).sqrt();
+                keep = patch.clip(&within(reach));
+            }
+            if keep {
+                out[k] = Some(patch);
+            }
+        }
+        out
+    }
+
+    /// Sutherland–Hodgman clip of the polygon by `line` (keeping `line >= 0`); false when
+    /// nothing of positive area is left.
+    fn clip(&mut self, line: &Line) -> bool {
+        if self.verts[..self.len].iter().all(|&p| line.at(p) >= 0.0) {
+            return true;
+        }
+        let mut out = [[0.0; 2]; MAX_VERTICES];
+        let mut m = 0;
+        for i in 0..self.len {
+            let p = self.verts[i];
+            let q = self.verts[(i + 1) % self.len];
+            let (gp, gq) = (line.at(p), line.at(q));
+            let crossing = || {
+                let t = gp / (gp - gq);
+                [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+            };
+            let (first, second) = match (gp >= 0.0, gq >= 0.0) {
+                (true, true) => (Some(p), None),
+                (true, false) if gp == 0.0 => (Some(p), None),
+                (true, false) => (Some(p), Some(crossing())),
+                // q on the line is appended as the next p.
+                (false, true) if gq > 0.0 => (Some(crossing()), None),
+                (false, _) => (None, None),
+            };
+            for v in [first, second].into_iter().flatten() {
+                if m < MAX_VERTICES {
+                    out[m] = v;
+                    m += 1;
+                }
+            }
+        }
+        self.verts = out;
+        self.len = m;
+        m >= 3 && self.area_xi() > 0.0
+    }
+
+    /// Area of the polygon in `ξ` (the square's is 4).
+    fn area_xi(&self) -> f64 {
+        let mut twice = 0.0;
+        for i in 0..self.len {
+            let p = self.verts[i];
+            let q = self.verts[(i + 1) % self.len];
+            twice += p[0] * q[1] - q[0] * p[1];
+        }
+        0.5 * twice
+    }
+
+    /// Share of the inner face that is pressed, 0..1.
+    pub fn share(&self) -> f64 {
+        self.area_xi() / 4.0
+    }
+
+    /// The world point of `ξ`.
+    #[inline]
+    fn point(&self, p: [f64; 2]) -> Point3<f64> {
+        self.centre + self.axis_u * p[0] + self.axis_v * p[1]
+    }
+
+    /// The deepest vertex of the patch: its penetration (m) and ball centre (world).
+    pub fn deepest(&self) -> (f64, Point3<f64>) {
+        let mut best = (f64::NEG_INFINITY, [0.0; 2]);
+        for &p in &self.verts[..self.len] {
+            let w = self.depth.at(p);
+            if w > best.0 {
+                best = (w, p);
+            }
+        }
+        (best.0, self.point(best.1))
+    }
+
+    /// Calls `visit(centre, weight)` for every node of the patch rule: the ball centre (world)
+    /// and its share of the face's stiffness (the rule's weight in `ξ` over the square's area
+    /// 4, so a fully pressed face's weights sum to 1).
+    pub fn for_each_node(&self, order: QuadratureOrder, visit: &mut impl FnMut(Point3<f64>, f64)) {
+        self.for_each_node_sliced(order, 1, visit);
+    }
+
+    /// [`FacePatch::for_each_node`] with each slice between vertices cut into `parts` equal
+    /// slices (for an integrand with a kink inside the patch).
+    pub fn for_each_node_sliced(
+        &self,
+        order: QuadratureOrder,
+        parts: usize,
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
+        let mut us = [0.0; MAX_VERTICES];
+        for (u, p) in us.iter_mut().zip(&self.verts[..self.len]) {
+            *u = p[0];
+        }
+        let us = &mut us[..self.len];
+        us.sort_unstable_by(f64::total_cmp);
+        let (xs_u, ws_u) = rule(order.along);
+        let (xs_v, ws_v) = rule(order.across);
+        let parts = parts.max(1);
+        for k in 1..us.len() {
+            let (ua, ub) = (us[k - 1], us[k]);
+            if ub <= ua {
+                continue;
+            }
+            let Some((lower, upper)) = self.chains_at(0.5 * (ua + ub)) else {
+                continue;
+            };
+            let (lower, upper) = (
+                (lower.0 - lower.1 * 0.5 * (ua + ub), lower.1),
+                (upper.0 - upper.1 * 0.5 * (ua + ub), upper.1),
+            );
+            for part in 0..parts {
+                let u0 = ua + (ub - ua) * part as f64 / parts as f64;
+                let u1 = ua + (ub - ua) * (part + 1) as f64 / parts as f64;
+                let mid = 0.5 * (u0 + u1);
+                let half_u = 0.5 * (u1 - u0);
+                let lower = (lower.0 + lower.1 * mid, lower.1);
+                let upper = (upper.0 + upper.1 * mid, upper.1);
+                self.slice_nodes(mid, half_u, lower, upper, xs_u, ws_u, xs_v, ws_v, visit);
+            }
+        }
+    }
+
+    /// The nodes of one slice `[mid − half_u, mid + half_u]` whose lower and upper sides are
+    /// (value at `mid`, slope).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn slice_nodes(
+        &self,
+        mid: f64,
+        half_u: f64,
+        lower: (f64, f64),
+        upper: (f64, f64),
+        xs_u: &[f64],
+        ws_u: &[f64],
+        xs_v: &[f64],
+        ws_v: &[f64],
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
+        for (xu, wu) in xs_u.iter().zip(ws_u) {
+            let u = mid + half_u * xu;
+            let (lo, hi) = (lower.0 + lower.1 * (u - mid), upper.0 + upper.1 * (u - mid));
+            if hi <= lo {
+                continue;
+            }
+            let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+            for (xv, wv) in xs_v.iter().zip(ws_v) {
+                let v = vm + half_v * xv;
+                visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+            }
+        }
+    }
+
+    /// The lower and upper boundary of the polygon over the slice through `u` (strictly
+    /// between two vertices' `u`): each as (value at `u`, slope dv/du).
+    fn chains_at(&self, u: f64) -> Option<((f64, f64), (f64, f64))> {
+        let mut lower: Option<(f64, f64)> = None;
+        let mut upper: Option<(f64, f64)> = None;
+        for i in 0..self.len {
+            let p = self.verts[i];
+            let q = self.verts[(i + 1) % self.len];
+            if (p[0] - u) * (q[0] - u) >= 0.0 {
+                continue;
+            }
+            let slope = (q[1] - p[1]) / (q[0] - p[0]);
+            let v = p[1] + slope * (u - p[0]);
+            if lower.is_none_or(|l| v < l.0) {
+                lower = Some((v, slope));
+            }
+            if upper.is_none_or(|h| v > h.0) {
+                upper = Some((v, slope));
+            }
+        }
+        Some((lower?, upper?))
+    }
+}
+
+#[inline]
+fn rule(n: usize) -> (&'static [f64], &'static [f64]) {
+    let i = n.clamp(1, 5) - 1;
+    (GL_NODES[i], GL_WEIGHTS[i])
+}
+
+/// The six faces of an inner box of half extents `inner` placed by `pose`: (centre, axis_u,
+/// axis_v) in the world, each face's axes spanning it (`|u|, |v| <= 1`).
+pub fn inner_box_faces(
+    inner: &Vector3<f64>,
+    pose: &nalgebra::Isometry3<f64>,
+) -> [(Point3<f64>, Vector3<f64>, Vector3<f64>); 6] {
+    let r = pose.rotation.to_rotation_matrix();
+    let axes = [
+        r.matrix().column(0),
+        r.matrix().column(1),
+        r.matrix().column(2),
+    ];
+    let c = Point3::from(pose.translation.vector);
+    let mut out = [(c, Vector3::zeros(), Vector3::zeros()); 6];
+    for k in 0..3 {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let normal = axes[k] * inner[k];
+        let au = axes[i] * inner[i];
+        let av = axes[j] * inner[j];
+        out[2 * k] = (c + normal, au, av);
+        out[2 * k + 1] = (c - normal, au, av);
+    }
+    out
+}

@@ -1,0 +1,213 @@
+//! One contact point's IMPACT force and Coulomb friction (the per-material-point law of
+//! docs/models.md "Contact formulation"), and a track's sums over its points: shared by the
+//! contact-point lattice and the exactly integrated face contact, whose quadrature nodes are
+//! points of the same law ([`super::face`]).
+
+use super::{PointLoad, TrackLinearization};
+use crate::physics::body::BodyFrame;
+use crate::physics::friction::FrictionParams;
+use nalgebra::{Matrix3, Point3, Vector3};
+
+/// Where one (piece, face) pair's point evaluations go.
+pub(super) struct PointOutputs<'s, 'p> {
+    /// Index of the contact in the system.
+    pub(super) index: u32,
+    /// Track index within the contact.
+    pub(super) track: u32,
+    /// Receives each loaded point's force derivatives.
+    pub(super) linearizations: Option<&'s mut Vec<TrackLinearization>>,
+    /// Receives each loaded point's load.
+    pub(super) points: Option<&'s mut (dyn FnMut(&PointLoad) + 'p)>,
+    /// The contact's stored elastic energy, J: each point adds its own (in the points' order,
+    /// so the sum is the lattice's bit for bit).
+    pub(super) energy: &'s mut f64,
+    /// The track's sums.
+    pub(super) sum: TrackSum,
+}
+
+impl super::Contact {
+    /// The IMPACT force and friction of one ball of `radius` centred at `centre` (world, a
+    /// material point of body a) carrying the share `beta` of the face law, at signed
+    /// distance `distance` (m) from the face's solid whose outward unit normal there is
+    /// `normal`: nothing when `w = radius − distance <= 0`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn evaluate_point(
+        &self,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        centre: &Point3<f64>,
+        radius: f64,
+        beta: f64,
+        distance: f64,
+        normal: &Vector3<f64>,
+        out: &mut PointOutputs<'_, '_>,
+    ) {
+        let normal = *normal;
+        let w = radius - distance;
+        if w <= 0.0 {
+            return;
+        }
+        let p = centre - normal * radius;
+        let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
+        let wdot = -v_rel.dot(&normal);
+        // The force's parts once (each STEP evaluated once per point): the same numbers as
+        // `ImpactParams::force`, `elastic_force` and `force_gradient`.
+        let (spring, damping) = self.impact.force_parts(w);
+        let fn_mag = beta * (spring + damping * wdot).max(0.0);
+        let elastic = beta * spring;
+        let slip = v_rel - normal * v_rel.dot(&normal);
+        let speed = slip.norm();
+        let mut ft = 0.0;
+        let mut mu = None;
+        let mut force = normal * fn_mag;
+        if let Some(fr) = &self.friction {
+            if speed > 0.0 && fn_mag > 0.0 {
+                let m = fr.coefficient(speed);
+                mu = Some(m);
+                ft = m * fn_mag;
+                force -= slip * (ft / speed);
+            }
+        }
+        if let Some(lin) = out.linearizations.as_deref_mut() {
+            if fn_mag > 0.0 {
+                let (dfn_dw, dfn_dwdot) = self.impact.unclamped_gradient(w, wdot, damping);
+                let (dforce_dfn, dforce_dslip) =
+                    friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag, mu);
+                lin.push(TrackLinearization {
+                    body_a: self.body_a,
+                    body_b: self.body_b,
+                    deepest_point: p,
+                    point: p,
+                    centre: *centre,
+                    force,
+                    normal,
+                    dfn_dw: beta * dfn_dw,
+                    dfn_dwdot: beta * dfn_dwdot,
+                    dforce_dfn,
+                    dforce_dslip,
+                });
+            }
+        }
+        *out.energy += beta * self.impact.potential(w);
+        if let Some(sink) = out.points.as_deref_mut() {
+            if fn_mag > 0.0 {
+                sink(&PointLoad {
+                    contact: out.index,
+                    track: out.track,
+                    normal_force: fn_mag,
+                    weight: beta,
+                    slip_speed: speed,
+                });
+            }
+        }
+        out.sum.add(&PointForce {
+            point: p,
+            force,
+            normal,
+            normal_force: fn_mag,
+            penetration: w,
+            penetration_rate: wdot,
+            slip,
+            speed,
+            friction_force: ft,
+            damping_power: (fn_mag - elastic) * wdot,
+            lever_a: p.coords - fa.position,
+            lever_b: p.coords - fb.position,
+        });
+    }
+}
+
+/// One contact point's force and rates (an input of [`TrackSum::add`]).
+pub(super) struct PointForce {
+    pub(super) point: Point3<f64>,
+    pub(super) force: Vector3<f64>,
+    pub(super) normal: Vector3<f64>,
+    pub(super) normal_force: f64,
+    pub(super) penetration: f64,
+    pub(super) penetration_rate: f64,
+    pub(super) slip: Vector3<f64>,
+    pub(super) speed: f64,
+    pub(super) friction_force: f64,
+    pub(super) damping_power: f64,
+    pub(super) lever_a: Vector3<f64>,
+    pub(super) lever_b: Vector3<f64>,
+}
+
+/// A track's sums over its contact points. Points arrive in mirror pairs
+/// ([`crate::geometry::lattice`]), so in a configuration symmetric about a piece's mid-plane
+/// the out-of-plane sums cancel pair by pair, exactly.
+#[derive(Default)]
+pub(super) struct TrackSum {
+    pub(super) touching: bool,
+    pub(super) force: Vector3<f64>,
+    pub(super) torque_a: Vector3<f64>,
+    pub(super) torque_b: Vector3<f64>,
+    pub(super) normal_force: f64,
+    pub(super) weighted_slip: Vector3<f64>,
+    pub(super) weighted_speed: f64,
+    pub(super) weighted_point: Vector3<f64>,
+    pub(super) friction_force: f64,
+    pub(super) damping_power: f64,
+    pub(super) friction_power: f64,
+    pub(super) penetration: f64,
+    pub(super) penetration_rate: f64,
+    pub(super) deepest_point: Point3<f64>,
+    pub(super) normal: Vector3<f64>,
+}
+
+impl TrackSum {
+    #[inline]
+    pub(super) fn add(&mut self, p: &PointForce) {
+        self.touching = true;
+        self.force += p.force;
+        self.torque_a += p.lever_a.cross(&p.force);
+        self.torque_b += p.lever_b.cross(&p.force);
+        self.normal_force += p.normal_force;
+        self.weighted_slip += p.slip * p.normal_force;
+        self.weighted_speed += p.speed * p.normal_force;
+        self.weighted_point += p.point.coords * p.normal_force;
+        self.friction_force += p.friction_force;
+        self.damping_power += p.damping_power;
+        self.friction_power += p.friction_force * p.speed;
+        if p.penetration > self.penetration {
+            self.penetration = p.penetration;
+            self.penetration_rate = p.penetration_rate;
+            self.deepest_point = p.point;
+            self.normal = p.normal;
+        }
+    }
+}
+
+/// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
+/// and slip `slip` (tangential; `mu` = μ(|s|) when already known): `∂F/∂f_n = n − μ ŝ` and
+/// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
+/// `μ/|s| → μ'(0)` is used.
+pub(super) fn friction_derivatives(
+    friction: Option<&FrictionParams>,
+    normal: &Vector3<f64>,
+    slip: &Vector3<f64>,
+    fn_mag: f64,
+    mu: Option<f64>,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    let Some(fr) = friction else {
+        return (*normal, Matrix3::zeros());
+    };
+    let tangent = Matrix3::identity() - normal * normal.transpose();
+    let speed = slip.norm();
+    if speed > 0.0 {
+        let dir = slip / speed;
+        let along = dir * dir.transpose();
+        let mu = mu.unwrap_or_else(|| fr.coefficient(speed));
+        let dmu = fr.coefficient_derivative(speed);
+        (
+            normal - dir * mu,
+            -(along * dmu + (tangent - along) * (mu / speed)) * fn_mag,
+        )
+    } else {
+        (
+            *normal,
+            -tangent * (fr.coefficient_derivative(0.0) * fn_mag),
+        )
+    }
+}
