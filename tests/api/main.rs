@@ -15,6 +15,7 @@ mod service_dashboard;
 mod service_diagnose;
 mod service_fanout;
 mod service_jobs;
+mod service_metrics;
 mod service_openapi;
 mod service_queue;
 mod service_rails;
