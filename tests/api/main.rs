@@ -20,3 +20,4 @@ mod service_openapi;
 mod service_queue;
 mod service_rails;
 mod service_shutdown;
+mod wire;
