@@ -224,7 +224,9 @@ impl Plot {
         }
 
         let (px_x, px_y) = chart.plotting_area().get_pixel_range();
-        for marker in self.markers.iter().filter(|m| m.x.is_finite()) {
+        // Marker labels one under the other, so two markers close together do not overprint.
+        let marker_row = (1.4 * LABEL_PX) as i32;
+        for (i, marker) in self.markers.iter().filter(|m| m.x.is_finite()).enumerate() {
             let top = y.from.max(y.to);
             let bottom = y.from.min(y.to);
             chart
@@ -245,7 +247,7 @@ impl Plot {
             };
             root.draw(&Text::new(
                 marker.label.clone(),
-                (lx, px_y.start + 4),
+                (lx, px_y.start + 4 + marker_row * i as i32),
                 font(LABEL_PX).pos(Pos::new(anchor, VPos::Top)),
             ))
             .map_err(|e| e.to_string())?;
@@ -256,7 +258,7 @@ impl Plot {
             let row = (1.4 * LABEL_PX) as i32;
             let box_w = (legend_px + 40.0) as i32;
             let x0 = px_x.end - box_w - 8;
-            let y0 = px_y.start + if self.markers.is_empty() { 8 } else { 24 };
+            let y0 = px_y.start + 8 + marker_row * self.markers.len() as i32;
             let box_h = row * self.series.len() as i32 + 8;
             root.draw(&Rectangle::new(
                 [(x0, y0), (x0 + box_w, y0 + box_h)],
