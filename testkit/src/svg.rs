@@ -130,7 +130,7 @@ mod tests {
         let out = texts_outside_view_box(svg);
         assert_eq!(out.len(), 1, "{out:?}");
         assert!(out[0].contains("long label"));
-        let rotated = r#"<svg width="100" height="100"><text x="10" y="50" dy="0.76em" text-anchor="middle" font-size="10" transform="rotate(270, 10, 50)">a label of 20 chars</text></svg>"#;
+        let rotated = r#"<svg width="100" height="100"><text x="10" y="50" dy="0.76em" text-anchor="middle" font-size="10" transform="rotate(270, 10, 50)">a rotated label</text></svg>"#;
         assert!(texts_outside_view_box(rotated).is_empty());
     }
 }
