@@ -244,7 +244,11 @@ impl AxisCoord {
                 let span = (decades(lo).max(decades(hi)) - c + 1).max(1);
                 let every = (span + 3) / 4;
                 let mut ticks = vec![0.0];
-                for k in (c..=decades(lo).max(decades(hi))).filter(|k| (k - c) % every == 0) {
+                // The decade of the linear part sits next to zero: labelled only when no other
+                // decade is, or its label would run into zero's.
+                let top = decades(lo).max(decades(hi));
+                let first = if top >= c + every { c + every } else { c };
+                for k in (first..=top).filter(|k| (k - c) % every == 0) {
                     let v = tidy(10f64.powi(k));
                     if v <= hi * (1.0 + 1e-9) {
                         ticks.push(v);
