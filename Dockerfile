@@ -6,6 +6,9 @@ ARG RAILWEAR_GIT_HASH=""
 ENV RAILWEAR_GIT_HASH=${RAILWEAR_GIT_HASH}
 COPY Cargo.toml Cargo.lock ./
 COPY src ./src
+# Workspace members (dev-only: the image builds and ships the railwear binary alone).
+COPY testkit ./testkit
+COPY bench ./bench
 COPY migrations ./migrations
 COPY configs ./configs
 COPY api ./api

@@ -28,7 +28,6 @@ pub(crate) const FLOORS: &[&[&str]] = &[
     &["jobs"],
     &["config"],
     &["http"],
-    &["testkit"],
     &["cli"],
 ];
 

@@ -35,7 +35,6 @@ pub mod sampling;
 pub mod service_life;
 pub mod store;
 #[doc(hidden)]
-pub mod testkit;
 pub mod thesis;
 pub mod units;
 pub mod validation;

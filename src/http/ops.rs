@@ -103,15 +103,12 @@ pub async fn readyz(State(state): State<AppState>) -> Response {
 }
 
 /// Prometheus metrics: queue depth, job durations, simulated seconds per second.
-#[utoipa::path(get, path = "/metrics", tag = "ops", responses((status = 200, description = "Prometheus text format", body = String)))]
+#[utoipa::path(get, path = "/metrics", tag = "ops", responses((status = 200, description = "OpenMetrics text format (version 1.0.0), as Prometheus scrapes it", body = String, content_type = "application/openmetrics-text")))]
 pub async fn metrics(State(state): State<AppState>) -> Result<Response, Problem> {
     let counts = state.store.job_counts().await?;
     let text = state.jobs.metrics.render(&counts);
     Ok((
-        [(
-            header::CONTENT_TYPE,
-            "text/plain; version=0.0.4; charset=utf-8",
-        )],
+        [(header::CONTENT_TYPE, crate::jobs::metrics::CONTENT_TYPE)],
         text,
     )
         .into_response())

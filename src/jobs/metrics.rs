@@ -1,11 +1,27 @@
-//! Prometheus metrics of the job system, rendered as text exposition format by `/metrics`.
+//! Prometheus metrics of the job system and the HTTP layer, served by `/metrics` in the
+//! OpenMetrics text format ([`CONTENT_TYPE`]).
+//!
+//! The metric types, the registry and the exposition are `prometheus-client`'s (the Prometheus
+//! project's Rust client); this module only says what is counted and when. What the store knows
+//! (jobs per status) and what is true at scrape time (running attempts, their rate) is read at
+//! [`Metrics::render`]; everything else accumulates in the registry's metrics as it happens.
 
 use super::model::{JobKind, JobStatus};
+use prometheus_client::encoding::text::{encode_eof, encode_registry};
+use prometheus_client::encoding::EncodeLabelSet;
+use prometheus_client::metrics::counter::Counter;
+use prometheus_client::metrics::family::Family;
+use prometheus_client::metrics::gauge::Gauge;
+use prometheus_client::metrics::histogram::Histogram;
+use prometheus_client::registry::{Registry, Unit};
 use std::collections::HashMap;
-use std::fmt::Write as _;
+use std::sync::atomic::AtomicU64;
 use std::sync::Mutex;
 use std::time::Instant;
 use uuid::Uuid;
+
+/// The media type of [`Metrics::render`]'s text (OpenMetrics 1.0, which Prometheus scrapes).
+pub const CONTENT_TYPE: &str = "application/openmetrics-text; version=1.0.0; charset=utf-8";
 
 /// Upper bounds of the job-duration histogram buckets, s.
 const DURATION_BUCKETS_S: [f64; 10] = [0.1, 0.5, 1.0, 5.0, 10.0, 30.0, 60.0, 300.0, 900.0, 3600.0];
@@ -15,163 +31,198 @@ const HTTP_BUCKETS_S: [f64; 12] = [
     0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 10.0,
 ];
 
-/// A cumulative histogram over the bucket bounds `N` of its kind.
-struct Histogram<const N: usize> {
-    counts: [u64; N],
-    count: u64,
-    sum_s: f64,
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct JobLabels {
+    kind: &'static str,
+    status: &'static str,
 }
 
-impl<const N: usize> Default for Histogram<N> {
-    fn default() -> Self {
-        Self {
-            counts: [0; N],
-            count: 0,
-            sum_s: 0.0,
-        }
-    }
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct StatusLabels {
+    status: &'static str,
 }
 
-impl<const N: usize> Histogram<N> {
-    fn observe(&mut self, bounds: &[f64; N], seconds: f64) {
-        for (slot, bound) in self.counts.iter_mut().zip(bounds) {
-            if seconds <= *bound {
-                *slot += 1;
-            }
-        }
-        self.count += 1;
-        self.sum_s += seconds;
-    }
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct CheckpointLabels {
+    checkpoint: bool,
 }
 
-/// A labelled histogram metric: HELP, TYPE and each label set's series, label sets sorted.
-fn histogram<K: Ord + std::hash::Hash, const N: usize>(
-    out: &mut String,
-    name: &str,
-    help: &str,
-    bounds: &[f64; N],
-    series: &HashMap<K, Histogram<N>>,
-    labels: impl Fn(&K) -> String,
-) {
-    let _ = writeln!(out, "# HELP {name} {help}");
-    let _ = writeln!(out, "# TYPE {name} histogram");
-    let mut keys: Vec<&K> = series.keys().collect();
-    keys.sort();
-    for key in keys {
-        let h = &series[key];
-        histogram_series(
-            out,
-            name,
-            &labels(key),
-            h.counts.iter().copied().zip(bounds.iter().copied()),
-            h.count,
-            h.sum_s,
-        );
-    }
+/// An HTTP request's method and matched route template (`/v1/jobs/{id}`, or `unmatched`), so
+/// the label set stays bounded.
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct RouteLabels {
+    method: String,
+    route: String,
 }
 
-/// One unlabelled metric: its HELP and TYPE lines and its value.
-fn scalar(out: &mut String, name: &str, kind: &str, help: &str, value: impl std::fmt::Display) {
-    let _ = writeln!(out, "# HELP {name} {help}");
-    let _ = writeln!(out, "# TYPE {name} {kind}");
-    let _ = writeln!(out, "{name} {value}");
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct RouteStatusLabels {
+    method: String,
+    route: String,
+    status: u16,
 }
 
-/// One labelled series of a histogram: its cumulative buckets (`le` = each bound, then
-/// `+Inf`), sum and count.
-fn histogram_series(
-    out: &mut String,
-    name: &str,
-    labels: &str,
-    buckets: impl Iterator<Item = (u64, f64)>,
-    count: u64,
-    sum_s: f64,
-) {
-    for (n, bound) in buckets {
-        let _ = writeln!(out, "{name}_bucket{{{labels},le=\"{bound}\"}} {n}");
-    }
-    let _ = writeln!(out, "{name}_bucket{{{labels},le=\"+Inf\"}} {count}");
-    let _ = writeln!(out, "{name}_sum{{{labels}}} {}", num(sum_s));
-    let _ = writeln!(out, "{name}_count{{{labels}}} {count}");
+type HistogramFamily<L> = Family<L, Histogram, fn() -> Histogram>;
+type FloatCounter = Counter<f64, AtomicU64>;
+type FloatGauge = Gauge<f64, AtomicU64>;
+
+fn duration_histogram() -> Histogram {
+    Histogram::new(DURATION_BUCKETS_S)
 }
 
-/// A number as Prometheus text, never `-0` (an empty float sum is -0.0 in Rust).
-fn num(x: f64) -> f64 {
-    x + 0.0
+fn http_histogram() -> Histogram {
+    Histogram::new(HTTP_BUCKETS_S)
 }
 
-#[derive(Default)]
-struct Inner {
-    durations: HashMap<(&'static str, &'static str), Histogram<{ DURATION_BUCKETS_S.len() }>>,
-    /// HTTP requests by (method, route template): latency histogram.
-    http_latency: HashMap<(String, String), Histogram<{ HTTP_BUCKETS_S.len() }>>,
-    /// HTTP requests by (method, route template, status code).
-    http_requests: HashMap<(String, String, u16), u64>,
-    simulated_s_total: f64,
-    /// Running attempts in this process: (start, simulated seconds reached, simulated seconds
-    /// it resumed from).
-    running: HashMap<Uuid, (Instant, f64, f64)>,
-    /// Attempts given back at shutdown, without and with a checkpoint.
-    released: [u64; 2],
-    /// Simulated time kept by the checkpoints of released attempts, s.
-    checkpointed_s_total: f64,
-    /// Attempts that resumed from a stored checkpoint.
-    resumed: u64,
+/// A running attempt in this process.
+#[derive(Clone, Copy)]
+struct Running {
+    started: Instant,
+    /// Simulated time reached, s.
+    simulated_s: f64,
+    /// Simulated time it resumed from (a checkpoint of an earlier attempt), s.
+    resumed_from_s: f64,
 }
 
-impl Inner {
-    /// One job (or attempt) of `kind` that ended with `status` after `seconds`.
-    fn observe(&mut self, kind: JobKind, status: JobStatus, seconds: f64) {
-        self.durations
-            .entry((kind.as_str(), status.as_str()))
-            .or_default()
-            .observe(&DURATION_BUCKETS_S, seconds);
-    }
-}
-
-/// Counters and gauges of this process.
-#[derive(Default)]
+/// Counters, gauges and histograms of this process.
 pub struct Metrics {
-    inner: Mutex<Inner>,
+    /// The metrics that accumulate, registered once; encoded after the scrape-time gauges.
+    registry: Registry,
+    job_duration: HistogramFamily<JobLabels>,
+    simulated: FloatCounter,
+    released: Family<CheckpointLabels, Counter>,
+    checkpointed: FloatCounter,
+    resumed: Counter,
+    http_requests: Family<RouteStatusLabels, Counter>,
+    http_latency: HistogramFamily<RouteLabels>,
+    /// Attempts running here: what the rate gauge and the progress accounting read.
+    running: Mutex<HashMap<Uuid, Running>>,
+}
+
+impl Default for Metrics {
+    fn default() -> Self {
+        let job_duration: HistogramFamily<JobLabels> =
+            Family::new_with_constructor(duration_histogram);
+        let simulated = FloatCounter::default();
+        let released = Family::<CheckpointLabels, Counter>::default();
+        let checkpointed = FloatCounter::default();
+        let resumed = Counter::default();
+        let http_requests = Family::<RouteStatusLabels, Counter>::default();
+        let http_latency: HistogramFamily<RouteLabels> =
+            Family::new_with_constructor(http_histogram);
+        // Both label values of the released counter exist from the start (0 until counted).
+        for checkpoint in [false, true] {
+            drop(released.get_or_create(&CheckpointLabels { checkpoint }));
+        }
+
+        let mut registry = Registry::default();
+        registry.register_with_unit(
+            "railwear_job_duration",
+            "Wall time of jobs ended by this process: an attempt's, or for a job that fanned out (a sweep) the whole job's, from its first claim through its children to its assembly",
+            Unit::Seconds,
+            job_duration.clone(),
+        );
+        registry.register_with_unit(
+            "railwear_simulated",
+            "Simulated time advanced by this process",
+            Unit::Seconds,
+            simulated.clone(),
+        );
+        registry.register(
+            "railwear_attempts_released",
+            "Attempts this process gave back at shutdown, by whether they stored a checkpoint",
+            released.clone(),
+        );
+        registry.register_with_unit(
+            "railwear_checkpointed_simulated",
+            "Simulated time the checkpoints of released attempts kept (not simulated again by the next attempt)",
+            Unit::Seconds,
+            checkpointed.clone(),
+        );
+        registry.register(
+            "railwear_attempts_resumed",
+            "Attempts this process started from a stored checkpoint",
+            resumed.clone(),
+        );
+        registry.register(
+            "railwear_http_requests",
+            "HTTP requests answered by this process, by method, route and status",
+            http_requests.clone(),
+        );
+        registry.register_with_unit(
+            "railwear_http_request_duration",
+            "Latency of HTTP requests answered by this process, by method and route",
+            Unit::Seconds,
+            http_latency.clone(),
+        );
+        Metrics {
+            registry,
+            job_duration,
+            simulated,
+            released,
+            checkpointed,
+            resumed,
+            http_requests,
+            http_latency,
+            running: Mutex::new(HashMap::new()),
+        }
+    }
 }
 
 impl Metrics {
-    fn with<R>(&self, f: impl FnOnce(&mut Inner) -> R) -> R {
-        let mut guard = match self.inner.lock() {
+    fn running<R>(&self, f: impl FnOnce(&mut HashMap<Uuid, Running>) -> R) -> R {
+        let mut guard = match self.running.lock() {
             Ok(g) => g,
             Err(poisoned) => poisoned.into_inner(),
         };
         f(&mut guard)
     }
 
+    /// One job (or attempt) of `kind` that ended with `status` after `seconds` of wall time.
+    fn observe(&self, kind: JobKind, status: JobStatus, seconds: f64) {
+        self.job_duration
+            .get_or_create(&JobLabels {
+                kind: kind.as_str(),
+                status: status.as_str(),
+            })
+            .observe(seconds);
+    }
+
     /// An attempt started in this process.
     pub fn attempt_started(&self, id: Uuid) {
-        self.with(|m| {
-            m.running.insert(id, (Instant::now(), 0.0, 0.0));
+        self.running(|running| {
+            running.insert(
+                id,
+                Running {
+                    started: Instant::now(),
+                    simulated_s: 0.0,
+                    resumed_from_s: 0.0,
+                },
+            );
         });
     }
 
     /// A running attempt resumes from a checkpoint at `simulated_time_s`: the time before it
     /// was simulated by an earlier attempt and is not counted again.
     pub fn attempt_resumed(&self, id: Uuid, simulated_time_s: f64) {
-        self.with(|m| {
-            if let Some(entry) = m.running.get_mut(&id) {
+        self.running(|running| {
+            if let Some(entry) = running.get_mut(&id) {
                 if simulated_time_s.is_finite() {
-                    entry.1 = entry.1.max(simulated_time_s);
-                    entry.2 = simulated_time_s;
+                    entry.simulated_s = entry.simulated_s.max(simulated_time_s);
+                    entry.resumed_from_s = simulated_time_s;
                 }
-                m.resumed += 1;
+                self.resumed.inc();
             }
         });
     }
 
     /// Progress of a running attempt: simulated time reached, s.
     pub fn attempt_progress(&self, id: Uuid, simulated_time_s: f64) {
-        self.with(|m| {
-            if let Some(entry) = m.running.get_mut(&id) {
-                if simulated_time_s.is_finite() && simulated_time_s > entry.1 {
-                    m.simulated_s_total += simulated_time_s - entry.1;
-                    entry.1 = simulated_time_s;
+        self.running(|running| {
+            if let Some(entry) = running.get_mut(&id) {
+                if simulated_time_s.is_finite() && simulated_time_s > entry.simulated_s {
+                    self.simulated.inc_by(simulated_time_s - entry.simulated_s);
+                    entry.simulated_s = simulated_time_s;
                 }
             }
         });
@@ -179,23 +230,28 @@ impl Metrics {
 
     /// An attempt ended with `status`: its wall time goes to the duration histogram.
     pub fn attempt_finished(&self, id: Uuid, kind: JobKind, status: JobStatus) {
-        self.with(|m| {
-            if let Some((start, _, _)) = m.running.remove(&id) {
-                m.observe(kind, status, start.elapsed().as_secs_f64());
-            }
-        });
+        if let Some(run) = self.running(|running| running.remove(&id)) {
+            self.observe(kind, status, run.started.elapsed().as_secs_f64());
+        }
     }
 
     /// An attempt was given back at shutdown (with a checkpoint at `checkpoint_s` simulated
     /// seconds, if it stored one): no longer running here, not a finished job.
     pub fn attempt_released(&self, id: Uuid, checkpoint_s: Option<f64>) {
-        self.with(|m| {
-            let resumed_from = m.running.remove(&id).map_or(0.0, |r| r.2);
-            m.released[usize::from(checkpoint_s.is_some())] += 1;
-            if let Some(t) = checkpoint_s.filter(|t| t.is_finite()) {
-                m.checkpointed_s_total += (t - resumed_from).max(0.0);
+        let resumed_from = self
+            .running(|running| running.remove(&id))
+            .map_or(0.0, |run| run.resumed_from_s);
+        self.released
+            .get_or_create(&CheckpointLabels {
+                checkpoint: checkpoint_s.is_some(),
+            })
+            .inc();
+        if let Some(t) = checkpoint_s.filter(|t| t.is_finite()) {
+            let kept = t - resumed_from;
+            if kept > 0.0 {
+                self.checkpointed.inc_by(kept);
             }
-        });
+        }
     }
 
     /// The attempt that ended a fanned-out job (a sweep's assembly) ended with `status`; the
@@ -208,148 +264,102 @@ impl Metrics {
         status: JobStatus,
         whole_s: f64,
     ) {
-        self.with(|m| {
-            m.running.remove(&id);
-            m.observe(kind, status, whole_s.max(0.0));
-        });
+        self.running(|running| running.remove(&id));
+        self.observe(kind, status, whole_s.max(0.0));
     }
 
     /// A fanned-out job ended without an attempt of its own (a child's failure failed it),
     /// `whole_s` after its first claim.
     pub fn job_ended(&self, kind: JobKind, status: JobStatus, whole_s: f64) {
-        self.with(|m| m.observe(kind, status, whole_s.max(0.0)));
+        self.observe(kind, status, whole_s.max(0.0));
     }
 
     /// One HTTP request answered: `route` is the matched route template (`/v1/jobs/{id}`), or
     /// `unmatched`, so the label set stays bounded.
     pub fn http_request(&self, method: &str, route: &str, status: u16, seconds: f64) {
-        self.with(|m| {
-            *m.http_requests
-                .entry((method.to_string(), route.to_string(), status))
-                .or_default() += 1;
-            m.http_latency
-                .entry((method.to_string(), route.to_string()))
-                .or_default()
-                .observe(&HTTP_BUCKETS_S, seconds);
-        });
+        self.http_requests
+            .get_or_create(&RouteStatusLabels {
+                method: method.to_string(),
+                route: route.to_string(),
+                status,
+            })
+            .inc();
+        self.http_latency
+            .get_or_create(&RouteLabels {
+                method: method.to_string(),
+                route: route.to_string(),
+            })
+            .observe(seconds);
     }
 
-    /// Prometheus text with the given job counts per status (queue depth from the store).
+    /// The OpenMetrics text ([`CONTENT_TYPE`]) with the given job counts per status (queue
+    /// depth from the store).
     pub fn render(&self, counts: &[(JobStatus, i64)]) -> String {
-        let mut out = String::new();
-        let _ = writeln!(
-            out,
-            "# HELP railwear_jobs Jobs in the store by status (queue depth = queued)."
-        );
-        let _ = writeln!(out, "# TYPE railwear_jobs gauge");
+        // What is true now: the store's counts and the attempts running at this moment.
+        let mut now = Registry::default();
+        let jobs = Family::<StatusLabels, Gauge>::default();
         for (status, n) in counts {
-            let _ = writeln!(out, "railwear_jobs{{status=\"{}\"}} {n}", status.as_str());
+            jobs.get_or_create(&StatusLabels {
+                status: status.as_str(),
+            })
+            .set(*n);
         }
+        now.register(
+            "railwear_jobs",
+            "Jobs in the store by status (queue depth = queued)",
+            jobs,
+        );
         let queued = counts
             .iter()
             .find(|(s, _)| *s == JobStatus::Queued)
             .map_or(0, |(_, n)| *n);
-        scalar(
-            &mut out,
+        let queue_depth = Gauge::<i64>::default();
+        queue_depth.set(queued);
+        now.register(
             "railwear_queue_depth",
-            "gauge",
-            "Jobs waiting for a worker.",
-            queued,
+            "Jobs waiting for a worker",
+            queue_depth,
         );
-        self.with(|m| {
-            histogram(
-                &mut out,
-                "railwear_job_duration_seconds",
-                "Wall time of jobs ended by this process: an attempt's, or for a job that fanned out (a sweep) the whole job's, from its first claim through its children to its assembly.",
-                &DURATION_BUCKETS_S,
-                &m.durations,
-                |(kind, status)| format!("kind=\"{kind}\",status=\"{status}\""),
-            );
-            scalar(
-                &mut out,
-                "railwear_simulated_seconds_total",
-                "counter",
-                "Simulated time advanced by this process, s.",
-                num(m.simulated_s_total),
-            );
-            let rate = m.running.values().fold(0.0, |acc, (start, sim, from)| {
-                let wall = start.elapsed().as_secs_f64();
+        let (rate, running) = self.running(|running| {
+            let rate = running.values().fold(0.0, |acc, run| {
+                let wall = run.started.elapsed().as_secs_f64();
                 if wall > 0.0 {
-                    acc + (sim - from) / wall
+                    acc + (run.simulated_s - run.resumed_from_s) / wall
                 } else {
                     acc
                 }
             });
-            scalar(
-                &mut out,
-                "railwear_simulated_seconds_per_second",
-                "gauge",
-                "Simulated seconds per wall second, summed over running attempts.",
-                num(rate),
-            );
-            scalar(
-                &mut out,
-                "railwear_running_attempts",
-                "gauge",
-                "Attempts running in this process.",
-                m.running.len(),
-            );
-            let _ = writeln!(
-                out,
-                "# HELP railwear_attempts_released_total Attempts this process gave back at shutdown, by whether they stored a checkpoint."
-            );
-            let _ = writeln!(out, "# TYPE railwear_attempts_released_total counter");
-            for (i, label) in ["false", "true"].iter().enumerate() {
-                let _ = writeln!(
-                    out,
-                    "railwear_attempts_released_total{{checkpoint=\"{label}\"}} {}",
-                    m.released[i]
-                );
-            }
-            scalar(
-                &mut out,
-                "railwear_checkpointed_simulated_seconds_total",
-                "counter",
-                "Simulated time the checkpoints of released attempts kept (not simulated again by the next attempt), s.",
-                num(m.checkpointed_s_total),
-            );
-            scalar(
-                &mut out,
-                "railwear_attempts_resumed_total",
-                "counter",
-                "Attempts this process started from a stored checkpoint.",
-                m.resumed,
-            );
-            let _ = writeln!(
-                out,
-                "# HELP railwear_http_requests_total HTTP requests answered by this process, by method, route and status."
-            );
-            let _ = writeln!(out, "# TYPE railwear_http_requests_total counter");
-            let mut keys: Vec<_> = m.http_requests.keys().cloned().collect();
-            keys.sort();
-            for key in keys {
-                let n = m.http_requests.get(&key).copied().unwrap_or(0);
-                let _ = writeln!(
-                    out,
-                    "railwear_http_requests_total{{method=\"{}\",route=\"{}\",status=\"{}\"}} {n}",
-                    key.0, key.1, key.2
-                );
-            }
-            histogram(
-                &mut out,
-                "railwear_http_request_duration_seconds",
-                "Latency of HTTP requests answered by this process, by method and route.",
-                &HTTP_BUCKETS_S,
-                &m.http_latency,
-                |(method, route)| format!("method=\"{method}\",route=\"{route}\""),
-            );
+            (rate, running.len())
         });
+        let rate_gauge = FloatGauge::default();
+        // `+ 0.0`: an empty sum is -0.0, which is not a number Prometheus users expect to see.
+        rate_gauge.set(rate + 0.0);
+        now.register(
+            "railwear_simulated_seconds_per_second",
+            "Simulated seconds per wall second, summed over running attempts",
+            rate_gauge,
+        );
+        let running_gauge = Gauge::<i64>::default();
+        running_gauge.set(i64::try_from(running).unwrap_or(i64::MAX));
+        now.register(
+            "railwear_running_attempts",
+            "Attempts running in this process",
+            running_gauge,
+        );
+
+        let mut out = String::new();
+        // Writing to a String cannot fail.
+        let _ = encode_registry(&mut out, &now)
+            .and_then(|()| encode_registry(&mut out, &self.registry))
+            .and_then(|()| encode_eof(&mut out));
         out
     }
 }
 
 #[cfg(test)]
 mod tests {
+    //! The text as `prometheus-client` writes it; tests/api/service_metrics.rs reads a live
+    //! `/metrics` with the Prometheus project's OpenMetrics parser.
     use super::*;
 
     #[test]
@@ -361,15 +371,19 @@ mod tests {
         metrics.attempt_progress(id, 1.0); // progress never goes back
         metrics.attempt_finished(id, JobKind::Simulate, JobStatus::Succeeded);
         let text = metrics.render(&[(JobStatus::Queued, 4)]);
-        assert!(text.contains("railwear_queue_depth 4"));
-        assert!(text.contains("railwear_simulated_seconds_total 2"));
-        assert!(text.contains(
-            "railwear_job_duration_seconds_bucket{kind=\"simulate\",status=\"succeeded\",le=\"3600\"} 1"
-        ));
-        assert!(text.contains(
-            "railwear_job_duration_seconds_count{kind=\"simulate\",status=\"succeeded\"} 1"
-        ));
-        assert!(text.contains("railwear_running_attempts 0"));
+        assert!(text.ends_with("# EOF\n"), "{text}");
+        for line in [
+            "railwear_queue_depth 4\n",
+            "railwear_jobs{status=\"queued\"} 4\n",
+            "railwear_simulated_seconds_total 2.0\n",
+            "railwear_job_duration_seconds_bucket{le=\"3600.0\",kind=\"simulate\",status=\"succeeded\"} 1\n",
+            "railwear_job_duration_seconds_bucket{le=\"+Inf\",kind=\"simulate\",status=\"succeeded\"} 1\n",
+            "railwear_job_duration_seconds_count{kind=\"simulate\",status=\"succeeded\"} 1\n",
+            "railwear_running_attempts 0\n",
+            "# UNIT railwear_job_duration_seconds seconds\n",
+        ] {
+            assert!(text.contains(line), "{line} in {text}");
+        }
     }
 
     #[test]
@@ -380,24 +394,50 @@ mod tests {
         metrics.fanned_out_job_finished(id, JobKind::Sweep, JobStatus::Succeeded, 42.0);
         metrics.job_ended(JobKind::Sweep, JobStatus::Failed, 7.5);
         let text = metrics.render(&[]);
-        assert!(text
-            .contains("railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"succeeded\"} 42"));
-        assert!(text.contains(
-            "railwear_job_duration_seconds_bucket{kind=\"sweep\",status=\"succeeded\",le=\"30\"} 0"
-        ));
-        assert!(text
-            .contains("railwear_job_duration_seconds_count{kind=\"sweep\",status=\"failed\"} 1"));
-        assert!(text.contains("railwear_running_attempts 0"));
+        for line in [
+            "railwear_job_duration_seconds_sum{kind=\"sweep\",status=\"succeeded\"} 42.0\n",
+            "railwear_job_duration_seconds_bucket{le=\"30.0\",kind=\"sweep\",status=\"succeeded\"} 0\n",
+            "railwear_job_duration_seconds_bucket{le=\"60.0\",kind=\"sweep\",status=\"succeeded\"} 1\n",
+            "railwear_job_duration_seconds_count{kind=\"sweep\",status=\"failed\"} 1\n",
+            "railwear_running_attempts 0\n",
+        ] {
+            assert!(text.contains(line), "{line} in {text}");
+        }
     }
 
     #[test]
     fn idle_metrics_never_print_negative_zero() {
         let text = Metrics::default().render(&[]);
         assert!(
-            text.contains("railwear_simulated_seconds_per_second 0\n"),
+            text.contains("railwear_simulated_seconds_per_second 0.0\n"),
             "{text}"
         );
-        assert!(!text.contains("-0"), "{text}");
+        assert!(!text.contains(" -0"), "{text}");
+        assert!(
+            text.contains("railwear_attempts_released_total{checkpoint=\"false\"} 0\n"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn released_and_resumed_attempts_are_counted() {
+        let metrics = Metrics::default();
+        let id = Uuid::new_v4();
+        metrics.attempt_started(id);
+        metrics.attempt_resumed(id, 1.5);
+        metrics.attempt_progress(id, 4.0);
+        metrics.attempt_released(id, Some(3.5));
+        let text = metrics.render(&[]);
+        for line in [
+            "railwear_attempts_resumed_total 1\n",
+            "railwear_attempts_released_total{checkpoint=\"true\"} 1\n",
+            // The checkpoint kept the 3.5 - 1.5 s that the earlier attempt had not kept.
+            "railwear_checkpointed_simulated_seconds_total 2.0\n",
+            // Resumed at 1.5 s: only the 2.5 s simulated here count.
+            "railwear_simulated_seconds_total 2.5\n",
+        ] {
+            assert!(text.contains(line), "{line} in {text}");
+        }
     }
 
     #[test]
@@ -406,14 +446,12 @@ mod tests {
         metrics.http_request("GET", "/v1/jobs/{id}", 200, 0.003);
         metrics.http_request("GET", "/v1/jobs/{id}", 404, 0.2);
         let text = metrics.render(&[]);
-        assert!(text.contains(
-            "railwear_http_requests_total{method=\"GET\",route=\"/v1/jobs/{id}\",status=\"200\"} 1"
-        ));
-        assert!(text.contains(
-            "railwear_http_request_duration_seconds_bucket{method=\"GET\",route=\"/v1/jobs/{id}\",le=\"0.005\"} 1"
-        ));
-        assert!(text.contains(
-            "railwear_http_request_duration_seconds_count{method=\"GET\",route=\"/v1/jobs/{id}\"} 2"
-        ));
+        for line in [
+            "railwear_http_requests_total{method=\"GET\",route=\"/v1/jobs/{id}\",status=\"200\"} 1\n",
+            "railwear_http_request_duration_seconds_bucket{le=\"0.005\",method=\"GET\",route=\"/v1/jobs/{id}\"} 1\n",
+            "railwear_http_request_duration_seconds_count{method=\"GET\",route=\"/v1/jobs/{id}\"} 2\n",
+        ] {
+            assert!(text.contains(line), "{line} in {text}");
+        }
     }
 }

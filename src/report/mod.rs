@@ -1,10 +1,11 @@
 //! Reports: what a finished run is handed back as. A case run packaged into its outcome
 //! (summary JSON, track samples, SVG plots: [`case`]), the plots of a case and of a
-//! penalization curve ([`plots`]), and the dependency-free SVG writer they use ([`svg`]).
+//! penalization curve ([`plots`]), and the figures they and the diagnosis draw with plotters
+//! ([`figure`]).
 
 pub mod case;
+pub mod figure;
 pub mod plots;
-pub mod svg;
 
 pub use case::{package, run_case, run_case_from};
 pub use plots::{case_plots, curve_plot};

@@ -1,7 +1,7 @@
 //! The plots of a finished case (wear versus time, contact-pressure PDFs, response PSD) and of
-//! a service-life penalization curve (thesis Figure 6.68), drawn with [`super::svg`].
+//! a service-life penalization curve (thesis Figure 6.68), drawn with [`super::figure`].
 
-use super::svg::{AxisSpec, Plot, Series};
+use super::figure::{spans_decades, AxisSpec, Plot, Series};
 use crate::analysis::penalization::PenalizationCurve;
 use crate::models::run::RunReport;
 use crate::models::spec::{CaseSpec, ModelSpecRef};
@@ -22,18 +22,43 @@ pub fn case_plots(
         _ => crate::wear::material::Material::default(),
     };
     let density = material.density_kg_per_m3;
+    let wear_series: Vec<Series> = r
+        .contacts
+        .iter()
+        .enumerate()
+        .map(|(ci, c)| {
+            let pts: Vec<(f64, f64)> = r
+                .wear_history
+                .iter()
+                .map(|(t, v)| (*t, v.get(ci).copied().unwrap_or(0.0) * density * 1e6))
+                .collect();
+            Series::line(&c.name, pts)
+        })
+        .collect();
+    // The contacts' wear is compared at the end of the run: where their final masses span
+    // more than two decades the axis is logarithmic, down to three decades below the least.
+    let finals: Vec<f64> = wear_series
+        .iter()
+        .filter_map(|s| s.points.last().map(|p| p.1))
+        .filter(|m| m.is_finite() && *m > 0.0)
+        .collect();
+    let wear_axis = if spans_decades(finals.iter().copied()) {
+        let least = finals.iter().copied().fold(f64::INFINITY, f64::min);
+        let most = finals.iter().copied().fold(0.0, f64::max);
+        AxisSpec::log("wear mass (mg)").with_range(
+            10f64.powf(least.log10().floor() - 3.0),
+            10f64.powf(most.log10().ceil()),
+        )
+    } else {
+        AxisSpec::linear("wear mass (mg)")
+    };
     let mut wear_plot = Plot::new(
         format!("{}: wear versus time", case.name),
         AxisSpec::linear("time (s)"),
-        AxisSpec::linear("wear mass (mg)"),
+        wear_axis,
     );
-    for (ci, c) in r.contacts.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = r
-            .wear_history
-            .iter()
-            .map(|(t, v)| (*t, v.get(ci).copied().unwrap_or(0.0) * density * 1e6))
-            .collect();
-        wear_plot = wear_plot.with_series(Series::line(&c.name, pts));
+    for series in wear_series {
+        wear_plot = wear_plot.with_series(series);
     }
     out.push(("wear_vs_time.svg".to_string(), wear_plot.to_svg()));
     // Contact-pressure PDF per contact with S_y and the cutoff marked.
@@ -56,12 +81,12 @@ pub fn case_plots(
         let mut p = Plot::new(
             format!("{}: contact-pressure PDF, {}", case.name, c.name),
             AxisSpec::log("contact pressure (MPa)"),
-            AxisSpec::linear("time density (1/MPa)"),
+            AxisSpec::auto("time density (1/MPa)"),
         )
         .with_series(Series::histogram("time share", &edges, &values));
-        p = p.with_marker(material.yield_strength_pa / 1e6, "Sy");
+        p = p.with_marker(material.yield_strength_pa / 1e6, "yield strength Sy");
         if let Some(cut) = c.wear.cutoff_pressure_pa {
-            p = p.with_marker(cut / 1e6, "cutoff");
+            p = p.with_marker(cut / 1e6, "wear-law cutoff");
         }
         out.push((format!("pressure_pdf_{}.svg", c.name), p.to_svg()));
     }
@@ -110,4 +135,29 @@ pub fn curve_plot(curve: &PenalizationCurve) -> String {
     .with_series(Series::line("0.9 K_SL", b90))
     .with_series(Series::line("0.8 K_SL", b80))
     .to_svg()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::penalization::SweepPoint;
+    use railwear_testkit::svg::texts_outside_view_box;
+
+    #[test]
+    fn the_penalization_curve_fits_its_picture() {
+        let point = |rattle_space, rate| SweepPoint {
+            offset_mm: None,
+            rattle_space,
+            rail_wear_rate_mg_per_h: rate,
+        };
+        let curve = PenalizationCurve::new(
+            &[point(0.8317, 1.0), point(0.7684, 4.0), point(0.7990, 2.0)],
+            0.7990,
+        )
+        .expect("curve");
+        let svg = curve_plot(&curve);
+        let outside = texts_outside_view_box(&svg);
+        assert!(outside.is_empty(), "{outside:#?}");
+        assert!(svg.contains("0.9 K_SL") && svg.contains("rattle space k_rs"));
+    }
 }

@@ -1,17 +1,19 @@
 //! The API tests' house: [`TestApp`] (the service in this process on port 0 with a fresh SQLite
 //! file), [`Binary`] (the real `railwear serve`), and [`Api`], the typed client both hand out.
-//! Built on `railwear::testkit` (the HTTP client, the process spawner), which the bench shares.
+//! Built on the `railwear-testkit` crate (the HTTP client on reqwest, the process spawner),
+//! which the bench shares.
 //!
 //! The client methods block: the tests drive the service from plain threads (`#[test]`
 //! functions and `spawn_blocking` closures beside an in-process service on the test's runtime).
-//! Each call runs the testkit's async client on a one-request runtime of its own thread, so it
-//! works from any thread, inside a runtime or not.
+//! Each call runs a fresh testkit client (a connection per request, none kept) on a one-request
+//! runtime of its own thread, so it works from any thread, inside a runtime or not, and never
+//! leaves an idle connection for a graceful shutdown to wait on.
 
 use crate::support::runner::{start, start_library, test_config};
 use crate::support::{temp_dir, tokens_env, TempDir, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::config::ServiceConfig;
 use railwear::http::RunningService;
-use railwear::testkit::{self, Client, ClientError, Request, ServerProcess};
+use railwear_testkit::{self as testkit, Client, ClientError, Request, ServerProcess};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -67,14 +69,12 @@ pub fn wait_for<T>(timeout: Duration, what: &str, mut f: impl FnMut() -> Option<
 #[derive(Debug, Clone)]
 pub struct Api {
     pub base: String,
-    client: Client,
 }
 
 impl Api {
     pub fn new(base: &str) -> Api {
         Api {
             base: base.trim_end_matches('/').to_string(),
-            client: Client::new(base),
         }
     }
 
@@ -118,14 +118,14 @@ impl Api {
         if let Some(body) = body {
             request = request.json(body);
         }
-        let client = self.client.clone();
+        let base = self.base.clone();
         // A thread of its own with a one-request runtime: callable from any thread.
         let response = std::thread::spawn(move || {
             let rt = tokio::runtime::Builder::new_current_thread()
                 .enable_all()
                 .build()
                 .expect("client runtime");
-            rt.block_on(client.send(&request))
+            rt.block_on(async { Client::new(&base)?.send(&request).await })
         })
         .join()
         .expect("client thread")?;
@@ -134,6 +134,12 @@ impl Api {
             body: response.text(),
             headers: response.headers,
         })
+    }
+
+    /// `method path` with a JSON body exactly as written, on a raw connection: for the probes
+    /// a conforming client will not send as is (see `wire.rs`).
+    pub fn wire(&self, method: &str, path: &str, token: Option<&str>, body: &str) -> Reply {
+        crate::wire::send(&self.base, method, path, token, body)
     }
 
     pub fn get(&self, path: &str, token: Option<&str>) -> Reply {

@@ -5,7 +5,7 @@
 
 use crate::helpers::{wait_for, Api};
 use crate::support::{tokens_env, ENGINEER};
-use railwear::testkit::ServerProcess;
+use railwear_testkit::ServerProcess;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;

@@ -229,9 +229,11 @@ async fn bad_measurements_are_422_naming_the_field_and_store_nothing() {
             .problem(400);
         // Issue 17: "." and ".." (and anything not starting with a letter or digit) are not
         // serials: a URL path resolves them away, so their report URL was unreachable.
+        // (On a raw connection: a conforming client resolves `%2E` segments away.)
         for serial in ["%2E", "%2E%2E", ".hidden", "-R1"] {
             let p = api
-                .post(
+                .wire(
+                    "POST",
                     &format!("/v1/rails/{serial}/measurements"),
                     Some(PLANNER),
                     &body,

@@ -187,6 +187,11 @@ fn assert_results_equal(got: &Results, expected: &Results, name: &str) {
         "{name}: too few track samples"
     );
     assert_eq!(got.plots, expected.plots, "{name}: plots differ");
+    // Each figure (wear versus time, pressure PDFs, PSD) keeps its text inside its picture.
+    for (plot, svg) in &expected.plots {
+        let outside = railwear_testkit::svg::texts_outside_view_box(svg);
+        assert!(outside.is_empty(), "{name}: {plot}: {outside:#?}");
+    }
 }
 
 #[test]

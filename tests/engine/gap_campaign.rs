@@ -3,7 +3,7 @@
 
 use railwear::gap::campaign::Campaign;
 use railwear::gap::GapError;
-use railwear::testkit::TempDir;
+use railwear_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -446,6 +446,12 @@ fn simulated_tables_follow_the_physics_and_the_report_is_written() {
             svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
             "{name}"
         );
+        // Every label, note and tick inside the picture; no Rust names in the words.
+        let outside = railwear_testkit::svg::texts_outside_view_box(&svg);
+        assert!(outside.is_empty(), "{name}: {outside:#?}");
+        for verdict in ["NoGap", "PartlyExplained", "NotExplained"] {
+            assert!(!svg.contains(verdict), "{name} prints {verdict}");
+        }
     }
 }
 

@@ -87,7 +87,7 @@ fn same_seed_same_campaign_other_seed_differs_and_zero_effect_is_the_control() {
     assert_eq!(tz.tests, ta.tests);
     assert_eq!(tz.effects.len(), zero.len());
     // The written campaign validates and reads back as written.
-    let scratch = railwear::testkit::TempDir::new("gap-rig").expect("scratch dir");
+    let scratch = railwear_testkit::TempDir::new("gap-rig").expect("scratch dir");
     let dir = scratch.path().to_path_buf();
     a.write_dir(&dir).unwrap();
     let back = Campaign::load(&dir.join("campaign.toml")).unwrap();

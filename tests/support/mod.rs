@@ -1,13 +1,13 @@
 //! Shared by the api and store test binaries: the four test tokens, temporary directories, a
 //! throwaway PostgreSQL database ([`postgres`]) and the counting test runner ([`runner`]).
 //! The HTTP side (client, real binary, `TestApp`) is in `tests/api/helpers.rs`; the pieces the
-//! bench uses too live in `railwear::testkit`.
+//! bench uses too live in the `railwear-testkit` crate (testkit/), a dev-dependency.
 #![allow(dead_code)]
 
 pub mod postgres;
 pub mod runner;
 
-pub use railwear::testkit::TempDir;
+pub use railwear_testkit::TempDir;
 
 pub const ADMIN: &str = "admin-token-0123456789abcdef";
 pub const ENGINEER: &str = "engineer-token-0123456789abcdef";

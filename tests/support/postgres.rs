@@ -1,11 +1,11 @@
 //! A fresh PostgreSQL database per test on the local server (127.0.0.1:5432, trust auth), dropped
-//! when the test ends ([`railwear::testkit::ThrowawayDb`]). If the server cannot be reached the
+//! when the test ends ([`railwear_testkit::ThrowawayDb`]). If the server cannot be reached the
 //! test fails with a message saying so, unless `RAILWEAR_SKIP_POSTGRES=1` (then the test returns
 //! early and prints that it skipped). `RAILWEAR_TEST_POSTGRES_URL` names another admin connection
 //! (default: user `postgres`, then `root`, database `test`).
 #![allow(dead_code)]
 
-pub use railwear::testkit::ThrowawayDb as TestDb;
+pub use railwear_testkit::ThrowawayDb as TestDb;
 
 fn candidates() -> Vec<String> {
     match std::env::var("RAILWEAR_TEST_POSTGRES_URL") {

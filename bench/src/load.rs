@@ -1,12 +1,13 @@
-//! `load`: reports under GET load from a minimal HTTP/1.1 keep-alive client.
+//! `load`: reports under GET load from HTTP/1.1 keep-alive clients, one connection per task.
 
 use super::*;
 
-use railwear::testkit::{ClientError, Conn, Request, ServerProcess, TempDir};
+use railwear_testkit::{Client, ClientError, Request, ServerProcess, TempDir};
 
-/// One request as `token` on a kept connection (the testkit's HTTP/1.1 client): status and body.
+/// One request as `token` on a kept connection (the testkit's client, on reqwest): status and
+/// body.
 async fn call(
-    conn: &mut Conn,
+    conn: &Client,
     method: &str,
     path: &str,
     token: &str,
@@ -42,7 +43,7 @@ pub(crate) fn start_server(bin: &Path, configs_dir: &Path, tokens: &str) -> Resu
         );
     }
     let dir = TempDir::new("bench")?;
-    let mut cmd = railwear::testkit::serve_command(bin, &dir.db_url(), tokens, configs_dir);
+    let mut cmd = railwear_testkit::serve_command(bin, &dir.db_url(), tokens, configs_dir);
     cmd.args(["--workers", "2"]);
     let process = ServerProcess::spawn(cmd, Duration::from_secs(60))
         .with_context(|| format!("starting {}", bin.display()))?;
@@ -108,7 +109,7 @@ async fn load_async(
     curve: bool,
 ) -> Result<Vec<Table>> {
     let mut notes = Vec::new();
-    let mut conn = Conn::new(&addr);
+    let conn = Client::keep_alive(&addr)?;
     // Optional short sweep so that reports compute K_SL from a stored curve.
     let mut curve_text = "none (reports answer `missing_curve`)".to_string();
     if curve {
@@ -117,7 +118,7 @@ async fn load_async(
             "config": "launcher-design", "points": 3,
             "overrides": {"simulation": {"settle_s": 0.1, "duration_s": 0.1, "record_interval_s": 0.01}}}})
         .to_string();
-        let (st, b) = call(&mut conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
+        let (st, b) = call(&conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
         let id = json_body(&b)
             .get("id")
             .and_then(Value::as_str)
@@ -128,7 +129,7 @@ async fn load_async(
                 loop {
                     tokio::time::sleep(Duration::from_millis(500)).await;
                     let (_, b) =
-                        call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
+                        call(&conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
                     let status = json_body(&b)
                         .get("status")
                         .and_then(Value::as_str)
@@ -163,11 +164,11 @@ async fn load_async(
     let mut tasks = Vec::new();
     for _ in 0..concurrency.min(16) {
         let next = next.clone();
-        let addr = addr.clone();
         let planner = planner.clone();
         let offsets = offsets.clone();
+        // One client per task: its one kept connection.
+        let c = Client::keep_alive(&addr)?;
         tasks.push(tokio::spawn(async move {
-            let mut c = Conn::new(&addr);
             let mut failures = 0usize;
             loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
@@ -184,7 +185,7 @@ async fn load_async(
                 })
                 .to_string();
                 match call(
-                    &mut c,
+                    &c,
                     "POST",
                     &format!("/v1/rails/R-{i:05}/measurements"),
                     &planner,
@@ -213,7 +214,7 @@ async fn load_async(
         let body = json!({"kind": "simulate", "params": {"config": "rattle-box-c", "seed": seed,
             "overrides": {"simulation": {"settle_s": 1.0, "duration_s": 3600.0}}}})
         .to_string();
-        let (st, b) = call(&mut conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
+        let (st, b) = call(&conn, "POST", "/v1/jobs", &engineer, Some(&body)).await?;
         match json_body(&b).get("id").and_then(Value::as_str) {
             Some(id) if st < 300 => job_ids.push(id.to_string()),
             _ => notes.push(format!(
@@ -228,7 +229,7 @@ async fn load_async(
     while t_wait.elapsed() < Duration::from_secs(30) {
         running = 0;
         for id in &job_ids {
-            let (_, b) = call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
+            let (_, b) = call(&conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
             if json_body(&b).get("status").and_then(Value::as_str) == Some("running") {
                 running += 1;
             }
@@ -239,7 +240,7 @@ async fn load_async(
         tokio::time::sleep(Duration::from_millis(200)).await;
     }
     // A sample report.
-    let (st, b) = call(&mut conn, "GET", "/v1/rails/R-00000/report", &planner, None).await?;
+    let (st, b) = call(&conn, "GET", "/v1/rails/R-00000/report", &planner, None).await?;
     let sample = json_body(&b);
     let report_kind = if st != 200 {
         format!("status {st}")
@@ -254,10 +255,10 @@ async fn load_async(
     let t_load = Instant::now();
     let mut tasks = Vec::new();
     for k in 0..concurrency {
-        let addr = addr.clone();
         let planner = planner.clone();
+        // One client per task: its one kept connection.
+        let c = Client::keep_alive(&addr)?;
         tasks.push(tokio::spawn(async move {
-            let mut c = Conn::new(&addr);
             let mut lat_us: Vec<u64> = Vec::with_capacity(4096);
             let mut non_ok = 0usize;
             let mut errors = 0usize;
@@ -269,7 +270,7 @@ async fn load_async(
                 let i = (x % rails as u64) as usize;
                 let t = Instant::now();
                 match call(
-                    &mut c,
+                    &c,
                     "GET",
                     &format!("/v1/rails/R-{i:05}/report"),
                     &planner,
@@ -303,12 +304,12 @@ async fn load_async(
     // Still running? Then cancel.
     let mut still = 0;
     for id in &job_ids {
-        let (_, b) = call(&mut conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
+        let (_, b) = call(&conn, "GET", &format!("/v1/jobs/{id}"), &engineer, None).await?;
         if json_body(&b).get("status").and_then(Value::as_str) == Some("running") {
             still += 1;
         }
         let _ = call(
-            &mut conn,
+            &conn,
             "POST",
             &format!("/v1/jobs/{id}/cancel"),
             &engineer,
@@ -350,7 +351,7 @@ async fn load_async(
          simulations are rattle box C jobs (3600 s windows, cancelled after the load); report content: {report_kind}; curve: {curve_text}"
     ));
     t.note(
-        "client: raw HTTP/1.1 keep-alive on tokio in this process, one connection per task, \
+        "client: reqwest (HTTP/1.1 keep-alive) on tokio in this process, one connection per task, \
          random serials; client, server and both simulations share the same cores",
     );
     for n in notes {

@@ -59,7 +59,7 @@ pub(crate) fn sweep_procs(
         .build()?;
     // A database created beside the admin connection's, dropped at the end (testkit).
     let db = rt
-        .block_on(railwear::testkit::ThrowawayDb::create(
+        .block_on(railwear_testkit::ThrowawayDb::create(
             admin_url,
             "railwear_bench",
         ))
