@@ -348,6 +348,31 @@ fn settled_launcher(t: f64) -> (Vec<f64>, f64) {
     (run.state, e)
 }
 
+/// The settled launcher `rest` with its missile (body 0) shifted within its clearances
+/// (0.2 mm along the rail, 0.1 mm across), turned by under a milliradian (5 mrad about the
+/// rail) and moving (0.02 m/s, 0.2 rad/s); the latch as settled.
+pub(crate) fn random_missile_state(rest: &[f64], rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let mut y = rest.to_vec();
+    y[0] += rng.gen_range(-2e-4..2e-4);
+    y[1] += rng.gen_range(-1e-4..1e-4);
+    y[2] += rng.gen_range(-1e-4..1e-4);
+    let turn = UnitQuaternion::from_euler_angles(
+        rng.gen_range(-5e-4..5e-4),
+        rng.gen_range(-5e-4..5e-4),
+        rng.gen_range(-5e-3..5e-3),
+    );
+    let q =
+        turn * UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[3], y[4], y[5], y[6]));
+    y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+    for v in y[7..10].iter_mut() {
+        *v = rng.gen_range(-0.02..0.02);
+    }
+    for w in y[10..13].iter_mut() {
+        *w = rng.gen_range(-0.2..0.2);
+    }
+    y
+}
+
 #[test]
 fn a_hundred_random_missile_states_never_gain_energy() {
     let (sys, _, settings) = still_launcher();
@@ -357,24 +382,7 @@ fn a_hundred_random_missile_states_never_gain_energy() {
     for _ in 0..100 {
         // Missile (body 0): shifted within its clearances, turned by under a milliradian,
         // moving; the latch as settled.
-        let mut y = rest.clone();
-        y[0] += rng.gen_range(-2e-4..2e-4);
-        y[1] += rng.gen_range(-1e-4..1e-4);
-        y[2] += rng.gen_range(-1e-4..1e-4);
-        let turn = UnitQuaternion::from_euler_angles(
-            rng.gen_range(-5e-4..5e-4),
-            rng.gen_range(-5e-4..5e-4),
-            rng.gen_range(-5e-3..5e-3),
-        );
-        let q = turn
-            * UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[3], y[4], y[5], y[6]));
-        y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
-        for v in y[7..10].iter_mut() {
-            *v = rng.gen_range(-0.02..0.02);
-        }
-        for w in y[10..13].iter_mut() {
-            *w = rng.gen_range(-0.2..0.2);
-        }
+        let y = random_missile_state(&rest, &mut rng);
         let mut ws = sys.workspace();
         let available = sys.energy(0.0, &y, &mut ws).total() - rest_energy;
         let run = energy_run(&sys, &y, settings, 0.01).expect("runs");

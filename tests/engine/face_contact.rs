@@ -5,6 +5,7 @@
 //! differences, and the launcher's pressure resultants against a 33-point lattice.
 //! Every bound is fixed by physics (closed forms, conservation), not by the code's output.
 
+use super::energy_passivity::random_missile_state;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use railwear::geometry::{
     ConvexShape, FaceExtent, FacePatch, HalfSpace, PlacedFace, QuadratureOrder,
@@ -541,24 +542,7 @@ fn random_missile_states_never_gain_energy_with_the_exact_face_contact() {
     let rest_energy = sys.energy(0.0, &rest, &mut ws).total();
     let mut rng = ChaCha8Rng::seed_from_u64(127);
     for _ in 0..20 {
-        let mut y = rest.clone();
-        y[0] += rng.gen_range(-2e-4..2e-4);
-        y[1] += rng.gen_range(-1e-4..1e-4);
-        y[2] += rng.gen_range(-1e-4..1e-4);
-        let turn = UnitQuaternion::from_euler_angles(
-            rng.gen_range(-5e-4..5e-4),
-            rng.gen_range(-5e-4..5e-4),
-            rng.gen_range(-5e-3..5e-3),
-        );
-        let q = turn
-            * UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[3], y[4], y[5], y[6]));
-        y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
-        for v in y[7..10].iter_mut() {
-            *v = rng.gen_range(-0.02..0.02);
-        }
-        for w in y[10..13].iter_mut() {
-            *w = rng.gen_range(-0.2..0.2);
-        }
+        let y = random_missile_state(&rest, &mut rng);
         let available = sys.energy(0.0, &y, &mut ws).total() - rest_energy;
         let run = energy_run(sys, &y, settings, 0.01).expect("runs");
         let a = &run.audit;
