@@ -291,11 +291,10 @@ impl TrackRecord {
         terms: &[&dyn WearTerm],
         history: SlipHistory,
     ) -> Result<Vec<f64>, GapError> {
-        if matches!(law, WearLaw::LegacyAppendix { .. }) && !terms.is_empty() {
+        if !law.gives_k_of_sigma() && !terms.is_empty() {
             return Err(GapError::field(
                 "wear.law",
-                "wear-law effects need a K(sigma) law (archard or modified); the legacy \
-                 appendix law feeds N, not sigma",
+                crate::wear::law::TERMS_NEED_K_OF_SIGMA,
             ));
         }
         // Slip accumulated by each step, for terms that depend on it.

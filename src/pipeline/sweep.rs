@@ -262,14 +262,7 @@ impl SweepPlan {
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
             match (&diagnosed, case.launcher.as_ref()) {
                 (Some(d), Some(launcher)) => {
-                    if matches!(case.wear.law, crate::wear::WearLaw::LegacyAppendix { .. }) {
-                        return Err(FieldError::new(
-                            "wear_law",
-                            "a diagnosed mechanism needs a K(sigma) law; the config's is the \
-                             legacy appendix law",
-                        )
-                        .into());
-                    }
+                    // A legacy law is refused by the case's own rule (`wear.mechanism`).
                     case.wear.mechanism = Some(d.mechanism(launcher.material.hardness_pa())?);
                     Ok(())
                 }

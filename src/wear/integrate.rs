@@ -127,7 +127,7 @@ struct Point {
 /// Integrates one contact track sample by sample (serializable: part of a run's checkpoint).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct WearAccumulator {
-    #[serde(with = "law_as_json")]
+    #[serde(with = "as_json_text")]
     law: WearLaw,
     quadrature: Quadrature,
     cutoff_pressure_pa: f64,
@@ -139,7 +139,7 @@ pub struct WearAccumulator {
 /// A wear mechanism carried by the accumulator, with what it needs between samples.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct MechanismState {
-    #[serde(with = "mechanism_as_json")]
+    #[serde(with = "as_json_text")]
     mechanism: WearMechanism,
     /// Yield strength of the softer body, Pa (severe wear's threshold).
     yield_strength_pa: f64,
@@ -162,32 +162,21 @@ pub struct TrackLoad {
     pub penetration_rate_m_s: f64,
 }
 
-/// The law as its JSON text inside a checkpoint: [`WearLaw`] is an internally tagged enum,
-/// which only self-describing formats read back (the checkpoint's bincode is not).
-mod law_as_json {
-    use super::WearLaw;
-    use serde::{de::Error as _, ser::Error as _, Deserialize, Deserializer, Serializer};
+/// A tagged enum (the law, the mechanism) as its JSON text inside a checkpoint: internally
+/// tagged enums are read back only by self-describing formats, and the checkpoint's bincode
+/// is not.
+mod as_json_text {
+    use serde::de::{DeserializeOwned, Error as _};
+    use serde::ser::Error as _;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-    pub fn serialize<S: Serializer>(law: &WearLaw, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&serde_json::to_string(law).map_err(S::Error::custom)?)
+    pub fn serialize<T: Serialize, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(value).map_err(S::Error::custom)?)
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WearLaw, D::Error> {
-        let text = String::deserialize(d)?;
-        serde_json::from_str(&text).map_err(D::Error::custom)
-    }
-}
-
-/// The mechanism as its JSON text inside a checkpoint (tagged enum; see `law_as_json`).
-mod mechanism_as_json {
-    use super::WearMechanism;
-    use serde::{de::Error as _, ser::Error as _, Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(m: &WearMechanism, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&serde_json::to_string(m).map_err(S::Error::custom)?)
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<WearMechanism, D::Error> {
+    pub fn deserialize<'de, T: DeserializeOwned, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<T, D::Error> {
         let text = String::deserialize(d)?;
         serde_json::from_str(&text).map_err(D::Error::custom)
     }
@@ -221,13 +210,8 @@ impl WearAccumulator {
         yield_strength_pa: f64,
     ) -> Result<Self, WearError> {
         mechanism.validate()?;
-        if matches!(law, WearLaw::LegacyAppendix { .. }) {
-            return Err(FieldError::new(
-                "mechanism",
-                "needs a K(sigma) law (archard or modified); the legacy appendix law feeds N, \
-                 not sigma",
-            )
-            .into());
+        if !law.gives_k_of_sigma() {
+            return Err(FieldError::new("mechanism", super::law::TERMS_NEED_K_OF_SIGMA).into());
         }
         if !(yield_strength_pa.is_finite() && yield_strength_pa > 0.0) {
             return Err(FieldError::new("yield_strength_pa", "must be a finite number > 0").into());

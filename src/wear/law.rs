@@ -12,6 +12,11 @@ pub const TABLE_4_3_C2: f64 = 6.3197;
 /// Table 4.3, C3, m²/N.
 pub const TABLE_4_3_C3: f64 = -9.5089e-16;
 
+/// Why a law without K(sigma) refuses wear mechanisms and wear-law effects
+/// ([`WearLaw::gives_k_of_sigma`]).
+pub const TERMS_NEED_K_OF_SIGMA: &str = "wear mechanisms and wear-law effects need a K(sigma) \
+     law (archard or modified); the legacy appendix law feeds N, not sigma";
+
 /// How a track's rate samples are integrated over time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -142,6 +147,12 @@ impl WearLaw {
             }
         }
         Ok(())
+    }
+
+    /// Whether the law gives K(sigma), which wear mechanisms and wear-law effects act on (the
+    /// legacy appendix law feeds N instead: [`TERMS_NEED_K_OF_SIGMA`]).
+    pub fn gives_k_of_sigma(&self) -> bool {
+        !matches!(self, Self::LegacyAppendix { .. })
     }
 
     /// The quadrature this law is integrated with: the legacy law keeps the appendix' rule.

@@ -259,11 +259,10 @@ impl CaseSpec {
                 .map_err(|crate::wear::WearError::Invalid(e)| {
                     FieldError::new(format!("wear.mechanism.{}", e.field), e.rule)
                 })?;
-            if matches!(self.wear.law, crate::wear::WearLaw::LegacyAppendix { .. }) {
+            if !self.wear.law.gives_k_of_sigma() {
                 return Err(FieldError::new(
                     "wear.mechanism",
-                    "needs a K(sigma) law (archard or modified); the legacy appendix law feeds \
-                     N, not sigma",
+                    crate::wear::law::TERMS_NEED_K_OF_SIGMA,
                 ));
             }
         }
