@@ -195,6 +195,10 @@ enum Command {
         /// Simulation threads.
         #[arg(long, default_value_t = 2)]
         threads: usize,
+        /// Keep only the campaigns whose truth names this effect (or `control`); each keeps
+        /// the seed it has in the full draw.
+        #[arg(long)]
+        truth: Option<String>,
         /// Write every outcome as JSON here.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -537,6 +541,7 @@ async fn main() -> Result<()> {
             skeleton,
             window_s,
             threads,
+            truth,
             out,
             emulator_file,
             configs_dir,
@@ -546,6 +551,7 @@ async fn main() -> Result<()> {
                 campaigns: *campaigns,
                 seed: *seed,
                 rig_window_s: *window_s,
+                truth_filter: truth.clone(),
                 ..Default::default()
             };
             options.diagnose.emulator.window_s = *window_s;

@@ -19,7 +19,7 @@ use crate::jobs::{CaseRunner, CurveDefaults, Jobs};
 use crate::store::{self, Store, StoreError};
 use axum::extract::DefaultBodyLimit;
 use axum::http::StatusCode;
-use axum::{middleware, Router};
+use axum::{middleware, Extension, Router};
 use problem::Problem;
 use std::collections::HashMap;
 use std::net::SocketAddr;
@@ -52,7 +52,9 @@ impl Deref for AppState {
 /// `campaign_body_limit_bytes` (accelerometer samples inline). The limits apply when a
 /// handler reads the body, which each does after checking the caller's role, so a caller
 /// without the role gets 403 whatever the body's size (issue 29); no layer refuses a body by
-/// its `Content-Length` before that. Query parameters a route does not document are refused
+/// its `Content-Length` before that. A refused body is read to its end (within bounds) before
+/// the 413 or 415 goes out, so a client that sends before it listens still hears the refusal
+/// ([`problem::json_body_bytes`]). Query parameters a route does not document are refused
 /// before its handler runs ([`query`]).
 pub fn app(state: AppState) -> Router {
     let limit = state.config.body_limit_bytes;
@@ -64,8 +66,12 @@ pub fn app(state: AppState) -> Router {
         .merge(tokens::router())
         .merge(ops::router())
         .merge(openapi::router())
-        .layer(DefaultBodyLimit::max(limit));
-    let campaigns = campaigns::router().layer(DefaultBodyLimit::max(campaign_limit));
+        .layer(DefaultBodyLimit::max(limit))
+        .layer(Extension(problem::RouteBodyLimit(limit)));
+    // DefaultBodyLimit stays for any axum extractor; the JSON readers use RouteBodyLimit.
+    let campaigns = campaigns::router()
+        .layer(DefaultBodyLimit::max(campaign_limit))
+        .layer(Extension(problem::RouteBodyLimit(campaign_limit)));
     Router::new()
         .merge(general)
         .merge(campaigns)

@@ -200,9 +200,52 @@ where
     }
 }
 
+/// The body limit of the route a request is on (`body_limit_bytes` or
+/// `campaign_body_limit_bytes`), set by the router as a request extension; the JSON body readers
+/// take it from there.
+#[derive(Debug, Clone, Copy)]
+pub struct RouteBodyLimit(pub usize);
+
+/// How much of a refused body (over the limit, or not JSON) is still read and thrown away, and
+/// for how long, before the refusal is sent. A client that sends its whole body before reading
+/// the answer (no `Expect: 100-continue`) would otherwise have its connection closed, and often
+/// reset, in mid-send, and lose the 413 or 415 (a server's "lingering close"). Past either bound
+/// the connection is closed as before.
+const REFUSED_BODY_DISCARD_BYTES: usize = 64 * 1024 * 1024;
+const REFUSED_BODY_DISCARD_TIME: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Read and drop what is left of a refused body, within the bounds above.
+async fn discard_refused_body(mut body: axum::body::Body) {
+    use http_body_util::BodyExt;
+    let drain = async {
+        let mut discarded = 0usize;
+        while let Some(Ok(frame)) = body.frame().await {
+            if let Some(data) = frame.data_ref() {
+                discarded += data.len();
+                if discarded > REFUSED_BODY_DISCARD_BYTES {
+                    break;
+                }
+            }
+        }
+    };
+    // Past the time bound the body is dropped unread: the connection closes, as it would have.
+    let _ = tokio::time::timeout(REFUSED_BODY_DISCARD_TIME, drain).await;
+}
+
+fn body_too_large(limit: usize) -> Problem {
+    Problem::new(
+        StatusCode::PAYLOAD_TOO_LARGE,
+        "body-too-large",
+        "Request body too large",
+        format!("the request body exceeds this route's limit of {limit} bytes"),
+    )
+}
+
 /// The bytes of a body sent as JSON (`application/json` or `*+json`, else 415), 413 when over
-/// the route's limit. Not parsed.
-pub async fn json_body_bytes<S: Send + Sync>(req: Request, state: &S) -> Result<Bytes, Problem> {
+/// the route's limit ([`RouteBodyLimit`]; 2 MiB where no route set one). Not parsed. A refused
+/// body is read to its end (within bounds) before the refusal goes out, so the client hears it.
+pub async fn json_body_bytes<S: Send + Sync>(req: Request, _state: &S) -> Result<Bytes, Problem> {
+    use http_body_util::BodyExt;
     let is_json = req
         .headers()
         .get(header::CONTENT_TYPE)
@@ -212,7 +255,18 @@ pub async fn json_body_bytes<S: Send + Sync>(req: Request, state: &S) -> Result<
             mime == "application/json" || mime.ends_with("+json")
         })
         .unwrap_or(false);
+    let limit = req
+        .extensions()
+        .get::<RouteBodyLimit>()
+        .map_or(DEFAULT_BODY_LIMIT_BYTES, |l| l.0);
+    let declared = req
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.trim().parse::<u64>().ok());
+    let mut body = req.into_body();
     if !is_json {
+        discard_refused_body(body).await;
         return Err(Problem::new(
             StatusCode::UNSUPPORTED_MEDIA_TYPE,
             "unsupported-media-type",
@@ -220,20 +274,33 @@ pub async fn json_body_bytes<S: Send + Sync>(req: Request, state: &S) -> Result<
             "send the body as Content-Type: application/json",
         ));
     }
-    Bytes::from_request(req, state).await.map_err(|rejection| {
-        let status = rejection.status();
-        if status == StatusCode::PAYLOAD_TOO_LARGE {
+    if declared.is_some_and(|n| n > limit as u64) {
+        discard_refused_body(body).await;
+        return Err(body_too_large(limit));
+    }
+    let mut bytes = Vec::new();
+    while let Some(frame) = body.frame().await {
+        let frame = frame.map_err(|e| {
             Problem::new(
-                status,
-                "body-too-large",
-                "Request body too large",
-                rejection.body_text(),
+                StatusCode::BAD_REQUEST,
+                "bad-body",
+                "Unreadable body",
+                format!("the request body could not be read: {e}"),
             )
-        } else {
-            Problem::new(status, "bad-body", "Unreadable body", rejection.body_text())
+        })?;
+        if let Some(data) = frame.data_ref() {
+            if bytes.len() + data.len() > limit {
+                discard_refused_body(body).await;
+                return Err(body_too_large(limit));
+            }
+            bytes.extend_from_slice(data);
         }
-    })
+    }
+    Ok(Bytes::from(bytes))
 }
+
+/// The body limit of a route that did not set one: axum's default.
+const DEFAULT_BODY_LIMIT_BYTES: usize = 2 * 1024 * 1024;
 
 /// 400 when `bytes` is not one well-formed JSON value (syntax, truncation, trailing text);
 /// checked without building the value.

@@ -69,6 +69,10 @@ pub struct BenchOptions {
     pub fractions: Vec<f64>,
     /// Pairs drawn per noise level of each kind (dynamics + wear law, dynamics + dynamics).
     pub pairs_per_kind: usize,
+    /// Keep only the campaigns whose truth names this effect (alone or in a pair), or
+    /// `control`: a focused study. Each kept campaign has the seed, records and draw it has in
+    /// the full bench. None: every campaign.
+    pub truth_filter: Option<String>,
     /// Diagnosis options.
     pub diagnose: DiagnoseOptions,
 }
@@ -87,6 +91,7 @@ impl Default for BenchOptions {
             sensor_noise_m_s2: 0.5,
             fractions: vec![0.07, 0.3, 0.8],
             pairs_per_kind: 4,
+            truth_filter: None,
             diagnose: DiagnoseOptions {
                 emulator: EmulatorOptions {
                     window_s: 0.5,
@@ -324,9 +329,13 @@ fn scenarios(
     // Accelerometer records drawn per campaign after the order (so the order is the one
     // earlier benches drew): about half the campaigns weigh only.
     let mut records = ChaCha20Rng::seed_from_u64(o.seed ^ 0xacce1);
+    let named = |truth: &str| {
+        o.truth_filter
+            .as_deref()
+            .is_none_or(|f| truth.split('+').any(|t| t == f))
+    };
     Ok(list
         .into_iter()
-        .take(o.campaigns)
         .enumerate()
         .map(
             |(i, (truth, in_library, effects, magnitude, noise_rel))| Scenario {
@@ -339,6 +348,8 @@ fn scenarios(
                 accelerometers: records.gen_bool(o.records_share),
             },
         )
+        .filter(|s| named(&s.truth))
+        .take(o.campaigns)
         .collect())
 }
 

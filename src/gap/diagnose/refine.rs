@@ -151,7 +151,8 @@ fn refinement_requests(
 
 /// Step 2: when no single effect explains, the [`SECONDARY_CONTENDERS`] best singles that
 /// beat the nominal held out but leave lack-of-fit get their secondary parameters profiled
-/// (variant tables), then the chosen variant is refined at its fitted magnitudes.
+/// (variant tables), then the chosen variant is refined at its fitted magnitudes. Every
+/// wear-law effect with a secondary parameter is profiled as well (no simulation needed).
 fn secondary(
     campaign: &Campaign,
     emulator: &mut Emulator,
@@ -177,11 +178,24 @@ fn secondary(
             .filter(|c| c.spec.first().is_some_and(|s| s.1 != 0.0))
             .collect();
         order.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
-        order
+        let mut leaders: Vec<(usize, usize, f64)> = order
             .iter()
             .take(SECONDARY_CONTENDERS)
             .map(|c| (problem.families[c.families[0]][0], c.spec[0].0, c.spec[0].1))
-            .collect()
+            .collect();
+        // Every wear-law effect with a secondary parameter is profiled too, whatever its
+        // default's fit: a threshold (a breakthrough distance, a pressure ratio) can put the
+        // whole effect outside the campaign at its default and inside at another value, and
+        // its variants cost no simulation (they are evaluated on the recorded windows).
+        for family in &problem.families {
+            let default_table = family[0];
+            let info = emulator.effects[default_table].info;
+            let listed = leaders.iter().any(|l| l.0 == default_table);
+            if info.acts == Acts::WearLaw && info.parameters.len() > 1 && !listed {
+                leaders.push((default_table, default_table, 0.0));
+            }
+        }
+        leaders
     };
     for (default_table, _, m) in &leaders {
         profile_secondary(
