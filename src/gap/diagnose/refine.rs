@@ -25,11 +25,10 @@ use std::path::Path;
 /// Rounds of refinement of the pairs' dynamics members.
 const PAIR_ROUNDS: usize = 2;
 
-/// Values of a secondary parameter in the profile's first pass: five, log-spaced when its
+/// Values of a secondary parameter in the profile's first pass: `n`, log-spaced when its
 /// bounds are positive and span more than a factor 20, evenly spaced otherwise, bounds
 /// included.
-pub fn profile_values(p: &ParameterInfo) -> Vec<f64> {
-    let n = 5;
+pub fn profile_values(p: &ParameterInfo, n: usize) -> Vec<f64> {
     (0..n)
         .map(|i| {
             let t = i as f64 / (n - 1) as f64;
@@ -227,7 +226,7 @@ fn secondary(
 
 /// Profiles each secondary parameter of the effect of `default_table` (fitted magnitude `m`
 /// at the defaults): variants at [`profile_values`], then at the midpoints between the best
-/// value and its neighbours; with two or more secondary parameters, a variant at every best
+/// value and its neighbours (once for a dynamics effect, four times for a wear law); with two or more secondary parameters, a variant at every best
 /// value together.
 #[allow(clippy::too_many_arguments)]
 fn profile_secondary(
@@ -254,12 +253,19 @@ fn profile_secondary(
             .chain([m])
             .collect(),
     };
+    // A wear-law variant costs no simulation, and a threshold (where the extra wear starts)
+    // moves the fit sharply: nine first values and four bisections towards the best, against
+    // five and one for a simulated dynamics variant.
+    let (first, bisections) = match info.acts {
+        Acts::WearLaw => (9, 4),
+        Acts::Dynamics => (5, 1),
+    };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
     for p in &info.parameters[1..] {
-        let mut values = profile_values(p);
+        let mut values = profile_values(p, first);
         let mut tables = Vec::new();
-        for &v in &values {
-            let t = emulator.add_variant(
+        let mut add = |emulator: &mut Emulator, v: f64| {
+            emulator.add_variant(
                 campaign,
                 configs_dir,
                 default_table,
@@ -267,12 +273,18 @@ fn profile_secondary(
                 &magnitudes,
                 control,
                 cache,
-            )?;
-            tables.push(t);
+            )
+        };
+        for &v in &values {
+            tables.push(add(emulator, v)?);
         }
-        let best = best_value(campaign, emulator, options, &tables, p.name);
-        // Second pass: midway to the best value's neighbours.
-        if let Some(i) = values.iter().position(|v| *v == best) {
+        let mut best = best_value(campaign, emulator, options, &tables, p.name);
+        // Further passes: midway to the best value's neighbours among the values tried.
+        for _ in 0..bisections {
+            values.sort_by(f64::total_cmp);
+            let Some(i) = values.iter().position(|v| *v == best) else {
+                break;
+            };
             let mut more = Vec::new();
             if i > 0 {
                 more.push(midpoint(p, values[i - 1], best));
@@ -281,20 +293,11 @@ fn profile_secondary(
                 more.push(midpoint(p, best, values[i + 1]));
             }
             for v in more {
-                let t = emulator.add_variant(
-                    campaign,
-                    configs_dir,
-                    default_table,
-                    BTreeMap::from([(p.name.to_string(), v)]),
-                    &magnitudes,
-                    control,
-                    cache,
-                )?;
-                tables.push(t);
+                tables.push(add(emulator, v)?);
                 values.push(v);
             }
+            best = best_value(campaign, emulator, options, &tables, p.name);
         }
-        let best = best_value(campaign, emulator, options, &tables, p.name);
         bests.insert(p.name.to_string(), best);
     }
     let non_default: BTreeMap<String, f64> = bests
