@@ -34,7 +34,7 @@ pub enum RunError {
     /// Stopped with a checkpoint
     /// ([`RunControl::request_checkpoint`](crate::physics::control::RunControl::request_checkpoint)):
     /// handing its bytes to the same computation again resumes it
-    /// (`report::run_case_from`).
+    /// (`pipeline::run_case_from`).
     #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
     Checkpointed(Box<Checkpoint>),
 }

@@ -388,7 +388,7 @@ pub fn sweep_point_from(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = crate::report::run_case_from(&case, configs_dir, control, resume)?;
+    let (report, _) = super::run::run_case_from(&case, configs_dir, control, resume)?;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()
