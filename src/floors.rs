@@ -136,14 +136,14 @@ fn all_modules(files: &[SourceFile]) -> BTreeSet<Vec<String>> {
     modules
 }
 
-/// The modules a file imports, resolved, each with whether it is a top-level `pub use`.
-fn imports_of(file: &SourceFile, modules: &BTreeSet<Vec<String>>) -> Vec<(Vec<String>, bool)> {
+/// The modules a file imports, resolved.
+fn imports_of(file: &SourceFile, modules: &BTreeSet<Vec<String>>) -> Vec<Vec<String>> {
     file.scan
         .paths
         .iter()
-        .filter_map(|(inline, path, reexport)| {
+        .filter_map(|(inline, path)| {
             let current = [file.module.as_slice(), inline].concat();
-            resolve(&current, &path.segments, modules).map(|target| (target, *reexport))
+            resolve(&current, &path.segments, modules)
         })
         .collect()
 }
@@ -169,7 +169,7 @@ fn import_graph(src: &Path) -> Arrows {
         let Some(from) = file.module.first() else {
             continue;
         };
-        for (target, _) in imports_of(file, &modules) {
+        for target in imports_of(file, &modules) {
             if let Some(to) = target.first().filter(|to| *to != from) {
                 add_arrow(&mut arrows, from, to, &file.rel);
             }
@@ -234,12 +234,7 @@ fn sub_room_graphs(src: &Path) -> BTreeMap<Vec<String>, Arrows> {
                 .get(room.len())
                 .cloned()
                 .unwrap_or_else(|| ROOM_FILE.to_string());
-            // A room's own re-exports are its front door, not what its code depends on.
-            let door = file.room_file && file.module == *room;
-            for (target, reexport) in imports_of(file, &modules) {
-                if door && reexport {
-                    continue;
-                }
+            for target in imports_of(file, &modules) {
                 let Some(rest) = target.strip_prefix(room.as_slice()) else {
                     continue;
                 };
@@ -401,7 +396,7 @@ mod tests {
         modules.insert(vec!["models".into(), "case".into(), "child".into()]);
         let mut paths: Vec<String> = imports_of(&file, &modules)
             .iter()
-            .map(|(p, _)| p.join("::"))
+            .map(|p| p.join("::"))
             .collect();
         paths.sort();
         paths.dedup();

@@ -207,16 +207,18 @@ fn use_tree(toks: &[Token], i: &mut usize) -> Vec<WrittenPath> {
 /// makes public (items and `pub use` re-exports, globs included).
 #[derive(Debug, Default)]
 pub(super) struct FileScan {
-    pub(super) paths: Vec<(Vec<String>, WrittenPath, bool)>,
+    pub(super) paths: Vec<(Vec<String>, WrittenPath)>,
     pub(super) inline_modules: Vec<Vec<String>>,
     pub(super) public_items: BTreeSet<String>,
     pub(super) reexports: Vec<WrittenPath>,
 }
 
+/// The keywords a public item's name follows (`pub fn name`, `pub struct Name`, ...).
 const ITEM_KEYWORDS: &[&str] = &[
     "fn", "struct", "enum", "static", "type", "trait", "mod", "union", "const",
 ];
 
+/// Reads a file's paths, inline modules and public names ([`FileScan`]).
 pub(super) fn scan(source: &str) -> FileScan {
     let toks = tokens(source);
     let mut found = FileScan::default();
@@ -266,7 +268,7 @@ pub(super) fn scan(source: &str) -> FileScan {
                         j += 1;
                         for path in use_tree(&toks, &mut j) {
                             found.reexports.push(path.clone());
-                            found.paths.push((here.clone(), path, inline.is_empty()));
+                            found.paths.push((here.clone(), path));
                         }
                         i = j;
                         continue;
@@ -287,7 +289,7 @@ pub(super) fn scan(source: &str) -> FileScan {
             }
             Token::Ident(_) if toks.get(i + 1) == Some(&Token::PathSep) => {
                 for path in use_tree(&toks, &mut i) {
-                    found.paths.push((here.clone(), path, false));
+                    found.paths.push((here.clone(), path));
                 }
             }
             _ => i += 1,
