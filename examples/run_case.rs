@@ -1,7 +1,6 @@
 //! Development helper: runs a case with overrides and prints per-track friction-power shares.
 use railwear::models::case::load_case;
-use railwear::pipeline::RunControl;
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, RunControl};
 use std::collections::BTreeMap;
 use std::path::Path;
 fn main() {

@@ -3,8 +3,7 @@
 //! (anyhow is allowed here: this is the binary edge.)
 
 use crate::models::case::load_case;
-use crate::pipeline::{Progress, RunControl};
-use crate::report::run_case;
+use crate::pipeline::{run_case, Progress, RunControl};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;

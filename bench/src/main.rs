@@ -17,8 +17,7 @@ use railwear::physics::integrator::{
     ContactPatches, IntegratorKind, IntegratorSettings, NewtonJacobian, Tolerances,
 };
 use railwear::physics::simulate::{simulate, DivergenceLimits, SimError, StepView};
-use railwear::pipeline::{Progress, RunControl, RunError};
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, Progress, RunControl, RunError};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};

@@ -342,7 +342,7 @@ impl CaseRunner for LibraryRunner {
         self.run_from(kind, params, control, None)
     }
 
-    /// Simulate jobs and sweep points checkpoint and resume (`report::run_case_from`);
+    /// Simulate jobs and sweep points checkpoint and resume (`pipeline::run_case_from`);
     /// the other kinds stop as cancelled on a checkpoint request and start over.
     fn run_from(
         &self,
@@ -359,7 +359,7 @@ impl CaseRunner for LibraryRunner {
         match plan {
             JobPlan::Simulate(case) => {
                 let (_, out) =
-                    crate::report::run_case_from(&case, &self.configs_dir, control, checkpoint)?;
+                    crate::pipeline::run_case_from(&case, &self.configs_dir, control, checkpoint)?;
                 Ok(JobOutput {
                     summary: out.summary,
                     tracks: out.tracks,

@@ -357,7 +357,7 @@ impl Jobs {
         &self,
         id: uuid::Uuid,
         attempt: i64,
-        cp: crate::models::checkpoint::Checkpoint,
+        cp: crate::models::outcome::Checkpoint,
     ) -> Option<f64> {
         let t = cp.simulated_time_s;
         let new = NewCheckpoint {

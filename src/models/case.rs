@@ -1,6 +1,6 @@
 //! From a case file to a model ready to run: reads and validates the case, resolves the
-//! excitation (profiles by name), builds the model and maps the run settings. Running it and
-//! packaging the outcome (summary, tracks, plots) is [`crate::report`]'s.
+//! excitation (profiles by name), builds the model and maps the run settings. Running it is
+//! [`super::case_run`]'s, packaging the outcome (summary, tracks, plots) [`crate::report`]'s.
 
 use super::outcome::RunError;
 use super::run::{BuiltModel, ModelRunError, RunOptions};
@@ -33,7 +33,7 @@ impl From<ModelRunError> for RunError {
     fn from(e: ModelRunError) -> Self {
         match e {
             ModelRunError::Sim(SimError::Cancelled { .. }) => RunError::Cancelled,
-            // Only `run_case_from` can keep a checkpoint (it knows the case); elsewhere the
+            // Only `case_run::run_case_model` can keep a checkpoint (it knows the case); elsewhere the
             // request stopped the run like a cancellation.
             ModelRunError::Sim(SimError::Checkpointed(_)) | ModelRunError::Checkpointed(_) => {
                 RunError::Cancelled

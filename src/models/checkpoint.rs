@@ -16,6 +16,7 @@
 //! signal from its seed) and the run options, all from the case.
 
 use super::case::{code_version, resolve_excitation};
+use super::outcome::Checkpoint;
 use super::run::{BuiltModel, ModelCheckpoint};
 use super::spec::CaseSpec;
 use bincode::Options;
@@ -38,27 +39,6 @@ fn codec() -> impl Options {
         .with_fixint_encoding()
         .with_little_endian()
         .with_limit(MAX_DECODED_BYTES)
-}
-
-/// A stored checkpoint: its bytes and where it stands.
-#[derive(Clone, PartialEq)]
-pub struct Checkpoint {
-    /// Simulated time of the run in progress, s.
-    pub simulated_time_s: f64,
-    /// End of that run, s.
-    pub end_time_s: f64,
-    /// The encoded checkpoint.
-    pub bytes: Vec<u8>,
-}
-
-impl std::fmt::Debug for Checkpoint {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Checkpoint")
-            .field("simulated_time_s", &self.simulated_time_s)
-            .field("end_time_s", &self.end_time_s)
-            .field("bytes", &self.bytes.len())
-            .finish()
-    }
 }
 
 /// What a checkpoint must match to be resumed: the code version and the SHA-256 of the case

@@ -2,6 +2,7 @@
 //! multibody system from a config and run it with wear post-processing.
 
 pub mod case;
+pub mod case_run;
 pub mod checkpoint;
 pub mod launcher;
 pub mod motion;

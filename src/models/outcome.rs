@@ -1,6 +1,8 @@
 //! What a case run gives its caller: the packaged [`CaseOutcome`] (summary JSON, track samples,
 //! SVG plots) or why there is none, [`RunError`] (the one error of a model run, from a bad
-//! configuration to a checkpointed stop). `pipeline` re-exports both for the jobs.
+//! configuration to a checkpointed stop, which carries the stopped run's [`Checkpoint`]: its
+//! bytes, encoded and decoded by [`super::checkpoint`]). `pipeline` re-exports both for the
+//! jobs.
 
 use crate::physics::track::TrackSample;
 
@@ -32,9 +34,9 @@ pub enum RunError {
     /// Stopped with a checkpoint
     /// ([`RunControl::request_checkpoint`](crate::physics::control::RunControl::request_checkpoint)):
     /// handing its bytes to the same computation again resumes it
-    /// (`report::run_case_from`).
+    /// (`pipeline::run_case_from`).
     #[error("checkpointed at t = {:.6} s", .0.simulated_time_s)]
-    Checkpointed(Box<super::checkpoint::Checkpoint>),
+    Checkpointed(Box<Checkpoint>),
 }
 
 /// A field error is an invalid configuration (the variant keeps its named fields, which
@@ -44,5 +46,26 @@ impl From<crate::field_error::FieldError> for RunError {
         crate::field_error::FieldError { field, rule }: crate::field_error::FieldError,
     ) -> Self {
         RunError::InvalidConfig { field, rule }
+    }
+}
+
+/// A stored checkpoint: its bytes and where it stands.
+#[derive(Clone, PartialEq)]
+pub struct Checkpoint {
+    /// Simulated time of the run in progress, s.
+    pub simulated_time_s: f64,
+    /// End of that run, s.
+    pub end_time_s: f64,
+    /// The encoded checkpoint.
+    pub bytes: Vec<u8>,
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("simulated_time_s", &self.simulated_time_s)
+            .field("end_time_s", &self.end_time_s)
+            .field("bytes", &self.bytes.len())
+            .finish()
     }
 }

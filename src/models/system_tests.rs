@@ -1,6 +1,7 @@
 //! Tests of the multibody system's contact evaluation (geometry modes, patch reuse, contact
-//! Jacobian, the tracks the integrator leaves) on the reference models: they build rattle box C
-//! and the launcher from `configs/`, so they live above the physics floor.
+//! Jacobian, the tracks the integrator leaves) and of a model run's soundness on the reference
+//! models: they build rattle box C and the launcher from `configs/`, so they live above the
+//! physics floor and above `models::run` (which `models::case` builds for).
 
 use crate::physics::body::BodyKind;
 use crate::physics::contact::{GeometryMode, TrackState};
@@ -339,5 +340,46 @@ fn integrator_leaves_the_tracks_of_the_accepted_state() {
             steps_in_contact += usize::from(!fresh.is_empty());
         }
         assert!(steps_in_contact > 10, "the cube must touch the floor");
+    }
+}
+
+/// Issue 29's case, past the submit-time bounds: rattle box C shaken at 1e308 g. Its base
+/// motion is not finite, so its run must fail naming time, body and contact, not report
+/// zero wear.
+#[test]
+fn a_run_with_a_non_finite_base_motion_fails_with_a_diagnostic() {
+    use super::case::{build, run_options};
+    use super::run::{run_model, ModelRunError};
+    use crate::physics::simulate::SimError;
+    let configs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let mut case = crate::models::spec::tests::load("rattle-box-c.toml");
+    case.simulation.settle_s = 0.01;
+    case.simulation.duration_s = 0.02;
+    case.simulation.record_interval_s = 1e-3;
+    case.excitation["tones"][0]["amplitude_g"] = serde_json::json!(1e308);
+    let model = build(&case, &configs).unwrap();
+    let options = run_options(&case).unwrap();
+    let control = crate::physics::control::RunControl::silent();
+    match run_model(&model, &options, &control) {
+        Err(ModelRunError::Sim(SimError::Diverged {
+            time_s,
+            body,
+            contact,
+            reason,
+            ..
+        })) => {
+            // The excitation starts after the settle; the failure is found within it.
+            assert!(
+                (0.0..=case.simulation.settle_s + case.simulation.duration_s).contains(&time_s),
+                "{time_s}"
+            );
+            assert!(body == "cube" || body == "tube", "{body}");
+            assert!(!contact.is_empty() && !reason.is_empty());
+        }
+        Err(other) => panic!("failed without the diagnostic: {other}"),
+        Ok(report) => panic!(
+            "succeeded with wear {:?} mg",
+            report.bodies.iter().map(|b| b.mass_mg).collect::<Vec<_>>()
+        ),
     }
 }

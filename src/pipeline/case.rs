@@ -1,12 +1,12 @@
 //! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, and the run.
 
+use super::run::run_case;
 use super::{
     check_keys, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError, SIMULATE_KEYS,
 };
 use crate::field_error::FieldError;
 use crate::models::case::load_case;
 use crate::models::spec::CaseSpec;
-use crate::report::run_case;
 use std::path::Path;
 
 /// True when the dotted `path` (`simulation.duration_s`) is set in `value`.

@@ -3,7 +3,8 @@
 //! A job hands a case configuration (JSON, the same schema as the TOML files in `configs/`)
 //! and a [`RunControl`]; it gets back a [`CaseOutcome`] or a [`RunError`].
 //!
-//! One file per job kind's parameters: [`case`] (simulate jobs: params to a validated case),
+//! [`run_case`] runs a case to its packaged outcome ([`run`]). One file per job kind's
+//! parameters: [`case`] (simulate jobs: params to a validated case),
 //! [`sweep_range`] (the rattle-space range a sweep covers), [`sweep`] (the planned sweep, its
 //! points, labels and assembly), [`calibrate`] (calibration data sets). The bounds every parser
 //! applies are in [`limits`], the physical range of every case field in [`bounds`]; the worker and the submit-time validation call the same parsers.
@@ -14,6 +15,7 @@ mod bounds_tests;
 mod calibrate;
 mod case;
 mod diagnosed_wear;
+mod run;
 mod sweep;
 mod sweep_range;
 #[cfg(test)]
@@ -22,6 +24,7 @@ mod tests;
 pub use calibrate::*;
 pub use case::*;
 pub use diagnosed_wear::{DiagnosedWearLaw, SweepWearLaw};
+pub use run::{run_case, run_case_from};
 pub use sweep::*;
 pub use sweep_range::*;
 

@@ -28,19 +28,6 @@ pub struct SweepOutcome {
     pub rate_by_seed_mg_per_h: Vec<Vec<f64>>,
 }
 
-/// Material-condition offsets (mm) of an n-point sweep from tight to loose.
-pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
-    use crate::analysis::rattle_space::{LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM};
-    let n = n.max(2);
-    (0..n)
-        .map(|i| {
-            TIGHT_MATERIAL_CONDITION_MM
-                + (LOOSE_MATERIAL_CONDITION_MM - TIGHT_MATERIAL_CONDITION_MM) * i as f64
-                    / (n - 1) as f64
-        })
-        .collect()
-}
-
 /// Vehicle profile of a sweep when its params name none (the service fills in its own default
 /// from `[report]` before storing a sweep).
 pub const DEFAULT_VEHICLE_PROFILE: &str = "ah64";
@@ -401,7 +388,7 @@ pub fn sweep_point_from(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = crate::report::run_case_from(&case, configs_dir, control, resume)?;
+    let (report, _) = super::run::run_case_from(&case, configs_dir, control, resume)?;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()

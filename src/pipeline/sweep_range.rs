@@ -1,7 +1,20 @@
 //! The rattle-space range of a tolerance sweep and the sweep that covers a given rail.
 
-use super::{check_keys, limits, sweep_offsets_mm, RunError, DEFAULT_SWEEP_SEEDS};
+use super::{check_keys, limits, RunError, DEFAULT_SWEEP_SEEDS};
 use crate::field_error::FieldError;
+
+/// Material-condition offsets (mm) of an n-point sweep from tight to loose.
+pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
+    use crate::analysis::rattle_space::{LOOSE_MATERIAL_CONDITION_MM, TIGHT_MATERIAL_CONDITION_MM};
+    let n = n.max(2);
+    (0..n)
+        .map(|i| {
+            TIGHT_MATERIAL_CONDITION_MM
+                + (LOOSE_MATERIAL_CONDITION_MM - TIGHT_MATERIAL_CONDITION_MM) * i as f64
+                    / (n - 1) as f64
+        })
+        .collect()
+}
 
 /// The rattle-space range, points and seeds of a tolerance sweep, read from its params alone
 /// (no config is loaded: the report reads it from a queued sweep's params to tell whether that

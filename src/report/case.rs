@@ -1,88 +1,36 @@
-//! A case run to its packaged outcome: builds the model ([`crate::models::case`]), runs it
-//! (resuming from a checkpoint when one fits) and writes the summary JSON, the tracks and the
-//! plots ([`super::plots`]).
+//! A finished case run ([`crate::models::case_run`]) packaged into its outcome: the summary
+//! JSON, the tracks and the plots ([`super::plots`]). Running it is the model's; the two are
+//! put together by `pipeline::run_case`.
 
 use super::plots::case_plots;
 use crate::analysis::spectra::welch_psd;
 use crate::analysis::vdv::vibration_dose_value_uniform;
-use crate::models::case::{build, code_version, run_options};
-use crate::models::checkpoint::{self, RunIdentity};
-use crate::models::outcome::{CaseOutcome, RunError};
-use crate::models::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
+use crate::models::case::code_version;
+use crate::models::case_run::CaseRun;
+use crate::models::outcome::CaseOutcome;
+use crate::models::run::{BuiltModel, RunOptions, RunReport};
 use crate::models::spec::{CaseSpec, ModelSpecRef};
-use crate::physics::control::RunControl;
-use crate::physics::simulate::SimError;
 use serde_json::{json, Value};
-use std::path::Path;
 
-/// Builds and runs a case; returns the raw report and the packaged outcome.
-pub fn run_case(
-    case: &CaseSpec,
-    configs_dir: &Path,
-    control: &RunControl,
-) -> Result<(RunReport, CaseOutcome), RunError> {
-    run_case_from(case, configs_dir, control, None)
-}
-
-/// [`run_case`], resuming from `resume` (bytes of a [`RunError::Checkpointed`] of the same
-/// case and code) when it fits; a checkpoint that does not is logged and the run restarts
-/// from t = 0. A checkpoint request ([`RunControl::request_checkpoint`]) ends the run with
-/// [`RunError::Checkpointed`] at its next accepted step.
-pub fn run_case_from(
-    case: &CaseSpec,
-    configs_dir: &Path,
-    control: &RunControl,
-    resume: Option<&[u8]>,
-) -> Result<(RunReport, CaseOutcome), RunError> {
-    let model = build(case, configs_dir)?;
-    let options = run_options(case)?;
-    let identity = RunIdentity::of(case, &model, configs_dir);
-    let resume = resume.and_then(|bytes| match checkpoint::decode(bytes, &identity) {
-        Ok(cp) => {
-            tracing::info!(case = %case.name, time_s = cp.time_s(), "resuming from checkpoint");
-            Some(cp)
-        }
-        Err(reason) => {
-            tracing::warn!(case = %case.name, %reason, "checkpoint not used: the run restarts from t = 0");
-            None
-        }
-    });
-    let mut resumed_from_s = resume.as_ref().map(|cp| cp.time_s());
-    let run = match run_model_from(&model, &options, control, resume) {
-        Err(ModelRunError::Sim(SimError::BadCheckpoint(reason))) => {
-            // Refused before the first step: nothing of it was used.
-            tracing::warn!(case = %case.name, %reason, "checkpoint not used: the run restarts from t = 0");
-            resumed_from_s = None;
-            run_model_from(&model, &options, control, None)
-        }
-        other => other,
-    };
-    let mut report = match run {
-        Ok(report) => report,
-        Err(ModelRunError::Checkpointed(cp)) => {
-            return Err(match checkpoint::encode(&identity, &cp) {
-                Ok(saved) => RunError::Checkpointed(Box::new(saved)),
-                Err(e) => {
-                    tracing::warn!(case = %case.name, error = %e, "stopped without a checkpoint");
-                    RunError::Cancelled
-                }
-            })
-        }
-        Err(e) => return Err(e.into()),
-    };
-    report.resumed_from_s = resumed_from_s;
-    // The track samples move to the outcome (the report's `tracks` is left empty): a long run
-    // holds them once (a 60 s launcher run records ~0.7 million).
+/// A finished case run packaged: its raw report and its outcome. The track samples move to
+/// the outcome (the report's `tracks` is left empty): a long run holds them once (a 60 s
+/// launcher run records ~0.7 million).
+pub fn package_run(case: &CaseSpec, run: CaseRun) -> (RunReport, CaseOutcome) {
+    let CaseRun {
+        model,
+        options,
+        mut report,
+    } = run;
     let tracks = std::mem::take(&mut report.tracks);
     let (summary, plots) = package_parts(case, &model, &options, &report, tracks.len());
-    Ok((
+    (
         report,
         CaseOutcome {
             summary,
             tracks,
             plots,
         },
-    ))
+    )
 }
 
 /// Summary JSON and plots of a finished run.

@@ -3,7 +3,7 @@
 use super::anchor::Anchor;
 use crate::models::case::load_case;
 use crate::physics::control::RunControl;
-use crate::report::run_case;
+use crate::pipeline::run_case;
 use std::path::Path;
 
 /// Thesis Table 5.4 (ADAMS) rattle-box wear rates, mg/h.

@@ -119,7 +119,7 @@ fn a_run_carrying_impact_wear_adds_k_e_times_the_damping_work() {
                 min_normal_speed_m_s: 0.0,
             })
         });
-        railwear::report::run_case(&c, &configs, &RunControl::silent())
+        railwear::pipeline::run_case(&c, &configs, &RunControl::silent())
             .unwrap()
             .0
     };

@@ -105,7 +105,8 @@ fn control_agrees_with_a_plain_simulation_within_the_noise() {
     case.simulation.duration_s = 0.3;
     case.simulation.settle_s = 0.05;
     case.simulation.record_interval_s = 0.3;
-    let (report, _) = railwear::report::run_case(&case, &configs(), &RunControl::silent()).unwrap();
+    let (report, _) =
+        railwear::pipeline::run_case(&case, &configs(), &RunControl::silent()).unwrap();
     let scale = 5400.0 / report.window_s;
     for comp in ["cube", "tube"] {
         let plain = report

@@ -4,8 +4,7 @@
 
 use railwear::analysis::penalization::{PenalizationCurve, SweepPoint};
 use railwear::models::case::load_case;
-use railwear::pipeline::RunControl;
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, RunControl};
 use std::path::Path;
 
 fn rail_rate(variant: &str) -> (f64, f64) {

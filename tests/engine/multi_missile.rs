@@ -8,8 +8,7 @@
 use railwear::models::case::{build, load_case};
 use railwear::models::spec::{CaseSpec, ModelSpecRef};
 use railwear::physics::partition::independent_parts;
-use railwear::pipeline::RunControl;
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, RunControl};
 use std::path::Path;
 
 fn configs() -> &'static Path {

@@ -8,8 +8,7 @@
 
 use railwear::models::case::load_case;
 use railwear::physics::integrator::{ContactPatches, NewtonJacobian};
-use railwear::pipeline::RunControl;
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, RunControl};
 use std::path::Path;
 
 fn rail_rate(newton: NewtonJacobian, patches: ContactPatches) -> f64 {

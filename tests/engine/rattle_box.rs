@@ -3,8 +3,7 @@
 
 use railwear::models::case::load_case;
 use railwear::models::run::RunReport;
-use railwear::pipeline::RunControl;
-use railwear::report::run_case;
+use railwear::pipeline::{run_case, RunControl};
 use railwear::units::STANDARD_GRAVITY;
 use std::path::Path;
 

@@ -3,8 +3,8 @@
 //! compression, the latch spring's installed length and the channel faces of the rail (eq.
 //! 6.1-6.3 through [`LauncherDimensions`]).
 
-use super::spec::{LatchSpec, LauncherSpec, ShoeSpec};
 use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
+use crate::models::spec::launcher::{LatchSpec, LauncherSpec, ShoeSpec};
 use crate::models::spec::{PlanarFace, RoundedBoxSpec};
 use crate::units;
 

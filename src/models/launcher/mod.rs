@@ -16,15 +16,15 @@
 //! - the latch tooth against the floor, roof and chamber walls;
 //! - the mid shoe's front protrusion against the tooth's rear face (a latch half-space).
 //!
-//! What the launcher is ([`LauncherSpec`], the case file's `[launcher]` table) is in `spec.rs`,
-//! the geometry derived from it in `geometry.rs`; how it is built is here.
+//! What the launcher is ([`LauncherSpec`], the case file's `[launcher]` table) is in
+//! `models/spec/launcher.rs`, the geometry derived from it in `geometry.rs`; how it is built is
+//! here.
 
 mod geometry;
-mod spec;
 #[cfg(test)]
 mod tests;
 
-pub use spec::{
+pub use super::spec::launcher::{
     CoilSpringSpec, ConstantForceSpec, LatchJoint, LatchSpec, LauncherContacts, LauncherSpec,
     LeafSpringSpec, MissileSpec, RailSpec, ShoeSpec, MAX_STATIONS,
 };

@@ -1,13 +1,12 @@
 //! Rattle box (thesis chapter 5): a rounded 1 in cube free inside a square tube that the shaker
 //! drives transversely. One contact "cube-tube" with one track per wall the cube touches.
-//! What the box is ([`RattleBoxSpec`], the case file's `[rattle_box]` table) is in `spec.rs`; how
-//! it is built as a multibody system is here.
+//! What the box is ([`RattleBoxSpec`], the case file's `[rattle_box]` table) is in
+//! `models/spec/rattle_box.rs`; how it is built as a multibody system is here.
 
-mod spec;
 #[cfg(test)]
 mod tests;
 
-pub use spec::{RattleBoxSpec, TABLE_5_1_TUBE_SIDES_IN};
+pub use super::spec::rattle_box::{RattleBoxSpec, TABLE_5_1_TUBE_SIDES_IN};
 
 use super::run::BuiltModel;
 use super::spec::CaseSpec;

@@ -138,7 +138,7 @@ pub struct RunReport {
     /// The run's energy account (settle and excitation).
     pub energy: Option<EnergyAudit>,
     /// Simulated time of the checkpoint the run resumed from, s (None: it ran from t = 0).
-    /// Set by `report::run_case_from`; not part of the results.
+    /// Set by `models::case_run::run_case_model`; not part of the results.
     #[serde(default)]
     pub resumed_from_s: Option<f64>,
 }

@@ -1,9 +1,11 @@
 //! What every case shares: the case file itself ([`CaseSpec`]: model kind, name, run control,
 //! the one model table, excitation and wear) and the specs all three models use (contact,
 //! friction and material checks, rounded boxes, planar faces, run control), with the field rules
-//! the models' own specs are validated by. Each model's own spec lives in its folder:
-//! [`crate::models::persistent_contact`] (thesis chapter 4), [`crate::models::rattle_box`]
-//! (chapter 5) and [`crate::models::launcher`] (chapter 6), where it is also built.
+//! the models' own specs are validated by. Each model's own spec is a file here:
+//! [`persistent_contact`] (thesis chapter 4), [`rattle_box`] (chapter 5) and [`launcher`]
+//! (chapter 6); each model is built in its own folder ([`crate::models::launcher`], ...), which
+//! re-exports its spec. What a case is sits below how it is built, so the builders import the
+//! specs and never the other way round.
 //!
 //! Conventions (SPEC 1, thesis 6.2.2): SI unless a field name says otherwise (`_mm`, `_deg`,
 //! `_n_per_mm_e`); y is vertical (up, towards the vehicle), gravity is standard gravity along -y;
@@ -14,10 +16,10 @@
 //! written to mm/s by [`in_mm_per_s`](crate::physics::friction::in_mm_per_s). Values the thesis
 //! does not give are engineering estimates, flagged `estimate` in `docs/models.md`.
 
-use super::launcher::LauncherSpec;
-use super::persistent_contact::PersistentContactSpec;
-use super::rattle_box::RattleBoxSpec;
 use crate::field_error::FieldError;
+use launcher::LauncherSpec;
+use persistent_contact::PersistentContactSpec;
+use rattle_box::RattleBoxSpec;
 use serde::{Deserialize, Serialize};
 
 /// `prefix.name`, or `name` when `prefix` is empty: the dotted path of a field in a case file.
@@ -105,6 +107,9 @@ pub(in crate::models) fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Resu
     Ok(())
 }
 
+pub mod launcher;
+pub mod persistent_contact;
+pub mod rattle_box;
 mod shared;
 #[cfg(test)]
 pub(in crate::models) mod tests;

@@ -1,6 +1,7 @@
 //! Chapter 6: what the launcher is, the case file's `[launcher]` table (its lettered dimensions,
 //! rail, missile, shoes, latch, springs, contacts, friction and stations) and its field and
-//! assembly rules. The geometry derived from it (rail faces, shoe heads) is in `geometry.rs`.
+//! assembly rules. The geometry derived from it (rail faces, shoe heads) is in
+//! `models/launcher/geometry.rs`.
 
 use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
 use crate::field_error::FieldError;
