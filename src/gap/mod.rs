@@ -21,6 +21,7 @@ pub mod effects;
 pub mod point_pressure;
 pub mod rig;
 pub mod rig_effects;
+pub mod track_point;
 pub mod tracks;
 pub mod window;
 

@@ -15,7 +15,7 @@
 //! the bin's width; `a <= 2` for Table 4.3 gives <= 0.11 %), and a pressure threshold is
 //! resolved to the bin's width (4.7 %).
 
-use super::tracks::TrackPoint;
+use super::track_point::TrackPoint;
 use crate::physics::contact::PointLoad;
 
 pub use crate::wear::mechanism::PressureBin;

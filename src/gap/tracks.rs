@@ -11,38 +11,13 @@
 
 use super::point_pressure::push_pressure_bins;
 pub use super::point_pressure::{PressureBin, PRESSURE_BINS_PER_DECADE};
+pub use super::track_point::TrackPoint;
 use super::GapError;
 use crate::physics::contact::PointLoad;
 use crate::physics::simulate::StepView;
 use crate::physics::system::Workspace;
 use crate::wear::law::WearLaw;
 use std::collections::BTreeMap;
-
-/// One active track at one step.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TrackPoint {
-    /// Contact index in the model.
-    pub contact: u32,
-    /// Track index within the contact.
-    pub track: u32,
-    /// Normal force, N.
-    pub normal_force_n: f64,
-    /// Slip speed, m/s.
-    pub slip_speed_m_s: f64,
-    /// Contact area, m² (thesis 2.5).
-    pub area_m2: f64,
-    /// Power dissipated by the IMPACT damping (normal, the impacts), W.
-    pub damping_power_w: f64,
-    /// Power dissipated by friction, W.
-    pub friction_power_w: f64,
-    /// Penetration rate of the deepest point (positive approaching), m/s.
-    pub penetration_rate_m_s: f64,
-    /// The track's point-pressure bins: `bins[first_bin .. first_bin + bin_count]` of the
-    /// record.
-    pub first_bin: u32,
-    /// Number of its point-pressure bins (0 when the points were not recorded).
-    pub bin_count: u32,
-}
 
 use crate::wear::mechanism::volume_rate_with_terms_m3_s;
 pub use crate::wear::mechanism::{WearSample, WearTerm};

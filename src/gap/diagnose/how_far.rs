@@ -8,7 +8,7 @@ use super::*;
 /// fitted without the mass's group.
 pub(super) fn held_out_predictions(
     campaign: &Campaign,
-    problem: &Problem,
+    problem: &FitProblem,
     c: &Candidate,
 ) -> Vec<HeldOutPrediction> {
     let nominal = problem.emulator.predict(&[]);
@@ -42,7 +42,7 @@ pub(super) fn held_out_predictions(
 }
 
 pub(super) fn best_effect(
-    problem: &Problem,
+    problem: &FitProblem,
     c: &Candidate,
     nominal: &Candidate,
     resamples: &[Vec<usize>],
@@ -119,7 +119,7 @@ pub(super) fn best_effect(
 
 /// 95 % profile-likelihood interval of member `i`'s magnitude around the full-data optimum
 /// `spec` (the other member, for a pair, held at its fitted magnitude: a conditional interval).
-fn profile_interval(problem: &Problem, spec: &[(usize, f64)], i: usize) -> [f64; 2] {
+fn profile_interval(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> [f64; 2] {
     let (t, best) = spec[i];
     let nll = |m: f64| {
         let mut s = spec.to_vec();
@@ -162,7 +162,7 @@ fn widen_to_grid(grid: &[f64], [lo, hi]: [f64; 2]) -> [f64; 2] {
 /// the values within [`PROFILE_95`] of the best, spanned. None when the family holds no
 /// variant in that parameter (it was not fitted). Its resolution is the profile's grid.
 fn secondary_interval(
-    problem: &Problem,
+    problem: &FitProblem,
     family: usize,
     spec: &[(usize, f64)],
     i: usize,
@@ -200,7 +200,7 @@ fn secondary_interval(
 /// Why a chosen candidate only partly explains the gap: a magnitude fitted at its physical
 /// bound, or a held-out shrink under [`MIN_EXPLAINED_SHRINK`]. None when neither holds.
 pub(super) fn partly_explained(
-    problem: &Problem,
+    problem: &FitProblem,
     c: &Candidate,
     b: &BestEffect,
 ) -> Option<PartlyExplained> {

@@ -14,7 +14,7 @@
 
 use super::emulator::{PRESSURE_BANDS, SLIP_BANDS};
 use super::noise::{Quantity, CHANNELS};
-use super::{stats, Problem};
+use super::{stats, FitProblem};
 use crate::analysis::spectra::welch_psd;
 use crate::gap::accel::AccelLocation;
 use crate::gap::Campaign;
@@ -175,7 +175,7 @@ fn test_label(campaign: &Campaign, ti: usize) -> String {
 }
 
 /// The residual breakdown of the nominal model.
-pub(super) fn locate(campaign: &Campaign, problem: &Problem) -> Where {
+pub(super) fn locate(campaign: &Campaign, problem: &FitProblem) -> Where {
     let em = problem.emulator;
     let nominal = &em.nominal;
     let ntests = campaign.tests.len();
@@ -371,7 +371,7 @@ fn total_psd(samples: &[[f64; 3]], rate: f64) -> Option<(crate::analysis::spectr
     total.map(|t| (t, segments))
 }
 
-fn frequency_bands(campaign: &Campaign, problem: &Problem) -> Vec<Group> {
+fn frequency_bands(campaign: &Campaign, problem: &FitProblem) -> Vec<Group> {
     let em = problem.emulator;
     let mut out = Vec::new();
     for (ti, test) in campaign.tests.iter().enumerate() {

@@ -123,7 +123,7 @@ impl Default for DiagnoseOptions {
 }
 
 /// The data, noise model and folds of one diagnosis.
-pub struct Problem<'a> {
+pub struct FitProblem<'a> {
     obs: Vec<Observation>,
     noise: NoiseModel,
     emulator: &'a Emulator,
@@ -152,7 +152,7 @@ enum Model {
     Pair(usize, usize),
 }
 
-impl<'a> Problem<'a> {
+impl<'a> FitProblem<'a> {
     fn new(campaign: &Campaign, emulator: &'a Emulator, options: &DiagnoseOptions) -> Self {
         let mut obs = noise::observations(campaign);
         let noise = NoiseModel::estimate(campaign, &mut obs, emulator, options);
@@ -259,7 +259,7 @@ impl<'a> Problem<'a> {
         out
     }
 
-    /// [`Problem::candidates`] of table `e` between the table points either side of its
+    /// [`FitProblem::candidates`] of table `e` between the table points either side of its
     /// point `x`.
     fn candidates_near(&self, e: usize, x: f64) -> Vec<f64> {
         let m = &self.emulator.effects[e].magnitudes;
@@ -662,7 +662,7 @@ pub fn diagnose_with(
     emulator: &Emulator,
     options: &DiagnoseOptions,
 ) -> Result<Report, GapError> {
-    let problem = Problem::new(campaign, emulator, options);
+    let problem = FitProblem::new(campaign, emulator, options);
     if problem.obs.is_empty() {
         return Err(no_measurement());
     }

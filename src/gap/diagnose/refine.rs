@@ -11,7 +11,7 @@
 //!    refined at the magnitudes the pair's fits land on.
 
 use super::{
-    diagnose_with, location, stats, Candidate, DiagnoseOptions, Model, Problem, Report,
+    diagnose_with, location, stats, Candidate, DiagnoseOptions, FitProblem, Model, Report,
     REFINE_CONTENDERS, SECONDARY_CONTENDERS,
 };
 use crate::gap::diagnose::emulator::Emulator;
@@ -96,7 +96,7 @@ pub fn diagnose_refining(
 /// (None otherwise).
 fn singles_if_gap(
     campaign: &Campaign,
-    problem: &Problem,
+    problem: &FitProblem,
     options: &DiagnoseOptions,
 ) -> Option<(Candidate, Vec<Candidate>)> {
     if problem.obs.is_empty() {
@@ -131,7 +131,7 @@ fn refinement_requests(
     emulator: &Emulator,
     options: &DiagnoseOptions,
 ) -> Vec<(usize, f64)> {
-    let problem = Problem::new(campaign, emulator, options);
+    let problem = FitProblem::new(campaign, emulator, options);
     let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
         return Vec::new();
     };
@@ -161,7 +161,7 @@ fn secondary(
     cache: &WindowCache,
 ) -> Result<(), GapError> {
     let leaders: Vec<(usize, usize, f64)> = {
-        let problem = Problem::new(campaign, emulator, options);
+        let problem = FitProblem::new(campaign, emulator, options);
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
         };
@@ -213,7 +213,7 @@ fn secondary(
     }
     // The chosen variants at their fitted magnitudes.
     let requests: Vec<(usize, f64)> = {
-        let problem = Problem::new(campaign, emulator, options);
+        let problem = FitProblem::new(campaign, emulator, options);
         leaders
             .iter()
             .map(|(t, _, _)| problem.family_of(*t))
@@ -264,7 +264,7 @@ fn profile_secondary(
     for p in &info.parameters[1..] {
         let mut values = profile_values(p, first);
         let mut tables = Vec::new();
-        let mut add = |emulator: &mut Emulator, v: f64| {
+        let add = |emulator: &mut Emulator, v: f64| {
             emulator.add_variant(
                 campaign,
                 configs_dir,
@@ -331,7 +331,7 @@ fn best_value(
     tables: &[usize],
     name: &str,
 ) -> f64 {
-    let problem = Problem::new(campaign, emulator, options);
+    let problem = FitProblem::new(campaign, emulator, options);
     tables
         .iter()
         .map(|&t| (t, problem.fit_table(t, &|_| true).1))
@@ -352,7 +352,7 @@ fn exact_pairs(
 ) -> Result<(), GapError> {
     for round in 0..=PAIR_ROUNDS {
         let (models, requests) = {
-            let problem = Problem::new(campaign, emulator, options);
+            let problem = FitProblem::new(campaign, emulator, options);
             let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
                 return Ok(());
             };

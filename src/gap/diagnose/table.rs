@@ -2,7 +2,7 @@
 //! magnitudes, and the table's roughness (how far each point lies from what its neighbours
 //! interpolate).
 
-use super::emulator::TestPredictions;
+use super::prediction::TestPredictions;
 use crate::gap::effects::EffectInfo;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
