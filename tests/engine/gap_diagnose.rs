@@ -354,6 +354,54 @@ fn a_pattern_no_effect_makes_is_not_explained() {
     assert!(test_groups.iter().all(|g| g.mean_residual < 0.0));
 }
 
+#[test]
+fn an_effect_seen_in_one_test_only_is_named_as_unconfirmable() {
+    // A wear-law effect that acts on test T0 alone (a coating worn through only where the
+    // slip is longest): the campaign is drawn from it. Leave-one-test-out has nothing to fit
+    // it on when T0 is held out, so no held-out gain can confirm it, and the verdict stays
+    // not_explained; the summary must say which test carries it and that more such tests
+    // could confirm it.
+    let mut em = emulator();
+    let info = effects::info("coating_breakthrough").unwrap();
+    let max = info.parameters[0].max;
+    let magnitudes: Vec<f64> = (0..41).map(|i| max * i as f64 / 40.0).collect();
+    let only_t0 = |t: usize, k: usize, f: f64| {
+        let mut p = truth(t, k, 0.0, 0.0, 0.0);
+        if t == 0 {
+            for v in p.mass_mg.values_mut() {
+                *v *= 1.0 + 3.0 * f;
+            }
+        }
+        p
+    };
+    let predictions = magnitudes
+        .iter()
+        .map(|m| {
+            (0..TESTS)
+                .map(|t| (0..INCREMENTS).map(|k| only_t0(t, k, m / max)).collect())
+                .collect()
+        })
+        .collect();
+    em.effects.push(EffectTable {
+        info,
+        magnitudes,
+        predictions,
+        simulated: false,
+        parameters: BTreeMap::new(),
+    });
+    let c = campaign(|t, k| only_t0(t, k, 0.5), 11);
+    let r = diagnose_with(&c, &em, &options()).unwrap();
+    assert_eq!(r.verdict, Verdict::NotExplained, "{}", r.summary);
+    assert!(
+        r.summary
+            .contains("coating_breakthrough fits every observation")
+            && r.summary.contains("but T0 carries")
+            && r.summary.contains("more tests like T0 could"),
+        "{}",
+        r.summary
+    );
+}
+
 /// The two-test campaign of the fixture (cases C and D).
 fn small_campaign() -> Campaign {
     let text = include_str!("../fixtures/small-campaign.toml");

@@ -655,6 +655,50 @@ fn no_measurement() -> GapError {
     )
 }
 
+/// Share of a candidate's full-data chi-square reduction that one group must carry for the
+/// effect to count as seen in that group alone.
+const ONE_GROUP_SHARE: f64 = 0.9;
+
+/// For a `not_explained` verdict: the best single effect (by full-data chi-square) that fits
+/// every observation within the noise (lack-of-fit p >= `alpha`) but is not confirmed held
+/// out, when one held-out group carries at least [`ONE_GROUP_SHARE`] of its chi-square
+/// reduction. Such an effect is seen in that group alone, so leaving the group out leaves
+/// nothing to fit it on: the campaign cannot confirm it, and more tests like that group could.
+/// None otherwise.
+fn seen_in_one_group(
+    problem: &FitProblem,
+    singles: &[Candidate],
+    nominal: &Candidate,
+    alpha: f64,
+) -> Option<String> {
+    let c = singles
+        .iter()
+        .filter(|c| c.residual_p >= alpha && !c.explains(nominal))
+        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))?;
+    let reduction = |g: usize| {
+        let only = |h: usize| h == g;
+        problem.totals(&[], &only).r2 - problem.totals(&c.spec, &only).r2
+    };
+    let per_group: Vec<f64> = (0..problem.groups).map(reduction).collect();
+    let total: f64 = per_group.iter().sum();
+    let (g, top) = per_group
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    if !(total > 0.0 && top >= ONE_GROUP_SHARE * total) {
+        return None;
+    }
+    Some(format!(
+        "{} fits every observation within the noise (lack-of-fit p = {:.2}), but {} carries {:.0} % of what it explains, so held out it has nothing to be fitted on: this campaign cannot confirm it; more tests like {} could",
+        problem.name_of(&c.families),
+        c.residual_p,
+        problem.group_labels[g],
+        100.0 * top / total,
+        problem.group_labels[g],
+    ))
+}
+
 /// The diagnosis on an emulator already built for `campaign` (the bench reuses one emulator
 /// for many campaigns drawn on the same tests).
 pub fn diagnose_with(
@@ -814,9 +858,16 @@ pub fn diagnose_with(
         Verdict::PartlyExplained => partly
             .as_ref()
             .map_or_else(String::new, PartlyExplained::sentence),
-        Verdict::NotExplained => format!(
-            "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
-        ),
+        Verdict::NotExplained => {
+            let mut text = format!(
+                "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
+            );
+            if let Some(seen) = seen_in_one_group(&problem, &singles, &nominal, alpha) {
+                text.push_str("; ");
+                text.push_str(&seen);
+            }
+            text
+        }
     };
     Ok(Report {
         campaign: campaign.name.clone(),
