@@ -219,34 +219,27 @@ impl DiagnosePlan {
                 )
             })?;
         let mut options = crate::gap::diagnose::DiagnoseOptions::default();
-        let number =
-            |name: &str, lo: f64, lo_open: bool, hi: f64| -> Result<Option<f64>, RunError> {
-                let Some(value) = map.get(name) else {
-                    return Ok(None);
-                };
-                let bound = if lo_open { "(" } else { "[" };
-                let rule = || format!("must be a number in {bound}{lo}, {hi}] s");
-                let x = value
-                    .as_f64()
-                    .ok_or_else(|| FieldError::new(name, rule()))?;
-                let above = if lo_open { x > lo } else { x >= lo };
-                if !(x.is_finite() && above && x <= hi) {
-                    return Err(FieldError::new(name, rule()).into());
-                }
-                Ok(Some(x))
-            };
-        if let Some(x) = number("window_s", 0.05, false, 600.0)? {
+        // Types here; bounds in the one rule set, `gap::diagnose::check_options`, below.
+        let number = |name: &str| -> Result<Option<f64>, RunError> {
+            map.get(name)
+                .map(|value| {
+                    value
+                        .as_f64()
+                        .ok_or_else(|| FieldError::new(name, "must be a number of seconds").into())
+                })
+                .transpose()
+        };
+        if let Some(x) = number("window_s")? {
             options.emulator.window_s = x;
         }
-        if let Some(x) = number("settle_s", 0.0, false, 600.0)? {
+        if let Some(x) = number("settle_s")? {
             options.emulator.settle_s = x;
         }
         if let Some(value) = map.get("grid_points") {
             let n = value
                 .as_u64()
-                .filter(|n| (2..=12).contains(n))
                 .ok_or_else(|| FieldError::new("grid_points", "must be an integer in 2..=12"))?;
-            options.emulator.grid_points = n as usize;
+            options.emulator.grid_points = usize::try_from(n).unwrap_or(usize::MAX);
         }
         if let Some(value) = map.get("effects") {
             let names: Vec<String> = serde_json::from_value(value.clone())
@@ -270,6 +263,10 @@ impl DiagnosePlan {
             }
             options.emulator.effects = Some(names);
         }
+        crate::gap::diagnose::check_options(&options).map_err(|e| match e {
+            crate::gap::GapError::Field { field, rule } => FieldError::new(field, rule),
+            other => FieldError::new("params", other.to_string()),
+        })?;
         Ok(Self { campaign, options })
     }
 }

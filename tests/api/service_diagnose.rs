@@ -36,6 +36,10 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
         }
         for (bad, field) in [
             (json!({"window_s": 0}), "window_s"),
+            // The service's bounds are the CLI's (one rule set): below one 20 Hz period.
+            (json!({"window_s": 0.04}), "window_s"),
+            (json!({"settle_s": -1.0}), "settle_s"),
+            (json!({"window_s": "long"}), "window_s"),
             (json!({"effects": ["third_body", "gremlins"]}), "effects[1]"),
             (json!({"colour": "red"}), "colour"),
             (json!({"campaign": {}}), "campaign"),

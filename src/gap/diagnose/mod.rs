@@ -585,7 +585,9 @@ pub fn diagnose(
     Ok((report, emulator))
 }
 
-fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
+/// The one set of rules for a diagnosis' options, for the CLI and the service alike; an error
+/// names the option (`window_s`, `grid_points`, ...).
+pub fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
     let rule = GapError::require;
     rule(
         "alpha",
@@ -597,12 +599,13 @@ fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
         (10..=100_000).contains(&o.bootstrap_rounds),
         "must lie in 10..=100000",
     )?;
+    // One period of the thesis' slowest drive (20 Hz) at least.
     rule(
         "window_s",
         o.emulator.window_s.is_finite()
-            && o.emulator.window_s > 0.0
+            && o.emulator.window_s >= 0.05
             && o.emulator.window_s <= 600.0,
-        "must lie in (0, 600] s",
+        "must lie in [0.05, 600] s",
     )?;
     rule(
         "settle_s",
@@ -906,4 +909,25 @@ pub fn diagnose_with(
         partly_explained: partly,
         code_version: crate::models::case::code_version().to_string(),
     })
+}
+
+#[cfg(test)]
+mod option_tests {
+    use super::*;
+
+    #[test]
+    fn options_outside_their_bounds_are_refused_naming_the_option() {
+        assert!(check_options(&DiagnoseOptions::default()).is_ok());
+        let mut o = DiagnoseOptions::default();
+        o.emulator.window_s = 0.04;
+        let e = check_options(&o).unwrap_err();
+        assert_eq!(e.field_path(), Some("window_s"), "{e}");
+        assert!(e.to_string().contains("[0.05, 600] s"), "{e}");
+        let mut o = DiagnoseOptions::default();
+        o.emulator.grid_points = 13;
+        assert_eq!(
+            check_options(&o).unwrap_err().field_path(),
+            Some("grid_points")
+        );
+    }
 }
