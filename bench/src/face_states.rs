@@ -169,7 +169,8 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
         ],
     );
     let count = states.len().max(1) as f64;
-    let pct = |a: f64, r: f64| Cell::text(format!("{:+.3} %", 100.0 * (a - r) / r.abs().max(1e-300)));
+    let pct =
+        |a: f64, r: f64| Cell::text(format!("{:+.3} %", 100.0 * (a - r) / r.abs().max(1e-300)));
     for ci in 0..nc {
         table.row(vec![
             Cell::text(&names[ci]),

@@ -679,7 +679,10 @@ fn the_exact_face_contact_is_the_continuum_integral_at_impact_states() {
         );
     }
     assert!(loaded >= 4, "{loaded} loaded states");
-    assert!(separating >= 2, "states must separate in part: {separating}");
+    assert!(
+        separating >= 2,
+        "states must separate in part: {separating}"
+    );
 }
 
 /// Sum over the states of `|F_lattice − F_exact|` and of `|F_exact|` (force on body a, N) per
@@ -775,14 +778,13 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
     let gaps: Vec<Vec<f64>> = [33, 65, 129]
         .iter()
         .map(|&n| {
-            let gaps: Vec<f64> =
-                lattice_force_gaps(&exact.system, &lattice_at(n), &states, &shoes)
-                    .iter()
-                    .map(|(gap, total)| {
-                        assert!(*total > 0.0, "the shoes must be loaded");
-                        gap / total
-                    })
-                    .collect();
+            let gaps: Vec<f64> = lattice_force_gaps(&exact.system, &lattice_at(n), &states, &shoes)
+                .iter()
+                .map(|(gap, total)| {
+                    assert!(*total > 0.0, "the shoes must be loaded");
+                    gap / total
+                })
+                .collect();
             eprintln!("lattice {n}: Σ|ΔF| / Σ|F| per shoe {gaps:?}");
             gaps
         })
