@@ -300,6 +300,31 @@ impl FacePatch {
         }
     }
 
+    /// The same patch in material coordinates turned so that `u` runs along the gradient of
+    /// `line` (its value then depends on `u` alone): a rule sliced in `u` puts its `along`
+    /// nodes across `line`'s level lines. The turn is a rotation of `ξ` (unit Jacobian), so
+    /// every node keeps its share of the face; unchanged when `line` is constant.
+    pub fn aligned_with(&self, line: &Line) -> Self {
+        let g = (line.beta[0] * line.beta[0] + line.beta[1] * line.beta[1]).sqrt();
+        if g == 0.0 {
+            return *self;
+        }
+        let e1 = [line.beta[0] / g, line.beta[1] / g];
+        let e2 = [-e1[1], e1[0]];
+        let mut out = *self;
+        out.axis_u = self.axis_u * e1[0] + self.axis_v * e1[1];
+        out.axis_v = self.axis_u * e2[0] + self.axis_v * e2[1];
+        let b = self.depth.beta;
+        out.depth.beta = [b[0] * e1[0] + b[1] * e1[1], b[0] * e2[0] + b[1] * e2[1]];
+        for (o, p) in out.verts[..self.len]
+            .iter_mut()
+            .zip(&self.verts[..self.len])
+        {
+            *o = [p[0] * e1[0] + p[1] * e1[1], p[0] * e2[0] + p[1] * e2[1]];
+        }
+        out
+    }
+
     /// The parts of the patch where `line >= 0` and where `line <= 0` (each `None` when of
     /// zero area): together they cover the patch once.
     pub fn split(&self, line: &Line) -> (Option<Self>, Option<Self>) {

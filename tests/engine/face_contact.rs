@@ -695,7 +695,7 @@ fn lattice_force_gaps(
 ) -> Vec<(f64, f64)> {
     let mut sums = vec![(0.0, 0.0); shoes.len()];
     for (t, y) in states {
-        let mut forces = |sys: &MultibodySystem| {
+        let forces = |sys: &MultibodySystem| {
             let mut ws = sys.workspace();
             sys.tracks(*t, y, &mut ws, &mut |_| {});
             shoes
@@ -789,8 +789,7 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
             gaps
         })
         .collect();
-    for k in 0..shoes.len() {
-        let (g33, g65, g129) = (gaps[0][k], gaps[1][k], gaps[2][k]);
+    for (k, ((&g33, &g65), &g129)) in gaps[0].iter().zip(&gaps[1]).zip(&gaps[2]).enumerate() {
         assert!(g65 < g33 && g129 < g65, "shoe {k}: {g33} {g65} {g129}");
         assert!(g129 <= 8.0 / 128.0, "shoe {k}: {g129} above 8/(n − 1)");
     }

@@ -39,10 +39,19 @@ pub enum FaceContact {
 /// integrand has a kink where `w = 0` crosses it on a tilted face.
 const ROUNDED_EDGE_SLICES: usize = 2;
 
-/// The rule on the damping ramp `w < d` of a pressed polygon, where the damping's STEP is a
-/// cycloid in `w`: 5 × 5 Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's
+/// The rule on the separating part of the damping ramp `w < d` of a pressed polygon, where
+/// the damping's STEP is a cycloid in `w` and the clamp may cut it along a curve: 5 × 5 Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's
 /// force, tests/engine/face_contact.rs against the continuum).
 const RAMP_RULE: QuadratureOrder = QuadratureOrder::ROUNDED_EDGE;
+
+/// The rule on the closing part of the damping ramp (`ẇ >= 0`: no clamp), turned so that its
+/// slices run across the ramp ([`FacePatch::aligned_with`] `w`): 5 nodes across, on the
+/// cycloid, and 2 along the ramp, where `w` is constant and the force and torque densities are
+/// affine and quadratic in the position (exact).
+const CLOSING_RAMP_RULE: QuadratureOrder = QuadratureOrder {
+    across: 2,
+    along: 5,
+};
 
 /// The rule on the separating band where the force's clamp `max(0, k w^e + c ẇ)` may cut the
 /// polygon along a curve: 3 × 3 Gauss–Legendre, exact to degree 5 (so for the elastic
@@ -71,8 +80,8 @@ impl Contact {
         fb: &BodyFrame,
         radius: f64,
         normal: &Vector3<f64>,
-    ) -> [Option<(FacePatch, Option<QuadratureOrder>, usize)>; 4] {
-        let mut parts = [None; 4];
+    ) -> [Option<(FacePatch, Option<QuadratureOrder>, usize)>; 5] {
+        let mut parts = [None; 5];
         let mut count = 0;
         let mut push = |part: FacePatch, rule: Option<QuadratureOrder>, slices: usize| {
             parts[count] = Some((part, rule, slices));
@@ -81,15 +90,26 @@ impl Contact {
         if self.impact.max_damping == 0.0 {
             push(*patch, None, 1);
         } else {
+            let rate = patch.affine(|x| {
+                let p = x - normal * radius;
+                -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
+            });
             let (core, ramp) = patch.split(&patch.depth().minus(self.impact.full_damping_depth));
             if let Some(ramp) = ramp {
-                push(ramp, Some(RAMP_RULE), 1);
+                let (closing, opening) = ramp.split(&rate);
+                if let Some(closing) = closing {
+                    // No clamp: along the ramp `w` is constant and the density affine.
+                    push(
+                        closing.aligned_with(&patch.depth()),
+                        Some(CLOSING_RAMP_RULE),
+                        1,
+                    );
+                }
+                if let Some(opening) = opening {
+                    push(opening, Some(RAMP_RULE), 1);
+                }
             }
             if let Some(core) = core {
-                let rate = core.affine(|x| {
-                    let p = x - normal * radius;
-                    -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
-                });
                 let (closing, opening) = core.split(&rate);
                 if let Some(closing) = closing {
                     push(closing, None, 1);
