@@ -27,6 +27,7 @@ use std::time::{Duration, Instant};
 mod budget;
 mod convergence;
 mod engine;
+mod face_states;
 mod faces;
 mod launcher;
 mod load;
@@ -175,6 +176,29 @@ enum Command {
         /// the exact face contact, each at the case tolerance.
         #[arg(long)]
         faces: Option<String>,
+    },
+    /// Issue 27's per-state face study: a case run with the lattice, its states recorded, and
+    /// at each the contacts evaluated with the exact face contact and the lattice at several
+    /// points per edge (normal force, force, torque, friction power, per contact and track).
+    FaceStates {
+        /// Case (config name).
+        #[arg(long, default_value = "launcher-loose")]
+        case: String,
+        /// Lattice points per edge of the recording run.
+        #[arg(long, default_value_t = 9)]
+        record_points: usize,
+        /// Lattice points per edge evaluated at the states (comma list).
+        #[arg(long, default_value = "9,17,33,65")]
+        ladder: String,
+        /// Settle time, s.
+        #[arg(long, default_value_t = 1.0)]
+        settle: f64,
+        /// Excitation window, s.
+        #[arg(long, default_value_t = 2.0)]
+        window: f64,
+        /// Interval between recorded states, s.
+        #[arg(long, default_value_t = 0.01)]
+        every: f64,
     },
     /// Cost per missile of a launcher with 1, 2 and 4 missiles (issue 16).
     Missiles {
@@ -399,6 +423,27 @@ fn main() -> Result<()> {
                 None => convergence(&cli.configs_dir, &bench)?,
             }
         }
+        Command::FaceStates {
+            case,
+            record_points,
+            ladder,
+            settle,
+            window,
+            every,
+        } => face_states::face_states(
+            &cli.configs_dir,
+            &face_states::FaceStatesBench {
+                case: case.clone(),
+                record_points: *record_points,
+                ladder: parse_list(ladder, "--ladder")?
+                    .into_iter()
+                    .map(|n| n as usize)
+                    .collect(),
+                settle: *settle,
+                window: *window,
+                every: *every,
+            },
+        )?,
         Command::Missiles {
             settle,
             window,

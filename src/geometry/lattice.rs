@@ -28,8 +28,12 @@ use nalgebra::Point3;
 /// Nodes per box edge used by the reference models (25 per face, 98 per box).
 pub const DEFAULT_POINTS_PER_EDGE: usize = 5;
 
-/// Smallest and largest accepted nodes per edge.
+/// Smallest and largest accepted nodes per edge (a case's `contact_points_per_edge`).
 pub const POINTS_PER_EDGE_RANGE: (usize, usize) = (2, 33);
+
+/// Largest lattice [`contact_points`] builds: beyond a case's range, for convergence studies
+/// against the exact face contact (issue 27; 129 points per edge is about 99 000 points per box).
+pub const STUDY_POINTS_PER_EDGE_MAX: usize = 129;
 
 /// One contact point of a piece.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,6 +47,7 @@ pub struct ContactPoint {
 }
 
 /// The contact points of `shape` with `points_per_edge` nodes per box edge (clamped to
+/// 2..=[`STUDY_POINTS_PER_EDGE_MAX`]; a case's setting is validated against
 /// [`POINTS_PER_EDGE_RANGE`]; ignored for a sphere).
 ///
 /// The weights assume an inner box with all half extents > 0 (a roundover smaller than every
@@ -58,7 +63,7 @@ pub fn contact_points(shape: &ConvexShape, points_per_edge: usize) -> Vec<Contac
             half_extents,
             roundover,
         } => {
-            let n = points_per_edge.clamp(POINTS_PER_EDGE_RANGE.0, POINTS_PER_EDGE_RANGE.1);
+            let n = points_per_edge.clamp(POINTS_PER_EDGE_RANGE.0, STUDY_POINTS_PER_EDGE_MAX);
             let last = n - 1;
             let inner = half_extents.map(|h| (h - roundover).max(0.0));
             // Node coordinate as an exact fraction of the half extent: t(last − i) = −t(i).

@@ -39,7 +39,100 @@ pub enum FaceContact {
 /// integrand has a kink where `w = 0` crosses it on a tilted face.
 const ROUNDED_EDGE_SLICES: usize = 2;
 
+/// The rule on the separating part of the damping ramp `w < d` of a pressed polygon, where
+/// the damping's STEP is a cycloid in `w` and the clamp may cut it along a curve: 5 × 5 Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's
+/// force, tests/engine/face_contact.rs against the continuum).
+const RAMP_RULE: QuadratureOrder = QuadratureOrder::ROUNDED_EDGE;
+
+/// The rule on the closing part of the damping ramp (`ẇ >= 0`: no clamp), turned so that its
+/// slices run across the ramp ([`FacePatch::aligned_with`] `w`): 5 nodes across, on the
+/// cycloid, and 2 along the ramp, where `w` is constant and the force and torque densities are
+/// affine and quadratic in the position (exact).
+const CLOSING_RAMP_RULE: QuadratureOrder = QuadratureOrder {
+    across: 2,
+    along: 5,
+};
+
+/// The rule on the separating band where the force's clamp `max(0, k w^e + c ẇ)` may cut the
+/// polygon along a curve: 3 × 3 Gauss–Legendre, exact to degree 5 (so for the elastic
+/// densities of `e = 2`).
+const CLAMP_RULE: QuadratureOrder = QuadratureOrder {
+    across: 3,
+    along: 3,
+};
+
 impl Contact {
+    /// The pressed polygon `patch` cut where the per-point normal force
+    /// `max(0, k w^e + c STEP(w, 0, 0, d, 1) ẇ)` changes form, each part with its rule (`None`:
+    /// the patch rule) and slices per vertex interval. `w` and `ẇ` are affine in `ξ` (a rigid
+    /// relative motion), so the cuts are straight: `w = d`, where the STEP ramp ends, and
+    /// `ẇ = 0`. Where `w >= d` and `ẇ >= 0` the density is `k w^e + c ẇ`, a polynomial the patch
+    /// rule integrates exactly (`e = 2`); the ramp (a cycloid in `w`) gets [`RAMP_RULE`] and
+    /// the separating part (where `k w^e + c ẇ` may cross zero along a curve) [`CLAMP_RULE`],
+    /// except where
+    /// `ẇ <= −k w_max^e / c`: there every node is clamped to zero force and the patch rule
+    /// integrates the stored energy exactly. Every part's rule is exact for the elastic densities, so the
+    /// stored energy and its gradient are the patch's exact integrals whatever the cuts.
+    fn damping_parts(
+        &self,
+        patch: &FacePatch,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        radius: f64,
+        normal: &Vector3<f64>,
+    ) -> [Option<(FacePatch, Option<QuadratureOrder>, usize)>; 5] {
+        let mut parts = [None; 5];
+        let mut count = 0;
+        let mut push = |part: FacePatch, rule: Option<QuadratureOrder>, slices: usize| {
+            parts[count] = Some((part, rule, slices));
+            count += 1;
+        };
+        if self.impact.max_damping == 0.0 {
+            push(*patch, None, 1);
+        } else {
+            let rate = patch.affine(|x| {
+                let p = x - normal * radius;
+                -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
+            });
+            let (core, ramp) = patch.split(&patch.depth().minus(self.impact.full_damping_depth));
+            if let Some(ramp) = ramp {
+                let (closing, opening) = ramp.split(&rate);
+                if let Some(closing) = closing {
+                    // No clamp: along the ramp `w` is constant and the density affine.
+                    push(
+                        closing.aligned_with(&patch.depth()),
+                        Some(CLOSING_RAMP_RULE),
+                        1,
+                    );
+                }
+                if let Some(opening) = opening {
+                    push(opening, Some(RAMP_RULE), 1);
+                }
+            }
+            if let Some(core) = core {
+                let (closing, opening) = core.split(&rate);
+                if let Some(closing) = closing {
+                    push(closing, None, 1);
+                }
+                if let Some(opening) = opening {
+                    // Where ẇ <= −k w_max^e / c the force is clamped to zero at every node
+                    // (w <= w_max on the part): only the stored energy, a polynomial, is left,
+                    // for the patch rule. The clamp's curve lies in the band between.
+                    let (w_max, _) = opening.deepest();
+                    let dead = -self.impact.elastic_force(w_max) / self.impact.max_damping;
+                    let (band, clamped) = opening.split(&rate.minus(dead));
+                    if let Some(band) = band {
+                        push(band, Some(CLAMP_RULE), 1);
+                    }
+                    if let Some(clamped) = clamped {
+                        push(clamped, None, 1);
+                    }
+                }
+            }
+        }
+        parts
+    }
+
     /// Evaluates the six faces of the inner box `inner` (half extents, m) of a rounded box of
     /// roundover `radius` placed by `pose` against `face`, into `out`.
     #[allow(clippy::too_many_arguments)]
@@ -63,10 +156,15 @@ impl Contact {
                 if deepest.is_none_or(|best| d.0 > best.0) {
                     deepest = Some(d);
                 }
-                patch.for_each_node(order, &mut |x, share| {
+                let mut visit = |x: Point3<f64>, share: f64| {
                     let distance = normal.dot(&x.coords) - offset;
                     self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
-                });
+                };
+                let parts = self.damping_parts(&patch, fa, fb, radius, &normal);
+                for (part, rule, slices) in parts.into_iter().flatten() {
+                    let order = rule.unwrap_or(order);
+                    part.for_each_node_sliced(order, slices, &mut visit);
+                }
             }
             if !face.is_bounded() {
                 continue;
