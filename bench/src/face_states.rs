@@ -7,7 +7,7 @@
 //! at the states the dynamics visits, and which track makes a difference.
 
 use super::*;
-use railwear::models::run::run_model_observed;
+use railwear::models::run::record_states;
 use railwear::physics::contact::{FaceContact, TrackState};
 use railwear::physics::system::MultibodySystem;
 
@@ -71,17 +71,9 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
         Ok(model)
     };
     let recorder = model_at(Some(b.record_points))?;
-    let mut options = run_options(&case)?;
-    options.record_interval_s = -1.0;
-    let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
-    let mut next = f64::NEG_INFINITY;
-    run_model_observed(&recorder, &options, &RunControl::silent(), &mut |v| {
-        if v.t >= next {
-            states.push((v.t, v.state.to_vec()));
-            next = v.t + b.every;
-        }
-    })
-    .map_err(|e| anyhow!("{}: {e}", b.case))?;
+    let options = run_options(&case)?;
+    let states = record_states(&recorder, &options, &RunControl::silent(), b.every)
+        .map_err(|e| anyhow!("{}: {e}", b.case))?;
     eprintln!("face-states: {} states recorded", states.len());
     let exact = model_at(None)?;
     let lattices: Vec<(usize, BuiltModel)> = b

@@ -170,6 +170,16 @@ fn stored(contact: &Contact, pose: &Isometry3<f64>) -> f64 {
     evaluate(contact, pose, Vector3::zeros(), Vector3::zeros()).0
 }
 
+/// Height of the head's centre above its lowest point when turned by `rot`: the inner box's
+/// half extents projected on the vertical, plus the roundover.
+fn lowest_point_depth(rot: &UnitQuaternion<f64>) -> f64 {
+    let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
+    (0..3)
+        .map(|k| (HALF[k] - ROUNDOVER) * axis[k].abs())
+        .sum::<f64>()
+        + ROUNDOVER
+}
+
 /// A random pose of the head over the lip's edge, tilted a little, up to `max_w` deep.
 fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
     let rot = UnitQuaternion::from_euler_angles(
@@ -177,13 +187,7 @@ fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
         rng.gen_range(-0.3..0.3),
         rng.gen_range(-0.01..0.01),
     );
-    let lowest: f64 = (0..3)
-        .map(|k| {
-            let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
-            (HALF[k] - ROUNDOVER) * axis[k].abs()
-        })
-        .sum::<f64>()
-        + ROUNDOVER;
+    let lowest = lowest_point_depth(&rot);
     Isometry3::from_parts(
         Translation3::new(
             rng.gen_range(-0.03..0.02),
@@ -631,13 +635,7 @@ fn the_exact_face_contact_is_the_continuum_integral_at_impact_states() {
             rng.gen_range(-0.5..0.5),
             rng.gen_range(-0.004..0.004),
         );
-        let lowest: f64 = (0..3)
-            .map(|k| {
-                let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
-                (HALF[k] - ROUNDOVER) * axis[k].abs()
-            })
-            .sum::<f64>()
-            + ROUNDOVER;
+        let lowest = lowest_point_depth(&rot);
         let pose = Isometry3::from_parts(
             Translation3::new(0.0, lowest - rng.gen_range(5e-5..2e-4), 0.0),
             rot,
@@ -737,23 +735,14 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
     // lattice is therefore not within 0.5 % of the exact contact here (issue 27, item 3):
     // that needs n ≈ 800.
     use railwear::models::case::{build, load_case, run_options};
-    use railwear::models::run::run_model_observed;
+    use railwear::models::run::record_states;
     use railwear::pipeline::RunControl;
     let mut case = load_case(&configs().join("launcher-loose.toml")).expect("case");
     case.simulation.settle_s = 1.0;
     case.simulation.duration_s = 0.5;
     let recorder = build(&case, configs()).expect("model");
-    let mut options = run_options(&case).expect("options");
-    options.record_interval_s = -1.0;
-    let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
-    let mut next = f64::NEG_INFINITY;
-    run_model_observed(&recorder, &options, &RunControl::silent(), &mut |v| {
-        if v.t >= next {
-            states.push((v.t, v.state.to_vec()));
-            next = v.t + 0.025;
-        }
-    })
-    .expect("runs");
+    let options = run_options(&case).expect("options");
+    let states = record_states(&recorder, &options, &RunControl::silent(), 0.025).expect("runs");
     assert!(states.len() >= 19, "{} states", states.len());
     case.simulation.face_contact = FaceContact::Exact;
     let exact = build(&case, configs()).expect("exact");

@@ -362,6 +362,28 @@ pub fn run_model_observed(
         .map_err(|e| e.within_parts(Vec::new()))
 }
 
+/// The states a run of `model` passes through, one per `every_s` of simulated time (the first
+/// accepted step at or after each mark, from the first step on), each with its time, s: for
+/// studies that evaluate contacts at recorded states. No track samples are kept.
+pub fn record_states(
+    model: &BuiltModel,
+    options: &RunOptions,
+    control: &RunControl,
+    every_s: f64,
+) -> Result<Vec<(f64, Vec<f64>)>, ModelRunError> {
+    let mut options = *options;
+    options.record_interval_s = -1.0;
+    let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut next = f64::NEG_INFINITY;
+    run_model_observed(model, &options, control, &mut |v| {
+        if v.t >= next {
+            states.push((v.t, v.state.to_vec()));
+            next = v.t + every_s;
+        }
+    })?;
+    Ok(states)
+}
+
 /// The run of a model integrated as one system (from `resume`, its checkpoint, if given).
 fn run_whole(
     model: &BuiltModel,
