@@ -306,7 +306,7 @@ pub async fn upload_campaign(
     body: axum::extract::Request,
 ) -> Result<Response, Problem> {
     caller.require(Area::Campaigns, &Method::POST)?;
-    let bytes = json_body_bytes(body, &()).await?;
+    let bytes = json_body_bytes(body).await?;
     check_json_syntax(&bytes)?;
     let configs_dir = state.config.configs_dir.clone();
     // Validation builds each test's model: a blocking thread.

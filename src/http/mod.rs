@@ -65,13 +65,9 @@ pub fn app(state: AppState) -> Router {
         .merge(curves::router())
         .merge(tokens::router())
         .merge(ops::router())
-        .merge(openapi::router())
-        .layer(DefaultBodyLimit::max(limit))
-        .layer(Extension(problem::RouteBodyLimit(limit)));
-    // DefaultBodyLimit stays for any axum extractor; the JSON readers use RouteBodyLimit.
-    let campaigns = campaigns::router()
-        .layer(DefaultBodyLimit::max(campaign_limit))
-        .layer(Extension(problem::RouteBodyLimit(campaign_limit)));
+        .merge(openapi::router());
+    let general = with_body_limit(general, limit);
+    let campaigns = with_body_limit(campaigns::router(), campaign_limit);
     Router::new()
         .merge(general)
         .merge(campaigns)
@@ -90,6 +86,14 @@ pub fn app(state: AppState) -> Router {
         .layer(middleware::from_fn(ops::security_headers))
         .layer(TraceLayer::new_for_http())
         .with_state(state)
+}
+
+/// `router`'s body limit, `limit` bytes: for the JSON readers ([`problem::RouteBodyLimit`],
+/// which drain a refused body) and for any axum extractor (`DefaultBodyLimit`).
+fn with_body_limit(router: Router<AppState>, limit: usize) -> Router<AppState> {
+    router
+        .layer(DefaultBodyLimit::max(limit))
+        .layer(Extension(problem::RouteBodyLimit(limit)))
 }
 
 /// Counts each request and its latency per method and matched route (`/metrics`).

@@ -149,8 +149,8 @@ where
 {
     type Rejection = Problem;
 
-    async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
-        let bytes = json_body_bytes(req, state).await?;
+    async fn from_request(req: Request, _state: &S) -> Result<Self, Self::Rejection> {
+        let bytes = json_body_bytes(req).await?;
         let mut deserializer = serde_json::Deserializer::from_slice(&bytes);
         match serde_path_to_error::deserialize(&mut deserializer) {
             Ok(value) => {
@@ -232,19 +232,27 @@ async fn discard_refused_body(mut body: axum::body::Body) {
     let _ = tokio::time::timeout(REFUSED_BODY_DISCARD_TIME, drain).await;
 }
 
-fn body_too_large(limit: usize) -> Problem {
+/// The 413 for a body over a limit, `detail` saying which.
+fn body_too_large(detail: impl Into<String>) -> Problem {
     Problem::new(
         StatusCode::PAYLOAD_TOO_LARGE,
         "body-too-large",
         "Request body too large",
-        format!("the request body exceeds this route's limit of {limit} bytes"),
+        detail,
     )
+}
+
+/// [`body_too_large`] for a route's limit of `limit` bytes.
+fn over_route_limit(limit: usize) -> Problem {
+    body_too_large(format!(
+        "the request body exceeds this route's limit of {limit} bytes"
+    ))
 }
 
 /// The bytes of a body sent as JSON (`application/json` or `*+json`, else 415), 413 when over
 /// the route's limit ([`RouteBodyLimit`]; 2 MiB where no route set one). Not parsed. A refused
 /// body is read to its end (within bounds) before the refusal goes out, so the client hears it.
-pub async fn json_body_bytes<S: Send + Sync>(req: Request, _state: &S) -> Result<Bytes, Problem> {
+pub async fn json_body_bytes(req: Request) -> Result<Bytes, Problem> {
     use http_body_util::BodyExt;
     let is_json = req
         .headers()
@@ -276,7 +284,7 @@ pub async fn json_body_bytes<S: Send + Sync>(req: Request, _state: &S) -> Result
     }
     if declared.is_some_and(|n| n > limit as u64) {
         discard_refused_body(body).await;
-        return Err(body_too_large(limit));
+        return Err(over_route_limit(limit));
     }
     let mut bytes = Vec::new();
     while let Some(frame) = body.frame().await {
@@ -291,7 +299,7 @@ pub async fn json_body_bytes<S: Send + Sync>(req: Request, _state: &S) -> Result
         if let Some(data) = frame.data_ref() {
             if bytes.len() + data.len() > limit {
                 discard_refused_body(body).await;
-                return Err(body_too_large(limit));
+                return Err(over_route_limit(limit));
             }
             bytes.extend_from_slice(data);
         }
@@ -338,13 +346,8 @@ pub async fn problem_for_bare_errors(response: Response) -> Response {
         return response;
     }
     if status == StatusCode::PAYLOAD_TOO_LARGE {
-        return Problem::new(
-            StatusCode::PAYLOAD_TOO_LARGE,
-            "body-too-large",
-            "Request body too large",
-            "the request body exceeds the server's limit (body_limit_bytes)",
-        )
-        .into_response();
+        return body_too_large("the request body exceeds the server's limit (body_limit_bytes)")
+            .into_response();
     }
     let text = match axum::body::to_bytes(response.into_body(), 16 * 1024).await {
         Ok(bytes) => String::from_utf8_lossy(&bytes).trim().to_string(),
