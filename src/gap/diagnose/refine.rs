@@ -160,7 +160,8 @@ fn secondary(
     control: &RunControl,
     cache: &WindowCache,
 ) -> Result<(), GapError> {
-    let leaders: Vec<(usize, usize, f64)> = {
+    // (default table, fitted magnitude at the defaults) of each effect to profile.
+    let leaders: Vec<(usize, f64)> = {
         let problem = FitProblem::new(campaign, emulator, options);
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
@@ -177,10 +178,10 @@ fn secondary(
             .filter(|c| c.spec.first().is_some_and(|s| s.1 != 0.0))
             .collect();
         order.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
-        let mut leaders: Vec<(usize, usize, f64)> = order
+        let mut leaders: Vec<(usize, f64)> = order
             .iter()
             .take(SECONDARY_CONTENDERS)
-            .map(|c| (problem.families[c.families[0]][0], c.spec[0].0, c.spec[0].1))
+            .map(|c| (problem.families[c.families[0]][0], c.spec[0].1))
             .collect();
         // Every wear-law effect with a secondary parameter is profiled too, whatever its
         // default's fit: a threshold (a breakthrough distance, a pressure ratio) can put the
@@ -191,12 +192,12 @@ fn secondary(
             let info = emulator.effects[default_table].info;
             let listed = leaders.iter().any(|l| l.0 == default_table);
             if info.acts == Acts::WearLaw && info.parameters.len() > 1 && !listed {
-                leaders.push((default_table, default_table, 0.0));
+                leaders.push((default_table, 0.0));
             }
         }
         leaders
     };
-    for (default_table, _, m) in &leaders {
+    for (default_table, m) in &leaders {
         profile_secondary(
             campaign,
             emulator,
@@ -216,7 +217,7 @@ fn secondary(
         let problem = FitProblem::new(campaign, emulator, options);
         leaders
             .iter()
-            .map(|(t, _, _)| problem.family_of(*t))
+            .map(|(t, _)| problem.family_of(*t))
             .flat_map(|f| requests_of(emulator, &problem.evaluate(Model::Single(f), options.alpha)))
             .collect()
     };
@@ -226,8 +227,8 @@ fn secondary(
 
 /// Profiles each secondary parameter of the effect of `default_table` (fitted magnitude `m`
 /// at the defaults): variants at [`profile_values`], then at the midpoints between the best
-/// value and its neighbours (once for a dynamics effect, four times for a wear law); with two or more secondary parameters, a variant at every best
-/// value together.
+/// value and its neighbours (once for a dynamics effect, four times for a wear law); with two
+/// or more secondary parameters, a variant at every best value together.
 #[allow(clippy::too_many_arguments)]
 fn profile_secondary(
     campaign: &Campaign,
