@@ -40,8 +40,9 @@ pub enum FaceContact {
 const ROUNDED_EDGE_SLICES: usize = 2;
 
 /// The rule on the separating part of the damping ramp `w < d` of a pressed polygon, where
-/// the damping's STEP is a cycloid in `w` and the clamp may cut it along a curve: 5 × 5 Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's
-/// force, tests/engine/face_contact.rs against the continuum).
+/// the damping's STEP is a cycloid in `w` and the clamp may cut it along a curve: 5 × 5
+/// Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's force,
+/// tests/engine/face_contact.rs against the continuum).
 const RAMP_RULE: QuadratureOrder = QuadratureOrder::ROUNDED_EDGE;
 
 /// The rule on the closing part of the damping ramp (`ẇ >= 0`: no clamp), turned so that its
@@ -64,15 +65,15 @@ const CLAMP_RULE: QuadratureOrder = QuadratureOrder {
 impl Contact {
     /// The pressed polygon `patch` cut where the per-point normal force
     /// `max(0, k w^e + c STEP(w, 0, 0, d, 1) ẇ)` changes form, each part with its rule (`None`:
-    /// the patch rule) and slices per vertex interval. `w` and `ẇ` are affine in `ξ` (a rigid
+    /// the patch rule). `w` and `ẇ` are affine in `ξ` (a rigid
     /// relative motion), so the cuts are straight: `w = d`, where the STEP ramp ends, and
     /// `ẇ = 0`. Where `w >= d` and `ẇ >= 0` the density is `k w^e + c ẇ`, a polynomial the patch
     /// rule integrates exactly (`e = 2`); the ramp (a cycloid in `w`) gets [`RAMP_RULE`] and
     /// the separating part (where `k w^e + c ẇ` may cross zero along a curve) [`CLAMP_RULE`],
-    /// except where
-    /// `ẇ <= −k w_max^e / c`: there every node is clamped to zero force and the patch rule
-    /// integrates the stored energy exactly. Every part's rule is exact for the elastic densities, so the
-    /// stored energy and its gradient are the patch's exact integrals whatever the cuts.
+    /// except where `ẇ <= −k w_max^e / c`: there every node is clamped to zero force and the
+    /// patch rule integrates the stored energy exactly. Every part's rule is exact for the
+    /// elastic densities, so the stored energy and its gradient are the patch's exact integrals
+    /// whatever the cuts.
     fn damping_parts(
         &self,
         patch: &FacePatch,
@@ -80,15 +81,15 @@ impl Contact {
         fb: &BodyFrame,
         radius: f64,
         normal: &Vector3<f64>,
-    ) -> [Option<(FacePatch, Option<QuadratureOrder>, usize)>; 5] {
+    ) -> [Option<(FacePatch, Option<QuadratureOrder>)>; 5] {
         let mut parts = [None; 5];
         let mut count = 0;
-        let mut push = |part: FacePatch, rule: Option<QuadratureOrder>, slices: usize| {
-            parts[count] = Some((part, rule, slices));
+        let mut push = |part: FacePatch, rule: Option<QuadratureOrder>| {
+            parts[count] = Some((part, rule));
             count += 1;
         };
         if self.impact.max_damping == 0.0 {
-            push(*patch, None, 1);
+            push(*patch, None);
         } else {
             let rate = patch.affine(|x| {
                 let p = x - normal * radius;
@@ -102,17 +103,16 @@ impl Contact {
                     push(
                         closing.aligned_with(&patch.depth()),
                         Some(CLOSING_RAMP_RULE),
-                        1,
                     );
                 }
                 if let Some(opening) = opening {
-                    push(opening, Some(RAMP_RULE), 1);
+                    push(opening, Some(RAMP_RULE));
                 }
             }
             if let Some(core) = core {
                 let (closing, opening) = core.split(&rate);
                 if let Some(closing) = closing {
-                    push(closing, None, 1);
+                    push(closing, None);
                 }
                 if let Some(opening) = opening {
                     // Where ẇ <= −k w_max^e / c the force is clamped to zero at every node
@@ -122,10 +122,10 @@ impl Contact {
                     let dead = -self.impact.elastic_force(w_max) / self.impact.max_damping;
                     let (band, clamped) = opening.split(&rate.minus(dead));
                     if let Some(band) = band {
-                        push(band, Some(CLAMP_RULE), 1);
+                        push(band, Some(CLAMP_RULE));
                     }
                     if let Some(clamped) = clamped {
-                        push(clamped, None, 1);
+                        push(clamped, None);
                     }
                 }
             }
@@ -161,9 +161,8 @@ impl Contact {
                     self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
                 };
                 let parts = self.damping_parts(&patch, fa, fb, radius, &normal);
-                for (part, rule, slices) in parts.into_iter().flatten() {
-                    let order = rule.unwrap_or(order);
-                    part.for_each_node_sliced(order, slices, &mut visit);
+                for (part, rule) in parts.into_iter().flatten() {
+                    part.for_each_node(rule.unwrap_or(order), &mut visit);
                 }
             }
             if !face.is_bounded() {
