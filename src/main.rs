@@ -195,8 +195,8 @@ enum Command {
         /// Simulation threads.
         #[arg(long, default_value_t = 2)]
         threads: usize,
-        /// Keep only the campaigns whose truth names this effect (or `control`); each keeps
-        /// the seed it has in the full draw.
+        /// Keep only the campaigns whose truth names this effect, `control`, or `pairs` (every
+        /// pair); each keeps the seed it has in the full draw.
         #[arg(long)]
         truth: Option<String>,
         /// Write every outcome as JSON here.

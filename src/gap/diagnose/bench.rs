@@ -69,8 +69,8 @@ pub struct BenchOptions {
     pub fractions: Vec<f64>,
     /// Pairs drawn per noise level of each kind (dynamics + wear law, dynamics + dynamics).
     pub pairs_per_kind: usize,
-    /// Keep only the campaigns whose truth names this effect (alone or in a pair), or
-    /// `control`: a focused study. Each kept campaign has the seed, records and draw it has in
+    /// Keep only the campaigns whose truth names this effect (alone or in a pair), `control`,
+    /// or `pairs` (every pair): a focused study. Each kept campaign has the seed, records and draw it has in
     /// the full bench. None: every campaign.
     pub truth_filter: Option<String>,
     /// Diagnosis options.
@@ -143,6 +143,11 @@ pub struct Outcome {
     /// A pair's members' detectability, each given the other.
     #[serde(default)]
     pub member_detectability: Vec<f64>,
+    /// Tests in which the effect is detectable on their own observations (a pair: the
+    /// fewest over the pair against the control and each member given the other). Held-out
+    /// tests can confirm an effect only when at least two tests carry it.
+    #[serde(default)]
+    pub detectable_tests: usize,
     /// Verdict.
     pub verdict: Verdict,
     /// Best effect's name, if any.
@@ -182,9 +187,29 @@ pub struct Scores {
     pub detectable_in_library: usize,
     /// Of those, the share whose best effect is the true one.
     pub top1: f64,
+    /// Detectable in-library single effects that two or more tests carry (held-out tests can
+    /// confirm them).
+    #[serde(default)]
+    pub confirmable_in_library: usize,
+    /// Of those, the share whose best effect is the true one.
+    #[serde(default)]
+    pub top1_confirmable: f64,
+    /// Detectable in-library single effects that one test alone carries.
+    #[serde(default)]
+    pub one_test_singles: usize,
+    /// Of those, the share whose leading candidate (`explained` or `partly_explained`) is the
+    /// true effect.
+    #[serde(default)]
+    pub one_test_led_right: f64,
     /// Detectable pairs.
     #[serde(default)]
     pub detectable_pairs: usize,
+    /// Detectable pairs that two or more tests carry (each member given the other).
+    #[serde(default)]
+    pub confirmable_pairs: usize,
+    /// Of those, the share `explained` by exactly their two effects.
+    #[serde(default)]
+    pub confirmable_pairs_both_named: f64,
     /// Of those, the share `explained` by exactly their two effects.
     #[serde(default)]
     pub pairs_both_named: f64,
@@ -332,7 +357,10 @@ fn scenarios(
     let named = |truth: &str| {
         o.truth_filter
             .as_deref()
-            .is_none_or(|f| truth.split('+').any(|t| t == f))
+            .is_none_or(|f| match f {
+                "pairs" => truth.contains('+'),
+                _ => truth.split('+').any(|t| t == f),
+            })
     };
     Ok(list
         .into_iter()
@@ -392,10 +420,36 @@ fn detectability(
     noise: &NoiseModel,
     noisy: &[Observation],
 ) -> f64 {
+    detectability_in(effect, control, noise, noisy, |_| true)
+}
+
+/// Tests (indices below `tests`) in which the effect is detectable on that test's
+/// observations alone ([`detectability`] over them > 2).
+fn detectable_tests(
+    effect: &[Observation],
+    control: &[Observation],
+    noise: &NoiseModel,
+    noisy: &[Observation],
+    tests: usize,
+) -> usize {
+    (0..tests)
+        .filter(|&t| detectability_in(effect, control, noise, noisy, |o| o.test == t) > 2.0)
+        .count()
+}
+
+/// [`detectability`] over the observations `keep` selects.
+fn detectability_in(
+    effect: &[Observation],
+    control: &[Observation],
+    noise: &NoiseModel,
+    noisy: &[Observation],
+    keep: impl Fn(&Observation) -> bool,
+) -> f64 {
     let terms = effect
         .iter()
         .zip(control)
         .zip(noisy)
+        .filter(|(_, o)| keep(o))
         .map(|((e, c), o)| (noise.term(o, c.value, 0.0), e.value - c.value))
         .filter(|(t, _)| t.var > 0.0)
         .map(|(t, d)| Term { residual: d, ..t });
@@ -514,12 +568,15 @@ pub fn run(
         )?;
         let mut member_detectability = Vec::new();
         let control_obs = &control_obs_by_records[usize::from(s.accelerometers)];
+        let tests = skeleton.tests.len();
+        let mut in_tests = 0;
         let det = if s.truth == "control" {
             0.0
         } else {
             let mut noisy_obs = observations(&noisy);
             let noise = NoiseModel::estimate(&noisy, &mut noisy_obs, &emulator, &o.diagnose);
             let clean_obs = observations(&clean);
+            in_tests = detectable_tests(&clean_obs, control_obs, &noise, &noisy_obs, tests);
             if s.effects.len() == 2 {
                 // Each member given the other: the pair against the other member alone.
                 for drop in 0..2 {
@@ -534,11 +591,12 @@ pub fn run(
                         control,
                         &cache,
                     )?;
+                    let alone = observations(&alone);
                     member_detectability.push(detectability(
-                        &clean_obs,
-                        &observations(&alone),
-                        &noise,
-                        &noisy_obs,
+                        &clean_obs, &alone, &noise, &noisy_obs,
+                    ));
+                    in_tests = in_tests.min(detectable_tests(
+                        &clean_obs, &alone, &noise, &noisy_obs, tests,
                     ));
                 }
             }
@@ -563,6 +621,7 @@ pub fn run(
             detectability: det,
             detectable,
             member_detectability,
+            detectable_tests: in_tests,
             verdict: report.verdict,
             shrink: report.best_effect.as_ref().map(|b| b.shrink),
             fitted_magnitude: report
@@ -644,6 +703,17 @@ fn named_right(o: &Outcome) -> bool {
     o.verdict == Verdict::Explained && o.scenario.in_library && truth == chosen
 }
 
+/// Two or more tests carry the effect, so held-out tests can confirm it.
+fn confirmable(o: &Outcome) -> bool {
+    o.detectable && o.detectable_tests >= 2
+}
+
+/// The leading candidate (`explained` or `partly_explained`) is exactly the truth.
+fn led_right(o: &Outcome) -> bool {
+    let led = o.verdict == Verdict::Explained || o.verdict == Verdict::PartlyExplained;
+    led && o.chosen.as_deref() == Some(o.scenario.truth.as_str())
+}
+
 /// A confident name that is not the truth: explained by an effect the rig did not inject.
 fn named_wrong(o: &Outcome) -> bool {
     if o.verdict != Verdict::Explained {
@@ -681,6 +751,9 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .filter(|o| o.scenario.truth.contains('+') && o.detectable)
         .collect();
     let pairs_right = det_pairs.iter().filter(|o| named_right(o)).count();
+    let conf_pairs: Vec<&&&Outcome> = det_pairs.iter().filter(|o| confirmable(o)).collect();
+    let conf: Vec<&&&&Outcome> = det_lib.iter().filter(|o| confirmable(o)).collect();
+    let one_test: Vec<&&&&Outcome> = det_lib.iter().filter(|o| !confirmable(o)).collect();
     let undet: Vec<&&&Outcome> = singles.iter().filter(|o| !o.detectable).collect();
     let controls: Vec<&Outcome> = outcomes
         .iter()
@@ -693,8 +766,10 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
     let wrong = outcomes.iter().filter(|o| named_wrong(o)).count();
     let mut confusion: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
     for o in &outcomes {
-        let row = if o.scenario.truth == "control" || o.detectable {
+        let row = if o.scenario.truth == "control" || confirmable(o) {
             o.scenario.truth.clone()
+        } else if o.detectable {
+            format!("{} (one test)", o.scenario.truth)
         } else {
             format!("{} (undetectable)", o.scenario.truth)
         };
@@ -714,7 +789,16 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         campaigns: outcomes.len(),
         detectable_in_library: det_lib.len(),
         top1: share(right.len(), det_lib.len()),
+        confirmable_in_library: conf.len(),
+        top1_confirmable: share(conf.iter().filter(|o| named_right(o)).count(), conf.len()),
+        one_test_singles: one_test.len(),
+        one_test_led_right: share(one_test.iter().filter(|o| led_right(o)).count(), one_test.len()),
         detectable_pairs: det_pairs.len(),
+        confirmable_pairs: conf_pairs.len(),
+        confirmable_pairs_both_named: share(
+            conf_pairs.iter().filter(|o| named_right(o)).count(),
+            conf_pairs.len(),
+        ),
         pairs_both_named: share(pairs_right, det_pairs.len()),
         wrong_names: wrong,
         wrong_name_rate: share(wrong, outcomes.len()),
@@ -773,6 +857,16 @@ impl Scores {
             pct(self.top1)
         ));
         s.push_str(&format!(
+            "| of them carried by two or more tests, which held-out tests can confirm ({}) | {} | >= 85 % |\n",
+            self.confirmable_in_library,
+            pct(self.top1_confirmable)
+        ));
+        s.push_str(&format!(
+            "| of them carried by one test alone: leading candidate right ({}) | {} | |\n",
+            self.one_test_singles,
+            pct(self.one_test_led_right)
+        ));
+        s.push_str(&format!(
             "| of them weighed only, without accelerometer records ({}) | {} | |\n",
             self.detectable_weighed_only,
             pct(self.top1_weighed_only)
@@ -781,6 +875,11 @@ impl Scores {
             "| detectable pairs explained by both members ({}) | {} | >= 60 % |\n",
             self.detectable_pairs,
             pct(self.pairs_both_named)
+        ));
+        s.push_str(&format!(
+            "| of them carried by two or more tests ({}) | {} | >= 60 % |\n",
+            self.confirmable_pairs,
+            pct(self.confirmable_pairs_both_named)
         ));
         s.push_str(&format!(
             "| wrong names: explained by an effect not injected ({} of {}) | {} | <= 5 % |\n",
@@ -858,6 +957,7 @@ mod tests {
             detectability: 10.0,
             detectable: true,
             member_detectability: Vec::new(),
+            detectable_tests: 4,
             verdict,
             chosen: chosen.map(str::to_string),
             shrink: chosen.map(|_| 0.9),
