@@ -355,12 +355,10 @@ fn scenarios(
     // earlier benches drew): about half the campaigns weigh only.
     let mut records = ChaCha20Rng::seed_from_u64(o.seed ^ 0xacce1);
     let named = |truth: &str| {
-        o.truth_filter
-            .as_deref()
-            .is_none_or(|f| match f {
-                "pairs" => truth.contains('+'),
-                _ => truth.split('+').any(|t| t == f),
-            })
+        o.truth_filter.as_deref().is_none_or(|f| match f {
+            "pairs" => truth.contains('+'),
+            _ => truth.split('+').any(|t| t == f),
+        })
     };
     Ok(list
         .into_iter()
@@ -592,9 +590,8 @@ pub fn run(
                         &cache,
                     )?;
                     let alone = observations(&alone);
-                    member_detectability.push(detectability(
-                        &clean_obs, &alone, &noise, &noisy_obs,
-                    ));
+                    member_detectability
+                        .push(detectability(&clean_obs, &alone, &noise, &noisy_obs));
                     in_tests = in_tests.min(detectable_tests(
                         &clean_obs, &alone, &noise, &noisy_obs, tests,
                     ));
@@ -792,7 +789,10 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         confirmable_in_library: conf.len(),
         top1_confirmable: share(conf.iter().filter(|o| named_right(o)).count(), conf.len()),
         one_test_singles: one_test.len(),
-        one_test_led_right: share(one_test.iter().filter(|o| led_right(o)).count(), one_test.len()),
+        one_test_led_right: share(
+            one_test.iter().filter(|o| led_right(o)).count(),
+            one_test.len(),
+        ),
         detectable_pairs: det_pairs.len(),
         confirmable_pairs: conf_pairs.len(),
         confirmable_pairs_both_named: share(
@@ -1013,5 +1013,27 @@ mod tests {
         assert_eq!(s.wrong_names, 2);
         assert_eq!(s.partly_explained, 1);
         assert_eq!(s.controls_clean, 0.0);
+    }
+
+    /// A single effect one test alone carries counts apart: in the top-1 over every detectable
+    /// single, not in the top-1 over those two or more tests carry, and its leading candidate
+    /// is scored whether the verdict is `explained` or `partly_explained`.
+    #[test]
+    fn an_effect_one_test_carries_is_scored_apart() {
+        let one_test = |verdict, chosen| Outcome {
+            detectable_tests: 1,
+            ..outcome("friction_drift", true, verdict, chosen)
+        };
+        let s = score(vec![
+            outcome("cross_axis", true, Verdict::Explained, Some("cross_axis")),
+            one_test(Verdict::PartlyExplained, Some("friction_drift")),
+            one_test(Verdict::PartlyExplained, Some("fixture_compliance")),
+        ]);
+        assert_eq!(s.detectable_in_library, 3);
+        assert_eq!(s.top1, 1.0 / 3.0);
+        assert_eq!(s.confirmable_in_library, 1);
+        assert_eq!(s.top1_confirmable, 1.0);
+        assert_eq!(s.one_test_singles, 2);
+        assert_eq!(s.one_test_led_right, 0.5);
     }
 }

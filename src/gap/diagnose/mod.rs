@@ -738,7 +738,12 @@ pub fn diagnose_with(
         .copied()
         .filter(|&i| singles[i].explains(&nominal))
         .collect();
-    if !no_gap && explaining_singles.is_empty() {
+    // A single that explains only partly (fitted at a bound, or a small held-out shrink)
+    // leaves room for a second effect: the pairs are tried then too.
+    let clean_single = explaining_singles
+        .iter()
+        .any(|&i| !singles[i].only_partly(&nominal, emulator));
+    if !no_gap && !clean_single {
         pairs = problem
             .pair_models(&singles, &nominal)
             .into_iter()
@@ -803,22 +808,31 @@ pub fn diagnose_with(
 
     let chosen: Option<(&Candidate, Vec<String>)> = if no_gap {
         None
-    } else if let Some(&first) = explaining_singles.first() {
+    } else if let Some(&first) = explaining_singles.first().filter(|&&first| {
+        // A pair that explains cleanly and beats the partial single held out is named
+        // instead.
+        clean_single
+            || !pairs.iter().any(|p| {
+                p.explains(&nominal)
+                    && !p.only_partly(&nominal, emulator)
+                    && p.held_ll() - singles[first].held_ll() > MIN_HELD_OUT_GAIN
+            })
+    }) {
         // When the held-out error the first leaves hardly shrinks because one group carries
         // what it explains, no held-out fit predicts that group and the held-out likelihood
         // ranks the explaining singles by how they mispredict it: they are ranked by their
         // full-data AICc instead (docs/diagnosis.md, "Seen in one test").
         let c = &singles[first];
-        let best = if c.only_partly(&nominal, emulator) && carried_by_one_group(&problem, c).is_some()
-        {
-            explaining_singles
-                .iter()
-                .copied()
-                .min_by(|a, b| singles[*a].aicc.total_cmp(&singles[*b].aicc))
-                .unwrap_or(first)
-        } else {
-            first
-        };
+        let best =
+            if c.only_partly(&nominal, emulator) && carried_by_one_group(&problem, c).is_some() {
+                explaining_singles
+                    .iter()
+                    .copied()
+                    .min_by(|a, b| singles[*a].aicc.total_cmp(&singles[*b].aicc))
+                    .unwrap_or(first)
+            } else {
+                first
+            };
         let b = &singles[best];
         let others = explaining_singles
             .iter()
@@ -830,8 +844,10 @@ pub fn diagnose_with(
             .collect();
         Some((b, others))
     } else {
+        // Beside a partial single, only the pairs that explain cleanly.
         let explaining: Vec<usize> = (0..pairs.len())
             .filter(|&j| pairs[j].explains(&nominal))
+            .filter(|&j| explaining_singles.is_empty() || !pairs[j].only_partly(&nominal, emulator))
             .collect();
         explaining.first().map(|&j| {
             let b = &pairs[j];

@@ -6,9 +6,10 @@
 //!    parameters: each profiled over a few values within its bounds (a variant table per
 //!    value, simulated near the fitted magnitude), then the best value's neighbours, then the
 //!    chosen variant refined at its fitted magnitudes;
-//! 3. when still no single effect explains, the pairs of the best singles: a dynamics effect
-//!    with a wear-law effect made exact ([`Emulator::add_pair`]), and every dynamics member
-//!    refined at the magnitudes the pair's fits land on.
+//! 3. when still no single effect explains cleanly (only partly, or not at all), the pairs
+//!    of the best singles: a dynamics effect with a wear-law effect made exact
+//!    ([`Emulator::add_pair`]), and every dynamics member refined at the magnitudes the
+//!    pair's fits land on.
 
 use super::{
     diagnose_with, location, stats, Candidate, DiagnoseOptions, FitProblem, Model, Report,
@@ -340,9 +341,9 @@ fn best_value(
         .map_or(f64::NAN, |(t, _)| emulator.effects[t].parameter(name))
 }
 
-/// Step 3: when no single effect explains, the pairs of the best singles: each dynamics +
-/// wear-law pair made exact, and the dynamics members of every pair refined at the
-/// magnitudes the pair's fits land on (the exact pairs follow their refined tables).
+/// Step 3: when no single effect explains cleanly, the pairs of the best singles: each
+/// dynamics + wear-law pair made exact, and the dynamics members of every pair refined at
+/// the magnitudes the pair's fits land on (the exact pairs follow their refined tables).
 fn exact_pairs(
     campaign: &Campaign,
     emulator: &mut Emulator,
@@ -357,7 +358,10 @@ fn exact_pairs(
             let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
                 return Ok(());
             };
-            if singles.iter().any(|c| c.explains(&nominal)) {
+            // Pairs are tried beside a single that explains only partly too.
+            let cleanly =
+                |c: &Candidate| c.explains(&nominal) && !c.only_partly(&nominal, emulator);
+            if singles.iter().any(cleanly) {
                 return Ok(());
             }
             let models = problem.pair_models(&singles, &nominal);
