@@ -24,6 +24,14 @@
 //! detectable when each member is, given the other: the pair's noise-free readings differ from
 //! those of the other member alone by more than twice the uncertainty.
 //!
+//! **Carried by one test.** The diagnosis confirms an effect on held-out tests
+//! (leave-one-test-out), so an effect whose readings differ detectably in one test alone has
+//! nothing to be fitted on when that test is held out. The bench counts the tests in which an
+//! effect is detectable on their own observations (`detectable_tests`; a pair: the fewest over
+//! the pair and each member given the other). Top-1 and both-named are reported over every
+//! detectable campaign and over those two or more tests carry; for the singles one test
+//! carries, the share whose leading candidate (`explained` or `partly_explained`) is right.
+//!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
 
