@@ -129,29 +129,28 @@ fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunE
     Ok(())
 }
 
+/// Where a case comes from: a reference config by name (`configs/<name>.toml`) or a whole case
+/// object (the schema of those files, as JSON).
+#[derive(Debug, Clone, Copy)]
+pub enum CaseSource<'a> {
+    /// A reference config's name.
+    Reference(&'a str),
+    /// A case object.
+    Inline(&'a serde_json::Value),
+}
+
 /// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
-/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check). Overrides
-/// deep-merge into the case (e.g. `{"simulation": {"duration_s": 0.5}}`); `seed` sets
-/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
-/// excitation). The case is checked completely: unknown keys anywhere, the model's own rules,
-/// the bounds of [`limits`] and
-/// [`super::bounds`], and the model is built once (excitation, geometry, integrator),
-/// so an accepted job does not fail on its configuration later. Errors name the params path
-/// (`config`, `config.<path>` or `overrides.<path>`).
+/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check), read into
+/// their parts and resolved by [`resolve_config`]. Errors name the params path (`config`,
+/// `config.<path>` or `overrides.<path>`).
 pub fn resolve_case(
     params: &serde_json::Value,
     configs_dir: &Path,
     adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
 ) -> Result<CaseSpec, RunError> {
-    let mut value = match params.get("config") {
-        Some(serde_json::Value::String(name)) => {
-            let path = crate::models::reference::reference_config_path(configs_dir, name)
-                .map_err(|e| FieldError::new("config", e.to_string()))?;
-            // Validated once below, with the overrides merged in.
-            let case = read_case(&path)?;
-            serde_json::to_value(&case).map_err(|e| FieldError::new("config", e.to_string()))?
-        }
-        Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
+    let source = match params.get("config") {
+        Some(serde_json::Value::String(name)) => CaseSource::Reference(name),
+        Some(obj @ serde_json::Value::Object(_)) => CaseSource::Inline(obj),
         Some(_) => {
             return Err(FieldError::new(
                 "config",
@@ -167,15 +166,43 @@ pub fn resolve_case(
             .into())
         }
     };
-    let overrides = params.get("overrides");
+    let seed = params.get("seed").map(parse_seed).transpose()?;
+    resolve_config(source, params.get("overrides"), seed, configs_dir, adjust)
+}
+
+/// A case from its `source` with `overrides` deep-merged into it (e.g.
+/// `{"simulation": {"duration_s": 0.5}}`; must be an object) and `seed` as its
+/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
+/// excitation, a campaign test its rattle space and drive). The case is checked completely:
+/// unknown keys anywhere, the model's own rules (validated once, overrides merged), the
+/// bounds of [`limits`] and [`super::bounds`], and the model is built once (excitation,
+/// geometry, integrator), so an accepted job does not fail on its configuration later.
+/// Errors name the path as job params would (`config`, `config.<path>` or
+/// `overrides.<path>`).
+pub fn resolve_config(
+    source: CaseSource<'_>,
+    overrides: Option<&serde_json::Value>,
+    seed: Option<u64>,
+    configs_dir: &Path,
+    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
+) -> Result<CaseSpec, RunError> {
+    let mut value = match source {
+        CaseSource::Reference(name) => {
+            let path = crate::models::reference::reference_config_path(configs_dir, name)
+                .map_err(|e| FieldError::new("config", e.to_string()))?;
+            // Validated once below, with the overrides merged in.
+            let case = read_case(&path)?;
+            serde_json::to_value(&case).map_err(|e| FieldError::new("config", e.to_string()))?
+        }
+        CaseSource::Inline(case) => case.clone(),
+    };
     if let Some(over) = overrides {
         if !over.is_object() {
             return Err(FieldError::new("overrides", "must be an object").into());
         }
         merge_json(&mut value, over);
     }
-    if let Some(seed) = params.get("seed") {
-        let seed = parse_seed(seed)?;
+    if let Some(seed) = seed {
         merge_json(
             &mut value,
             &serde_json::json!({"simulation": {"seed": seed}}),
