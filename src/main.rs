@@ -217,6 +217,49 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// IMPACT stiffness k and exponent e (eq. 2.7) for a sphere on a flat, fitted by least
+    /// squares to a quasistatic model of thesis 2.3.1 (Hertz, fully plastic, Jackson-Green,
+    /// Kogut-Etsion); prints the fit with its range and weighting (docs/errata.md section 3).
+    /// Materials default to 7075-T73 for both bodies.
+    ContactFit {
+        /// hertz, fully_plastic, jackson_green or kogut_etsion (`-` for `_` allowed).
+        #[arg(long, value_parser = railwear::cli::contact_fit::parse_model)]
+        model: railwear::contact_models::QuasistaticModel,
+        /// Sphere radius, m (thesis 2.3.1: 0.05).
+        #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
+        radius_m: f64,
+        /// Young's modulus of both bodies, Pa (default 7075-T73, 72e9).
+        #[arg(long, allow_negative_numbers = true)]
+        youngs_modulus_pa: Option<f64>,
+        /// Poisson's ratio of both bodies (default 7075-T73, 0.33).
+        #[arg(long, allow_negative_numbers = true)]
+        poisson_ratio: Option<f64>,
+        /// Yield strength of both bodies, Pa (default 7075-T73, 435e6).
+        #[arg(long, allow_negative_numbers = true)]
+        yield_strength_pa: Option<f64>,
+        /// The flat's own Young's modulus, Pa.
+        #[arg(long, allow_negative_numbers = true)]
+        flat_youngs_modulus_pa: Option<f64>,
+        /// The flat's own Poisson's ratio.
+        #[arg(long, allow_negative_numbers = true)]
+        flat_poisson_ratio: Option<f64>,
+        /// The flat's own yield strength, Pa.
+        #[arg(long, allow_negative_numbers = true)]
+        flat_yield_strength_pa: Option<f64>,
+        /// Upper end of the fitted interference range, m (the thesis fits 0-1 mm).
+        #[arg(long, default_value_t = railwear::contact_models::impact_fit::DEFAULT_MAX_INTERFERENCE_M, allow_negative_numbers = true)]
+        max_interference_m: f64,
+        /// Points of the force curve fitted (3 to 1,000,000).
+        #[arg(long, default_value_t = railwear::contact_models::impact_fit::DEFAULT_SAMPLES)]
+        samples: usize,
+        /// linear: least squares on force, samples uniform in w (the thesis' NLINFIT); log:
+        /// least squares on ln F, samples log-spaced from max/1000.
+        #[arg(long, default_value = "linear", value_parser = railwear::cli::contact_fit::parse_fit_space)]
+        fit_space: railwear::contact_models::FitSpace,
+        /// Print the fit as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run the thesis anchors and print expected vs measured vs verdict.
     Validate {
         /// One JSON object per anchor (name, expected, measured, tolerance, pass).
@@ -410,6 +453,45 @@ async fn main() -> Result<()> {
             workers,
         } => worker(load_config(&cli)?, database_url.clone(), *workers).await,
         Command::Effects { json } => railwear::cli::effects(*json),
+        Command::ContactFit {
+            model,
+            radius_m,
+            youngs_modulus_pa,
+            poisson_ratio,
+            yield_strength_pa,
+            flat_youngs_modulus_pa,
+            flat_poisson_ratio,
+            flat_yield_strength_pa,
+            max_interference_m,
+            samples,
+            fit_space,
+            json,
+        } => {
+            use railwear::cli::contact_fit::{contact_fit, ContactFitArgs, MaterialFlags};
+            let args = ContactFitArgs {
+                model: *model,
+                radius_m: *radius_m,
+                material: MaterialFlags {
+                    youngs_modulus_pa: *youngs_modulus_pa,
+                    poisson_ratio: *poisson_ratio,
+                    yield_strength_pa: *yield_strength_pa,
+                },
+                flat: MaterialFlags {
+                    youngs_modulus_pa: *flat_youngs_modulus_pa,
+                    poisson_ratio: *flat_poisson_ratio,
+                    yield_strength_pa: *flat_yield_strength_pa,
+                },
+                max_interference_m: *max_interference_m,
+                samples: *samples,
+                space: *fit_space,
+            };
+            // A refused value is an answer, not a crash: the message names the flag and rule.
+            if let Err(e) = contact_fit(&args, *json) {
+                eprintln!("error: {e:#}");
+                std::process::exit(1);
+            }
+            Ok(())
+        }
         Command::Openapi => {
             print!("{}", railwear::http::openapi::openapi_json());
             Ok(())

@@ -19,6 +19,41 @@ pub enum FitSpace {
     Log,
 }
 
+impl FitSpace {
+    /// The interference samples of a fit over (0, `max_interference_m`], m, ascending: uniform
+    /// from `max/samples` for [`FitSpace::Linear`], log-spaced from `max/1000` for
+    /// [`FitSpace::Log`]. `samples` >= 2.
+    pub fn interference_samples_m(&self, max_interference_m: f64, samples: usize) -> Vec<f64> {
+        match self {
+            FitSpace::Linear => (1..=samples)
+                .map(|i| max_interference_m * i as f64 / samples as f64)
+                .collect(),
+            FitSpace::Log => (0..samples)
+                .map(|i| max_interference_m * 1e-3f64.powf(1.0 - i as f64 / (samples - 1) as f64))
+                .collect(),
+        }
+    }
+
+    /// How the samples are spaced, in words.
+    pub fn spacing(&self) -> &'static str {
+        match self {
+            FitSpace::Linear => "uniform in w",
+            FitSpace::Log => "log-spaced in w",
+        }
+    }
+
+    /// How the residuals are weighted, in words (docs/errata.md section 3: the exponent depends
+    /// on it, so it is stated with every fit).
+    pub fn weighting(&self) -> &'static str {
+        match self {
+            FitSpace::Linear => {
+                "least squares on force (large w dominate; MATLAB NLINFIT as in the thesis)"
+            }
+            FitSpace::Log => "least squares on ln F (equal weight to every relative error)",
+        }
+    }
+}
+
 /// Result of a fit `F = k w^e`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PowerLawFit {
@@ -67,14 +102,7 @@ pub fn fit_power_law(
             "must be in 3..=1000000",
         )));
     }
-    let ws: Vec<f64> = match space {
-        FitSpace::Linear => (1..=samples)
-            .map(|i| max_interference_m * i as f64 / samples as f64)
-            .collect(),
-        FitSpace::Log => (0..samples)
-            .map(|i| max_interference_m * 1e-3f64.powf(1.0 - i as f64 / (samples - 1) as f64))
-            .collect(),
-    };
+    let ws = space.interference_samples_m(max_interference_m, samples);
     let fs: Vec<f64> = ws.iter().map(|&w| force(w)).collect();
     if fs.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
         return Err(ContactModelError::Fit(

@@ -54,6 +54,33 @@ impl QuasistaticModel {
         Self::KogutEtsion,
     ];
 
+    /// The model's name as written in JSON and on the command line (`hertz`, `fully_plastic`,
+    /// `jackson_green`, `kogut_etsion`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Hertz => "hertz",
+            Self::FullyPlastic => "fully_plastic",
+            Self::JacksonGreen => "jackson_green",
+            Self::KogutEtsion => "kogut_etsion",
+        }
+    }
+
+    /// The model named `name` ([`QuasistaticModel::name`]; `-` may stand for `_`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        let name = name.replace('-', "_");
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The model's title in thesis 2.3.1.
+    pub fn title(&self) -> &'static str {
+        match self {
+            Self::Hertz => "Hertz (elastic)",
+            Self::FullyPlastic => "fully plastic (Abbott-Firestone)",
+            Self::JacksonGreen => "Jackson-Green (elastic-plastic)",
+            Self::KogutEtsion => "Kogut-Etsion (elastic-plastic)",
+        }
+    }
+
     /// Normal force F(w), N, for interference `w_m` (m); 0 for w <= 0.
     pub fn force_n(&self, c: &SphereOnFlat, w_m: f64) -> f64 {
         if w_m.is_nan() || w_m <= 0.0 {
@@ -135,9 +162,10 @@ impl SphereOnFlat {
                 "must be a finite number > 0",
             )));
         }
-        for m in [&sphere, &flat] {
-            m.validate()
-                .map_err(|crate::wear::WearError::Invalid(e)| ContactModelError::Invalid(e))?;
+        for (body, m) in [("sphere", &sphere), ("flat", &flat)] {
+            m.validate().map_err(|crate::wear::WearError::Invalid(e)| {
+                ContactModelError::Invalid(e.at(body))
+            })?;
         }
         Ok(Self {
             radius_m,
@@ -291,6 +319,22 @@ mod tests {
             QuasistaticModel::KogutEtsion.force_n(&c, w),
             fp.force_n(&c, w)
         );
+    }
+
+    #[test]
+    fn names_match_the_serde_names() {
+        for model in QuasistaticModel::ALL {
+            assert_eq!(
+                serde_json::to_value(model).unwrap(),
+                serde_json::Value::from(model.name())
+            );
+            assert_eq!(QuasistaticModel::from_name(model.name()), Some(model));
+        }
+        assert_eq!(
+            QuasistaticModel::from_name("kogut-etsion"),
+            Some(QuasistaticModel::KogutEtsion)
+        );
+        assert_eq!(QuasistaticModel::from_name("greenwood"), None);
     }
 
     #[test]

@@ -417,9 +417,10 @@ impl CampaignTest {
         if !self.overrides.is_object() {
             return Err(GapError::field(f("overrides"), "must be a table"));
         }
-        let params = serde_json::json!({"config": self.config, "overrides": self.overrides});
         let mut adjust_error: Option<GapError> = None;
-        let case = crate::pipeline::resolve_case(&params, configs_dir, |case| {
+        let source = crate::pipeline::CaseSource::Reference(&self.config);
+        let overrides = Some(&self.overrides);
+        let case = crate::pipeline::resolve_config(source, overrides, None, configs_dir, |case| {
             if let Err(e) = self.adjust(ti, case, configs_dir) {
                 adjust_error = Some(e);
                 return Err(RunError::InvalidConfig {

@@ -10,6 +10,8 @@ use crate::field_error::FieldError;
 /// The job records live with the store that keeps them (`store::job_records`).
 pub use crate::store::job_records as model;
 pub mod runner;
+#[cfg(test)]
+mod runner_tests;
 pub mod worker;
 
 use crate::store::{clock, NewJob, Store, StoreError, Submitted, WorkerHost};
@@ -351,11 +353,12 @@ impl Jobs {
             self.resolve_diagnosed_wear_law(&mut params).await?;
         }
         // The same parse the worker runs (one set of rules); it may build the model, so it
-        // runs on a blocking thread.
+        // runs on a blocking thread. A kind with a typed plan gets it back (with the job's
+        // seed), stored with the job and run by the worker as it is.
         let runner = Arc::clone(&self.runner);
-        let (check_kind, check_params) = (kind, params.clone());
+        let check_params = params.clone();
         let checked =
-            tokio::task::spawn_blocking(move || runner.validate(&check_kind, &check_params))
+            tokio::task::spawn_blocking(move || runner.submit_plan(&kind, &check_params, seed))
                 .await
                 .map_err(|e| {
                     SubmitError::Invalid(FieldError::new(
@@ -363,7 +366,7 @@ impl Jobs {
                         format!("could not be checked: {e}"),
                     ))
                 })?;
-        checked.map_err(|e| match e {
+        let plan = checked.map_err(|e| match e {
             crate::pipeline::RunError::InvalidConfig { field, rule } => {
                 let e = FieldError::new(field, rule);
                 SubmitError::Invalid(if e.field == "params" {
@@ -398,6 +401,7 @@ impl Jobs {
                 id: Uuid::new_v4(),
                 kind,
                 params,
+                plan,
                 seed,
                 code_version: code_version().to_string(),
                 submitted_by: submitted_by.to_string(),

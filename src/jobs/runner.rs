@@ -8,7 +8,7 @@ use crate::field_error::FieldError;
 use crate::models::spec::CaseSpec;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{
-    CalibrateParams, RunControl, RunError, SweepOutcome, SweepPlan, SweepPointSummary,
+    CalibrateParams, RunControl, RunError, SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary,
 };
 use std::path::PathBuf;
 
@@ -79,22 +79,35 @@ pub trait CaseRunner: Send + Sync {
     /// [`RunControl::request_checkpoint`], resumes from a checkpoint to the result of an
     /// uninterrupted run, and starts over (saying why) from one that does not fit. The default
     /// cannot checkpoint: it ignores `checkpoint` and runs from the start.
+    ///
+    /// `plan` is what [`CaseRunner::submit_plan`] returned for this job at submission, when it
+    /// returned one: the job is run from it, not from `params`. The default has no plans.
     fn run_from(
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
+        plan: Option<&serde_json::Value>,
         control: &RunControl,
         checkpoint: Option<&[u8]>,
     ) -> Result<JobOutput, RunError> {
-        let _ = checkpoint;
+        let _ = (plan, checkpoint);
         self.run(kind, params, control)
     }
 
     /// Check at submission (on a blocking thread) so a bad request gets a 422 naming the field
-    /// instead of a failed job. It should be the same parse [`CaseRunner::run`] does
-    /// ([`LibraryRunner::plan`]). The default accepts everything.
-    fn validate(&self, _kind: &JobKind, _params: &serde_json::Value) -> Result<(), RunError> {
-        Ok(())
+    /// instead of a failed job: the same parse [`CaseRunner::run`] does
+    /// ([`LibraryRunner::plan`]) of the params as submitted; `seed` is the job's seed (the
+    /// params' or the one drawn for it). Returns the job's typed plan as canonical JSON when
+    /// its kind has one (a simulate job's [`SimulatePlan`], seed included): the queue stores it
+    /// with the job and hands it to [`CaseRunner::run_from`], so the job is parsed and checked
+    /// once. The default accepts everything and has no plan.
+    fn submit_plan(
+        &self,
+        _kind: &JobKind,
+        _params: &serde_json::Value,
+        _seed: u64,
+    ) -> Result<Option<serde_json::Value>, RunError> {
+        Ok(None)
     }
 
     /// The store this runner's jobs read their stored inputs from (a diagnosis's campaign);
@@ -129,7 +142,7 @@ pub trait CaseRunner: Send + Sync {
 }
 
 /// A job's params parsed and checked for its kind: what the worker runs. Built by
-/// [`LibraryRunner::plan`], which submission ([`CaseRunner::validate`]) and every worker call,
+/// [`LibraryRunner::plan`], which submission ([`CaseRunner::submit_plan`]) and the worker call,
 /// so an accepted job's params are never re-interpreted by a second set of rules.
 #[derive(Debug, Clone)]
 pub enum JobPlan {
@@ -336,18 +349,31 @@ impl CaseRunner for LibraryRunner {
         params: &serde_json::Value,
         control: &RunControl,
     ) -> Result<JobOutput, RunError> {
-        self.run_from(kind, params, control, None)
+        self.run_from(kind, params, None, control, None)
     }
 
     /// Simulate jobs and sweep points checkpoint and resume (`pipeline::run_case_from`);
-    /// the other kinds stop as cancelled on a checkpoint request and start over.
+    /// the other kinds stop as cancelled on a checkpoint request and start over. A simulate
+    /// job with its stored [`SimulatePlan`] runs it (one validation and one build); without one
+    /// (a job queued before plans were stored) it is planned from its params first.
     fn run_from(
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
+        stored: Option<&serde_json::Value>,
         control: &RunControl,
         checkpoint: Option<&[u8]>,
     ) -> Result<JobOutput, RunError> {
+        if let (JobKind::Simulate, Some(stored)) = (kind, stored) {
+            let out =
+                SimulatePlan::from_json(stored)?.run(&self.configs_dir, control, checkpoint)?;
+            return Ok(JobOutput {
+                summary: out.summary,
+                tracks: out.tracks,
+                plots: out.plots,
+                ..JobOutput::default()
+            });
+        }
         let plan = self.plan(kind, params)?;
         let control = &match plan {
             JobPlan::Simulate(_) | JobPlan::SweepPoint(..) => control.clone(),
@@ -400,8 +426,18 @@ impl CaseRunner for LibraryRunner {
         }
     }
 
-    fn validate(&self, kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
-        self.plan(kind, params).map(|_| ())
+    fn submit_plan(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        seed: u64,
+    ) -> Result<Option<serde_json::Value>, RunError> {
+        match kind {
+            JobKind::Simulate => SimulatePlan::from_params(params, &self.configs_dir, seed)?
+                .to_json()
+                .map(Some),
+            _ => self.plan(kind, params).map(|_| None),
+        }
     }
 
     fn bind_store(&self, store: std::sync::Arc<dyn crate::store::Store>) {

@@ -107,9 +107,13 @@ impl Jobs {
             }
         };
         // A checkpoint an earlier attempt stored at its shutdown: this attempt resumes from it.
-        let resume = match work {
-            Work::Run => self.stored_checkpoint(id, attempt).await,
-            _ => None,
+        // The plan stored at submission is what a job with one runs.
+        let (resume, plan) = match work {
+            Work::Run => (
+                self.stored_checkpoint(id, attempt).await,
+                self.stored_plan(id).await,
+            ),
+            _ => (None, None),
         };
         let cancel = Arc::new(AtomicBool::new(job.cancel_requested));
         let checkpoint = Arc::new(AtomicBool::new(false));
@@ -156,6 +160,7 @@ impl Jobs {
             Work::Run => runner.run_from(
                 &kind,
                 &params,
+                plan.as_ref(),
                 &control,
                 resume.as_ref().map(|c| c.data.as_slice()),
             ),
@@ -331,6 +336,19 @@ impl Jobs {
     }
 
     /// The checkpoint stored for job `id` by an earlier attempt, if any.
+    /// The plan stored with job `id` at submission. A job without one (its kind has none, or
+    /// it was queued before plans were stored) is planned from its params by the runner; so is
+    /// one whose plan cannot be read now (logged).
+    async fn stored_plan(&self, id: uuid::Uuid) -> Option<serde_json::Value> {
+        match self.store.job_plan(id).await {
+            Ok(plan) => plan,
+            Err(e) => {
+                tracing::warn!(job = %id, error = %e, "reading the job's plan failed: planning from its params");
+                None
+            }
+        }
+    }
+
     async fn stored_checkpoint(&self, id: uuid::Uuid, attempt: i64) -> Option<JobCheckpoint> {
         match self.store.load_checkpoint(id).await {
             Ok(Some(cp)) => {

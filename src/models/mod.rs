@@ -4,6 +4,8 @@
 pub mod case;
 pub mod case_run;
 pub mod checkpoint;
+#[cfg(test)]
+pub(crate) mod counts;
 pub mod launcher;
 pub mod motion;
 pub mod outcome;

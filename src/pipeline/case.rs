@@ -1,12 +1,14 @@
-//! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, and the run.
+//! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, the typed plan a
+//! job stores ([`SimulatePlan`]), and the run.
 
-use super::run::run_case;
+use super::run::{run_case, run_case_from};
 use super::{
     check_keys, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError, SIMULATE_KEYS,
 };
 use crate::field_error::FieldError;
-use crate::models::case::load_case;
+use crate::models::case::read_case;
 use crate::models::spec::CaseSpec;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
@@ -127,28 +129,28 @@ fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunE
     Ok(())
 }
 
+/// Where a case comes from: a reference config by name (`configs/<name>.toml`) or a whole case
+/// object (the schema of those files, as JSON).
+#[derive(Debug, Clone, Copy)]
+pub enum CaseSource<'a> {
+    /// A reference config's name.
+    Reference(&'a str),
+    /// A case object.
+    Inline(&'a serde_json::Value),
+}
+
 /// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
-/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check). Overrides
-/// deep-merge into the case (e.g. `{"simulation": {"duration_s": 0.5}}`); `seed` sets
-/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
-/// excitation). The case is checked completely: unknown keys anywhere, the model's own rules,
-/// the bounds of [`limits`] and
-/// [`super::bounds`], and the model is built once (excitation, geometry, integrator),
-/// so an accepted job does not fail on its configuration later. Errors name the params path
-/// (`config`, `config.<path>` or `overrides.<path>`).
+/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check), read into
+/// their parts and resolved by [`resolve_config`]. Errors name the params path (`config`,
+/// `config.<path>` or `overrides.<path>`).
 pub fn resolve_case(
     params: &serde_json::Value,
     configs_dir: &Path,
     adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
 ) -> Result<CaseSpec, RunError> {
-    let mut value = match params.get("config") {
-        Some(serde_json::Value::String(name)) => {
-            let path = crate::models::reference::reference_config_path(configs_dir, name)
-                .map_err(|e| FieldError::new("config", e.to_string()))?;
-            let case = load_case(&path)?;
-            serde_json::to_value(&case).map_err(|e| FieldError::new("config", e.to_string()))?
-        }
-        Some(obj @ serde_json::Value::Object(_)) => obj.clone(),
+    let source = match params.get("config") {
+        Some(serde_json::Value::String(name)) => CaseSource::Reference(name),
+        Some(obj @ serde_json::Value::Object(_)) => CaseSource::Inline(obj),
         Some(_) => {
             return Err(FieldError::new(
                 "config",
@@ -164,15 +166,43 @@ pub fn resolve_case(
             .into())
         }
     };
-    let overrides = params.get("overrides");
+    let seed = params.get("seed").map(parse_seed).transpose()?;
+    resolve_config(source, params.get("overrides"), seed, configs_dir, adjust)
+}
+
+/// A case from its `source` with `overrides` deep-merged into it (e.g.
+/// `{"simulation": {"duration_s": 0.5}}`; must be an object) and `seed` as its
+/// `simulation.seed`. `adjust` edits the typed case before it is checked (a sweep sets its
+/// excitation, a campaign test its rattle space and drive). The case is checked completely:
+/// unknown keys anywhere, the model's own rules (validated once, overrides merged), the
+/// bounds of [`limits`] and [`super::bounds`], and the model is built once (excitation,
+/// geometry, integrator), so an accepted job does not fail on its configuration later.
+/// Errors name the path as job params would (`config`, `config.<path>` or
+/// `overrides.<path>`).
+pub fn resolve_config(
+    source: CaseSource<'_>,
+    overrides: Option<&serde_json::Value>,
+    seed: Option<u64>,
+    configs_dir: &Path,
+    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
+) -> Result<CaseSpec, RunError> {
+    let mut value = match source {
+        CaseSource::Reference(name) => {
+            let path = crate::models::reference::reference_config_path(configs_dir, name)
+                .map_err(|e| FieldError::new("config", e.to_string()))?;
+            // Validated once below, with the overrides merged in.
+            let case = read_case(&path)?;
+            serde_json::to_value(&case).map_err(|e| FieldError::new("config", e.to_string()))?
+        }
+        CaseSource::Inline(case) => case.clone(),
+    };
     if let Some(over) = overrides {
         if !over.is_object() {
             return Err(FieldError::new("overrides", "must be an object").into());
         }
         merge_json(&mut value, over);
     }
-    if let Some(seed) = params.get("seed") {
-        let seed = parse_seed(seed)?;
+    if let Some(seed) = seed {
         merge_json(
             &mut value,
             &serde_json::json!({"simulation": {"seed": seed}}),
@@ -218,6 +248,62 @@ pub fn case_from_params(
 pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
     check_keys(params, "params", SIMULATE_KEYS)?;
     case_from_params(params, configs_dir)
+}
+
+/// A simulate job parsed and checked once, at submission: the complete case (reference config,
+/// overrides and seed merged; `simulation.seed` is the job's seed), stored with the job as its
+/// canonical JSON ([`SimulatePlan::to_json`]) and run by the worker from there
+/// ([`SimulatePlan::from_json`], [`SimulatePlan::run`]) without reading the params or the
+/// reference config again.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulatePlan {
+    /// The case to run.
+    pub case: CaseSpec,
+}
+
+impl SimulatePlan {
+    /// Parses and checks a simulate job's params as submitted (the rules of [`simulate_case`],
+    /// and the model built once) for a job run with `seed` (the params' `seed`, or the one
+    /// drawn for the job): the case's `simulation.seed` is set to it before it is checked, as
+    /// the worker sets it for a job planned from its params. Errors name the params path.
+    pub fn from_params(
+        params: &serde_json::Value,
+        configs_dir: &Path,
+        seed: u64,
+    ) -> Result<Self, RunError> {
+        check_keys(params, "params", SIMULATE_KEYS)?;
+        let case = resolve_case(params, configs_dir, |case| {
+            case.simulation.seed = seed;
+            Ok(())
+        })?;
+        Ok(Self { case })
+    }
+
+    /// The plan's canonical JSON (every number round-trips exactly).
+    pub fn to_json(&self) -> Result<serde_json::Value, RunError> {
+        serde_json::to_value(self).map_err(|e| FieldError::new("plan", e.to_string()).into())
+    }
+
+    /// A stored plan, as [`SimulatePlan::to_json`] wrote it. It was checked at submission; the
+    /// run validates the case once more as it builds the model.
+    pub fn from_json(value: &serde_json::Value) -> Result<Self, RunError> {
+        Self::deserialize(value).map_err(|e| {
+            FieldError::new("plan", format!("is not a simulate job's stored plan: {e}")).into()
+        })
+    }
+
+    /// Runs the case (validated and built once), resuming from `resume` when it fits
+    /// ([`run_case_from`]).
+    pub fn run(
+        &self,
+        configs_dir: &Path,
+        control: &RunControl,
+        resume: Option<&[u8]>,
+    ) -> Result<CaseOutcome, RunError> {
+        let (_, outcome) = run_case_from(&self.case, configs_dir, control, resume)?;
+        Ok(outcome)
+    }
 }
 
 /// A simulate job: one case end to end.

@@ -209,3 +209,28 @@ fn a_curve_built_from_sweep_points_keeps_no_offsets() {
         serde_json::json!({"rattle_space": 0.7, "rail_wear_rate_mg_per_h": 2.0})
     );
 }
+
+#[test]
+fn a_case_resolved_from_its_parts_is_the_case_of_the_same_params() {
+    let overrides = serde_json::json!({"simulation": {"duration_s": 0.5}});
+    let params = serde_json::json!({"config": "rattle-box-b", "overrides": overrides, "seed": 5});
+    let by_params = resolve_case(&params, &configs(), |_| Ok(())).unwrap();
+    let source = CaseSource::Reference("rattle-box-b");
+    let by_parts =
+        resolve_config(source, Some(&overrides), Some(5), &configs(), |_| Ok(())).unwrap();
+    assert_eq!(by_parts, by_params);
+    assert_eq!(by_parts.simulation.seed, 5);
+    assert_eq!(by_parts.simulation.duration_s, 0.5);
+    // Errors name the path as job params would.
+    let bad = serde_json::json!({"simulation": {"duration_s": -1.0}});
+    let e = resolve_config(source, Some(&bad), None, &configs(), |_| Ok(())).unwrap_err();
+    assert_eq!(field_of(e), "overrides.simulation.duration_s");
+    let e = resolve_config(
+        CaseSource::Reference("no-such"),
+        None,
+        None,
+        &configs(),
+        |_| Ok(()),
+    );
+    assert_eq!(field_of(e.unwrap_err()), "config");
+}

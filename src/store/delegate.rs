@@ -287,6 +287,13 @@ macro_rules! portable_store_methods {
         ) -> $crate::store::StoreFuture<'_, Option<$crate::store::JobCheckpoint>> {
             Box::pin(<$shared>::load_checkpoint(&self.pool, id))
         }
+
+        fn job_plan(
+            &self,
+            id: ::uuid::Uuid,
+        ) -> $crate::store::StoreFuture<'_, Option<::serde_json::Value>> {
+            Box::pin(<$shared>::job_plan(&self.pool, id))
+        }
     };
 }
 pub(crate) use portable_store_methods;

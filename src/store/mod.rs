@@ -64,6 +64,9 @@ pub struct NewJob {
     pub id: Uuid,
     pub kind: JobKind,
     pub params: serde_json::Value,
+    /// The job's typed plan as canonical JSON, when its kind has one
+    /// (`jobs::CaseRunner::submit_plan`): what the worker runs.
+    pub plan: Option<serde_json::Value>,
     pub seed: u64,
     pub code_version: String,
     pub submitted_by: String,
@@ -523,6 +526,8 @@ pub trait Store: Send + Sync {
     ) -> StoreFuture<'_, bool>;
     /// The job's stored checkpoint, if any.
     fn load_checkpoint(&self, id: Uuid) -> StoreFuture<'_, Option<JobCheckpoint>>;
+    /// The typed plan stored with the job at submission ([`NewJob::plan`]), if any.
+    fn job_plan(&self, id: Uuid) -> StoreFuture<'_, Option<serde_json::Value>>;
 }
 
 /// Open the store named by `database_url` and apply migrations.

@@ -19,7 +19,7 @@ use super::job_records::{JobProgress, JobRecord, JobStatus};
 use super::rows::{
     child_of, corrupt, cut_page, records, AttemptRow, CampaignContentRow, CampaignRow, ChildRow,
     CurveRow, DbUuid, HostLeaseRow, JobRow, KeyedJobRow, LostRow, MeasurementRow, ParentLinkRow,
-    TokenRow, CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
+    PlanRow, TokenRow, CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
 };
 use super::Role;
 use super::{
@@ -56,6 +56,7 @@ where
     CampaignRow: for<'r> FromRow<'r, DB::Row>,
     CampaignContentRow: for<'r> FromRow<'r, DB::Row>,
     JobCheckpoint: for<'r> FromRow<'r, DB::Row>,
+    PlanRow: for<'r> FromRow<'r, DB::Row>,
     for<'c> &'c mut DB::Connection: Executor<'c, Database = DB>,
     for<'q> DB::Arguments<'q>: IntoArguments<'q, DB>,
     for<'q> bool: Encode<'q, DB> + Decode<'q, DB> + Type<DB>,
@@ -151,8 +152,8 @@ where
         }
         let sql = format!(
             "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
-             idempotency_key, request_sha256, curve_key, created_ms) \
-             VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7, $8, $9, $10) \
+             idempotency_key, request_sha256, curve_key, created_ms, plan) \
+             VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7, $8, $9, $10, $11) \
              ON CONFLICT (idempotency_key) DO NOTHING RETURNING {JOB_COLUMNS}"
         );
         let inserted: Option<JobRow> = sqlx::query_as(&sql)
@@ -166,6 +167,7 @@ where
             .bind(sha.clone())
             .bind(job.curve_key)
             .bind(job.created_ms)
+            .bind(job.plan.as_ref().map(|plan| plan.to_string()))
             .fetch_optional(&mut *tx)
             .await?;
         let submitted = match inserted {
@@ -996,5 +998,17 @@ where
         .bind(DbUuid(id))
         .fetch_optional(pool)
         .await?)
+    }
+
+    /// The plan stored with job `id` at submission (none: no such job, or none stored).
+    pub(crate) async fn job_plan(
+        pool: &Pool<DB>,
+        id: Uuid,
+    ) -> Result<Option<serde_json::Value>, StoreError> {
+        let row: Option<PlanRow> = sqlx::query_as("SELECT plan FROM jobs WHERE id = $1")
+            .bind(DbUuid(id))
+            .fetch_optional(pool)
+            .await?;
+        row.map_or(Ok(None), PlanRow::plan)
     }
 }

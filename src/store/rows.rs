@@ -233,6 +233,21 @@ impl TryFrom<JobRow> for JobRecord {
     }
 }
 
+/// A job's stored plan (`jobs.plan`), as `Store::job_plan` reads it.
+#[derive(sqlx::FromRow)]
+pub(crate) struct PlanRow {
+    plan: Option<String>,
+}
+
+impl PlanRow {
+    /// The plan's JSON, if one was stored.
+    pub(crate) fn plan(self) -> Result<Option<serde_json::Value>, StoreError> {
+        self.plan
+            .map(|text| parse_json(&text, "job plan"))
+            .transpose()
+    }
+}
+
 /// The parent link a finishing job's update returns.
 #[derive(sqlx::FromRow)]
 pub(crate) struct ParentLinkRow {

@@ -2,6 +2,7 @@
 //! and error control, called as a library (no HTTP, no store). One module per concern.
 
 mod checkpoint_resume;
+mod contact_fit;
 mod energy_passivity;
 mod engine_closed_forms;
 mod error_control;

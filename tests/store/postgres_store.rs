@@ -21,6 +21,7 @@ fn new_job(n: u128, kind: JobKind, idempotency: Option<(&str, &str)>) -> NewJob 
         id: Uuid::from_u128(0x5eed_0000 + n),
         kind,
         params: serde_json::json!({ "n": n as u64, "x": 0.1 + 1e-17 * n as f64 }),
+        plan: None,
         seed: u64::MAX - n as u64, // above i64::MAX: the bit-pattern round trip matters
         code_version: "test".into(),
         submitted_by: "tester".into(),

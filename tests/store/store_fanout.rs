@@ -25,6 +25,7 @@ fn sweep_job(n: u128) -> NewJob {
         id: Uuid::from_u128(0xf0_0000 + n),
         kind: JobKind::Sweep,
         params: serde_json::json!({ "points": 3, "n": n as u64 }),
+        plan: None,
         seed: u64::MAX - n as u64,
         code_version: "test".into(),
         submitted_by: "planner-7".into(),

@@ -171,6 +171,7 @@ fn numbered_job(base: u128, n: u128) -> railwear::store::NewJob {
         id: Uuid::from_u128(base + n),
         kind: JobKind::Simulate,
         params: serde_json::json!({"n": n as u64}),
+        plan: None,
         seed: n as u64,
         code_version: "test".into(),
         submitted_by: "tester".into(),

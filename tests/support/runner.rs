@@ -166,13 +166,18 @@ impl CaseRunner for CountingRunner {
         })
     }
 
-    fn validate(&self, _kind: &JobKind, params: &serde_json::Value) -> Result<(), RunError> {
+    fn submit_plan(
+        &self,
+        _kind: &JobKind,
+        params: &serde_json::Value,
+        _seed: u64,
+    ) -> Result<Option<serde_json::Value>, RunError> {
         match params.get("steps") {
             Some(v) if v.as_u64().is_none() => Err(RunError::InvalidConfig {
                 field: "steps".into(),
                 rule: "must be a non-negative integer".into(),
             }),
-            _ => Ok(()),
+            _ => Ok(None),
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Command-line front ends of the library: `railwear run`, `validate`, `campaign check`,
-//! `rig`, `effects`, `diagnose`.
+//! `rig`, `effects`, `diagnose`, and `contact-fit` ([`contact_fit`]).
 //! (anyhow is allowed here: this is the binary edge.)
+
+pub mod contact_fit;
 
 use crate::models::case::load_case;
 use crate::pipeline::{run_case, Progress, RunControl};
@@ -330,7 +332,7 @@ pub fn campaign_check(file: &Path, json: bool, configs_dir: &Path) -> Result<()>
 }
 
 /// The thesis campaign, built in (`railwear rig --base thesis`).
-pub const BUILTIN_THESIS_CAMPAIGN: &str = include_str!("../campaigns/thesis-rattle-box.toml");
+pub const BUILTIN_THESIS_CAMPAIGN: &str = include_str!("../../campaigns/thesis-rattle-box.toml");
 
 /// `railwear rig`: writes `<out>/campaign.toml` (+ CSVs) and `<out>/truth.json`.
 pub fn rig(
