@@ -52,10 +52,14 @@ pub struct TrackMoments {
     q_d: Matrix3<f64>,
     /// `Σ [q]× D [q]×`.
     q_d_q: Matrix3<f64>,
-    /// `Σ D [u]× [q_c]×`.
-    d_u_qc: Matrix3<f64>,
-    /// `Σ [q]× D [u]× [q_c]×`.
-    q_d_u_qc: Matrix3<f64>,
+    /// `Σ D q_c`.
+    d_qc: Vector3<f64>,
+    /// `Σ (u·q_c) D`.
+    u_qc_d: Matrix3<f64>,
+    /// `Σ q × D q_c`.
+    q_d_qc: Vector3<f64>,
+    /// `Σ (u·q_c) [q]× D`.
+    u_qc_q_d: Matrix3<f64>,
     /// `Σ F`.
     force: Vector3<f64>,
     /// `Σ q × F`.
@@ -82,8 +86,10 @@ impl TrackMoments {
             d_q: z,
             q_d: z,
             q_d_q: z,
-            d_u_qc: z,
-            q_d_u_qc: z,
+            d_qc: Vector3::zeros(),
+            u_qc_d: z,
+            q_d_qc: Vector3::zeros(),
+            u_qc_q_d: z,
             force: Vector3::zeros(),
             q_force: Vector3::zeros(),
             force_qc: z,
@@ -121,9 +127,13 @@ impl TrackMoments {
         self.q_d += q_d;
         self.q_d_q += q_d * qx;
         if self.spin != Vector3::zeros() {
-            let d_u_qc = d * self.spin.cross_matrix() * qc.cross_matrix();
-            self.d_u_qc += d_u_qc;
-            self.q_d_u_qc += qx * d_u_qc;
+            // D [u]× [q_c]× = (D q_c) uᵀ − (u·q_c) D: the sums of the two parts.
+            let d_qc = d * qc;
+            let u_qc = self.spin.dot(&qc);
+            self.d_qc += d_qc;
+            self.u_qc_d += d * u_qc;
+            self.q_d_qc += q.cross(&d_qc);
+            self.u_qc_q_d += q_d * u_qc;
         }
         self.force += lin.force;
         self.q_force += q.cross(&lin.force);
@@ -174,9 +184,11 @@ impl TrackMoments {
             let mut d_theta = (self.g_qn - self.g_n * e_k) * -sign_k;
             let mut q_d_theta = (self.qg_qn - self.qg_n * e_k) * -sign_k;
             if sign_k > 0.0 {
-                d_theta += self.d_u_qc + self.d * u_x * e_a + self.d_q * w_a + self.d * e_a * w_a;
+                let d_u_qc = self.d_qc * u.transpose() - self.u_qc_d;
+                let q_d_u_qc = self.q_d_qc * u.transpose() - self.u_qc_q_d;
+                d_theta += d_u_qc + self.d * u_x * e_a + self.d_q * w_a + self.d * e_a * w_a;
                 q_d_theta +=
-                    self.q_d_u_qc + self.q_d * u_x * e_a + self.q_d_q * w_a + self.q_d * e_a * w_a;
+                    q_d_u_qc + self.q_d * u_x * e_a + self.q_d_q * w_a + self.q_d * e_a * w_a;
             }
             df.fixed_view_mut::<3, 3>(0, 3).copy_from(&d_theta);
             q_df.fixed_view_mut::<3, 3>(0, 3).copy_from(&q_d_theta);
