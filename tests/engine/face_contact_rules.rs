@@ -151,8 +151,9 @@ fn strips_beyond_a_lip_edge_integrate_to_a_fine_reference() {
     // slices within 2e-8). Force ∫ w², its moment along the edge ∫ z w², stored energy
     // ∫ w³ / 3, within 1e-3 of the reference (the gradient and power tests in
     // face_contact.rs bound what such errors do to the dynamics). With 3 nodes along the
-    // edge instead of 5 the error was 5 %: the edge's `w = 0` kink runs along it on a face
-    // tilted along the edge.
+    // edge instead of 5 the error was 5 %, also with the columns cut where the balls stop
+    // touching: near the edge the density varies along it on the scale of the head's height
+    // over the plane.
     let face = lip(true);
     let radius = 5e-4;
     let moments = |strip: &FacePatch, order: QuadratureOrder, slices: usize| {
