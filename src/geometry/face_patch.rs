@@ -118,8 +118,9 @@ pub struct Line {
 }
 
 impl Line {
+    /// The value at `ξ = p`.
     #[inline]
-    fn at(&self, p: [f64; 2]) -> f64 {
+    pub fn at(&self, p: [f64; 2]) -> f64 {
         self.alpha + self.beta[0] * p[0] + self.beta[1] * p[1]
     }
 
@@ -227,15 +228,7 @@ impl FacePatch {
         };
         for (k, side) in sides.iter().enumerate() {
             let Some(side) = side else { continue };
-            // Slice across the side's edge (`u` the face axis most nearly across it): the
-            // integrand's kink at `w = 0` then lies in few slices.
-            let across_v = side.0.dot(&axis_v).abs() > side.0.dot(&axis_u).abs();
-            let (au, av) = if across_v {
-                (axis_v, axis_u)
-            } else {
-                (axis_u, axis_v)
-            };
-            let Some(mut patch) = Self::square(centre, au, av, radius, face) else {
+            let Some(mut patch) = Self::square(centre, axis_u, axis_v, radius, face) else {
                 return out;
             };
             let g = patch.side_line(side);
@@ -276,7 +269,12 @@ impl FacePatch {
                 keep = patch.clip(&within(reach));
             }
             if keep {
-                out[k] = Some(patch);
+                // Sliced exactly across the side's edge (`u` along the gradient of `g`): the
+                // strip's lines `g = 0` and `g = −reach` are then slice boundaries, the strip
+                // one vertex interval (a face's axis only nearly across the edge cut thin
+                // end slices off it, each with the whole rule), and the integrand's kink at
+                // `w = 0` lies in few slices.
+                out[k] = Some(patch.aligned_with(&g));
             }
         }
         out
@@ -432,14 +430,74 @@ impl FacePatch {
         parts: usize,
         visit: &mut impl FnMut(Point3<f64>, f64),
     ) {
+        let (xs_v, ws_v) = rule(order.across);
+        self.for_each_column(order.along, parts, |u, half_u, wu, lo, hi| {
+            let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+            for (xv, wv) in xs_v.iter().zip(ws_v) {
+                let v = vm + half_v * xv;
+                visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+            }
+        });
+    }
+
+    /// The patch rule for a density `max(0, a(u) + b(u) v)` times a polynomial in `v`, the
+    /// clamp's zero `v = −a/b` a curve across the patch: `sign(u) = (a, b)`. On each node
+    /// `u` of the slices, `order.across` nodes cover the part of the column where
+    /// `a + b v > 0` (exact for the polynomial there), and one node in the middle of the rest
+    /// carries the rest's share (its force clamped to zero; what is left there, a density
+    /// constant along `v` such as the stored energy of a patch aligned with `w`
+    /// ([`FacePatch::aligned_with`]), is exact with it).
+    pub fn for_each_node_clamped(
+        &self,
+        order: QuadratureOrder,
+        sign: impl Fn(f64) -> (f64, f64),
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
+        let (xs_v, ws_v) = rule(order.across);
+        self.for_each_column(order.along, 1, |u, half_u, wu, lo, hi| {
+            let (a, b) = sign(u);
+            // The pressing part [plo, phi] of the column and the middle of the clamped rest.
+            let (plo, phi, rest_mid) = if b > 0.0 {
+                let cut = (-a / b).clamp(lo, hi);
+                (cut, hi, 0.5 * (lo + cut))
+            } else if b < 0.0 {
+                let cut = (-a / b).clamp(lo, hi);
+                (lo, cut, 0.5 * (cut + hi))
+            } else if a > 0.0 {
+                (lo, hi, lo)
+            } else {
+                (hi, hi, 0.5 * (lo + hi))
+            };
+            if phi > plo {
+                let (vm, half_v) = (0.5 * (plo + phi), 0.5 * (phi - plo));
+                for (xv, wv) in xs_v.iter().zip(ws_v) {
+                    let v = vm + half_v * xv;
+                    visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+                }
+            }
+            let rest = (hi - lo) - (phi - plo);
+            if rest > 0.0 {
+                visit(self.point([u, rest_mid]), 0.25 * half_u * wu * rest);
+            }
+        });
+    }
+
+    /// Calls `column(u, half_u, w_u, lo, hi)` for each of the `along` Gauss nodes `u` of
+    /// every slice (each slice between vertices cut into `parts` equal slices): the slice's
+    /// half width, the node's weight, and the polygon's extent `lo < v < hi` at `u`.
+    fn for_each_column(
+        &self,
+        along: usize,
+        parts: usize,
+        mut column: impl FnMut(f64, f64, f64, f64, f64),
+    ) {
         let mut us = [0.0; MAX_VERTICES];
         for (u, p) in us.iter_mut().zip(&self.verts[..self.len]) {
             *u = p[0];
         }
         let us = &mut us[..self.len];
         us.sort_unstable_by(f64::total_cmp);
-        let (xs_u, ws_u) = rule(order.along);
-        let (xs_v, ws_v) = rule(order.across);
+        let (xs_u, ws_u) = rule(along);
         let parts = parts.max(1);
         for k in 1..us.len() {
             let (ua, ub) = (us[k - 1], us[k]);
@@ -460,37 +518,13 @@ impl FacePatch {
                 let half_u = 0.5 * (u1 - u0);
                 let lower = (lower.0 + lower.1 * mid, lower.1);
                 let upper = (upper.0 + upper.1 * mid, upper.1);
-                self.slice_nodes(mid, half_u, lower, upper, xs_u, ws_u, xs_v, ws_v, visit);
-            }
-        }
-    }
-
-    /// The nodes of one slice `[mid − half_u, mid + half_u]` whose lower and upper sides are
-    /// (value at `mid`, slope).
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn slice_nodes(
-        &self,
-        mid: f64,
-        half_u: f64,
-        lower: (f64, f64),
-        upper: (f64, f64),
-        xs_u: &[f64],
-        ws_u: &[f64],
-        xs_v: &[f64],
-        ws_v: &[f64],
-        visit: &mut impl FnMut(Point3<f64>, f64),
-    ) {
-        for (xu, wu) in xs_u.iter().zip(ws_u) {
-            let u = mid + half_u * xu;
-            let (lo, hi) = (lower.0 + lower.1 * (u - mid), upper.0 + upper.1 * (u - mid));
-            if hi <= lo {
-                continue;
-            }
-            let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-            for (xv, wv) in xs_v.iter().zip(ws_v) {
-                let v = vm + half_v * xv;
-                visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+                for (xu, wu) in xs_u.iter().zip(ws_u) {
+                    let u = mid + half_u * xu;
+                    let (lo, hi) = (lower.0 + lower.1 * (u - mid), upper.0 + upper.1 * (u - mid));
+                    if hi > lo {
+                        column(u, half_u, *wu, lo, hi);
+                    }
+                }
             }
         }
     }

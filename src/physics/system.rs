@@ -3,7 +3,8 @@
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
 use super::contact::{
-    Contact, EvaluationOutputs, GeometryCache, PointLoad, TrackLinearization, TrackState,
+    Contact, EvaluationOutputs, GeometryCache, Matrix6x12, PointLoad, TrackLinearization,
+    TrackMoments, TrackState,
 };
 use super::forces::{ForceElement, Wrench};
 use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
@@ -37,8 +38,12 @@ pub struct Workspace {
     pub geometry: GeometryCache,
     /// Record each active track's force derivatives during a derivative evaluation.
     pub linearize: bool,
-    /// The tracks' force derivatives of the last evaluation (when `linearize`).
+    /// The tracks' force derivatives of the last evaluation (when `linearize`), per contact
+    /// point.
     pub linearizations: Vec<TrackLinearization>,
+    /// The exact face contact's force derivatives of the last evaluation (when `linearize`),
+    /// one sum per track.
+    pub linearization_moments: Vec<TrackMoments>,
     /// Leave the contacts out of the derivative (the contact-free part of the Jacobian).
     pub skip_contacts: bool,
     /// Keep the active tracks of each derivative evaluation in `tracks`.
@@ -142,6 +147,7 @@ impl MultibodySystem {
             geometry: GeometryCache::default(),
             linearize: false,
             linearizations: Vec::new(),
+            linearization_moments: Vec::new(),
             skip_contacts: false,
             keep_tracks: false,
             power: PowerBalance::default(),
@@ -203,6 +209,7 @@ impl MultibodySystem {
             power.applied += p.applied;
         }
         ws.linearizations.clear();
+        ws.linearization_moments.clear();
         if !ws.skip_contacts {
             let keep = ws.keep_tracks;
             let mut kept = std::mem::take(&mut ws.tracks);
@@ -225,6 +232,7 @@ impl MultibodySystem {
                     &mut ws.geometry,
                     EvaluationOutputs {
                         linearizations: ws.linearize.then_some(&mut ws.linearizations),
+                        moments: ws.linearize.then_some(&mut ws.linearization_moments),
                         points: None,
                     },
                 );
@@ -295,6 +303,10 @@ impl MultibodySystem {
         // mass on m, differentiated by k's [δx, δθ, δv, δω_world]. The points' blocks are summed
         // here (in the points' order: mirror pairs cancel exactly) and mapped to the state once.
         let mut blocks: Vec<Option<Matrix6x12>> = vec![None; nb * nb];
+        let dynamic = |k: usize| matches!(self.bodies[k].kind, BodyKind::Dynamic { .. });
+        for sum in &ws.linearization_moments {
+            sum.add_blocks(&ws.frames, dynamic, &mut blocks);
+        }
         for lin in &ws.linearizations {
             let ends = [(lin.body_a, 1.0), (lin.body_b, -1.0)];
             let nrm = lin.normal;
@@ -528,11 +540,6 @@ impl MultibodySystem {
         k
     }
 }
-
-/// The force (rows 0-2) and the torque about the target's centre of mass (rows 3-5) on one body,
-/// differentiated by another body's `[δx, δθ, δv, δω_world]` (columns), in
-/// [`MultibodySystem::contact_jacobian`].
-type Matrix6x12 = nalgebra::SMatrix<f64, 6, 12>;
 
 /// `[r]× M`: the cross product of `r` with each column of `M`.
 #[inline]

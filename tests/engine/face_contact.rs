@@ -401,7 +401,7 @@ fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
     ws.linearize = true;
     let mut f = vec![0.0; n];
     sys.derivative(0.0, y, &mut f, &mut ws);
-    assert!(!ws.linearizations.is_empty());
+    assert!(!ws.linearization_moments.is_empty());
     let mut analytic = vec![0.0; n * n];
     sys.contact_jacobian(y, &ws, &mut analytic);
     let full = fd_jacobian(sys, y, true);

@@ -7,6 +7,8 @@ mod energy_passivity;
 mod engine_closed_forms;
 mod error_control;
 mod face_contact;
+mod face_contact_blocks;
+mod face_contact_rules;
 mod gap_campaign;
 mod gap_diagnose;
 mod gap_effects;

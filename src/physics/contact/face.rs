@@ -16,7 +16,7 @@
 
 use super::point::PointOutputs;
 use super::Contact;
-use crate::geometry::{inner_box_faces, FacePatch, PlacedFace, QuadratureOrder};
+use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -39,11 +39,17 @@ pub enum FaceContact {
 /// integrand has a kink where `w = 0` crosses it on a tilted face.
 const ROUNDED_EDGE_SLICES: usize = 2;
 
-/// The rule on the separating part of the damping ramp `w < d` of a pressed polygon, where
-/// the damping's STEP is a cycloid in `w` and the clamp may cut it along a curve: 5 × 5
-/// Gauss–Legendre (3 nodes across the cycloid left 1e-3 of an impact's force,
-/// tests/engine/face_contact.rs against the continuum).
-const RAMP_RULE: QuadratureOrder = QuadratureOrder::ROUNDED_EDGE;
+/// The rule on the separating part of the damping ramp `w < d` of a pressed polygon, turned
+/// so that its slices run across the ramp ([`FacePatch::aligned_with`] `w`): 5 nodes across,
+/// on the STEP's cycloid in `w` (3 left 1e-3 of an impact's force, tests/engine/face_contact.rs
+/// against the continuum), and along the ramp, where `w` is constant and the density
+/// `max(0, k w^e + c STEP(w) ẇ)` is piecewise affine in the position with its kink where the
+/// clamp cuts, 2 nodes on the pressing side of the kink (exact) and one on the clamped rest
+/// ([`FacePatch::for_each_node_clamped`]).
+const RAMP_RULE: QuadratureOrder = QuadratureOrder {
+    across: 2,
+    along: 5,
+};
 
 /// The rule on the closing part of the damping ramp (`ẇ >= 0`: no clamp), turned so that its
 /// slices run across the ramp ([`FacePatch::aligned_with`] `w`): 5 nodes across, on the
@@ -55,12 +61,26 @@ const CLOSING_RAMP_RULE: QuadratureOrder = QuadratureOrder {
 };
 
 /// The rule on the separating band where the force's clamp `max(0, k w^e + c ẇ)` may cut the
-/// polygon along a curve: 3 × 3 Gauss–Legendre, exact to degree 5 (so for the elastic
-/// densities of `e = 2`).
+/// polygon along a curve, turned as the ramp: along the band, 2 nodes on the pressing side of
+/// the clamp's kink (exact) and one on the clamped rest; across it 3 nodes, exact to degree 5
+/// away from where the clamp's curve meets the band's sides (for `e = 2` the pressing
+/// column's integral is a polynomial of degree 5 in `u` between those points).
 const CLAMP_RULE: QuadratureOrder = QuadratureOrder {
-    across: 3,
+    across: 2,
     along: 3,
 };
+
+/// How a part of a pressed polygon is integrated.
+#[derive(Debug, Clone, Copy)]
+enum PartRule {
+    /// The patch rule for the exponent (exact for the polynomial densities).
+    Patch,
+    /// A fixed rule.
+    Fixed(QuadratureOrder),
+    /// A part turned along `w` whose force clamps to zero along a curve: the rule with its
+    /// columns cut at the clamp ([`FacePatch::for_each_node_clamped`]).
+    Clamped(QuadratureOrder),
+}
 
 impl Contact {
     /// The pressed polygon `patch` cut where the per-point normal force
@@ -81,20 +101,17 @@ impl Contact {
         fb: &BodyFrame,
         radius: f64,
         normal: &Vector3<f64>,
-    ) -> [Option<(FacePatch, Option<QuadratureOrder>)>; 5] {
+    ) -> [Option<(FacePatch, PartRule)>; 5] {
         let mut parts = [None; 5];
         let mut count = 0;
-        let mut push = |part: FacePatch, rule: Option<QuadratureOrder>| {
+        let mut push = |part: FacePatch, rule: PartRule| {
             parts[count] = Some((part, rule));
             count += 1;
         };
         if self.impact.max_damping == 0.0 {
-            push(*patch, None);
+            push(*patch, PartRule::Patch);
         } else {
-            let rate = patch.affine(|x| {
-                let p = x - normal * radius;
-                -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
-            });
+            let rate = penetration_rate(patch, fa, fb, radius, normal);
             let (core, ramp) = patch.split(&patch.depth().minus(self.impact.full_damping_depth));
             if let Some(ramp) = ramp {
                 let (closing, opening) = ramp.split(&rate);
@@ -102,17 +119,20 @@ impl Contact {
                     // No clamp: along the ramp `w` is constant and the density affine.
                     push(
                         closing.aligned_with(&patch.depth()),
-                        Some(CLOSING_RAMP_RULE),
+                        PartRule::Fixed(CLOSING_RAMP_RULE),
                     );
                 }
                 if let Some(opening) = opening {
-                    push(opening, Some(RAMP_RULE));
+                    push(
+                        opening.aligned_with(&patch.depth()),
+                        PartRule::Clamped(RAMP_RULE),
+                    );
                 }
             }
             if let Some(core) = core {
                 let (closing, opening) = core.split(&rate);
                 if let Some(closing) = closing {
-                    push(closing, None);
+                    push(closing, PartRule::Patch);
                 }
                 if let Some(opening) = opening {
                     // Where ẇ <= −k w_max^e / c the force is clamped to zero at every node
@@ -122,10 +142,13 @@ impl Contact {
                     let dead = -self.impact.elastic_force(w_max) / self.impact.max_damping;
                     let (band, clamped) = opening.split(&rate.minus(dead));
                     if let Some(band) = band {
-                        push(band, Some(CLAMP_RULE));
+                        push(
+                            band.aligned_with(&patch.depth()),
+                            PartRule::Clamped(CLAMP_RULE),
+                        );
                     }
                     if let Some(clamped) = clamped {
-                        push(clamped, None);
+                        push(clamped, PartRule::Patch);
                     }
                 }
             }
@@ -162,7 +185,25 @@ impl Contact {
                 };
                 let parts = self.damping_parts(&patch, fa, fb, radius, &normal);
                 for (part, rule) in parts.into_iter().flatten() {
-                    part.for_each_node(rule.unwrap_or(order), &mut visit);
+                    match rule {
+                        PartRule::Patch => part.for_each_node(order, &mut visit),
+                        PartRule::Fixed(rule) => part.for_each_node(rule, &mut visit),
+                        PartRule::Clamped(rule) => {
+                            // Turned along `w`: `w` depends on `u` alone, `ẇ` is affine.
+                            let depth = part.depth();
+                            let rate = penetration_rate(&part, fa, fb, radius, &normal);
+                            let sign = |u: f64| {
+                                let w = depth.at([u, 0.0]);
+                                if w <= 0.0 {
+                                    return (0.0, 0.0);
+                                }
+                                let (spring, damping) = self.impact.force_parts(w);
+                                let r0 = rate.at([u, 0.0]);
+                                (spring + damping * r0, damping * (rate.at([u, 1.0]) - r0))
+                            };
+                            part.for_each_node_clamped(rule, sign, &mut visit);
+                        }
+                    }
                 }
             }
             if !face.is_bounded() {
@@ -190,4 +231,19 @@ impl Contact {
             out.sum.normal = normal;
         }
     }
+}
+
+/// The penetration rate `ẇ = −n·v_rel` of the balls of `radius` on `patch` (affine in its `ξ`:
+/// a rigid relative motion).
+fn penetration_rate(
+    patch: &FacePatch,
+    fa: &BodyFrame,
+    fb: &BodyFrame,
+    radius: f64,
+    normal: &Vector3<f64>,
+) -> Line {
+    patch.affine(|x| {
+        let p = x - normal * radius;
+        -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
+    })
 }

@@ -36,10 +36,13 @@ use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
 mod face;
 mod geometry_cache;
+mod moments;
 mod point;
 
 pub use face::FaceContact;
 pub use geometry_cache::{GeometryCache, GeometryMode, PATCH_REUSE};
+pub(crate) use moments::Matrix6x12;
+pub use moments::TrackMoments;
 use point::{PointOutputs, TrackSum};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
@@ -191,8 +194,11 @@ pub struct PointLoad {
 /// track's force derivatives, and every touching point's load.
 #[derive(Default)]
 pub struct EvaluationOutputs<'a> {
-    /// Receives each active track's force derivatives.
+    /// Receives each active track's force derivatives (per contact point).
     pub linearizations: Option<&'a mut Vec<TrackLinearization>>,
+    /// Receives the exact face contact's force derivatives, one sum per track (its nodes'
+    /// derivatives as moments; taken only together with `linearizations`).
+    pub moments: Option<&'a mut Vec<TrackMoments>>,
     /// Receives each touching contact point's load.
     pub points: Option<&'a mut dyn FnMut(&PointLoad)>,
 }
@@ -318,8 +324,8 @@ impl Contact {
             sink,
             &mut GeometryCache::default(),
             EvaluationOutputs {
-                linearizations: None,
                 points: Some(points),
+                ..Default::default()
             },
         )
     }
@@ -338,6 +344,7 @@ impl Contact {
     ) -> f64 {
         let EvaluationOutputs {
             mut linearizations,
+            mut moments,
             mut points,
         } = outputs;
         let fa = &frames[self.body_a];
@@ -390,10 +397,18 @@ impl Contact {
                     self.face_extents.get(jf).and_then(Option::as_ref),
                     &iso_b,
                 );
+                // The exact face contact's nodes sum their derivatives into one block per
+                // track when the moments are taken.
+                let exact_faces = self.face_contact == FaceContact::Exact
+                    && matches!(shape, ConvexShape::RoundedBox { .. });
+                let mut track_moments =
+                    (exact_faces && linearizations.is_some() && moments.is_some())
+                        .then(|| TrackMoments::new(self.body_a, self.body_b, fa, fb));
                 let mut out = PointOutputs {
                     index,
                     track: (ip * nfaces + jf) as u32,
                     linearizations: linearizations.as_deref_mut(),
+                    moments: track_moments.as_mut(),
                     points: points.as_deref_mut(),
                     energy: &mut energy,
                     sum: TrackSum::default(),
@@ -438,6 +453,11 @@ impl Contact {
                     }
                 }
                 let track = out.sum;
+                if let (Some(sum), Some(all)) = (track_moments, moments.as_deref_mut()) {
+                    if !sum.is_empty() {
+                        all.push(sum);
+                    }
+                }
                 if !track.touching {
                     continue;
                 }

@@ -3,7 +3,7 @@
 //! contact-point lattice and the exactly integrated face contact, whose quadrature nodes are
 //! points of the same law ([`super::face`]).
 
-use super::{PointLoad, TrackLinearization};
+use super::{PointLoad, TrackLinearization, TrackMoments};
 use crate::physics::body::BodyFrame;
 use crate::physics::friction::FrictionParams;
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -16,6 +16,8 @@ pub(super) struct PointOutputs<'s, 'p> {
     pub(super) track: u32,
     /// Receives each loaded point's force derivatives.
     pub(super) linearizations: Option<&'s mut Vec<TrackLinearization>>,
+    /// Or sums them into one block per track (the exact face contact's nodes).
+    pub(super) moments: Option<&'s mut TrackMoments>,
     /// Receives each loaded point's load.
     pub(super) points: Option<&'s mut (dyn FnMut(&PointLoad) + 'p)>,
     /// The contact's stored elastic energy, J: each point adds its own (in the points' order,
@@ -69,24 +71,27 @@ impl super::Contact {
                 force -= slip * (ft / speed);
             }
         }
-        if let Some(lin) = out.linearizations.as_deref_mut() {
-            if fn_mag > 0.0 {
-                let (dfn_dw, dfn_dwdot) = self.impact.unclamped_gradient(w, wdot, damping);
-                let (dforce_dfn, dforce_dslip) =
-                    friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag, mu);
-                lin.push(TrackLinearization {
-                    body_a: self.body_a,
-                    body_b: self.body_b,
-                    deepest_point: p,
-                    point: p,
-                    centre: *centre,
-                    force,
-                    normal,
-                    dfn_dw: beta * dfn_dw,
-                    dfn_dwdot: beta * dfn_dwdot,
-                    dforce_dfn,
-                    dforce_dslip,
-                });
+        if fn_mag > 0.0 && (out.linearizations.is_some() || out.moments.is_some()) {
+            let (dfn_dw, dfn_dwdot) = self.impact.unclamped_gradient(w, wdot, damping);
+            let (dforce_dfn, dforce_dslip) =
+                friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag, mu);
+            let lin = TrackLinearization {
+                body_a: self.body_a,
+                body_b: self.body_b,
+                deepest_point: p,
+                point: p,
+                centre: *centre,
+                force,
+                normal,
+                dfn_dw: beta * dfn_dw,
+                dfn_dwdot: beta * dfn_dwdot,
+                dforce_dfn,
+                dforce_dslip,
+            };
+            if let Some(sum) = out.moments.as_deref_mut() {
+                sum.add(&lin);
+            } else if let Some(all) = out.linearizations.as_deref_mut() {
+                all.push(lin);
             }
         }
         *out.energy += beta * self.impact.potential(w);

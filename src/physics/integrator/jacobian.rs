@@ -121,7 +121,7 @@ impl Integrator {
         hd: f64,
         t: f64,
     ) -> bool {
-        if ws.linearizations.is_empty() {
+        if ws.linearizations.is_empty() && ws.linearization_moments.is_empty() {
             if self.lu_valid && self.lu_contact_free && self.lu_h == hd {
                 return true;
             }
