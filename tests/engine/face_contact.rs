@@ -4,6 +4,10 @@
 //! energy balance, a shoe sliding off a lip, the contact Jacobian against central
 //! differences, and the launcher's pressure resultants against a 33-point lattice.
 //! Every bound is fixed by physics (closed forms, conservation), not by the code's output.
+//!
+//! Over 700 lines: these tests and the fixtures the other face-contact files borrow (the head,
+//! the lip, the pressed cube); the Jacobian blocks and the fixed-order rules already have their
+//! own files.
 
 use super::energy_passivity::random_missile_state;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
@@ -36,9 +40,9 @@ fn head() -> ConvexShape {
     ConvexShape::rounded_box(Vector3::new(HALF[0], HALF[1], HALF[2]), ROUNDOVER).expect("head")
 }
 
-/// A lip top: plane y = 0 (solid below), real edge at x = 0 (the slot for x > 0), open
-/// elsewhere; `bounded = false` gives the whole plane.
-fn lip_contact(bounded: bool, friction: bool) -> Contact {
+/// The plane y = 0, solid below, and its extent bounded at x = 0 (the solid for x < 0), open
+/// elsewhere: a rail lip's top.
+pub(crate) fn lip_plane() -> (HalfSpace, FaceExtent) {
     let plane = HalfSpace::new(Vector3::y(), 0.0).expect("plane");
     let extent = FaceExtent {
         origin: Point3::origin(),
@@ -46,6 +50,13 @@ fn lip_contact(bounded: bool, friction: bool) -> Contact {
         s_range_m: (f64::NEG_INFINITY, 0.0),
         t_range_m: (f64::NEG_INFINITY, f64::INFINITY),
     };
+    (plane, extent)
+}
+
+/// A lip top: plane y = 0 (solid below), real edge at x = 0 (the slot for x > 0), open
+/// elsewhere; `bounded = false` gives the whole plane.
+fn lip_contact(bounded: bool, friction: bool) -> Contact {
+    let (plane, extent) = lip_plane();
     Contact::new(
         "head-lip",
         0,
@@ -359,7 +370,7 @@ fn a_head_sliding_off_a_lip_unloads_continuously_and_its_work_is_the_energy_drop
 
 /// Rattle box C with the cube tilted, pressed into the floor, spinning and sliding, in the
 /// exact face contact (as the lattice's Jacobian test in `models::system_tests`).
-fn pressed_cube(moving: bool) -> (MultibodySystem, Vec<f64>) {
+pub(crate) fn pressed_cube(moving: bool) -> (MultibodySystem, Vec<f64>) {
     let mut case =
         railwear::models::case::load_case(&configs().join("rattle-box-c.toml")).expect("case");
     case.simulation.face_contact = FaceContact::Exact;

@@ -97,15 +97,7 @@ fn the_exact_face_jacobian_per_track_is_the_sum_over_its_nodes() {
         assert_round_off(&by_track, &by_node, n, 1e-11);
     }
 
-    let mut case =
-        railwear::models::case::load_case(&configs().join("rattle-box-c.toml")).expect("case");
-    case.simulation.face_contact = FaceContact::Exact;
-    let model = railwear::models::case::build(&case, configs()).expect("model");
-    let mut y = model.initial_state.clone();
-    y[1] -= 3e-5;
-    let q = nalgebra::UnitQuaternion::from_euler_angles(2e-3, 1e-3, -4e-3).into_inner();
-    y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
-    y[7..13].copy_from_slice(&[0.3, -0.05, 0.1, 2.0, -1.0, 0.5]);
-    let (by_track, by_node, _) = both_jacobians(&model.system, &y);
-    assert_round_off(&by_track, &by_node, model.system.state_len(), 1e-11);
+    let (system, y) = super::face_contact::pressed_cube(true);
+    let (by_track, by_node, _) = both_jacobians(&system, &y);
+    assert_round_off(&by_track, &by_node, system.state_len(), 1e-11);
 }

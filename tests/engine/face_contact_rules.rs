@@ -4,19 +4,13 @@
 //! slices, against the same strip cut into 64 slices.
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use railwear::geometry::{FaceExtent, FacePatch, HalfSpace, PlacedFace, QuadratureOrder};
+use railwear::geometry::{FacePatch, PlacedFace, QuadratureOrder};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The plane y = 0, solid below; bounded at x = 0 (the solid for x < 0) when `bounded`.
 fn lip(bounded: bool) -> PlacedFace {
-    let plane = HalfSpace::new(Vector3::y(), 0.0).expect("plane");
-    let extent = FaceExtent {
-        origin: Point3::origin(),
-        tangent: Vector3::x_axis(),
-        s_range_m: (f64::NEG_INFINITY, 0.0),
-        t_range_m: (f64::NEG_INFINITY, f64::INFINITY),
-    };
+    let (plane, extent) = super::face_contact::lip_plane();
     PlacedFace::new(plane, bounded.then_some(&extent), &Isometry3::identity())
 }
 

@@ -11,6 +11,9 @@
 //! 2. The simulator path on a small campaign: tables move the way the physics says (third-body
 //!    abrasion only adds wear; cross-axis drive puts response on the other axes), an effect at
 //!    magnitude 0 is the nominal bit for bit, and the CLI writes the report and its plots.
+//!
+//! Over 700 lines: part 1's hand-built emulator and campaign drawer are one fixture all its
+//! tests share; part 2 (the simulator path) is the part that could move to its own file.
 
 use railwear::gap::accel::AccelLocation;
 use railwear::gap::campaign::{Campaign, Increment, Specimen};
