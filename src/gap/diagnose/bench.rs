@@ -26,7 +26,8 @@
 //!
 //! **Carried by one test.** The diagnosis confirms an effect on held-out tests
 //! (leave-one-test-out), so an effect whose readings differ detectably in one test alone has
-//! nothing to be fitted on when that test is held out. The bench counts the tests in which an
+//! nothing to be fitted on when that test is held out. A proxy: an effect spread thinly over
+//! several tests, detectable in none alone, counts as carried by fewer than two. The bench counts the tests in which an
 //! effect is detectable on their own observations (`detectable_tests`; a pair: the fewest over
 //! the pair and each member given the other). Top-1 and both-named are reported over every
 //! detectable campaign and over those two or more tests carry; for the singles one test
@@ -195,14 +196,14 @@ pub struct Scores {
     pub detectable_in_library: usize,
     /// Of those, the share whose best effect is the true one.
     pub top1: f64,
-    /// Detectable in-library single effects that two or more tests carry (held-out tests can
-    /// confirm them).
+    /// Detectable in-library single effects detectable in two or more tests on their own
+    /// (held-out tests can confirm them).
     #[serde(default)]
     pub confirmable_in_library: usize,
     /// Of those, the share whose best effect is the true one.
     #[serde(default)]
     pub top1_confirmable: f64,
-    /// Detectable in-library single effects that one test alone carries.
+    /// Detectable in-library single effects detectable in fewer than two tests on their own.
     #[serde(default)]
     pub one_test_singles: usize,
     /// Of those, the share whose leading candidate (`explained` or `partly_explained`) is the
@@ -212,7 +213,8 @@ pub struct Scores {
     /// Detectable pairs.
     #[serde(default)]
     pub detectable_pairs: usize,
-    /// Detectable pairs that two or more tests carry (each member given the other).
+    /// Detectable pairs detectable in two or more tests on their own (each member given the
+    /// other).
     #[serde(default)]
     pub confirmable_pairs: usize,
     /// Of those, the share `explained` by exactly their two effects.
@@ -865,12 +867,12 @@ impl Scores {
             pct(self.top1)
         ));
         s.push_str(&format!(
-            "| of them carried by two or more tests, which held-out tests can confirm ({}) | {} | >= 85 % |\n",
+            "| of them detectable in two or more tests on their own, which held-out tests can confirm ({}) | {} | >= 85 % |\n",
             self.confirmable_in_library,
             pct(self.top1_confirmable)
         ));
         s.push_str(&format!(
-            "| of them carried by one test alone: leading candidate right ({}) | {} | |\n",
+            "| of them detectable in fewer than two tests on their own: leading candidate right ({}) | {} | |\n",
             self.one_test_singles,
             pct(self.one_test_led_right)
         ));
@@ -885,7 +887,7 @@ impl Scores {
             pct(self.pairs_both_named)
         ));
         s.push_str(&format!(
-            "| of them carried by two or more tests ({}) | {} | >= 60 % |\n",
+            "| of them detectable in two or more tests on their own ({}) | {} | >= 60 % |\n",
             self.confirmable_pairs,
             pct(self.confirmable_pairs_both_named)
         ));
