@@ -179,9 +179,18 @@ fn secondary(
             .filter(|c| c.spec.first().is_some_and(|s| s.1 != 0.0))
             .collect();
         order.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
+        // The best by held-out likelihood, and every single that explains only partly: when
+        // one test carries what they explain, the held-out likelihood does not rank them
+        // (docs/diagnosis.md, "Seen in one test").
         let mut leaders: Vec<(usize, f64)> = order
             .iter()
             .take(SECONDARY_CONTENDERS)
+            .chain(
+                order
+                    .iter()
+                    .skip(SECONDARY_CONTENDERS)
+                    .filter(|c| c.explains(&nominal)),
+            )
             .map(|c| (problem.families[c.families[0]][0], c.spec[0].1))
             .collect();
         // Every wear-law effect with a secondary parameter is profiled too, whatever its
