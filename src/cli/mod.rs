@@ -4,7 +4,7 @@
 
 pub mod contact_fit;
 
-use crate::models::case::load_case;
+use crate::models::case::{load_case, read_case};
 use crate::pipeline::{run_case, Progress, RunControl};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -21,7 +21,8 @@ pub fn run(
     settle: Option<f64>,
     configs_dir: &Path,
 ) -> Result<()> {
-    let mut case = load_case(config_file)?;
+    // Read unchecked and validated once, after the overrides.
+    let mut case = read_case(config_file)?;
     if let Some(d) = duration {
         case.simulation.duration_s = d;
     }
