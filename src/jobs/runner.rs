@@ -364,17 +364,12 @@ impl CaseRunner for LibraryRunner {
         control: &RunControl,
         checkpoint: Option<&[u8]>,
     ) -> Result<JobOutput, RunError> {
-        if let (JobKind::Simulate, Some(stored)) = (kind, stored) {
-            let out =
-                SimulatePlan::from_json(stored)?.run(&self.configs_dir, control, checkpoint)?;
-            return Ok(JobOutput {
-                summary: out.summary,
-                tracks: out.tracks,
-                plots: out.plots,
-                ..JobOutput::default()
-            });
-        }
-        let plan = self.plan(kind, params)?;
+        let plan = match (kind, stored) {
+            (JobKind::Simulate, Some(stored)) => {
+                JobPlan::Simulate(Box::new(SimulatePlan::from_json(stored)?.case))
+            }
+            _ => self.plan(kind, params)?,
+        };
         let control = &match plan {
             JobPlan::Simulate(_) | JobPlan::SweepPoint(..) => control.clone(),
             _ => control.without_checkpoint(),

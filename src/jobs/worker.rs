@@ -335,7 +335,6 @@ impl Jobs {
         }
     }
 
-    /// The checkpoint stored for job `id` by an earlier attempt, if any.
     /// The plan stored with job `id` at submission. A job without one (its kind has none, or
     /// it was queued before plans were stored) is planned from its params by the runner; so is
     /// one whose plan cannot be read now (logged).
@@ -349,6 +348,7 @@ impl Jobs {
         }
     }
 
+    /// The checkpoint stored for job `id` by an earlier attempt, if any.
     async fn stored_checkpoint(&self, id: uuid::Uuid, attempt: i64) -> Option<JobCheckpoint> {
         match self.store.load_checkpoint(id).await {
             Ok(Some(cp)) => {

@@ -1,7 +1,7 @@
 //! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, the typed plan a
 //! job stores ([`SimulatePlan`]), and the run.
 
-use super::run::{run_case, run_case_from};
+use super::run::run_case;
 use super::{
     check_keys, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError, SIMULATE_KEYS,
 };
@@ -253,8 +253,7 @@ pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<C
 /// A simulate job parsed and checked once, at submission: the complete case (reference config,
 /// overrides and seed merged; `simulation.seed` is the job's seed), stored with the job as its
 /// canonical JSON ([`SimulatePlan::to_json`]) and run by the worker from there
-/// ([`SimulatePlan::from_json`], [`SimulatePlan::run`]) without reading the params or the
-/// reference config again.
+/// ([`SimulatePlan::from_json`]) without reading the params or the reference config again.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimulatePlan {
@@ -291,18 +290,6 @@ impl SimulatePlan {
         Self::deserialize(value).map_err(|e| {
             FieldError::new("plan", format!("is not a simulate job's stored plan: {e}")).into()
         })
-    }
-
-    /// Runs the case (validated and built once), resuming from `resume` when it fits
-    /// ([`run_case_from`]).
-    pub fn run(
-        &self,
-        configs_dir: &Path,
-        control: &RunControl,
-        resume: Option<&[u8]>,
-    ) -> Result<CaseOutcome, RunError> {
-        let (_, outcome) = run_case_from(&self.case, configs_dir, control, resume)?;
-        Ok(outcome)
     }
 }
 

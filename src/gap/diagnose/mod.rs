@@ -541,6 +541,11 @@ impl Candidate {
             && self.residual_p >= self.alpha
             && self.explained_share(nominal) >= MIN_EXPLAINED_SHARE
     }
+
+    /// Explains, and not only partly: what lets a single stand without pairs or profiles.
+    fn explains_cleanly(&self, nominal: &Candidate, emulator: &Emulator) -> bool {
+        self.explains(nominal) && !self.only_partly(nominal, emulator)
+    }
 }
 
 /// Runs the diagnosis: builds the emulator (simulations, reported through `progress(done,
@@ -740,9 +745,9 @@ pub fn diagnose_with(
         .collect();
     // A single that explains only partly (fitted at a bound, or a small held-out shrink)
     // leaves room for a second effect: the pairs are tried then too.
-    let clean_single = explaining_singles
+    let clean_single = singles
         .iter()
-        .any(|&i| !singles[i].only_partly(&nominal, emulator));
+        .any(|c| c.explains_cleanly(&nominal, emulator));
     if !no_gap && !clean_single {
         pairs = problem
             .pair_models(&singles, &nominal)
@@ -813,8 +818,7 @@ pub fn diagnose_with(
         // instead.
         clean_single
             || !pairs.iter().any(|p| {
-                p.explains(&nominal)
-                    && !p.only_partly(&nominal, emulator)
+                p.explains_cleanly(&nominal, emulator)
                     && p.held_ll() - singles[first].held_ll() > MIN_HELD_OUT_GAIN
             })
     }) {

@@ -167,8 +167,10 @@ fn secondary(
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
         };
-        let cleanly = |c: &Candidate| c.explains(&nominal) && !c.only_partly(&nominal, emulator);
-        if singles.iter().any(cleanly) {
+        if singles
+            .iter()
+            .any(|c| c.explains_cleanly(&nominal, emulator))
+        {
             return Ok(());
         }
         let mut order: Vec<&Candidate> = singles
@@ -368,9 +370,10 @@ fn exact_pairs(
                 return Ok(());
             };
             // Pairs are tried beside a single that explains only partly too.
-            let cleanly =
-                |c: &Candidate| c.explains(&nominal) && !c.only_partly(&nominal, emulator);
-            if singles.iter().any(cleanly) {
+            if singles
+                .iter()
+                .any(|c| c.explains_cleanly(&nominal, emulator))
+            {
                 return Ok(());
             }
             let models = problem.pair_models(&singles, &nominal);
