@@ -199,6 +199,13 @@ enum Command {
         /// pair); each keeps the seed it has in the full draw.
         #[arg(long)]
         truth: Option<String>,
+        /// Write each campaign's diagnosis report (with its truth) as <DIR>/<rig seed>.json.
+        #[arg(long)]
+        reports: Option<PathBuf>,
+        /// Keep only the campaigns with these rig seeds (seed x 1000 + index in the draw),
+        /// each as the full bench draws it: `--only 1039,1042`.
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<u64>,
         /// Write every outcome as JSON here.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -624,6 +631,8 @@ async fn main() -> Result<()> {
             window_s,
             threads,
             truth,
+            reports,
+            only,
             out,
             emulator_file,
             configs_dir,
@@ -634,6 +643,8 @@ async fn main() -> Result<()> {
                 seed: *seed,
                 rig_window_s: *window_s,
                 truth_filter: truth.clone(),
+                reports_dir: reports.clone(),
+                only_seeds: only.clone(),
                 ..Default::default()
             };
             options.diagnose.emulator.window_s = *window_s;

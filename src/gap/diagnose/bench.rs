@@ -82,6 +82,12 @@ pub struct BenchOptions {
     /// or `pairs` (every pair): a focused study. Each kept campaign has the seed, records and draw it has in
     /// the full bench. None: every campaign.
     pub truth_filter: Option<String>,
+    /// Write each campaign's diagnosis report here, as `<rig seed>.json` (with its truth beside
+    /// it): what a confusion row hides.
+    pub reports_dir: Option<std::path::PathBuf>,
+    /// Keep only the campaigns with these rig seeds (empty: all): one campaign re-run as the
+    /// full bench draws it.
+    pub only_seeds: Vec<u64>,
     /// Diagnosis options.
     pub diagnose: DiagnoseOptions,
 }
@@ -101,6 +107,8 @@ impl Default for BenchOptions {
             fractions: vec![0.07, 0.3, 0.8],
             pairs_per_kind: 4,
             truth_filter: None,
+            reports_dir: None,
+            only_seeds: Vec::new(),
             diagnose: DiagnoseOptions {
                 emulator: EmulatorOptions {
                     window_s: 0.5,
@@ -385,6 +393,7 @@ fn scenarios(
             },
         )
         .filter(|s| named(&s.truth))
+        .filter(|s| o.only_seeds.is_empty() || o.only_seeds.contains(&s.seed))
         .take(o.campaigns)
         .collect())
 }
@@ -622,6 +631,9 @@ pub fn run(
             &|_, _| {},
         )?;
         let refinements = refined.simulations - emulator.simulations;
+        if let Some(dir) = &o.reports_dir {
+            write_report(dir, s, &report)?;
+        }
         let chosen = report.best_effect.as_ref().map(|b| b.name.clone());
         outcomes.push(Outcome {
             scenario: s.clone(),
@@ -669,6 +681,20 @@ pub fn run(
         ));
     }
     Ok(score(outcomes))
+}
+
+/// Writes `report` and its scenario as `<dir>/<rig seed>.json`.
+fn write_report(dir: &Path, s: &Scenario, report: &Report) -> Result<(), GapError> {
+    let path = dir.join(format!("{}.json", s.seed));
+    let write_error = |x: String| GapError::Write {
+        path: path.display().to_string(),
+        message: x,
+    };
+    std::fs::create_dir_all(dir).map_err(|x| write_error(x.to_string()))?;
+    let text =
+        serde_json::to_string_pretty(&serde_json::json!({ "scenario": s, "report": report }))
+            .map_err(|x| write_error(x.to_string()))?;
+    std::fs::write(&path, text).map_err(|x| write_error(x.to_string()))
 }
 
 fn answer(o: &Outcome) -> String {
