@@ -157,9 +157,17 @@ pub struct Outcome {
     pub detectability: f64,
     /// Detectable (score > 2; a pair: each member's score given the other > 2 too).
     pub detectable: bool,
-    /// A pair's members' detectability, each given the other.
+    /// A pair's members' detectability, each given the other at its drawn magnitude.
     #[serde(default)]
     pub member_detectability: Vec<f64>,
+    /// A pair's members' detectability, each given the other at the magnitude that brings the
+    /// other alone closest to the pair's readings (its drawn secondary values kept): a member
+    /// the other can stand in for, at some magnitude, is not seen (module `bench`, "Pairs").
+    #[serde(default)]
+    pub member_distinguishable: Vec<f64>,
+    /// Detectable at the drawn magnitudes (the older measure, `member_detectability` over 2).
+    #[serde(default)]
+    pub detectable_at_drawn: bool,
     /// Tests in which the effect is detectable on their own observations (a pair: the
     /// fewest over the pair against the control and each member given the other). Held-out
     /// tests can confirm an effect only when at least two tests carry it.
@@ -231,6 +239,13 @@ pub struct Scores {
     /// Of those, the share `explained` by exactly their two effects.
     #[serde(default)]
     pub pairs_both_named: f64,
+    /// Pairs detectable with each member given the other at its drawn magnitude (the older
+    /// measure: it counts a member that the other, at another magnitude, stands in for).
+    #[serde(default)]
+    pub pairs_detectable_at_drawn: usize,
+    /// Of those, the share `explained` by exactly their two effects.
+    #[serde(default)]
+    pub pairs_at_drawn_both_named: f64,
     /// Campaigns `explained` by an effect that is not (part of) the truth.
     #[serde(default)]
     pub wrong_names: usize,
@@ -440,6 +455,67 @@ fn detectability(
     detectability_in(effect, control, noise, noisy, |_| true)
 }
 
+/// Fractions of a magnitude's bound the search for the closest stand-in starts from.
+const STAND_IN_FRACTIONS: [f64; 8] = [0.01, 0.03, 0.07, 0.15, 0.3, 0.5, 0.75, 1.0];
+
+/// The effect `other` alone at the magnitude whose noise-free readings come closest to a
+/// pair's (its secondary values as drawn): `score` over [`STAND_IN_FRACTIONS`] of its bound
+/// on the drawn magnitude's side, then three golden-section steps between the best one's
+/// neighbours. Returns those readings and their score (`at_drawn` if nothing comes closer).
+fn closest_alone(
+    other: &Effect,
+    alone_at: &dyn Fn(f64) -> Result<Vec<Observation>, GapError>,
+    score: &dyn Fn(&[Observation]) -> f64,
+    at_drawn: f64,
+) -> Result<(Vec<Observation>, f64), GapError> {
+    let info = other.info()?;
+    let drawn = other.magnitude();
+    let bound = if drawn < 0.0 {
+        info.parameters[0].min
+    } else {
+        info.parameters[0].max
+    };
+    let mut tried: Vec<(f64, f64)> = vec![(drawn, at_drawn)];
+    let mut best = (alone_at(drawn)?, at_drawn);
+    let mut try_at = |m: f64, tried: &mut Vec<(f64, f64)>| -> Result<(), GapError> {
+        let obs = alone_at(m)?;
+        let d = score(&obs);
+        tried.push((m, d));
+        if d < best.1 {
+            best = (obs, d);
+        }
+        Ok(())
+    };
+    for f in STAND_IN_FRACTIONS {
+        try_at(f * bound, &mut tried)?;
+    }
+    for _ in 0..3 {
+        tried.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let Some(i) = tried
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+            .map(|(i, _)| i)
+        else {
+            break;
+        };
+        let lo = tried[i.saturating_sub(1)].0;
+        let hi = tried[(i + 1).min(tried.len() - 1)].0;
+        let m = tried[i].0;
+        // Into the wider side, by the golden ratio.
+        let next = if hi - m > m - lo {
+            m + 0.381_966 * (hi - m)
+        } else {
+            m - 0.381_966 * (m - lo)
+        };
+        if tried.iter().any(|t| t.0 == next) {
+            break;
+        }
+        try_at(next, &mut tried)?;
+    }
+    Ok(best)
+}
+
 /// Tests (indices below `tests`) in which the effect is detectable on that test's
 /// observations alone ([`detectability`] over them > 2).
 fn detectable_tests(
@@ -584,6 +660,7 @@ pub fn run(
             &cache,
         )?;
         let mut member_detectability = Vec::new();
+        let mut member_distinguishable = Vec::new();
         let control_obs = &control_obs_by_records[usize::from(s.accelerometers)];
         let tests = skeleton.tests.len();
         let mut in_tests = 0;
@@ -595,30 +672,46 @@ pub fn run(
             let clean_obs = observations(&clean);
             in_tests = detectable_tests(&clean_obs, control_obs, &noise, &noisy_obs, tests);
             if s.effects.len() == 2 {
-                // Each member given the other: the pair against the other member alone.
+                // Each member given the other: the pair against the other member alone, at its
+                // drawn magnitude, then at the magnitude that comes closest.
                 for drop in 0..2 {
-                    let other = Scenario {
-                        effects: vec![s.effects[1 - drop].clone()],
-                        ..s.clone()
+                    let other = &s.effects[1 - drop];
+                    let alone_at = |m: f64| -> Result<Vec<Observation>, GapError> {
+                        let info = other.info()?;
+                        let one = Scenario {
+                            effects: vec![effect_with(info, m, &other.parameters)],
+                            ..s.clone()
+                        };
+                        let (alone, _) = run_cached(
+                            skeleton,
+                            configs_dir,
+                            &rig_options(&one, o, false)?,
+                            control,
+                            &cache,
+                        )?;
+                        Ok(observations(&alone))
                     };
-                    let (alone, _) = run_cached(
-                        skeleton,
-                        configs_dir,
-                        &rig_options(&other, o, false)?,
-                        control,
-                        &cache,
-                    )?;
-                    let alone = observations(&alone);
-                    member_detectability
-                        .push(detectability(&clean_obs, &alone, &noise, &noisy_obs));
+                    let score = |alone: &[Observation]| {
+                        detectability(&clean_obs, alone, &noise, &noisy_obs)
+                    };
+                    let drawn = alone_at(other.magnitude())?;
+                    let at_drawn = score(&drawn);
+                    member_detectability.push(at_drawn);
+                    let (closest, d) = if at_drawn > 2.0 {
+                        closest_alone(other, &alone_at, &score, at_drawn)?
+                    } else {
+                        (drawn, at_drawn)
+                    };
+                    member_distinguishable.push(d);
                     in_tests = in_tests.min(detectable_tests(
-                        &clean_obs, &alone, &noise, &noisy_obs, tests,
+                        &clean_obs, &closest, &noise, &noisy_obs, tests,
                     ));
                 }
             }
             detectability(&clean_obs, control_obs, &noise, &noisy_obs)
         };
-        let detectable = det > 2.0 && member_detectability.iter().all(|d| *d > 2.0);
+        let detectable_at_drawn = det > 2.0 && member_detectability.iter().all(|d| *d > 2.0);
+        let detectable = det > 2.0 && member_distinguishable.iter().all(|d| *d > 2.0);
         // Each campaign refines its own copy, so its diagnosis is the one it would get alone.
         let mut refined = emulator.clone();
         let report: Report = diagnose_refining(
@@ -640,6 +733,8 @@ pub fn run(
             detectability: det,
             detectable,
             member_detectability,
+            member_distinguishable,
+            detectable_at_drawn,
             detectable_tests: in_tests,
             verdict: report.verdict,
             shrink: report.best_effect.as_ref().map(|b| b.shrink),
@@ -784,6 +879,10 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .filter(|o| o.scenario.truth.contains('+') && o.detectable)
         .collect();
     let pairs_right = det_pairs.iter().filter(|o| named_right(o)).count();
+    let drawn_pairs: Vec<&&Outcome> = lib
+        .iter()
+        .filter(|o| o.scenario.truth.contains('+') && o.detectable_at_drawn)
+        .collect();
     let conf_pairs: Vec<&&&Outcome> = det_pairs.iter().filter(|o| confirmable(o)).collect();
     let conf: Vec<&&&&Outcome> = det_lib.iter().filter(|o| confirmable(o)).collect();
     let one_test: Vec<&&&&Outcome> = det_lib.iter().filter(|o| !confirmable(o)).collect();
@@ -836,6 +935,11 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             conf_pairs.len(),
         ),
         pairs_both_named: share(pairs_right, det_pairs.len()),
+        pairs_detectable_at_drawn: drawn_pairs.len(),
+        pairs_at_drawn_both_named: share(
+            drawn_pairs.iter().filter(|o| named_right(o)).count(),
+            drawn_pairs.len(),
+        ),
         wrong_names: wrong,
         wrong_name_rate: share(wrong, outcomes.len()),
         partly_explained: outcomes
@@ -918,6 +1022,11 @@ impl Scores {
             pct(self.confirmable_pairs_both_named)
         ));
         s.push_str(&format!(
+            "| pairs detectable at the drawn magnitudes, explained by both members ({}) | {} | |\n",
+            self.pairs_detectable_at_drawn,
+            pct(self.pairs_at_drawn_both_named)
+        ));
+        s.push_str(&format!(
             "| wrong names: explained by an effect not injected ({} of {}) | {} | <= 5 % |\n",
             self.wrong_names,
             self.campaigns,
@@ -993,6 +1102,8 @@ mod tests {
             detectability: 10.0,
             detectable: true,
             member_detectability: Vec::new(),
+            member_distinguishable: Vec::new(),
+            detectable_at_drawn: true,
             detectable_tests: 4,
             verdict,
             chosen: chosen.map(str::to_string),

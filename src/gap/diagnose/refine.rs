@@ -399,8 +399,8 @@ fn exact_pairs(
         };
         let (requests, joints) = requests;
         if round == 0 {
-            for m in models {
-                if let Model::Pair(a, b) = m {
+            for m in &models {
+                if let Model::Pair(a, b) = *m {
                     let (acts_a, acts_b) =
                         (emulator.effects[a].info.acts, emulator.effects[b].info.acts);
                     let pair = match (acts_a, acts_b) {
@@ -415,6 +415,7 @@ fn exact_pairs(
                     }
                 }
             }
+            pair_variants(campaign, emulator, options, configs_dir, control, cache)?;
             continue;
         }
         let mut added =
@@ -426,6 +427,117 @@ fn exact_pairs(
         }
         if added == 0 {
             break;
+        }
+    }
+    Ok(())
+}
+
+/// Dynamics + wear-law pairs whose members' variants get exact pair tables.
+const PAIR_VARIANT_CONTENDERS: usize = 2;
+
+/// The secondary values of a dynamics + wear-law pair's members profiled together: a
+/// single's profile chose each member's variant without the other member, which may have
+/// pulled it (a pressure threshold fitted to the nominal tracks, not to a cross-axis drive's).
+/// For the [`PAIR_VARIANT_CONTENDERS`] best such pairs by held-out likelihood that beat the
+/// nominal, each member's variant tables get an exact pair table with the other member's
+/// (the wear law on the dynamics effect's own windows); the pair's fit then chooses among
+/// them (`FitProblem::pair_combinations`). For the as many best pairs of two dynamics
+/// effects, each member's tables are simulated with the other at the pair's fit (a member
+/// the fit left at 0 at its single's fit): the product of their ratios may hide what one
+/// adds beside the other, and a joint point corrects it; the refinement rounds then simulate
+/// the chosen two together where the fits land.
+fn pair_variants(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<(), GapError> {
+    // (dynamics table, wear-law table) of each mixed pair to profile, and (table,
+    // magnitude) twice for each pair of dynamics effects.
+    let (contenders, dynamics): (Vec<(usize, usize)>, Vec<[(usize, f64); 2]>) = {
+        let problem = FitProblem::new(campaign, emulator, options);
+        let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
+            return Ok(());
+        };
+        let mut pairs: Vec<(bool, Candidate)> = problem
+            .pair_models(&singles, &nominal)
+            .into_iter()
+            .filter_map(|m| match m {
+                Model::Pair(a, b) => {
+                    let acts = (emulator.effects[a].info.acts, emulator.effects[b].info.acts);
+                    (acts != (Acts::WearLaw, Acts::WearLaw)).then_some((acts.0 == acts.1, m))
+                }
+                _ => None,
+            })
+            .map(|(both, m)| (both, problem.evaluate(m, options.alpha)))
+            .filter(|(_, c)| c.held_ll() > nominal.held_ll())
+            .collect();
+        pairs.sort_by(|a, b| b.1.held_ll().total_cmp(&a.1.held_ll()));
+        let mixed = pairs
+            .iter()
+            .filter(|(both, _)| !both)
+            .take(PAIR_VARIANT_CONTENDERS)
+            .filter_map(|(_, c)| match c.spec[..] {
+                [(a, _), (b, _)] if emulator.effects[a].info.acts == Acts::Dynamics => Some((a, b)),
+                [(a, _), (b, _)] => Some((b, a)),
+                _ => None,
+            })
+            .collect();
+        // A member the pair's fit left at 0 is put at its single's fit: the product of the
+        // two ratios may hide what the member adds beside the other.
+        let single_magnitude = |t: usize| {
+            singles[problem.family_of(t)]
+                .spec
+                .first()
+                .map_or(0.0, |s| s.1)
+        };
+        let dynamics = pairs
+            .iter()
+            .filter(|(both, _)| *both)
+            .take(PAIR_VARIANT_CONTENDERS)
+            .filter_map(|(_, c)| match c.spec[..] {
+                [(a, ma), (b, mb)] => Some([
+                    (a, if ma != 0.0 { ma } else { single_magnitude(a) }),
+                    (b, if mb != 0.0 { mb } else { single_magnitude(b) }),
+                ]),
+                _ => None,
+            })
+            .collect();
+        (mixed, dynamics)
+    };
+    // Two dynamics effects: each member's tables simulated with the other at the pair's fit.
+    for [(a, ma), (b, mb)] in dynamics {
+        let family = |t: usize, emulator: &Emulator| -> Vec<usize> {
+            let name = emulator.effects[t].info.name;
+            (0..emulator.effects.len())
+                .filter(|&i| emulator.effects[i].info.name == name)
+                .collect()
+        };
+        for a2 in family(a, emulator) {
+            emulator.add_joint(campaign, configs_dir, (a2, ma), (b, mb), control, cache)?;
+        }
+        for b2 in family(b, emulator) {
+            emulator.add_joint(campaign, configs_dir, (a, ma), (b2, mb), control, cache)?;
+        }
+    }
+    for (d, w) in contenders {
+        let others = |t: usize, emulator: &Emulator| -> Vec<usize> {
+            let name = emulator.effects[t].info.name;
+            (0..emulator.effects.len())
+                .filter(|&i| i != t && emulator.effects[i].info.name == name)
+                .collect()
+        };
+        for w2 in others(w, emulator) {
+            if emulator.pair(d, w2).is_none() {
+                emulator.add_pair(campaign, configs_dir, d, w2, control, cache)?;
+            }
+        }
+        for d2 in others(d, emulator) {
+            if emulator.pair(d2, w).is_none() {
+                emulator.add_pair(campaign, configs_dir, d2, w, control, cache)?;
+            }
         }
     }
     Ok(())
