@@ -281,15 +281,13 @@ impl SimulatePlan {
 
     /// The plan's canonical JSON (every number round-trips exactly).
     pub fn to_json(&self) -> Result<serde_json::Value, RunError> {
-        serde_json::to_value(self).map_err(|e| FieldError::new("plan", e.to_string()).into())
+        super::plan_to_json(self)
     }
 
     /// A stored plan, as [`SimulatePlan::to_json`] wrote it. It was checked at submission; the
     /// run validates the case once more as it builds the model.
     pub fn from_json(value: &serde_json::Value) -> Result<Self, RunError> {
-        Self::deserialize(value).map_err(|e| {
-            FieldError::new("plan", format!("is not a simulate job's stored plan: {e}")).into()
-        })
+        super::plan_from_json(value, "simulate")
     }
 }
 
