@@ -498,7 +498,9 @@ pub fn diagnose(
     configs_dir: &Path,
 ) -> Result<()> {
     use crate::gap::Campaign;
-    let campaign = Campaign::load(file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let campaign = Campaign::load(file)
+        .and_then(|c| c.validate(configs_dir).map(|()| c))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
     let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template(

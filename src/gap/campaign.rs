@@ -14,6 +14,7 @@
 use super::accel::{self, AccelRecord, ACCEL_COLUMNS};
 use super::GapError;
 use crate::models::outcome::RunError;
+use crate::models::run::BuiltModel;
 use crate::models::spec::{CaseSpec, ModelSpecRef};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
@@ -238,6 +239,8 @@ impl Campaign {
     /// (finite, >= 0, of declared components) and accelerometer records (increment in range,
     /// rate, noise, samples). Errors name the field (`tests[i]...`) and, for CSV data, the row.
     pub fn validate(&self, configs_dir: &Path) -> Result<(), GapError> {
+        #[cfg(test)]
+        crate::models::counts::campaign_validated();
         if self.format_version != FORMAT_VERSION {
             return Err(GapError::field(
                 "format_version",
@@ -278,9 +281,7 @@ impl Campaign {
                 &test.description,
                 MAX_TEXT_CHARS,
             )?;
-            let case = test.case(ti, configs_dir)?;
-            let model =
-                crate::models::case::build(&case, configs_dir).map_err(|e| relocate(ti, e))?;
+            let (_, model) = test.case_model(ti, configs_dir)?;
             let bodies: Vec<(&str, Option<f64>)> = model
                 .system
                 .bodies
@@ -306,61 +307,6 @@ impl Campaign {
             }
         }
         out
-    }
-
-    /// The manifest TOML and the CSV files (name, text) that hold this campaign; records'
-    /// samples go to `<test>_<specimen>_inc<k>_<location>.csv`.
-    pub fn to_manifest(&self) -> Result<(String, Vec<(String, String)>), GapError> {
-        let mut manifest = self.clone();
-        let mut files = Vec::new();
-        for test in &mut manifest.tests {
-            for spec in &mut test.specimens {
-                for rec in &mut spec.accelerometers {
-                    let name = format!(
-                        "{}_{}_inc{}_{}.csv",
-                        test.id,
-                        spec.id,
-                        rec.increment,
-                        rec.location.as_str()
-                    );
-                    files.push((name.clone(), accel::to_csv(&rec.samples)));
-                    rec.samples.clear();
-                    rec.csv = Some(name);
-                }
-            }
-        }
-        let text = toml::to_string(&manifest).map_err(|e| GapError::Write {
-            path: "campaign.toml".into(),
-            message: e.to_string(),
-        })?;
-        Ok((text, files))
-    }
-
-    /// Writes `<dir>/campaign.toml` and its CSV files.
-    pub fn write_dir(&self, dir: &Path) -> Result<(), GapError> {
-        let (text, files) = self.to_manifest()?;
-        let write = |name: &str, body: &str| {
-            let path = dir.join(name);
-            std::fs::write(&path, body).map_err(|e| GapError::Write {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })
-        };
-        std::fs::create_dir_all(dir).map_err(|e| GapError::Write {
-            path: dir.display().to_string(),
-            message: e.to_string(),
-        })?;
-        write(
-            "campaign.toml",
-            &format!(
-                "# Test campaign, format version {FORMAT_VERSION} (railwear campaign check \
-                 <file>). Units are in the key names.\n{text}"
-            ),
-        )?;
-        for (name, body) in &files {
-            write(name, body)?;
-        }
-        Ok(())
     }
 }
 
@@ -401,6 +347,15 @@ impl CampaignTest {
     /// reference config with `overrides`, `rattle_space` and `drive` applied. The model is
     /// built once to check it.
     pub fn case(&self, ti: usize, configs_dir: &Path) -> Result<CaseSpec, GapError> {
+        self.case_model(ti, configs_dir).map(|(case, _)| case)
+    }
+
+    /// [`CampaignTest::case`] with the model built to check it.
+    fn case_model(
+        &self,
+        ti: usize,
+        configs_dir: &Path,
+    ) -> Result<(CaseSpec, BuiltModel), GapError> {
         let f = |rest: &str| format!("tests[{ti}].{rest}");
         if crate::models::reference::reference_config_path(configs_dir, &self.config).is_err() {
             let known = crate::models::reference::reference_config_names(configs_dir);
@@ -420,7 +375,7 @@ impl CampaignTest {
         let mut adjust_error: Option<GapError> = None;
         let source = crate::pipeline::CaseSource::Reference(&self.config);
         let overrides = Some(&self.overrides);
-        let case = crate::pipeline::resolve_config(source, overrides, None, configs_dir, |case| {
+        let case = crate::pipeline::resolve_model(source, overrides, None, configs_dir, |case| {
             if let Err(e) = self.adjust(ti, case, configs_dir) {
                 adjust_error = Some(e);
                 return Err(RunError::InvalidConfig {

@@ -18,6 +18,7 @@ pub mod campaign;
 pub mod diagnose;
 mod drive_edits;
 pub mod effects;
+mod manifest;
 pub mod point_pressure;
 pub mod rig;
 pub mod rig_effects;

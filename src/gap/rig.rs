@@ -204,16 +204,9 @@ fn check_options(o: &RigOptions) -> Result<(), GapError> {
         o.scatter_rel.is_finite() && (0.0..=2.0).contains(&o.scatter_rel),
         "must lie in [0, 2]",
     )?;
-    rule(
-        "window_s",
-        o.window_s.is_finite() && o.window_s > 0.0 && o.window_s <= 600.0,
-        "must lie in (0, 600] s",
-    )?;
-    rule(
-        "settle_s",
-        o.settle_s.is_finite() && (0.0..=600.0).contains(&o.settle_s),
-        "must lie in [0, 600] s",
-    )?;
+    // A diagnosis' window and settle bounds: the rig makes the campaigns a diagnosis reads.
+    crate::pipeline::check_window_s(o.window_s)?;
+    crate::pipeline::check_settle_s(o.settle_s)?;
     rule(
         "segments_per_increment",
         (1..=100).contains(&o.segments_per_increment),

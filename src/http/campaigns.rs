@@ -551,4 +551,22 @@ mod tests {
         assert_eq!(a, compact);
         assert_eq!(a, b, "layout does not change the stored text");
     }
+
+    /// The upload is the one validation of a campaign: once, each test's case validated and
+    /// its model built once (the model the measurements are checked against).
+    #[test]
+    fn an_upload_validates_the_campaign_once_and_builds_each_test_once() {
+        let campaign = full_campaign();
+        let body = serde_json::to_string(&campaign).expect("json");
+        crate::models::counts::take();
+        crate::models::counts::take_campaign_validations();
+        check_campaign(body.as_bytes(), &repo().join("configs")).expect("valid");
+        assert_eq!(crate::models::counts::take_campaign_validations(), 1);
+        let tests = campaign.tests.len() as u32;
+        assert_eq!(
+            crate::models::counts::take(),
+            (tests, tests),
+            "(case validations, builds) for {tests} tests"
+        );
+    }
 }

@@ -60,7 +60,7 @@ pub struct JobRequest {
 }
 
 /// A job as shown by the API.
-#[derive(Debug, Serialize, ToSchema)]
+#[derive(Debug, Serialize, Deserialize, ToSchema)]
 pub struct JobView {
     pub id: Uuid,
     pub kind: JobKind,
@@ -146,7 +146,7 @@ impl From<AttemptRecord> for AttemptView {
 }
 
 /// URLs of a job's resources.
-#[derive(Debug, Serialize, ToSchema)]
+#[derive(Debug, Serialize, Deserialize, ToSchema)]
 pub struct JobLinks {
     #[serde(rename = "self")]
     pub self_: String,

@@ -17,7 +17,9 @@ pub mod worker;
 use crate::store::{clock, NewJob, Store, StoreError, Submitted, WorkerHost};
 pub use metrics::Metrics;
 pub use model::{ChildCounts, ChildOf, JobKind, JobProgress, JobRecord, JobStatus};
-pub use runner::{CaseRunner, ChildJob, CurveInfo, FanOutPlan, JobOutput, LibraryRunner};
+pub use runner::{
+    CaseRunner, ChildJob, CurveInfo, FanOutPlan, JobInputs, JobOutput, LibraryRunner, StoredInput,
+};
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
@@ -89,8 +91,6 @@ impl Jobs {
         settings: WorkerSettings,
         curve_defaults: CurveDefaults,
     ) -> Arc<Self> {
-        // Jobs read their stored inputs (a diagnosis's campaign) from the queue's store.
-        runner.bind_store(Arc::clone(&store));
         Arc::new(Self {
             store,
             runner,
@@ -198,7 +198,7 @@ impl Jobs {
     }
 
     /// Queue a diagnosis of a stored campaign: `options` are the client's params (keys of
-    /// [`runner::DIAGNOSE_CLIENT_KEYS`]; others are refused, naming the key); the campaign's
+    /// [`crate::pipeline::DIAGNOSE_CLIENT_KEYS`]; others are refused, naming the key); the campaign's
     /// id and the SHA-256 of its content are stored with them, and the job reads the campaign
     /// from the store when it runs (so its result depends on its params and that content).
     /// Errors name the client's field (`window_s`, `effects[0]`, ...).
@@ -218,13 +218,13 @@ impl Jobs {
         };
         if let Some(key) = map
             .keys()
-            .find(|k| !runner::DIAGNOSE_CLIENT_KEYS.contains(&k.as_str()))
+            .find(|k| !crate::pipeline::DIAGNOSE_CLIENT_KEYS.contains(&k.as_str()))
         {
             return Err(SubmitError::Invalid(FieldError::new(
                 key.clone(),
                 format!(
                     "is not a known parameter (known: {})",
-                    runner::DIAGNOSE_CLIENT_KEYS.join(", ")
+                    crate::pipeline::DIAGNOSE_CLIENT_KEYS.join(", ")
                 ),
             )));
         }

@@ -2,13 +2,14 @@
 //! The queue never looks inside a computation; it hands over kind + params + [`RunControl`] and
 //! stores what comes back.
 
+pub use super::inputs::{JobInputs, StoredInput};
 use super::model::JobKind;
 use crate::analysis::penalization::PenalizationCurve;
 use crate::field_error::FieldError;
-use crate::models::spec::CaseSpec;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{
-    CalibrateParams, RunControl, RunError, SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary,
+    plan_from_json, plan_to_json, CalibrateParams, DiagnosePlan, RunControl, RunError,
+    SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary,
 };
 use std::path::PathBuf;
 
@@ -46,6 +47,9 @@ pub struct ChildJob {
     /// Complete params of the child (they carry the parent's seed): the child's result depends
     /// on them alone.
     pub params: serde_json::Value,
+    /// The child's typed plan as canonical JSON (what [`CaseRunner::run_from`] runs), when the
+    /// runner has one; stored with the child like a submitted job's.
+    pub plan: Option<serde_json::Value>,
 }
 
 /// How a job splits into child jobs that any worker (any process, any host) can run.
@@ -62,6 +66,10 @@ pub struct FanOutPlan {
 /// a second of `control.cancel` being set, and should call `control.progress` a few times per
 /// second at most. `params` carry the job's `seed`.
 ///
+/// `plan`, where a method takes it, is what [`CaseRunner::submit_plan`] returned for the job at
+/// submission (or the parent's fan-out gave a child), when it returned one: the job is run from
+/// it, not from `params`. A job stored without one is planned from its params.
+///
 /// A job may instead fan out ([`CaseRunner::fan_out`]): the queue then stores the child jobs,
 /// and once every child has succeeded one worker calls [`CaseRunner::assemble`] with their
 /// results.
@@ -73,33 +81,32 @@ pub trait CaseRunner: Send + Sync {
         control: &RunControl,
     ) -> Result<JobOutput, RunError>;
 
-    /// [`CaseRunner::run`] resuming from `checkpoint`, the bytes of an earlier attempt's
-    /// [`RunError::Checkpointed`] for this job. A computation that can checkpoint returns
-    /// [`RunError::Checkpointed`] at its next step boundary after
+    /// [`CaseRunner::run`] from the job's stored `plan`, with the `inputs` the worker read for
+    /// it ([`CaseRunner::stored_inputs`]), resuming from `checkpoint`, the bytes of an earlier
+    /// attempt's [`RunError::Checkpointed`] for this job. A computation that can checkpoint
+    /// returns [`RunError::Checkpointed`] at its next step boundary after
     /// [`RunControl::request_checkpoint`], resumes from a checkpoint to the result of an
     /// uninterrupted run, and starts over (saying why) from one that does not fit. The default
-    /// cannot checkpoint: it ignores `checkpoint` and runs from the start.
-    ///
-    /// `plan` is what [`CaseRunner::submit_plan`] returned for this job at submission, when it
-    /// returned one: the job is run from it, not from `params`. The default has no plans.
+    /// has no plans, reads nothing and cannot checkpoint: it runs from the start.
     fn run_from(
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
         plan: Option<&serde_json::Value>,
+        inputs: &JobInputs,
         control: &RunControl,
         checkpoint: Option<&[u8]>,
     ) -> Result<JobOutput, RunError> {
-        let _ = (plan, checkpoint);
+        let _ = (plan, inputs, checkpoint);
         self.run(kind, params, control)
     }
 
     /// Check at submission (on a blocking thread) so a bad request gets a 422 naming the field
-    /// instead of a failed job: the same parse [`CaseRunner::run`] does
-    /// ([`LibraryRunner::plan`]) of the params as submitted; `seed` is the job's seed (the
-    /// params' or the one drawn for it). Returns the job's typed plan as canonical JSON when
-    /// its kind has one (a simulate job's [`SimulatePlan`], seed included): the queue stores it
-    /// with the job and hands it to [`CaseRunner::run_from`], so the job is parsed and checked
+    /// instead of a failed job: the one parse of the params as submitted
+    /// ([`LibraryRunner::plan`]); `seed` is the job's seed (the params' or the one drawn for
+    /// it). Returns the job's typed plan as canonical JSON when it has one (seed included):
+    /// the queue stores it with the job and hands it to [`CaseRunner::run_from`],
+    /// [`CaseRunner::fan_out`] and [`CaseRunner::assemble`], so the job is parsed and checked
     /// once. The default accepts everything and has no plan.
     fn submit_plan(
         &self,
@@ -110,9 +117,17 @@ pub trait CaseRunner: Send + Sync {
         Ok(None)
     }
 
-    /// The store this runner's jobs read their stored inputs from (a diagnosis's campaign);
-    /// `Jobs::new` calls it with the queue's store. The default reads nothing.
-    fn bind_store(&self, _store: std::sync::Arc<dyn crate::store::Store>) {}
+    /// What the job reads from the store when it runs (a diagnosis's campaign): the worker
+    /// reads it once per attempt, asynchronously, and hands it to [`CaseRunner::run_from`].
+    /// Should be quick (no simulation, no I/O). The default reads nothing.
+    fn stored_inputs(
+        &self,
+        _kind: &JobKind,
+        _params: &serde_json::Value,
+        _plan: Option<&serde_json::Value>,
+    ) -> Result<Vec<StoredInput>, RunError> {
+        Ok(Vec::new())
+    }
 
     /// The child jobs this job splits into, or `None` to run it whole with
     /// [`CaseRunner::run`] (the default). Called on a blocking thread; should be quick (no
@@ -121,17 +136,19 @@ pub trait CaseRunner: Send + Sync {
         &self,
         _kind: &JobKind,
         _params: &serde_json::Value,
+        _plan: Option<&serde_json::Value>,
     ) -> Result<Option<FanOutPlan>, RunError> {
         Ok(None)
     }
 
     /// The output of a job that fanned out, from its children's result summaries in index
-    /// order (all succeeded). Must depend on `params` and the summaries only: if the worker
-    /// assembling dies, another assembles again and only one result is stored.
+    /// order (all succeeded). Must depend on `params`, `plan` and the summaries only: if the
+    /// worker assembling dies, another assembles again and only one result is stored.
     fn assemble(
         &self,
         kind: &JobKind,
         _params: &serde_json::Value,
+        _plan: Option<&serde_json::Value>,
         _children: &[serde_json::Value],
     ) -> Result<JobOutput, RunError> {
         Err(RunError::InvalidConfig {
@@ -141,174 +158,117 @@ pub trait CaseRunner: Send + Sync {
     }
 }
 
-/// A job's params parsed and checked for its kind: what the worker runs. Built by
-/// [`LibraryRunner::plan`], which submission ([`CaseRunner::submit_plan`]) and the worker call,
-/// so an accepted job's params are never re-interpreted by a second set of rules.
+/// A job's params parsed and checked for its kind: what the worker runs. Built once, at
+/// submission, by [`LibraryRunner::plan`] and stored as its canonical JSON
+/// ([`JobPlan::to_json`]); the worker reads it back ([`JobPlan::from_json`]) without checking
+/// it again.
 #[derive(Debug, Clone)]
 pub enum JobPlan {
     /// The case to simulate.
-    Simulate(Box<CaseSpec>),
+    Simulate(Box<SimulatePlan>),
     /// The sweep to fan out (or run in one process).
     Sweep(Box<SweepPlan>),
     /// One run of a sweep: the sweep's plan, the point's index and the replica (seed) index.
     SweepPoint(Box<SweepPlan>, usize, usize),
     /// The calibration data.
-    Calibrate(CalibrateParams),
-    /// The campaign to diagnose and how.
+    Calibrate(Box<CalibrateParams>),
+    /// The stored campaign to diagnose and how.
     Diagnose(Box<DiagnosePlan>),
 }
 
-/// A `diagnose` job, parsed: the campaign (read from the store by the id in the params and
-/// checked against their SHA-256) and the options.
-#[derive(Debug, Clone)]
-pub struct DiagnosePlan {
-    pub campaign: crate::gap::Campaign,
-    pub options: crate::gap::diagnose::DiagnoseOptions,
+impl JobPlan {
+    /// The run of a sweep that `plan` (a `sweep_point` child's) names.
+    fn sweep_point(plan: SweepPlan) -> Result<Self, RunError> {
+        let index = plan.point.ok_or_else(|| RunError::InvalidConfig {
+            field: "point".into(),
+            rule: "is required (a non-negative integer)".into(),
+        })?;
+        let replica = plan.replica.unwrap_or(0);
+        Ok(JobPlan::SweepPoint(Box::new(plan), index, replica))
+    }
+
+    /// The plan's canonical JSON, as a job stores it.
+    pub fn to_json(&self) -> Result<serde_json::Value, RunError> {
+        match self {
+            JobPlan::Simulate(plan) => plan_to_json(plan),
+            JobPlan::Sweep(plan) | JobPlan::SweepPoint(plan, ..) => plan_to_json(plan),
+            JobPlan::Calibrate(plan) => plan_to_json(plan),
+            JobPlan::Diagnose(plan) => plan_to_json(plan),
+        }
+    }
+
+    /// A `kind` job's stored plan, as [`JobPlan::to_json`] wrote it. Errors name `plan`.
+    pub fn from_json(kind: &JobKind, value: &serde_json::Value) -> Result<Self, RunError> {
+        let name = kind.as_str();
+        Ok(match kind {
+            JobKind::Simulate => JobPlan::Simulate(Box::new(plan_from_json(value, name)?)),
+            JobKind::Sweep => JobPlan::Sweep(Box::new(plan_from_json(value, name)?)),
+            JobKind::SweepPoint => JobPlan::sweep_point(plan_from_json(value, name)?)?,
+            JobKind::Calibrate => JobPlan::Calibrate(Box::new(plan_from_json(value, name)?)),
+            JobKind::Diagnose => JobPlan::Diagnose(Box::new(plan_from_json(value, name)?)),
+        })
+    }
 }
 
-/// Params a client may give a diagnosis (`POST /v1/campaigns/{id}/diagnoses`).
-pub const DIAGNOSE_CLIENT_KEYS: &[&str] =
-    &["window_s", "settle_s", "grid_points", "effects", "seed"];
-
-/// Params of a stored `diagnose` job: the client's plus the campaign's id and the SHA-256 of
-/// its content, which the service adds at submission.
-pub const DIAGNOSE_KEYS: &[&str] = &[
-    "campaign_id",
-    "campaign_sha256",
-    "window_s",
-    "settle_s",
-    "grid_points",
-    "effects",
-    "seed",
-];
-
-impl DiagnosePlan {
-    /// Parse a `diagnose` job's params and read its campaign from `inputs`. Errors name the
-    /// params field.
-    pub fn from_params(
-        params: &serde_json::Value,
-        configs_dir: &std::path::Path,
-        inputs: &super::inputs::StoredInputs,
-    ) -> Result<Self, RunError> {
-        let map = params
-            .as_object()
-            .ok_or_else(|| FieldError::new("params", "must be a JSON object"))?;
-        for key in map.keys() {
-            if !DIAGNOSE_KEYS.contains(&key.as_str()) {
-                return Err(FieldError::new(
-                    key,
-                    format!(
-                        "is not a known parameter (known: {})",
-                        DIAGNOSE_CLIENT_KEYS.join(", ")
-                    ),
-                )
-                .into());
-            }
-        }
-        let submit_here = "is required (submit through POST /v1/campaigns/{id}/diagnoses)";
-        let campaign_id = map
-            .get("campaign_id")
-            .ok_or_else(|| FieldError::new("campaign_id", submit_here))?
-            .as_str()
-            .and_then(|s| uuid::Uuid::parse_str(s).ok())
-            .ok_or_else(|| FieldError::new("campaign_id", "must be a campaign's UUID"))?;
-        let is_sha256 =
-            |s: &&str| s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
-        let sha256 = map
-            .get("campaign_sha256")
-            .ok_or_else(|| FieldError::new("campaign_sha256", submit_here))?
-            .as_str()
-            .filter(is_sha256)
-            .ok_or_else(|| {
-                FieldError::new("campaign_sha256", "must be 64 lower-case hex digits")
-            })?;
-        let content = inputs.campaign(campaign_id, sha256)?;
-        let campaign = crate::gap::Campaign::from_json_str(&content)
-            .and_then(|c| c.validate(configs_dir).map(|_| c))
-            .map_err(|e| {
-                FieldError::new(
-                    "campaign_id",
-                    format!("names a campaign that no longer checks out against the configs: {e}"),
-                )
-            })?;
-        let mut options = crate::gap::diagnose::DiagnoseOptions::default();
-        // Types here; bounds in the one rule set, `gap::diagnose::check_options`, below.
-        let number = |name: &str| -> Result<Option<f64>, RunError> {
-            map.get(name)
-                .map(|value| {
-                    value
-                        .as_f64()
-                        .ok_or_else(|| FieldError::new(name, "must be a number of seconds").into())
-                })
-                .transpose()
-        };
-        if let Some(x) = number("window_s")? {
-            options.emulator.window_s = x;
-        }
-        if let Some(x) = number("settle_s")? {
-            options.emulator.settle_s = x;
-        }
-        if let Some(value) = map.get("grid_points") {
-            let n = value
-                .as_u64()
-                .ok_or_else(|| FieldError::new("grid_points", "must be an integer in 2..=12"))?;
-            options.emulator.grid_points = usize::try_from(n).unwrap_or(usize::MAX);
-        }
-        if let Some(value) = map.get("effects") {
-            let names: Vec<String> = serde_json::from_value(value.clone())
-                .map_err(|_| FieldError::new("effects", "must be a list of effect names"))?;
-            if names.is_empty() {
-                return Err(FieldError::new("effects", "must name at least one effect").into());
-            }
-            let library = crate::gap::effects::LIBRARY;
-            for (i, name) in names.iter().enumerate() {
-                if !library.iter().any(|e| e.name == name) {
-                    let known: Vec<&str> = library.iter().map(|e| e.name).collect();
-                    return Err(FieldError::new(
-                        format!("effects[{i}]"),
-                        format!(
-                            "`{name}` is not a library effect (known: {})",
-                            known.join(", ")
-                        ),
-                    )
-                    .into());
-                }
-            }
-            options.emulator.effects = Some(names);
-        }
-        crate::gap::diagnose::check_options(&options).map_err(|e| match e {
-            crate::gap::GapError::Field { field, rule } => FieldError::new(field, rule),
-            other => FieldError::new("params", other.to_string()),
-        })?;
-        Ok(Self { campaign, options })
+/// A diagnosis's options: the defaults with what its plan sets (bounded in the plan).
+pub fn diagnose_options(plan: &DiagnosePlan) -> crate::gap::diagnose::DiagnoseOptions {
+    let mut options = crate::gap::diagnose::DiagnoseOptions::default();
+    let emulator = &mut options.emulator;
+    emulator.window_s = plan.window_s.unwrap_or(emulator.window_s);
+    emulator.settle_s = plan.settle_s.unwrap_or(emulator.settle_s);
+    emulator.grid_points = plan.grid_points.unwrap_or(emulator.grid_points);
+    if let Some(effects) = &plan.effects {
+        emulator.effects = Some(effects.clone());
     }
+    options
+}
+
+/// Names of the gap library's effects, which a diagnosis may name.
+fn library_effects() -> Vec<&'static str> {
+    crate::gap::effects::LIBRARY
+        .iter()
+        .map(|e| e.name)
+        .collect()
 }
 
 /// The production runner: calls `railwear::pipeline` with reference configs from `configs_dir`.
 pub struct LibraryRunner {
     /// Directory of the reference model configs (`configs/`).
     pub configs_dir: PathBuf,
-    /// Where a diagnosis reads its campaign (bound to the queue's store by `Jobs::new`).
-    pub inputs: super::inputs::StoredInputs,
 }
 
 impl LibraryRunner {
-    /// A runner for the reference configs in `configs_dir`, not yet bound to a store.
+    /// A runner for the reference configs in `configs_dir`.
     pub fn new(configs_dir: impl Into<PathBuf>) -> Self {
         LibraryRunner {
             configs_dir: configs_dir.into(),
-            inputs: super::inputs::StoredInputs::default(),
         }
     }
 
-    /// Parse and check `params` for `kind` (the one set of rules; see [`JobPlan`]). Errors
-    /// name the params field (`config`, `overrides.simulation.duration_s`, `points`, ...).
+    /// Parse and check `params` for `kind` (the one set of rules; see [`JobPlan`]), the seed
+    /// in the params. Errors name the params field (`config`,
+    /// `overrides.simulation.duration_s`, `points`, ...).
     pub fn plan(&self, kind: &JobKind, params: &serde_json::Value) -> Result<JobPlan, RunError> {
+        self.plan_seeded(kind, params, None)
+    }
+
+    /// [`LibraryRunner::plan`] for a job run with `seed` when given (a submitted job's; the
+    /// params may lack it): it is set as the case's `simulation.seed` after the config's own
+    /// value is checked.
+    fn plan_seeded(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        seed: Option<u64>,
+    ) -> Result<JobPlan, RunError> {
         let dir = &self.configs_dir;
         match kind {
-            JobKind::Simulate => Ok(JobPlan::Simulate(Box::new(crate::pipeline::simulate_case(
-                params, dir,
-            )?))),
+            JobKind::Simulate => Ok(JobPlan::Simulate(Box::new(match seed {
+                Some(seed) => SimulatePlan::from_params(params, dir, seed)?,
+                None => SimulatePlan {
+                    case: crate::pipeline::simulate_case(params, dir)?,
+                },
+            }))),
             JobKind::Sweep => {
                 if params.get("point").is_some() {
                     return Err(RunError::InvalidConfig {
@@ -319,25 +279,34 @@ impl LibraryRunner {
                         ),
                     });
                 }
-                Ok(JobPlan::Sweep(Box::new(SweepPlan::from_params(
-                    params, dir,
+                Ok(JobPlan::Sweep(Box::new(SweepPlan::from_params_seeded(
+                    params, dir, seed,
                 )?)))
             }
             JobKind::SweepPoint => {
-                let plan = SweepPlan::from_params(params, dir)?;
-                let index = plan.point.ok_or_else(|| RunError::InvalidConfig {
-                    field: "point".into(),
-                    rule: "is required (a non-negative integer)".into(),
-                })?;
-                let replica = plan.replica.unwrap_or(0);
-                Ok(JobPlan::SweepPoint(Box::new(plan), index, replica))
+                JobPlan::sweep_point(SweepPlan::from_params_seeded(params, dir, seed)?)
             }
-            JobKind::Calibrate => Ok(JobPlan::Calibrate(CalibrateParams::parse(params)?)),
+            JobKind::Calibrate => Ok(JobPlan::Calibrate(Box::new(CalibrateParams::parse(
+                params,
+            )?))),
             JobKind::Diagnose => Ok(JobPlan::Diagnose(Box::new(DiagnosePlan::from_params(
                 params,
-                dir,
-                &self.inputs,
+                &library_effects(),
             )?))),
+        }
+    }
+
+    /// The job's plan: the `stored` one, or (a job queued before plans were stored) planned
+    /// from its params.
+    fn job_plan(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        stored: Option<&serde_json::Value>,
+    ) -> Result<JobPlan, RunError> {
+        match stored {
+            Some(stored) => JobPlan::from_json(kind, stored),
+            None => self.plan(kind, params),
         }
     }
 }
@@ -349,35 +318,34 @@ impl CaseRunner for LibraryRunner {
         params: &serde_json::Value,
         control: &RunControl,
     ) -> Result<JobOutput, RunError> {
-        self.run_from(kind, params, None, control, None)
+        self.run_from(kind, params, None, &JobInputs::default(), control, None)
     }
 
     /// Simulate jobs and sweep points checkpoint and resume (`pipeline::run_case_from`);
     /// the other kinds stop as cancelled on a checkpoint request and start over. A simulate
-    /// job with its stored [`SimulatePlan`] runs it (one validation and one build); without one
-    /// (a job queued before plans were stored) it is planned from its params first.
+    /// job or sweep point runs its stored plan with one validation and one build.
     fn run_from(
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
         stored: Option<&serde_json::Value>,
+        inputs: &JobInputs,
         control: &RunControl,
         checkpoint: Option<&[u8]>,
     ) -> Result<JobOutput, RunError> {
-        let plan = match (kind, stored) {
-            (JobKind::Simulate, Some(stored)) => {
-                JobPlan::Simulate(Box::new(SimulatePlan::from_json(stored)?.case))
-            }
-            _ => self.plan(kind, params)?,
-        };
+        let plan = self.job_plan(kind, params, stored)?;
         let control = &match plan {
             JobPlan::Simulate(_) | JobPlan::SweepPoint(..) => control.clone(),
             _ => control.without_checkpoint(),
         };
         match plan {
-            JobPlan::Simulate(case) => {
-                let (_, out) =
-                    crate::pipeline::run_case_from(&case, &self.configs_dir, control, checkpoint)?;
+            JobPlan::Simulate(plan) => {
+                let (_, out) = crate::pipeline::run_case_from(
+                    &plan.case,
+                    &self.configs_dir,
+                    control,
+                    checkpoint,
+                )?;
                 Ok(JobOutput {
                     summary: out.summary,
                     tracks: out.tracks,
@@ -417,7 +385,24 @@ impl CaseRunner for LibraryRunner {
                 summary: crate::pipeline::run_calibration(&data)?,
                 ..JobOutput::default()
             }),
-            JobPlan::Diagnose(plan) => run_diagnosis(&plan, &self.configs_dir, control),
+            JobPlan::Diagnose(plan) => {
+                let content = inputs.campaign.as_deref().ok_or_else(|| {
+                    FieldError::new(
+                        "campaign_id",
+                        "was not read: diagnoses run in the service's workers, which read the \
+                         stored campaign",
+                    )
+                })?;
+                // Validated on upload and pinned by its SHA-256: parsed, not checked again.
+                let campaign = crate::gap::Campaign::from_json_str(content).map_err(|e| {
+                    FieldError::new(
+                        "campaign_id",
+                        format!("names a stored campaign that does not parse: {e}"),
+                    )
+                })?;
+                let options = diagnose_options(&plan);
+                run_diagnosis(&campaign, &options, &self.configs_dir, control)
+            }
         }
     }
 
@@ -427,38 +412,62 @@ impl CaseRunner for LibraryRunner {
         params: &serde_json::Value,
         seed: u64,
     ) -> Result<Option<serde_json::Value>, RunError> {
-        match kind {
-            JobKind::Simulate => SimulatePlan::from_params(params, &self.configs_dir, seed)?
-                .to_json()
-                .map(Some),
-            _ => self.plan(kind, params).map(|_| None),
+        self.plan_seeded(kind, params, Some(seed))?
+            .to_json()
+            .map(Some)
+    }
+
+    /// A diagnosis reads its campaign.
+    fn stored_inputs(
+        &self,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        stored: Option<&serde_json::Value>,
+    ) -> Result<Vec<StoredInput>, RunError> {
+        if *kind != JobKind::Diagnose {
+            return Ok(Vec::new());
         }
+        let JobPlan::Diagnose(plan) = self.job_plan(kind, params, stored)? else {
+            return Ok(Vec::new());
+        };
+        Ok(vec![StoredInput::Campaign {
+            id: plan.campaign_id,
+            sha256: plan.campaign_sha256,
+        }])
     }
 
-    fn bind_store(&self, store: std::sync::Arc<dyn crate::store::Store>) {
-        self.inputs.bind(store);
-    }
-
-    /// A sweep fans out into one `sweep_point` child per point and seed (point-major).
+    /// A sweep fans out into one `sweep_point` child per point and seed (point-major), each
+    /// with the sweep's plan naming its point and replica.
     fn fan_out(
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
+        stored: Option<&serde_json::Value>,
     ) -> Result<Option<FanOutPlan>, RunError> {
         if *kind != JobKind::Sweep {
             return Ok(None);
         }
-        let JobPlan::Sweep(plan) = self.plan(kind, params)? else {
+        let JobPlan::Sweep(plan) = self.job_plan(kind, params, stored)? else {
             return Ok(None);
         };
         let seeds = plan.seeds.len();
-        Ok(Some(FanOutPlan {
-            children: (0..plan.runs())
-                .map(|run| ChildJob {
+        let children = (0..plan.runs())
+            .map(|run| {
+                let (point, replica) = (run / seeds, run % seeds);
+                let child = SweepPlan {
+                    point: Some(point),
+                    replica: Some(replica),
+                    ..(*plan).clone()
+                };
+                Ok(ChildJob {
                     kind: JobKind::SweepPoint,
-                    params: crate::pipeline::sweep_point_params(params, run / seeds, run % seeds),
+                    params: crate::pipeline::sweep_point_params(params, point, replica),
+                    plan: Some(plan_to_json(&child)?),
                 })
-                .collect(),
+            })
+            .collect::<Result<Vec<_>, RunError>>()?;
+        Ok(Some(FanOutPlan {
+            children,
             end_time_s: plan.runs() as f64 * plan.point_end_time_s(),
         }))
     }
@@ -468,15 +477,15 @@ impl CaseRunner for LibraryRunner {
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
+        stored: Option<&serde_json::Value>,
         children: &[serde_json::Value],
     ) -> Result<JobOutput, RunError> {
-        if *kind != JobKind::Sweep {
+        let JobPlan::Sweep(plan) = self.job_plan(kind, params, stored)? else {
             return Err(RunError::InvalidConfig {
                 field: "kind".into(),
                 rule: format!("{} jobs do not fan out", kind.as_str()),
             });
-        }
-        let plan = SweepPlan::from_params(params, &self.configs_dir)?;
+        };
         if children.len() != plan.runs() {
             return Err(RunError::InvalidConfig {
                 field: "points".into(),
@@ -507,7 +516,8 @@ impl CaseRunner for LibraryRunner {
 /// `simulated_time_s` = simulations done of `end_time_s` = simulations in all); the summary is
 /// the report, the plots its figures.
 pub fn run_diagnosis(
-    plan: &DiagnosePlan,
+    campaign: &crate::gap::Campaign,
+    options: &crate::gap::diagnose::DiagnoseOptions,
     configs_dir: &std::path::Path,
     control: &RunControl,
 ) -> Result<JobOutput, RunError> {
@@ -525,9 +535,9 @@ pub fn run_diagnosis(
     };
     let cache = crate::gap::window::WindowCache::new();
     let (report, _) = crate::gap::diagnose::diagnose(
-        &plan.campaign,
+        campaign,
         configs_dir,
-        &plan.options,
+        options,
         &inner,
         &cache,
         &report_progress,

@@ -11,7 +11,8 @@
 //! stores its child jobs and leaves it waiting. When its last child succeeds the store re-queues
 //! it, and the attempt that claims it then assembles its result from the children's results.
 
-use super::model::{JobProgress, JobRecord, JobStatus};
+use super::inputs::JobInputs;
+use super::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::runner::FanOutPlan;
 use super::Jobs;
 use crate::pipeline::{Progress, RunControl, RunError};
@@ -80,6 +81,8 @@ impl Jobs {
         if let Some(map) = params.as_object_mut() {
             map.insert("seed".into(), serde_json::Value::from(job.seed));
         }
+        // The plan stored at submission is what a job with one runs, fans out or assembles.
+        let plan = self.stored_plan(id).await;
         // What this attempt does: assemble a fanned-out job whose children all succeeded, fan
         // a job out, or run it whole.
         let work = if job.children.is_some() {
@@ -93,10 +96,11 @@ impl Jobs {
             }
         } else {
             let runner = Arc::clone(&self.runner);
-            let plan_params = params.clone();
-            match tokio::task::spawn_blocking(move || runner.fan_out(&kind, &plan_params)).await {
+            let (plan_params, stored) = (params.clone(), plan.clone());
+            let fan_out = move || runner.fan_out(&kind, &plan_params, stored.as_ref());
+            match tokio::task::spawn_blocking(fan_out).await {
                 Ok(Ok(Some(plan))) => return self.fan_out(&job, plan).await,
-                Ok(Ok(None)) => Work::Run,
+                Ok(Ok(None)) => self.run_work(id, &kind, &params, plan.as_ref()).await,
                 Ok(Err(e)) => Work::Refused(e),
                 Err(join) => {
                     tracing::error!(job = %id, error = %join, "fan-out planning panicked");
@@ -107,13 +111,9 @@ impl Jobs {
             }
         };
         // A checkpoint an earlier attempt stored at its shutdown: this attempt resumes from it.
-        // The plan stored at submission is what a job with one runs.
-        let (resume, plan) = match work {
-            Work::Run => (
-                self.stored_checkpoint(id, attempt).await,
-                self.stored_plan(id).await,
-            ),
-            _ => (None, None),
+        let resume = match work {
+            Work::Run(_) => self.stored_checkpoint(id, attempt).await,
+            _ => None,
         };
         let cancel = Arc::new(AtomicBool::new(job.cancel_requested));
         let checkpoint = Arc::new(AtomicBool::new(false));
@@ -157,14 +157,17 @@ impl Jobs {
         let stop = control.clone();
         let runner = Arc::clone(&self.runner);
         let mut computation = tokio::task::spawn_blocking(move || match work {
-            Work::Run => runner.run_from(
+            Work::Run(inputs) => runner.run_from(
                 &kind,
                 &params,
                 plan.as_ref(),
+                &inputs,
                 &control,
                 resume.as_ref().map(|c| c.data.as_slice()),
             ),
-            Work::Assemble(Ok(summaries)) => runner.assemble(&kind, &params, &summaries),
+            Work::Assemble(Ok(summaries)) => {
+                runner.assemble(&kind, &params, plan.as_ref(), &summaries)
+            }
             Work::Assemble(Err(e)) | Work::Refused(e) => Err(e),
         });
 
@@ -335,6 +338,31 @@ impl Jobs {
         }
     }
 
+    /// Running job `id` whole: with the stored inputs its runner names, read once here (or
+    /// refused, naming the input that cannot be read).
+    async fn run_work(
+        &self,
+        id: uuid::Uuid,
+        kind: &JobKind,
+        params: &serde_json::Value,
+        plan: Option<&serde_json::Value>,
+    ) -> Work {
+        let wanted = match self.runner.stored_inputs(kind, params, plan) {
+            Ok(wanted) => wanted,
+            Err(e) => return Work::Refused(e),
+        };
+        if wanted.is_empty() {
+            return Work::Run(JobInputs::default());
+        }
+        match JobInputs::read(self.store.as_ref(), &wanted).await {
+            Ok(inputs) => Work::Run(inputs),
+            Err(e) => {
+                tracing::warn!(job = %id, error = %e, "reading the job's stored inputs failed");
+                Work::Refused(e)
+            }
+        }
+    }
+
     /// The plan stored with job `id` at submission. A job without one (its kind has none, or
     /// it was queued before plans were stored) is planned from its params by the runner; so is
     /// one whose plan cannot be read now (logged).
@@ -470,6 +498,7 @@ impl Jobs {
                     id: uuid::Uuid::new_v4(),
                     kind: child.kind,
                     params: child.params,
+                    plan: child.plan,
                 })
                 .collect(),
             end_time_s: plan.end_time_s,
@@ -518,8 +547,8 @@ async fn shutdown_begun(stopping: &mut tokio::sync::watch::Receiver<bool>) {
 
 /// What an attempt computes.
 enum Work {
-    /// The whole job.
-    Run,
+    /// The whole job, with the stored inputs read for it.
+    Run(JobInputs),
     /// The result of a fanned-out job from its children's summaries (or why it cannot be).
     Assemble(Result<Vec<serde_json::Value>, RunError>),
     /// Nothing: the fan-out planning refused the params.

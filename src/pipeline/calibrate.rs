@@ -2,16 +2,19 @@
 
 use super::{check_keys, limits, parse_seed, RunError, CALIBRATE_KEYS};
 use crate::field_error::FieldError;
+use serde::{Deserialize, Serialize};
 
 /// Friction data of a calibrate job (thesis 4.3): the fixture and its torque records.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FrictionData {
     pub fixture: crate::analysis::calibration::Fixture,
     pub records: Vec<crate::analysis::calibration::TorqueRecord>,
 }
 
 /// Wear-law data of a calibrate job (thesis 4.4): material density, cutoff and wear tests.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct WearLawData {
     /// kg/m³ (default 2810, 7075-T73), within [`limits::DENSITY_KG_M3_RANGE`].
     pub density_kg_m3: f64,
@@ -20,8 +23,10 @@ pub struct WearLawData {
     pub records: Vec<crate::analysis::calibration::WearTestRecord>,
 }
 
-/// A calibrate job's params, parsed and checked ([`CALIBRATE_KEYS`]).
-#[derive(Debug, Clone)]
+/// A calibrate job's params, parsed and checked ([`CALIBRATE_KEYS`]): the plan a calibrate
+/// job stores at submission as its canonical JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CalibrateParams {
     pub friction: Option<FrictionData>,
     pub wear_law: Option<WearLawData>,

@@ -7,6 +7,7 @@ use super::{
 };
 use crate::field_error::FieldError;
 use crate::models::case::read_case;
+use crate::models::run::BuiltModel;
 use crate::models::spec::CaseSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -186,6 +187,18 @@ pub fn resolve_config(
     configs_dir: &Path,
     adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
 ) -> Result<CaseSpec, RunError> {
+    resolve_model(source, overrides, seed, configs_dir, adjust).map(|(case, _)| case)
+}
+
+/// [`resolve_config`] with the model it built, for a caller that reads the model (a campaign
+/// checks its measurements against the model's bodies) without building it again.
+pub fn resolve_model(
+    source: CaseSource<'_>,
+    overrides: Option<&serde_json::Value>,
+    seed: Option<u64>,
+    configs_dir: &Path,
+    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
+) -> Result<(CaseSpec, BuiltModel), RunError> {
     let mut value = match source {
         CaseSource::Reference(name) => {
             let path = crate::models::reference::reference_config_path(configs_dir, name)
@@ -232,8 +245,8 @@ pub fn resolve_config(
     case.validate().map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
     // Validated above (and not changed since): build without validating again.
-    crate::models::case::build_validated(&case, configs_dir).map_err(relocate)?;
-    Ok(case)
+    let model = crate::models::case::build_validated(&case, configs_dir).map_err(relocate)?;
+    Ok((case, model))
 }
 
 /// [`resolve_case`] without adjustment (the params' other keys are not checked).
@@ -281,15 +294,13 @@ impl SimulatePlan {
 
     /// The plan's canonical JSON (every number round-trips exactly).
     pub fn to_json(&self) -> Result<serde_json::Value, RunError> {
-        serde_json::to_value(self).map_err(|e| FieldError::new("plan", e.to_string()).into())
+        super::plan_to_json(self)
     }
 
     /// A stored plan, as [`SimulatePlan::to_json`] wrote it. It was checked at submission; the
     /// run validates the case once more as it builds the model.
     pub fn from_json(value: &serde_json::Value) -> Result<Self, RunError> {
-        Self::deserialize(value).map_err(|e| {
-            FieldError::new("plan", format!("is not a simulate job's stored plan: {e}")).into()
-        })
+        super::plan_from_json(value, "simulate")
     }
 }
 

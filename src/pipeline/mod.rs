@@ -6,14 +6,18 @@
 //! [`run_case`] runs a case to its packaged outcome ([`run`]). One file per job kind's
 //! parameters: [`case`] (simulate jobs: params to a validated case),
 //! [`sweep_range`] (the rattle-space range a sweep covers), [`sweep`] (the planned sweep, its
-//! points, labels and assembly), [`calibrate`] (calibration data sets). The bounds every parser
-//! applies are in [`limits`], the physical range of every case field in [`bounds`]; the worker and the submit-time validation call the same parsers.
+//! points, labels and assembly), [`calibrate`] (calibration data sets), [`diagnose`] (a
+//! diagnosis' options). The bounds every parser applies are in [`limits`], the physical range
+//! of every case field in [`bounds`]. Each kind's params are parsed once, at submission, into
+//! its typed plan, stored as canonical JSON ([`plan_to_json`]) and run by the worker from there
+//! ([`plan_from_json`]).
 
 pub mod bounds;
 #[cfg(test)]
 mod bounds_tests;
 mod calibrate;
 mod case;
+mod diagnose;
 mod diagnosed_wear;
 mod run;
 mod sweep;
@@ -23,6 +27,7 @@ mod tests;
 
 pub use calibrate::*;
 pub use case::*;
+pub use diagnose::*;
 pub use diagnosed_wear::{DiagnosedWearLaw, SweepWearLaw};
 pub use run::{run_case, run_case_from};
 pub use sweep::*;
@@ -31,6 +36,23 @@ pub use sweep_range::*;
 use crate::field_error::FieldError;
 pub use crate::models::outcome::{CaseOutcome, RunError};
 pub use crate::physics::control::{Progress, RunControl};
+
+/// A typed job plan as its canonical JSON, what a job stores at submission (every number
+/// round-trips exactly).
+pub fn plan_to_json<T: serde::Serialize>(plan: &T) -> Result<serde_json::Value, RunError> {
+    serde_json::to_value(plan).map_err(|e| FieldError::new("plan", e.to_string()).into())
+}
+
+/// A stored plan of a `kind` job read back, as [`plan_to_json`] wrote it. It was checked at
+/// submission and is not checked again; an error names `plan`.
+pub fn plan_from_json<T: serde::de::DeserializeOwned>(
+    value: &serde_json::Value,
+    kind: &str,
+) -> Result<T, RunError> {
+    T::deserialize(value).map_err(|e| {
+        FieldError::new("plan", format!("is not a {kind} job's stored plan: {e}")).into()
+    })
+}
 
 /// Deep-merges `patch` into `base` (objects merge key by key; anything else replaces).
 pub fn merge_json(base: &mut serde_json::Value, patch: &serde_json::Value) {
@@ -89,6 +111,13 @@ pub mod limits {
     pub const MAX_CUTOFF_PRESSURE_PA: f64 = 1.0e10;
     /// Most records of one calibration data set (a request body holds them anyway).
     pub const MAX_CALIBRATION_RECORDS: usize = 100_000;
+    /// Simulated excitation per increment of a diagnosis (and of the virtual rig), s: at least
+    /// one period of the thesis' slowest drive (20 Hz), at most ten minutes
+    /// ([`MAX_SETTLE_S`]'s reason: past that a window is a typing error, not a test).
+    pub const WINDOW_S_RANGE: (f64, f64) = (0.05, 600.0);
+    /// Grid points per effect parameter of a diagnosis' emulator: two ends at least; each point
+    /// costs one simulation per test, and 12 caps that cost.
+    pub const GRID_POINTS: std::ops::RangeInclusive<usize> = 2..=12;
 }
 
 /// Parameters of a simulate job.

@@ -135,7 +135,10 @@ fn select_wear_law(case: &mut CaseSpec, name: &str) -> Result<(), RunError> {
 /// A planned tolerance sweep: the launcher case every point starts from and the
 /// material-condition offsets of its points. Built from a sweep job's params alone, so the
 /// sequential [`sweep_job`] and each `sweep_point` child job of a fanned-out sweep agree on it.
-#[derive(Debug, Clone)]
+/// A sweep job stores it at submission as its canonical JSON, and each child the same plan
+/// with its `point` and `replica` set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SweepPlan {
     /// The launcher case of `params.config` (default `launcher-design`) with `overrides` and
     /// `seed` applied, its excitation the vehicle profile's and its wear law the one named;
@@ -171,6 +174,17 @@ impl SweepPlan {
     /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`resolve_case`]
     /// applies to the base case.
     pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
+        Self::from_params_seeded(params, configs_dir, None)
+    }
+
+    /// [`SweepPlan::from_params`] for a job run with `seed` when given (a submitted job's, which
+    /// its params may lack): the base case's `simulation.seed`, set after the config's own value
+    /// is checked, and the replicas' seeds drawn from it.
+    pub fn from_params_seeded(
+        params: &serde_json::Value,
+        configs_dir: &Path,
+        seed: Option<u64>,
+    ) -> Result<Self, RunError> {
         let mut keys = SWEEP_KEYS.to_vec();
         keys.extend(["point", "replica"]);
         check_keys(params, "params", &keys)?;
@@ -245,6 +259,9 @@ impl SweepPlan {
                      (launcher-tight, launcher-design, launcher-loose or an inline launcher)",
                 )
                 .into());
+            }
+            if let Some(seed) = seed {
+                case.simulation.seed = seed;
             }
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
             match (&diagnosed, case.launcher.as_ref()) {

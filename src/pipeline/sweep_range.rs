@@ -33,7 +33,8 @@ pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
 /// space, because K_SL is the ratio to the wear rate there (eq. 6.4). A rail tighter than the
 /// design family reaches (a measured k_rs of 0.861) is covered by a sweep around its own
 /// dimensions: `base_dimensions_mm` (default: the design rail).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SweepRange {
     /// Dimensions the offsets apply to, mm.
     pub base: LauncherDimensions,

@@ -117,6 +117,8 @@ pub struct NewChild {
     pub id: Uuid,
     pub kind: JobKind,
     pub params: serde_json::Value,
+    /// The child's typed plan (canonical JSON), as [`NewJob::plan`].
+    pub plan: Option<serde_json::Value>,
 }
 
 /// A fan-out to store: the children, and the simulated time all of them reach together, s

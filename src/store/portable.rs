@@ -505,8 +505,8 @@ where
             // Seed, code version and submitter are the parent's.
             sqlx::query(
                 "INSERT INTO jobs (id, kind, status, params, seed, code_version, submitted_by, \
-                 created_ms, parent_id, child_index) \
-                 SELECT $1, $2, 'queued', $3, seed, code_version, submitted_by, $4, id, $5 \
+                 created_ms, parent_id, child_index, plan) \
+                 SELECT $1, $2, 'queued', $3, seed, code_version, submitted_by, $4, id, $5, $7 \
                  FROM jobs WHERE id = $6",
             )
             .bind(DbUuid(child.id))
@@ -515,6 +515,7 @@ where
             .bind(now_ms)
             .bind(index as i64)
             .bind(DbUuid(parent))
+            .bind(child.plan.as_ref().map(|plan| plan.to_string()))
             .execute(&mut *tx)
             .await?;
         }

@@ -12,6 +12,7 @@
 use crate::support::runner::{start, start_library, test_config};
 use crate::support::{temp_dir, tokens_env, TempDir, ENGINEER, PLANNER, TEST_ENGINEER};
 use railwear::config::ServiceConfig;
+use railwear::http::jobs::JobView;
 use railwear::http::RunningService;
 use railwear_testkit::{self as testkit, Client, ClientError, Request, ServerProcess};
 use std::path::Path;
@@ -187,6 +188,12 @@ impl Api {
     /// The job record `GET /v1/jobs/{id}` as the engineer.
     pub fn get_job(&self, id: &str) -> serde_json::Value {
         self.get_json(&format!("/v1/jobs/{id}"))
+    }
+
+    /// The job record `GET /v1/jobs/{id}` as the engineer, typed.
+    pub fn job(&self, id: &str) -> JobView {
+        let j = self.get_job(id);
+        serde_json::from_value(j.clone()).unwrap_or_else(|e| panic!("not a job ({e}): {j}"))
     }
 
     /// Poll the job until its status is `status` (panics if it fails first or on timeout).

@@ -5,6 +5,7 @@
 use crate::helpers::{wait_for, Api, TestApp};
 use crate::support::runner::{sample, start, test_config};
 use crate::support::{temp_dir, ENGINEER, PLANNER};
+use railwear::jobs::JobStatus;
 use serde_json::json;
 use std::time::{Duration, Instant};
 
@@ -63,19 +64,19 @@ async fn cancel_stops_a_running_job_within_a_second() {
         let body = r#"{"kind":"simulate","params":{"steps":600,"step_ms":50}}"#;
         let id = api.submit_job(body);
         wait_for(Duration::from_secs(10), "progress", || {
-            let j = api.get_job(&id);
-            (j["status"] == "running" && j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0)
-                .then_some(())
+            let j = api.job(&id);
+            let moving = j.progress.is_some_and(|p| p.fraction > 0.0);
+            (j.status == JobStatus::Running && moving).then_some(())
         });
-        let job = api.get_job(&id);
-        assert!(job["progress"]["simulated_time_s"].as_f64().unwrap() > 0.0);
-        assert!(job["progress"]["eta_s"].as_f64().unwrap() > 0.0);
+        let progress = api.job(&id).progress.expect("a running job's progress");
+        assert!(progress.simulated_time_s > 0.0);
+        assert!(progress.eta_s.expect("an ETA") > 0.0);
 
         let asked = Instant::now();
         let r = api.cancel_job(&id);
         assert_eq!(r.status, 202, "{}", r.body);
         wait_for(Duration::from_secs(5), "cancelled", || {
-            (api.get_job(&id)["status"] == "cancelled").then_some(())
+            (api.job(&id).status == JobStatus::Cancelled).then_some(())
         });
         let took = asked.elapsed();
         assert!(took < Duration::from_millis(1500), "cancel took {took:?}");
@@ -101,11 +102,11 @@ async fn results_and_tracks_export_with_downsampling() {
             r#"{"kind":"simulate","params":{"steps":3,"step_ms":10,"samples":2500,"seed":99}}"#;
         let id = api.submit_job(body);
         wait_for(Duration::from_secs(20), "success", || {
-            (api.get_job(&id)["status"] == "succeeded").then_some(())
+            (api.job(&id).status == JobStatus::Succeeded).then_some(())
         });
-        let job = api.get_job(&id);
-        assert_eq!(job["track_samples"], 2500);
-        assert_eq!(job["progress"]["fraction"], 1.0);
+        let job = api.job(&id);
+        assert_eq!(job.track_samples, 2500);
+        assert_eq!(job.progress.map(|p| p.fraction), Some(1.0));
 
         let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
         assert_eq!(result.status, 200);

@@ -46,6 +46,7 @@ fn children_of(n: u128, count: usize) -> FanOut {
                 id: Uuid::from_u128(0xc0_0000 + n * 0x100 + i as u128),
                 kind: JobKind::SweepPoint,
                 params: serde_json::json!({ "points": count, "point": i }),
+                plan: Some(serde_json::json!({ "point": i })),
             })
             .collect(),
         end_time_s: 0.5 * count as f64,
@@ -150,6 +151,13 @@ async fn script(store: &dyn Store) -> Vec<String> {
         outcomes(&store.attempts(p).await.unwrap()),
         [AttemptOutcome::FannedOut]
     );
+    // Each child keeps the plan its fan-out gave it.
+    for (i, child) in store.children(p).await.unwrap().iter().enumerate() {
+        assert_eq!(
+            store.job_plan(child.id).await.unwrap(),
+            Some(serde_json::json!({ "point": i }))
+        );
+    }
 
     // 2. Listing: children by parent; top level without them.
     let page = PageRequest {

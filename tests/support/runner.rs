@@ -116,6 +116,7 @@ impl CaseRunner for CountingRunner {
         &self,
         kind: &JobKind,
         params: &serde_json::Value,
+        _plan: Option<&serde_json::Value>,
     ) -> Result<Option<FanOutPlan>, RunError> {
         let Some(n) = params.get("children").and_then(|v| v.as_u64()) else {
             return Ok(None);
@@ -132,6 +133,7 @@ impl CaseRunner for CountingRunner {
                     ChildJob {
                         kind: JobKind::SweepPoint,
                         params: child,
+                        plan: None,
                     }
                 })
                 .collect(),
@@ -143,6 +145,7 @@ impl CaseRunner for CountingRunner {
         &self,
         _kind: &JobKind,
         params: &serde_json::Value,
+        _plan: Option<&serde_json::Value>,
         children: &[serde_json::Value],
     ) -> Result<JobOutput, RunError> {
         for (i, child) in children.iter().enumerate() {

@@ -604,7 +604,8 @@ impl Candidate {
 }
 
 /// Runs the diagnosis: builds the emulator (simulations, reported through `progress(done,
-/// total)`), then fits, ranks and locates.
+/// total)`), then fits, ranks and locates. The campaign is taken as validated
+/// ([`Campaign::validate`]): the service validates it once on upload, the CLI as it loads it.
 pub fn diagnose(
     campaign: &Campaign,
     configs_dir: &Path,
@@ -613,7 +614,6 @@ pub fn diagnose(
     cache: &WindowCache,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Report, Emulator), GapError> {
-    campaign.validate(configs_dir)?;
     check_options(options)?;
     // Refused before anything is simulated.
     if noise::observations(campaign).is_empty() {
@@ -659,24 +659,10 @@ pub fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
         (10..=100_000).contains(&o.bootstrap_rounds),
         "must lie in 10..=100000",
     )?;
-    // One period of the thesis' slowest drive (20 Hz) at least.
-    rule(
-        "window_s",
-        o.emulator.window_s.is_finite()
-            && o.emulator.window_s >= 0.05
-            && o.emulator.window_s <= 600.0,
-        "must lie in [0.05, 600] s",
-    )?;
-    rule(
-        "settle_s",
-        o.emulator.settle_s.is_finite() && (0.0..=600.0).contains(&o.emulator.settle_s),
-        "must lie in [0, 600] s",
-    )?;
-    rule(
-        "grid_points",
-        (2..=12).contains(&o.emulator.grid_points),
-        "must lie in 2..=12",
-    )?;
+    // The service's bounds (one set, with their reasons, in pipeline::limits).
+    crate::pipeline::check_window_s(o.emulator.window_s)?;
+    crate::pipeline::check_settle_s(o.emulator.settle_s)?;
+    crate::pipeline::check_grid_points(o.emulator.grid_points)?;
     rule(
         "threads",
         (1..=64).contains(&o.emulator.threads),
