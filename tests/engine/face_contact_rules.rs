@@ -249,5 +249,8 @@ fn the_strips_damping_resultant_is_measured_against_a_converged_reference() {
         total[1] / total[2] - 1.0
     );
     assert!(checked >= 30, "{checked} strips touched");
-    assert!(worst_reference <= 1e-3, "reference not converged: {worst_reference:e}");
+    assert!(
+        worst_reference <= 1e-3,
+        "reference not converged: {worst_reference:e}"
+    );
 }
