@@ -50,6 +50,11 @@ fn simpson_over(verts: &[[f64; 2]], f: &dyn Fn(f64, f64) -> f64, panels: usize) 
     sum * h / 3.0
 }
 
+/// An affine function `c + g · (ξ − ξ₀)` as [`PolygonMoments::product`] takes it.
+type Affine = (f64, [f64; 2]);
+/// A density of `ξ = (u, v)`.
+type Density<'a> = dyn Fn(f64, f64) -> f64 + 'a;
+
 /// A shoe head's inner bottom face at a random tilt and depth against a bounded lip top,
 /// split by a random line (where the law would change form): one of the parts.
 fn random_part(rng: &mut ChaCha8Rng) -> Option<FacePatch> {
@@ -110,7 +115,7 @@ fn closed_form_moments_equal_a_fine_quadrature_on_random_clipped_polygons() {
         let (w, r) = (depth.about(o), rate.about(o));
         let u = (o[0], [1.0, 0.0]);
         let v = (o[1], [0.0, 1.0]);
-        let cases: [(&[(f64, [f64; 2])], &dyn Fn(f64, f64) -> f64); 7] = [
+        let cases: [(&[Affine], &Density<'_>); 7] = [
             (&[], &|_, _| 1.0),
             (&[w, w, w], &|a, b| depth.at([a, b]).powi(3)),
             (&[w, w, r], &|a, b| {

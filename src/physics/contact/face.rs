@@ -266,11 +266,14 @@ impl Contact {
         out: &mut PointOutputs<'_, '_>,
     ) -> bool {
         let e = self.impact.exponent;
-        let power = match e {
-            x if x == 0.0 => 0,
-            x if x == 1.0 => 1,
-            x if x == 2.0 => 2,
-            _ => return false,
+        let power = if e == 0.0 {
+            0
+        } else if e == 1.0 {
+            1
+        } else if e == 2.0 {
+            2
+        } else {
+            return false;
         };
         let moments = part.moments();
         let depth = part.depth().about(moments.origin);
