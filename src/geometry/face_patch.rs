@@ -33,6 +33,7 @@
 //! Hot path: fixed-size arrays only, no heap allocation.
 
 use super::bounded_face::PlacedFace;
+use super::polygon_moments::PolygonMoments;
 use nalgebra::{Point3, Vector3};
 
 /// Room for the vertices of a clipped face: the square's 4, one more per clipping line (the
@@ -122,6 +123,12 @@ impl Line {
     #[inline]
     pub fn at(&self, p: [f64; 2]) -> f64 {
         self.alpha + self.beta[0] * p[0] + self.beta[1] * p[1]
+    }
+
+    /// The value at `origin` and the gradient in `ξ`: the function as
+    /// `c + g · (ξ − origin)` ([`PolygonMoments::product`]).
+    pub fn about(&self, origin: [f64; 2]) -> (f64, [f64; 2]) {
+        (self.at(origin), self.beta)
     }
 
     /// The same function minus `c`.
@@ -390,6 +397,17 @@ impl FacePatch {
             twice += p[0] * q[1] - q[0] * p[1];
         }
         0.5 * twice
+    }
+
+    /// The polygon's vertices in `ξ`, in order.
+    pub fn vertices(&self) -> &[[f64; 2]] {
+        &self.verts[..self.len]
+    }
+
+    /// The polygon's closed-form monomial moments in `ξ` ([`PolygonMoments`]; a share of the
+    /// face is the `ξ` area over 4).
+    pub fn moments(&self) -> PolygonMoments {
+        PolygonMoments::of(&self.verts[..self.len])
     }
 
     /// Share of the inner face that is pressed, 0..1.

@@ -28,13 +28,13 @@ fn configs() -> &'static Path {
 }
 
 /// Table 6.2's shoe-rail law: k 1000 N/mm², e 2, c 500 N·s/mm, d 0.01 mm.
-fn table_6_2() -> ImpactParams {
+pub(crate) fn table_6_2() -> ImpactParams {
     ImpactParams::from_adams_units(1000.0, 2.0, 500.0, 0.01)
 }
 
 /// A shoe head's size (half extents, m) and roundover (m).
-const HALF: [f64; 3] = [0.019, 0.005, 0.04];
-const ROUNDOVER: f64 = 5e-4;
+pub(crate) const HALF: [f64; 3] = [0.019, 0.005, 0.04];
+pub(crate) const ROUNDOVER: f64 = 5e-4;
 
 fn head() -> ConvexShape {
     ConvexShape::rounded_box(Vector3::new(HALF[0], HALF[1], HALF[2]), ROUNDOVER).expect("head")
@@ -55,7 +55,7 @@ pub(crate) fn lip_plane() -> (HalfSpace, FaceExtent) {
 
 /// A lip top: plane y = 0 (solid below), real edge at x = 0 (the slot for x > 0), open
 /// elsewhere; `bounded = false` gives the whole plane.
-fn lip_contact(bounded: bool, friction: bool) -> Contact {
+pub(crate) fn lip_contact(bounded: bool, friction: bool) -> Contact {
     let (plane, extent) = lip_plane();
     Contact::new(
         "head-lip",
@@ -85,7 +85,7 @@ fn ground() -> BodyFrame {
 
 /// Stored energy (J), force and torque about the head's centre on the head (N, N·m), and the
 /// tracks, of `contact` with the head at `pose` moving with (v, ω).
-fn evaluate(
+pub(crate) fn evaluate(
     contact: &Contact,
     pose: &Isometry3<f64>,
     v: Vector3<f64>,
@@ -183,7 +183,7 @@ fn stored(contact: &Contact, pose: &Isometry3<f64>) -> f64 {
 
 /// Height of the head's centre above its lowest point when turned by `rot`: the inner box's
 /// half extents projected on the vertical, plus the roundover.
-fn lowest_point_depth(rot: &UnitQuaternion<f64>) -> f64 {
+pub(crate) fn lowest_point_depth(rot: &UnitQuaternion<f64>) -> f64 {
     let axis: Vector3<f64> = rot.inverse_transform_vector(&Vector3::y());
     (0..3)
         .map(|k| (HALF[k] - ROUNDOVER) * axis[k].abs())

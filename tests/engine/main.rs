@@ -8,6 +8,7 @@ mod engine_closed_forms;
 mod error_control;
 mod face_contact;
 mod face_contact_blocks;
+mod face_contact_closed_form;
 mod face_contact_rules;
 mod gap_campaign;
 mod gap_diagnose;

@@ -80,6 +80,11 @@ enum PartRule {
     /// A part turned along `w` whose force clamps to zero along a curve: the rule with its
     /// columns cut at the clamp ([`FacePatch::for_each_node_clamped`]).
     Clamped(QuadratureOrder),
+    /// A part of the core (`w >= d`) where the clamp holds at every point
+    /// (`ẇ <= −k w_max^e / c`): no force, so no friction; its stored energy and the clamp's
+    /// dissipation are polynomials in `ξ`, integrated in closed form
+    /// ([`Contact::unloaded_part`]) instead of at nodes.
+    Unloaded,
 }
 
 impl Contact {
@@ -90,8 +95,9 @@ impl Contact {
     /// `ẇ = 0`. Where `w >= d` and `ẇ >= 0` the density is `k w^e + c ẇ`, a polynomial the patch
     /// rule integrates exactly (`e = 2`); the ramp (a cycloid in `w`) gets [`RAMP_RULE`] and
     /// the separating part (where `k w^e + c ẇ` may cross zero along a curve) [`CLAMP_RULE`],
-    /// except where `ẇ <= −k w_max^e / c`: there every node is clamped to zero force and the
-    /// patch rule integrates the stored energy exactly. Every part's rule is exact for the
+    /// except where `ẇ <= −k w_max^e / c`: there every point is clamped to zero force, and the
+    /// stored energy and the clamp's dissipation are integrated in closed form
+    /// ([`PartRule::Unloaded`]). Every part's rule is exact for the
     /// elastic densities, so the stored energy and its gradient are the patch's exact integrals
     /// whatever the cuts.
     fn damping_parts(
@@ -135,9 +141,10 @@ impl Contact {
                     push(closing, PartRule::Patch);
                 }
                 if let Some(opening) = opening {
-                    // Where ẇ <= −k w_max^e / c the force is clamped to zero at every node
-                    // (w <= w_max on the part): only the stored energy, a polynomial, is left,
-                    // for the patch rule. The clamp's curve lies in the band between.
+                    // Where ẇ <= −k w_max^e / c the force is clamped to zero at every point
+                    // (w <= w_max on the part): only the stored energy and the clamp's
+                    // dissipation, polynomials, are left, in closed form. The clamp's curve
+                    // lies in the band between.
                     let (w_max, _) = opening.deepest();
                     let dead = -self.impact.elastic_force(w_max) / self.impact.max_damping;
                     let (band, clamped) = opening.split(&rate.minus(dead));
@@ -148,7 +155,7 @@ impl Contact {
                         );
                     }
                     if let Some(clamped) = clamped {
-                        push(clamped, PartRule::Patch);
+                        push(clamped, PartRule::Unloaded);
                     }
                 }
             }
@@ -179,14 +186,22 @@ impl Contact {
                 if deepest.is_none_or(|best| d.0 > best.0) {
                     deepest = Some(d);
                 }
-                let mut visit = |x: Point3<f64>, share: f64| {
-                    let distance = normal.dot(&x.coords) - offset;
-                    self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
-                };
                 let parts = self.damping_parts(&patch, fa, fb, radius, &normal);
                 for (part, rule) in parts.into_iter().flatten() {
+                    if matches!(rule, PartRule::Unloaded)
+                        && self.unloaded_part(&part, fa, fb, radius, &normal, out)
+                    {
+                        continue;
+                    }
+                    let mut visit = |x: Point3<f64>, share: f64| {
+                        let distance = normal.dot(&x.coords) - offset;
+                        self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
+                    };
                     match rule {
-                        PartRule::Patch => part.for_each_node(order, &mut visit),
+                        // An unloaded part whose exponent has no closed form: its nodes.
+                        PartRule::Patch | PartRule::Unloaded => {
+                            part.for_each_node(order, &mut visit)
+                        }
                         PartRule::Fixed(rule) => part.for_each_node(rule, &mut visit),
                         PartRule::Clamped(rule) => {
                             // Turned along `w`: `w` depends on `u` alone, `ẇ` is affine.
@@ -230,6 +245,48 @@ impl Contact {
             out.sum.deepest_point = p;
             out.sum.normal = normal;
         }
+    }
+}
+
+impl Contact {
+    /// The closed form of a part where the clamp holds at every point (no force, no
+    /// friction): adds its stored energy `∫ β k w^(e+1)/(e+1)` and the clamp's dissipation
+    /// `∫ β (f_n − k w^e) ẇ = −∫ β k w^e ẇ >= 0` (the per-point law's `damping_power`) with
+    /// `β = dA_ξ / 4`, and marks the track touching (every point of the part penetrates).
+    /// Both densities are polynomials of degree `e + 1` in `ξ` ([`crate::geometry::PolygonMoments`]); false
+    /// (nothing added) unless `e` is 0, 1 or 2, for which they are exact: the caller then
+    /// integrates the part at nodes.
+    pub(super) fn unloaded_part(
+        &self,
+        part: &FacePatch,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        radius: f64,
+        normal: &Vector3<f64>,
+        out: &mut PointOutputs<'_, '_>,
+    ) -> bool {
+        let e = self.impact.exponent;
+        let power = if e == 0.0 {
+            0
+        } else if e == 1.0 {
+            1
+        } else if e == 2.0 {
+            2
+        } else {
+            return false;
+        };
+        let moments = part.moments();
+        let depth = part.depth().about(moments.origin);
+        let rate = penetration_rate(part, fa, fb, radius, normal).about(moments.origin);
+        let mut factors = [depth; 3];
+        let k = self.impact.stiffness;
+        // ∫ w^(e+1) and ∫ w^e ẇ over the part (ξ units).
+        let w_e1 = moments.product(&factors[..power + 1]);
+        factors[power] = rate;
+        let w_e_rate = moments.product(&factors[..power + 1]);
+        *out.energy += 0.25 * k * w_e1 / (e + 1.0);
+        out.sum.add_unloaded(-0.25 * k * w_e_rate);
+        true
     }
 }
 

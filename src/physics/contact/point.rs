@@ -162,6 +162,13 @@ pub(super) struct TrackSum {
 }
 
 impl TrackSum {
+    /// A part of the track whose points all penetrate with their force clamped to zero
+    /// (`face.rs`, closed form): it dissipates `damping_power` (W) and carries no force.
+    pub(super) fn add_unloaded(&mut self, damping_power: f64) {
+        self.touching = true;
+        self.damping_power += damping_power;
+    }
+
     #[inline]
     pub(super) fn add(&mut self, p: &PointForce) {
         self.touching = true;
