@@ -197,9 +197,9 @@ fn the_strips_damping_resultant_is_measured_against_a_converged_reference() {
     // What the elastic test above does not check: the damping density c STEP(w) ẇ (uniform
     // closing rate 1 mm/s) over the strips, whose STEP ramps over w < d = 0.01 mm along a
     // curve across each 0.5 mm strip. The 64-slice reference must agree with 256 slices
-    // within 1e-3 of its value (it resolves the ramp); the contact's rule (and one slice, the
-    // option the thirteenth pass rejected) are reported against it, not bounded
-    // (docs/performance.md, thirteenth pass).
+    // within 1e-3 of its value (it resolves the ramp). The contact's two-slice rule is held
+    // to the accuracy docs/performance.md (thirteenth pass) states for it, 5 % per strip
+    // (3.7 % measured); one slice, the option that pass rejected, is only reported.
     let face = lip(true);
     let impact = super::face_contact::table_6_2();
     let radius = 5e-4;
@@ -252,5 +252,10 @@ fn the_strips_damping_resultant_is_measured_against_a_converged_reference() {
     assert!(
         worst_reference <= 1e-3,
         "reference not converged: {worst_reference:e}"
+    );
+    assert!(
+        worst[0] <= 0.05,
+        "the two-slice rule's damping is off by {:.2e} on a strip (stated: 5 %)",
+        worst[0]
     );
 }
