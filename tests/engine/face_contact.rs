@@ -589,11 +589,39 @@ fn continuum_reference(
     omega: Vector3<f64>,
     m: usize,
 ) -> (Vector3<f64>, Vector3<f64>, f64) {
+    let (mut force, mut torque, mut gross) = (Vector3::zeros(), Vector3::zeros(), 0.0);
+    continuum_cells(pose, v, omega, m, &mut |c| {
+        let f = Vector3::y() * (c.share * impact.force(c.w, c.wdot));
+        gross += c.share * impact.force(c.w, c.wdot.abs());
+        force += f;
+        torque += c.lever.cross(&f);
+    });
+    (force, torque, gross)
+}
+
+/// One pressed cell of the continuum: its share of the face law (`1/m²`), its depth `w` and
+/// closing rate `ẇ` against the plane `y = 0`, and its lever from the head's centre.
+pub struct ContinuumCell {
+    pub share: f64,
+    pub w: f64,
+    pub wdot: f64,
+    pub lever: Vector3<f64>,
+}
+
+/// Visits the pressed cells (`w > 0`) of an `m × m` midpoint grid on each of the six faces of
+/// the head's inner box at `pose`, moving with `(v, ω)`: each cell a ball of the roundover
+/// radius against the plane `y = 0`.
+pub fn continuum_cells(
+    pose: &Isometry3<f64>,
+    v: Vector3<f64>,
+    omega: Vector3<f64>,
+    m: usize,
+    visit: &mut dyn FnMut(ContinuumCell),
+) {
     let normal = Vector3::y();
     let centre = pose.translation.vector;
     let rot = pose.rotation.to_rotation_matrix();
     let inner = Vector3::new(HALF[0], HALF[1], HALF[2]).map(|h| h - ROUNDOVER);
-    let (mut force, mut torque, mut gross) = (Vector3::zeros(), Vector3::zeros(), 0.0);
     let share = 1.0 / (m * m) as f64;
     for k in 0..3 {
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
@@ -611,15 +639,16 @@ fn continuum_reference(
                     }
                     let lever = x - normal * ROUNDOVER - centre;
                     let wdot = -normal.dot(&(v + omega.cross(&lever)));
-                    let f = normal * (share * impact.force(w, wdot));
-                    gross += share * impact.force(w, wdot.abs());
-                    force += f;
-                    torque += lever.cross(&f);
+                    visit(ContinuumCell {
+                        share,
+                        w,
+                        wdot,
+                        lever,
+                    });
                 }
             }
         }
     }
-    (force, torque, gross)
 }
 
 #[test]

@@ -5,7 +5,8 @@
 //! integrated in closed form) against the continuum by a brute-force midpoint rule.
 
 use super::face_contact::{
-    evaluate, lip_contact, lip_plane, lowest_point_depth, table_6_2, HALF, ROUNDOVER,
+    continuum_cells, evaluate, lip_contact, lip_plane, lowest_point_depth, table_6_2, HALF,
+    ROUNDOVER,
 };
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use railwear::geometry::{FacePatch, PlacedFace, PolygonMoments};
@@ -159,39 +160,16 @@ fn continuum_energy(
     omega: Vector3<f64>,
     m: usize,
 ) -> (f64, f64, f64, usize) {
-    let normal = Vector3::y();
-    let centre = pose.translation.vector;
-    let rot = pose.rotation.to_rotation_matrix();
-    let inner = Vector3::new(HALF[0], HALF[1], HALF[2]).map(|h| h - ROUNDOVER);
-    let share = 1.0 / (m * m) as f64;
     let (mut energy, mut dissipation, mut gross, mut unloaded) = (0.0, 0.0, 0.0, 0);
-    for k in 0..3 {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let axis = |a: usize| rot.matrix().column(a).into_owned() * inner[a];
-        for sign in [1.0, -1.0] {
-            let face_centre = centre + axis(k) * sign;
-            for a in 0..m {
-                let u = -1.0 + (2.0 * a as f64 + 1.0) / m as f64;
-                for b in 0..m {
-                    let s = -1.0 + (2.0 * b as f64 + 1.0) / m as f64;
-                    let x = face_centre + axis(i) * u + axis(j) * s;
-                    let w = ROUNDOVER - x.y;
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    let lever = x - normal * ROUNDOVER - centre;
-                    let wdot = -normal.dot(&(v + omega.cross(&lever)));
-                    let f = impact.force(w, wdot);
-                    energy += share * impact.potential(w);
-                    dissipation += share * (f - impact.elastic_force(w)) * wdot;
-                    gross += share * impact.force(w, wdot.abs()) * wdot.abs();
-                    if f == 0.0 && w >= impact.full_damping_depth {
-                        unloaded += 1;
-                    }
-                }
-            }
+    continuum_cells(pose, v, omega, m, &mut |c| {
+        let f = impact.force(c.w, c.wdot);
+        energy += c.share * impact.potential(c.w);
+        dissipation += c.share * (f - impact.elastic_force(c.w)) * c.wdot;
+        gross += c.share * impact.force(c.w, c.wdot.abs()) * c.wdot.abs();
+        if f == 0.0 && c.w >= impact.full_damping_depth {
+            unloaded += 1;
         }
-    }
+    });
     (energy, dissipation, gross, unloaded)
 }
 
