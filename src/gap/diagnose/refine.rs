@@ -456,7 +456,8 @@ fn pair_variants(
 ) -> Result<(), GapError> {
     // (dynamics table, wear-law table) of each mixed pair to profile, and (table,
     // magnitude) twice for each pair of dynamics effects.
-    let (contenders, dynamics): (Vec<(usize, usize)>, Vec<[(usize, f64); 2]>) = {
+    type Contenders = (Vec<(usize, usize)>, Vec<[(usize, f64); 2]>);
+    let (contenders, dynamics): Contenders = {
         let problem = FitProblem::new(campaign, emulator, options);
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
