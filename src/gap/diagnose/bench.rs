@@ -163,7 +163,8 @@ pub struct Outcome {
     pub scenario: Scenario,
     /// Detectability score (see the module documentation).
     pub detectability: f64,
-    /// Detectable (score > 2; a pair: each member's score given the other > 2 too).
+    /// Detectable (score > 2; a pair: each member's score given the other at its closest
+    /// magnitude, `member_distinguishable`, > 2 too).
     pub detectable: bool,
     /// A pair's members' detectability, each given the other at its drawn magnitude.
     #[serde(default)]
@@ -469,12 +470,13 @@ const STAND_IN_FRACTIONS: [f64; 8] = [0.01, 0.03, 0.07, 0.15, 0.3, 0.5, 0.75, 1.
 /// The effect `other` alone at the magnitude whose noise-free readings come closest to a
 /// pair's (its secondary values as drawn): `score` over [`STAND_IN_FRACTIONS`] of its bound
 /// on the drawn magnitude's side, then three golden-section steps between the best one's
-/// neighbours. Returns those readings and their score (`at_drawn` if nothing comes closer).
+/// neighbours. Returns those readings and their score (`at_drawn`, the drawn magnitude's
+/// readings and score, if nothing comes closer).
 fn closest_alone(
     other: &Effect,
     alone_at: &dyn Fn(f64) -> Result<Vec<Observation>, GapError>,
     score: &dyn Fn(&[Observation]) -> f64,
-    at_drawn: f64,
+    at_drawn: (Vec<Observation>, f64),
 ) -> Result<(Vec<Observation>, f64), GapError> {
     let info = other.info()?;
     let drawn = other.magnitude();
@@ -483,8 +485,8 @@ fn closest_alone(
     } else {
         info.parameters[0].max
     };
-    let mut tried: Vec<(f64, f64)> = vec![(drawn, at_drawn)];
-    let mut best = (alone_at(drawn)?, at_drawn);
+    let mut tried: Vec<(f64, f64)> = vec![(drawn, at_drawn.1)];
+    let mut best = at_drawn;
     let mut try_at = |m: f64, tried: &mut Vec<(f64, f64)>| -> Result<(), GapError> {
         let obs = alone_at(m)?;
         let d = score(&obs);
@@ -706,7 +708,7 @@ pub fn run(
                     let at_drawn = score(&drawn);
                     member_detectability.push(at_drawn);
                     let (closest, d) = if at_drawn > 2.0 {
-                        closest_alone(other, &alone_at, &score, at_drawn)?
+                        closest_alone(other, &alone_at, &score, (drawn, at_drawn))?
                     } else {
                         (drawn, at_drawn)
                     };

@@ -715,6 +715,15 @@ impl Emulator {
         Ok(true)
     }
 
+    /// Every table of the effect of table `t` (its library defaults and its variants), in
+    /// table order.
+    pub fn family(&self, t: usize) -> Vec<usize> {
+        let name = self.effects[t].info.name;
+        (0..self.effects.len())
+            .filter(|&i| self.effects[i].info.name == name)
+            .collect()
+    }
+
     /// Index of the exact pair table of tables `a` and `b` (either order), if built.
     pub fn pair(&self, a: usize, b: usize) -> Option<usize> {
         self.pairs

@@ -192,16 +192,13 @@ impl<'a> FitProblem<'a> {
                     .collect()
             })
             .collect();
-        let mut families: Vec<Vec<usize>> = Vec::new();
-        for (i, t) in emulator.effects.iter().enumerate() {
-            match families
-                .iter_mut()
-                .find(|f| emulator.effects[f[0]].info.name == t.info.name)
-            {
-                Some(f) => f.push(i),
-                None => families.push(vec![i]),
-            }
-        }
+        // One family per effect, from its first table, in the order effects first appear.
+        let families: Vec<Vec<usize>> = (0..emulator.effects.len())
+            .map(|i| emulator.family(i))
+            .enumerate()
+            .filter(|(i, f)| f[0] == *i)
+            .map(|(_, f)| f)
+            .collect();
         Self {
             obs,
             noise,
@@ -305,42 +302,27 @@ impl<'a> FitProblem<'a> {
     ///   never fits the training data worse than either member), then both over the tables'
     ///   points, refined five-fold around the best; both are taken only when they beat the
     ///   better member alone by more than [`PROFILE_95`].
-    fn fit(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> (Vec<(usize, f64)>, f64) {
+    fn fit(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> Fit {
         match model {
             Model::Nominal => (Vec::new(), self.nll_of(&[], mask)),
             Model::Single(f) => {
                 let tables = &self.families[f];
                 let (m0, n0) = self.fit_table(tables[0], mask);
-                let mut best = (vec![(tables[0], m0)], n0);
-                let mut variant = (Vec::new(), f64::INFINITY);
-                for &t in &tables[1..] {
+                let variants = tables[1..].iter().map(|&t| {
                     let (m, n) = self.fit_table(t, mask);
-                    if n < variant.1 {
-                        variant = (vec![(t, m)], n);
-                    }
-                }
-                if variant.1 < n0 - PROFILE_95 {
-                    best = variant;
-                }
-                best
+                    (vec![(t, m)], n)
+                });
+                unless_beaten((vec![(tables[0], m0)], n0), variants)
             }
             Model::Pair(a, b) => {
                 // The tables the singles chose first; another combination of the two
                 // effects' tables (their secondary values profiled with the other member on)
                 // only when it beats them by more than [`PROFILE_95`], as for a single.
-                let (spec, n0) = self.fit_pair_tables(a, b, mask);
-                let mut variant = (Vec::new(), f64::INFINITY);
-                for (ta, tb) in self.pair_combinations(a, b) {
-                    let (s, n) = self.fit_pair_tables(ta, tb, mask);
-                    if n < variant.1 {
-                        variant = (s, n);
-                    }
-                }
-                if variant.1 < n0 - PROFILE_95 {
-                    variant
-                } else {
-                    (spec, n0)
-                }
+                let combinations = self
+                    .pair_combinations(a, b)
+                    .into_iter()
+                    .map(|(ta, tb)| self.fit_pair_tables(ta, tb, mask));
+                unless_beaten(self.fit_pair_tables(a, b, mask), combinations)
             }
         }
     }
@@ -405,6 +387,27 @@ impl<'a> FitProblem<'a> {
             .map(|f| self.emulator.effects[self.families[*f][0]].info.name)
             .collect::<Vec<_>>()
             .join("+")
+    }
+}
+
+/// A fit `(spec, negative log-likelihood)`.
+type Fit = (Vec<(usize, f64)>, f64);
+
+/// `first` (the library defaults, or the tables the singles chose), unless the best of
+/// `others` (other secondary values) beats it by more than [`PROFILE_95`]: a likelihood-ratio
+/// test at 95 %, so noise does not buy parameters. The first of equal bests is kept.
+fn unless_beaten(first: Fit, others: impl Iterator<Item = Fit>) -> Fit {
+    let best = others.fold((Vec::new(), f64::INFINITY), |best, fit| {
+        if fit.1 < best.1 {
+            fit
+        } else {
+            best
+        }
+    });
+    if best.1 < first.1 - PROFILE_95 {
+        best
+    } else {
+        first
     }
 }
 

@@ -2,7 +2,7 @@
 //! take (its members' secondary values chosen with the other member on), and the fit of two
 //! tables' magnitudes (docs/diagnosis.md, "Exact pairs", "A pair's secondary values").
 
-use super::{Candidate, FitProblem, Model, PROFILE_95};
+use super::{unless_beaten, Candidate, Fit, FitProblem, Model};
 use crate::gap::effects::Acts;
 
 impl FitProblem<'_> {
@@ -10,15 +10,10 @@ impl FitProblem<'_> {
     /// magnitude of each alone (the singles' own candidates, so a pair never fits the training
     /// data worse than either member), then both over the tables' points, refined five-fold
     /// around the best; both are taken only when they beat the better member alone by more
-    /// than [`PROFILE_95`].
-    pub(super) fn fit_pair_tables(
-        &self,
-        a: usize,
-        b: usize,
-        mask: &dyn Fn(usize) -> bool,
-    ) -> (Vec<(usize, f64)>, f64) {
+    /// than [`PROFILE_95`](super::PROFILE_95).
+    pub(super) fn fit_pair_tables(&self, a: usize, b: usize, mask: &dyn Fn(usize) -> bool) -> Fit {
         let mut member = (vec![(a, 0.0), (b, 0.0)], self.nll_of(&[], mask));
-        let consider = |best: &mut (Vec<(usize, f64)>, f64), x: f64, y: f64| {
+        let consider = |best: &mut Fit, x: f64, y: f64| {
             let spec = vec![(a, x), (b, y)];
             let nll = self.nll_of(&spec, mask);
             if nll < best.1 {
@@ -48,11 +43,7 @@ impl FitProblem<'_> {
                 }
             }
         }
-        if joint.1 < member.1 - PROFILE_95 {
-            joint
-        } else {
-            member
-        }
+        unless_beaten(member, std::iter::once(joint))
     }
 
     /// Other table combinations of the effects of tables `a` and `b` a pair may take (their

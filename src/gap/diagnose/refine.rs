@@ -510,32 +510,21 @@ fn pair_variants(
     };
     // Two dynamics effects: each member's tables simulated with the other at the pair's fit.
     for [(a, ma), (b, mb)] in dynamics {
-        let family = |t: usize, emulator: &Emulator| -> Vec<usize> {
-            let name = emulator.effects[t].info.name;
-            (0..emulator.effects.len())
-                .filter(|&i| emulator.effects[i].info.name == name)
-                .collect()
-        };
-        for a2 in family(a, emulator) {
+        for a2 in emulator.family(a) {
             emulator.add_joint(campaign, configs_dir, (a2, ma), (b, mb), control, cache)?;
         }
-        for b2 in family(b, emulator) {
+        for b2 in emulator.family(b) {
             emulator.add_joint(campaign, configs_dir, (a, ma), (b2, mb), control, cache)?;
         }
     }
     for (d, w) in contenders {
-        let others = |t: usize, emulator: &Emulator| -> Vec<usize> {
-            let name = emulator.effects[t].info.name;
-            (0..emulator.effects.len())
-                .filter(|&i| i != t && emulator.effects[i].info.name == name)
-                .collect()
-        };
-        for w2 in others(w, emulator) {
+        // Each member's own table is paired already (round 0 of `exact_pairs`).
+        for w2 in emulator.family(w) {
             if emulator.pair(d, w2).is_none() {
                 emulator.add_pair(campaign, configs_dir, d, w2, control, cache)?;
             }
         }
-        for d2 in others(d, emulator) {
+        for d2 in emulator.family(d) {
             if emulator.pair(d2, w).is_none() {
                 emulator.add_pair(campaign, configs_dir, d2, w, control, cache)?;
             }
