@@ -24,13 +24,15 @@
 //!
 //! **Pairs.** A pair is detectable when each member is, given the other: the pair's
 //! noise-free readings differ from those of the other member alone by more than twice the
-//! uncertainty, *at every magnitude of the other member* (its secondary values as drawn). The
-//! bench searches the other member's magnitude that comes closest (eight fractions of its
-//! bound, then three golden-section steps) and scores the member against that. A member that
-//! the other, at another magnitude, stands in for within the noise is not seen by any
-//! diagnosis: a friction drift at 0.045 fits a drift of 0.18 with a 6 ms fixture compliance
-//! within the noise (bench seed 2045). The older measure, the other member at its drawn
-//! magnitude only, is reported beside it (`pairs_detectable_at_drawn`).
+//! uncertainty, *at every magnitude and secondary value of the other member*. The bench
+//! searches the other member's values that come closest (its magnitude over eight fractions
+//! of its bound and three golden-section steps; then each secondary parameter over five values
+//! within its bounds, and the magnitude again) and scores the member against that. A member
+//! that the other, at other values, stands in for within the noise is not seen by any
+//! diagnosis: a friction drift at 0.045 with the default slip scale fits a drift of 0.18 over
+//! 997 m with a 6 ms fixture compliance within the noise (bench seed 2045). The older measure,
+//! the other member at its drawn values only, is reported beside it
+//! (`pairs_detectable_at_drawn`).
 //!
 //! **Carried by one test.** The diagnosis confirms an effect on held-out tests
 //! (leave-one-test-out), so an effect whose readings differ detectably in one test alone has
@@ -467,14 +469,26 @@ fn detectability(
 /// Fractions of a magnitude's bound the search for the closest stand-in starts from.
 const STAND_IN_FRACTIONS: [f64; 8] = [0.01, 0.03, 0.07, 0.15, 0.3, 0.5, 0.75, 1.0];
 
-/// The effect `other` alone at the magnitude whose noise-free readings come closest to a
-/// pair's (its secondary values as drawn): `score` over [`STAND_IN_FRACTIONS`] of its bound
-/// on the drawn magnitude's side, then three golden-section steps between the best one's
-/// neighbours. Returns those readings and their score (`at_drawn`, the drawn magnitude's
-/// readings and score, if nothing comes closer).
+/// Values of each secondary parameter the search for the closest stand-in tries (the
+/// profile's spacing, bounds included).
+const STAND_IN_SECONDARY_VALUES: usize = 5;
+
+/// Readings of the effect alone at a magnitude and secondary values.
+type AloneAt<'a> = dyn Fn(f64, &BTreeMap<String, f64>) -> Result<Vec<Observation>, GapError> + 'a;
+
+/// The closest stand-in found so far: magnitude, secondary values, readings, score.
+type StandIn = (f64, BTreeMap<String, f64>, Vec<Observation>, f64);
+
+/// The effect `other` alone at the magnitude and secondary values whose noise-free readings
+/// come closest to a pair's (`score`, smaller is closer). Coordinate search from the drawn
+/// values (`at_drawn`, their readings and score): the magnitude over [`STAND_IN_FRACTIONS`]
+/// of its bound on the drawn magnitude's side and three golden-section steps between the best
+/// one's neighbours; then, while the stand-in is still told apart (score > 2), each secondary
+/// parameter over [`STAND_IN_SECONDARY_VALUES`] values within its bounds, and the magnitude's
+/// golden-section steps again if one moved. Returns the closest readings and their score.
 fn closest_alone(
     other: &Effect,
-    alone_at: &dyn Fn(f64) -> Result<Vec<Observation>, GapError>,
+    alone_at: &AloneAt,
     score: &dyn Fn(&[Observation]) -> f64,
     at_drawn: (Vec<Observation>, f64),
 ) -> Result<(Vec<Observation>, f64), GapError> {
@@ -485,20 +499,76 @@ fn closest_alone(
     } else {
         info.parameters[0].max
     };
-    let mut tried: Vec<(f64, f64)> = vec![(drawn, at_drawn.1)];
-    let mut best = at_drawn;
-    let mut try_at = |m: f64, tried: &mut Vec<(f64, f64)>| -> Result<(), GapError> {
-        let obs = alone_at(m)?;
-        let d = score(&obs);
-        tried.push((m, d));
-        if d < best.1 {
-            best = (obs, d);
-        }
-        Ok(())
-    };
+    let secondary: BTreeMap<String, f64> = other
+        .parameters
+        .iter()
+        .filter(|(k, _)| k.as_str() != info.parameters[0].name)
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    let mut best: StandIn = (drawn, secondary, at_drawn.0, at_drawn.1);
+    let mut tried: Vec<(f64, f64)> = vec![(drawn, best.3)];
+    let try_at =
+        |m: f64, sec: &BTreeMap<String, f64>, best: &mut StandIn| -> Result<f64, GapError> {
+            let obs = alone_at(m, sec)?;
+            let d = score(&obs);
+            if d < best.3 {
+                *best = (m, sec.clone(), obs, d);
+            }
+            Ok(d)
+        };
     for f in STAND_IN_FRACTIONS {
-        try_at(f * bound, &mut tried)?;
+        let sec = best.1.clone();
+        let d = try_at(f * bound, &sec, &mut best)?;
+        tried.push((f * bound, d));
     }
+    golden_steps(&mut tried, &mut best, &try_at)?;
+    for p in &info.parameters[1..] {
+        if best.3 <= 2.0 {
+            break;
+        }
+        let before = best.1.get(p.name).copied();
+        for v in super::refine::profile_values(p, STAND_IN_SECONDARY_VALUES) {
+            let mut sec = best.1.clone();
+            sec.insert(p.name.to_string(), v);
+            let m = best.0;
+            try_at(m, &sec, &mut best)?;
+        }
+        if best.1.get(p.name).copied() != before {
+            // The magnitude's search again, around the best, at the new secondary values.
+            let sec = best.1.clone();
+            let m = best.0;
+            let mut around: Vec<(f64, f64)> = vec![(m, best.3)];
+            for f in STAND_IN_FRACTIONS {
+                let neighbour = f * bound;
+                if (neighbour - m).abs() > 0.0 {
+                    around.push((neighbour, f64::INFINITY));
+                }
+            }
+            // Only the best's two neighbours bracket it; the rest are not run.
+            around.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let i = around.iter().position(|t| t.0 == m).unwrap_or(0);
+            let lo = around[i.saturating_sub(1)].0;
+            let hi = around[(i + 1).min(around.len() - 1)].0;
+            let mut bracket = vec![(m, best.3)];
+            for n in [lo, hi] {
+                if n != m {
+                    let d = try_at(n, &sec, &mut best)?;
+                    bracket.push((n, d));
+                }
+            }
+            golden_steps(&mut bracket, &mut best, &try_at)?;
+        }
+    }
+    Ok((best.2, best.3))
+}
+
+/// Three golden-section steps of the magnitude at the best stand-in's secondary values,
+/// into the wider side of the best of `tried` (magnitude, score).
+fn golden_steps(
+    tried: &mut Vec<(f64, f64)>,
+    best: &mut StandIn,
+    try_at: &dyn Fn(f64, &BTreeMap<String, f64>, &mut StandIn) -> Result<f64, GapError>,
+) -> Result<(), GapError> {
     for _ in 0..3 {
         tried.sort_by(|a, b| a.0.total_cmp(&b.0));
         let Some(i) = tried
@@ -512,7 +582,6 @@ fn closest_alone(
         let lo = tried[i.saturating_sub(1)].0;
         let hi = tried[(i + 1).min(tried.len() - 1)].0;
         let m = tried[i].0;
-        // Into the wider side, by the golden ratio.
         let next = if hi - m > m - lo {
             m + 0.381_966 * (hi - m)
         } else {
@@ -521,9 +590,11 @@ fn closest_alone(
         if tried.iter().any(|t| t.0 == next) {
             break;
         }
-        try_at(next, &mut tried)?;
+        let sec = best.1.clone();
+        let d = try_at(next, &sec, best)?;
+        tried.push((next, d));
     }
-    Ok(best)
+    Ok(())
 }
 
 /// Tests (indices below `tests`) in which the effect is detectable on that test's
@@ -686,10 +757,12 @@ pub fn run(
                 // drawn magnitude, then at the magnitude that comes closest.
                 for drop in 0..2 {
                     let other = &s.effects[1 - drop];
-                    let alone_at = |m: f64| -> Result<Vec<Observation>, GapError> {
+                    let alone_at = |m: f64,
+                                    secondary: &BTreeMap<String, f64>|
+                     -> Result<Vec<Observation>, GapError> {
                         let info = other.info()?;
                         let one = Scenario {
-                            effects: vec![effect_with(info, m, &other.parameters)],
+                            effects: vec![effect_with(info, m, secondary)],
                             ..s.clone()
                         };
                         let (alone, _) = run_cached(
@@ -704,7 +777,7 @@ pub fn run(
                     let score = |alone: &[Observation]| {
                         detectability(&clean_obs, alone, &noise, &noisy_obs)
                     };
-                    let drawn = alone_at(other.magnitude())?;
+                    let drawn = alone_at(other.magnitude(), &other.parameters)?;
                     let at_drawn = score(&drawn);
                     member_detectability.push(at_drawn);
                     let (closest, d) = if at_drawn > 2.0 {
@@ -1097,6 +1170,69 @@ impl Scores {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A friction drift's mass readings after slip distances `l` (m): `delta (1 - e^(-l/s))`.
+    fn drift_readings(delta: f64, slip_scale: f64) -> Vec<Observation> {
+        [20.0_f64, 200.0, 2000.0]
+            .iter()
+            .enumerate()
+            .map(|(i, l)| Observation {
+                test: i,
+                increment: 0,
+                quantity: super::super::noise::Quantity::Mass("shoe".into()),
+                value: delta * (1.0 - (-l / slip_scale).exp()),
+                specimens: 1,
+                spread: None,
+                weight: 1.0,
+                fixed_var: 0.0,
+                floor_var: 0.0,
+                model_rel_var: 0.0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_closest_stand_in_is_searched_over_secondary_values_too() {
+        // A pair's readings that a friction drift of 0.042 over a 100 m slip scale reproduces
+        // exactly (both on the search's grids: 0.07 of the 0.6 bound, the middle of five
+        // log-spaced scales over [1, 10⁴] m); the drift was drawn at 0.18 over 997 m. At the
+        // drawn scale no magnitude comes within the noise (σ = 10⁻³), at 100 m one does.
+        let info = crate::gap::effects::info("friction_drift").expect("in the library");
+        let drawn = effect_with(
+            info,
+            0.18,
+            &BTreeMap::from([("slip_scale_m".into(), 997.0)]),
+        );
+        let target = drift_readings(0.042, 100.0);
+        let score = |obs: &[Observation]| {
+            let n = obs.len() as f64;
+            (obs.iter()
+                .zip(&target)
+                .map(|(a, b)| ((a.value - b.value) / 1e-3).powi(2))
+                .sum::<f64>()
+                / n)
+                .sqrt()
+        };
+        let alone_at = |m: f64, sec: &BTreeMap<String, f64>| {
+            Ok(drift_readings(
+                m,
+                sec.get("slip_scale_m").copied().unwrap_or(100.0),
+            ))
+        };
+        let at_drawn = drift_readings(0.18, 997.0);
+        let d0 = score(&at_drawn);
+        let (_, d) = closest_alone(&drawn, &alone_at, &score, (at_drawn, d0)).expect("searched");
+        assert!(d0 > 2.0, "drawn values told apart: {d0}");
+        let best_at_drawn_scale = STAND_IN_FRACTIONS
+            .iter()
+            .map(|f| score(&drift_readings(f * 0.6, 997.0)))
+            .fold(f64::INFINITY, f64::min);
+        assert!(best_at_drawn_scale > 2.0, "{best_at_drawn_scale}");
+        assert!(
+            d < 2.0,
+            "a stand-in within the noise (0.042 over 100 m) is found: score {d}"
+        );
+    }
 
     fn outcome(truth: &str, in_library: bool, verdict: Verdict, chosen: Option<&str>) -> Outcome {
         Outcome {

@@ -198,13 +198,15 @@ fn secondary_interval(
 }
 
 /// Why a chosen candidate only partly explains the gap: a magnitude fitted at its physical
-/// bound, or a held-out shrink under [`MIN_EXPLAINED_SHRINK`]. None when neither holds.
+/// bound, a held-out shrink under [`MIN_EXPLAINED_SHRINK`], or `also` (a reason the caller
+/// found: a pair's partner not identified). None when none holds.
 pub(super) fn partly_explained(
     problem: &FitProblem,
     c: &Candidate,
     b: &BestEffect,
+    also: Option<String>,
 ) -> Option<PartlyExplained> {
-    let mut reasons = Vec::new();
+    let mut reasons: Vec<String> = also.into_iter().collect();
     let mut at_bound = Vec::new();
     for &(t, m) in &c.spec {
         let table = &problem.emulator.effects[t];
