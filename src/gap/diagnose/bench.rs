@@ -479,6 +479,9 @@ type AloneAt<'a> = dyn Fn(f64, &BTreeMap<String, f64>) -> Result<Vec<Observation
 /// The closest stand-in found so far: magnitude, secondary values, readings, score.
 type StandIn = (f64, BTreeMap<String, f64>, Vec<Observation>, f64);
 
+/// Scores the effect alone at a magnitude and secondary values, keeping the closest.
+type TryAt<'a> = dyn Fn(f64, &BTreeMap<String, f64>, &mut StandIn) -> Result<f64, GapError> + 'a;
+
 /// The effect `other` alone at the magnitude and secondary values whose noise-free readings
 /// come closest to a pair's (`score`, smaller is closer). Coordinate search from the drawn
 /// values (`at_drawn`, their readings and score): the magnitude over [`STAND_IN_FRACTIONS`]
@@ -567,7 +570,7 @@ fn closest_alone(
 fn golden_steps(
     tried: &mut Vec<(f64, f64)>,
     best: &mut StandIn,
-    try_at: &dyn Fn(f64, &BTreeMap<String, f64>, &mut StandIn) -> Result<f64, GapError>,
+    try_at: &TryAt,
 ) -> Result<(), GapError> {
     for _ in 0..3 {
         tried.sort_by(|a, b| a.0.total_cmp(&b.0));
