@@ -103,7 +103,7 @@ fn effects_hash(configs: &Path) -> anyhow::Result<String> {
                     Err(e) => h.update(e.to_string()),
                 }
             }
-            if let Some(term) = effect.wear_term(hardness_pa) {
+            if let Some(term) = effect.wear_term(hardness_pa)? {
                 hash_term(&mut h, term.as_ref());
                 let carried = DiagnosedWearLaw {
                     diagnosis: uuid::Uuid::nil(),
