@@ -2,7 +2,7 @@
 //! them) and typed for the code that uses them.
 //!
 //! A closed set of options with a few numeric parameters each (the gap diagnosis' effects, the
-//! wear mechanisms they fit) is read from a name-to-value map at the edge. [`parameter_struct!`]
+//! wear mechanisms they fit) is read from a name-to-value map at the edge. `parameter_struct!`
 //! declares the typed struct and its [`ParameterInfo`] table in one place: a field's name is
 //! the parameter's name, so the table users read and the code that applies the values cannot
 //! drift apart, and reading the map refuses a missing or unknown name instead of taking 0.
@@ -28,7 +28,7 @@ pub struct ParameterInfo {
     pub reason: &'static str,
 }
 
-/// A typed set of named parameters (declared with [`parameter_struct!`]).
+/// A typed set of named parameters (declared with `parameter_struct!`).
 pub trait Parameters: Sized + Copy {
     /// Name of what the parameters belong to (an effect's library name).
     const NAME: &'static str;
