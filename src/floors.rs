@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 /// Rooms from the lowest floor up. Rooms on one floor import nothing from each other.
 pub(crate) const FLOORS: &[&[&str]] = &[
     &["units", "field_error", "thesis", "sampling"],
+    &["parameters"],
     &["geometry"],
     &["physics"],
     &["wear"],

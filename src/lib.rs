@@ -28,6 +28,7 @@ pub mod geometry;
 pub mod http;
 pub mod jobs;
 pub mod models;
+pub mod parameters;
 pub mod physics;
 pub mod pipeline;
 pub mod report;

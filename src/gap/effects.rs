@@ -1,8 +1,13 @@
 //! The effect library: candidate unmodelled effects, each an optional model term with few
 //! parameters, shared by the virtual rig and the diagnosis (SPEC 7, issue 14 item 3).
 //!
-//! Each effect is data ([`EffectInfo`]: name, what it acts on, the models it applies to, its
-//! parameters with unit, bounds, default and the reason for them) plus code:
+//! The effects are a closed set, [`EffectKind`]; each kind has its own parameter struct,
+//! declared with its units, bounds, defaults and reasons in one place (`parameter_struct!`:
+//! the wear-law effects' in `wear::mechanism`, the dynamics effects' here), and the library
+//! table users read ([`LIBRARY`], [`EffectInfo`]) is generated from the kinds. An [`Effect`]
+//! keeps its values by name for reports and generic profiling; the code that applies it reads
+//! them once into a [`TypedEffect`] (a missing or unknown name is an error, never 0) and
+//! matches on it exhaustively:
 //! - wear-law effects ([`Acts::WearLaw`]) give a [`WearTerm`] evaluated on recorded tracks
 //!   (`gap::tracks`), never re-simulating;
 //! - dynamics effects ([`Acts::Dynamics`]) edit the case before a segment is simulated, given
@@ -12,15 +17,22 @@
 //! an effect at magnitude 0 leaves the case and the wear unchanged bit for bit.
 
 pub use super::drive_edits::transmissibility;
-use super::drive_edits::{
-    add_cross_axis, filter_through_mount, resolved_excitation, set_excitation,
+pub use super::dynamics_effects::{
+    ClearanceGrowthParameters, CrossAxisParameters, FixtureComplianceParameters,
+    FrictionDriftParameters, PreloadLossParameters, SharpEdgesParameters, SpecimenState,
 };
 use super::tracks::WearTerm;
 use super::GapError;
+use crate::field_error::FieldError;
 use crate::models::spec::{CaseSpec, ModelKind};
-use crate::wear::mechanism::WearMechanism;
+pub use crate::parameters::ParameterInfo;
+use crate::parameters::Parameters;
 pub use crate::wear::mechanism::{
     AboveCutoff, CoatingBreakthrough, ImpactWear, LocalPressure, SevereWear, ThirdBody,
+};
+use crate::wear::mechanism::{
+    AboveCutoffParameters, CoatingBreakthroughParameters, ImpactWearParameters,
+    LocalPressureParameters, SevereWearParameters, ThirdBodyParameters, WearEffect, WearMechanism,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -34,23 +46,6 @@ pub enum Acts {
     WearLaw,
     /// The model or its drive: the segment is simulated with the edited case.
     Dynamics,
-}
-
-/// One parameter of an effect.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ParameterInfo {
-    /// Name, with its unit.
-    pub name: &'static str,
-    /// Unit.
-    pub unit: &'static str,
-    /// Smallest physical value.
-    pub min: f64,
-    /// Largest physical value.
-    pub max: f64,
-    /// Value when not given (the magnitude's default is its nominal 0).
-    pub default: f64,
-    /// Why these bounds: literature, thesis, or estimate.
-    pub reason: &'static str,
 }
 
 /// One effect of the library.
@@ -76,296 +71,324 @@ pub struct EffectInfo {
 
 const BOTH: &[ModelKind] = &[ModelKind::RattleBox, ModelKind::Launcher];
 
-/// The library, in issue order: (a)-(h) of issue 14, (i)-(l) of issue 26 (wear mechanisms
-/// beyond sliding Archard at the lumped pressure).
-pub const LIBRARY: &[EffectInfo] = &[
-    EffectInfo {
-        name: "wear_above_cutoff",
-        letter: 'a',
-        summary: "impact/plastic wear above the eq. 3.11 cutoff (2 Sy): K above it is a multiple of K at the cutoff instead of 0",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[ParameterInfo {
-            name: "k_ratio_above_cutoff",
-            unit: "1 (K above the cutoff / K(cutoff))",
-            min: 0.0,
-            max: 1000.0,
-            default: 0.0,
-            reason: "wear maps (Lim & Ashby 1987) put the mild-to-severe transition at contact pressures near the hardness, with K rising 100-1000x across it; thesis 5.5 and Fig. 5.7 show plastic flow at case A's corners",
-        }],
-        reason: "eq. 3.11 sets K = 0 above 2 Sy; thesis 5.5 reports the loose cases' pressures above yield and their measured wear 10-30x ADAMS'",
-        limitation: None,
-    },
-    EffectInfo {
-        name: "third_body",
-        letter: 'b',
-        summary: "three-body abrasion by trapped debris or sand: K raised by k_abr/H where pressure and slip let particles cut",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "k_abrasive",
-                unit: "1 (dimensionless Archard k; K_add = k/H)",
-                min: 0.0,
-                max: 1.0e-2,
-                default: 0.0,
-                reason: "three-body abrasive wear coefficients 5e-4 to 5e-3 (Hutchings, Tribology, 1992; Rabinowicz 1995), up to 1e-2 for sharp sand",
+/// The effects of the library, in issue order: (a)-(h) of issue 14, (i)-(l) of issue 26 (wear
+/// mechanisms beyond sliding Archard at the lumped pressure).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EffectKind {
+    /// (a) Wear above the eq. 3.11 cutoff.
+    WearAboveCutoff,
+    /// (b) Third-body abrasion.
+    ThirdBody,
+    /// (c) Clearance growth.
+    ClearanceGrowth,
+    /// (d) Friction drift.
+    FrictionDrift,
+    /// (e) Fixture compliance.
+    FixtureCompliance,
+    /// (f) Cross-axis excitation.
+    CrossAxis,
+    /// (g) Sharper edges.
+    SharpEdges,
+    /// (h) Launcher spring preload loss.
+    PreloadLoss,
+    /// (i) Impact wear.
+    ImpactWear,
+    /// (j) Severe wear.
+    SevereWear,
+    /// (k) Local-pressure Archard.
+    LocalPressure,
+    /// (l) Anodic-coating breakthrough.
+    CoatingBreakthrough,
+}
+
+impl EffectKind {
+    /// Every kind, in library order (the declaration order).
+    pub const ALL: [Self; 12] = [
+        Self::WearAboveCutoff,
+        Self::ThirdBody,
+        Self::ClearanceGrowth,
+        Self::FrictionDrift,
+        Self::FixtureCompliance,
+        Self::CrossAxis,
+        Self::SharpEdges,
+        Self::PreloadLoss,
+        Self::ImpactWear,
+        Self::SevereWear,
+        Self::LocalPressure,
+        Self::CoatingBreakthrough,
+    ];
+
+    /// Its library entry.
+    pub fn info(self) -> &'static EffectInfo {
+        &LIBRARY[self as usize]
+    }
+
+    /// The kind named `name` in the library.
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.info().name == name)
+    }
+
+    /// The library entry: name and parameters from the kind's parameter struct.
+    const fn describe(self) -> EffectInfo {
+        match self {
+            Self::WearAboveCutoff => EffectInfo {
+                name: AboveCutoffParameters::NAME,
+                letter: 'a',
+                summary: "impact/plastic wear above the eq. 3.11 cutoff (2 Sy): K above it is a multiple of K at the cutoff instead of 0",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: AboveCutoffParameters::PARAMETERS,
+                reason: "eq. 3.11 sets K = 0 above 2 Sy; thesis 5.5 reports the loose cases' pressures above yield and their measured wear 10-30x ADAMS'",
+                limitation: None,
             },
-            ParameterInfo {
-                name: "min_pressure_pa",
-                unit: "Pa",
-                min: 1.0e2,
-                max: 1.0e8,
-                default: 1.0e4,
-                reason: "estimate: a few trapped particles carry the load, so they cut at nominal pressures far below the hardness; 10 kPa is above a resting rattle-box cube's own weight (0.7 kPa), so mere resting does not grind; uncertain by orders (100 Pa to 100 MPa)",
+            Self::ThirdBody => EffectInfo {
+                name: ThirdBodyParameters::NAME,
+                letter: 'b',
+                summary: "three-body abrasion by trapped debris or sand: K raised by k_abr/H where pressure and slip let particles cut",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: ThirdBodyParameters::PARAMETERS,
+                reason: "SPEC 7 lists third-body abrasion (sand, dust, wear debris trapped in a closed tube) as unmodelled; railwear's environment is `clean` only",
+                limitation: None,
             },
-            ParameterInfo {
-                name: "min_slip_m_s",
-                unit: "m/s",
-                min: 0.0,
-                max: 0.1,
-                default: 1.0e-3,
-                reason: "estimate: below about 1 mm/s (the Table 5.2 stiction speed is 6.5 mm/s) the surfaces stick and trapped particles are not dragged",
+            Self::ClearanceGrowth => EffectInfo {
+                name: ClearanceGrowthParameters::NAME,
+                letter: 'c',
+                summary: "clearance opening as wear accumulates: the rattle box's tube side (launcher: the material condition) grows with test time, updated between segments",
+                acts: Acts::Dynamics,
+                models: BOTH,
+                parameters: ClearanceGrowthParameters::PARAMETERS,
+                reason: "the thesis' model keeps the nominal enclosure; cases C and D ran 4.5 h on one specimen (thesis 5.5), their rate rising 1.53 -> 2.33 and 0.17 -> 0.87 mg/h",
+                limitation: Some("the opening is a rate per test hour, not computed from the simulated wear: railwear's simulated wear is two orders below the measured (docs/validation.md), so it would open nothing"),
             },
-        ],
-        reason: "SPEC 7 lists third-body abrasion (sand, dust, wear debris trapped in a closed tube) as unmodelled; railwear's environment is `clean` only",
-        limitation: None,
-    },
-    EffectInfo {
-        name: "clearance_growth",
-        letter: 'c',
-        summary: "clearance opening as wear accumulates: the rattle box's tube side (launcher: the material condition) grows with test time, updated between segments",
-        acts: Acts::Dynamics,
-        models: BOTH,
-        parameters: &[ParameterInfo {
-            name: "opening_um_per_h",
-            unit: "µm/h of clearance (tube side; launcher material-condition offset)",
-            min: 0.0,
-            max: 50.0,
-            default: 0.0,
-            reason: "case B's measured 97 mg/h (Table 5.3) is 34.6 mm³/h of 7075; spread over the cube's six faces it thins each by 9 µm/h (18 µm/h across a pair), localised wear a few times more: 50 µm/h bounds it",
-        }],
-        reason: "the thesis' model keeps the nominal enclosure; cases C and D ran 4.5 h on one specimen (thesis 5.5), their rate rising 1.53 -> 2.33 and 0.17 -> 0.87 mg/h",
-        limitation: Some("the opening is a rate per test hour, not computed from the simulated wear: railwear's simulated wear is two orders below the measured (docs/validation.md), so it would open nothing"),
-    },
-    EffectInfo {
-        name: "friction_drift",
-        letter: 'd',
-        summary: "friction drift: mu_s and mu_d shift by delta_mu (1 - exp(-s/s0)) with the accumulated slip distance s, updated between segments",
-        acts: Acts::Dynamics,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "delta_mu",
-                unit: "1",
-                min: -0.1,
-                max: 0.6,
-                default: 0.0,
-                reason: "anodize worn through leaves bare 7075 on 7075, dry mu 0.6-1.0 (ASM Handbook 18); polishing lowers mu a little; -0.1 keeps mu_d of Table 5.2 (0.166) positive",
+            Self::FrictionDrift => EffectInfo {
+                name: FrictionDriftParameters::NAME,
+                letter: 'd',
+                summary: "friction drift: mu_s and mu_d shift by delta_mu (1 - exp(-s/s0)) with the accumulated slip distance s, updated between segments",
+                acts: Acts::Dynamics,
+                models: BOTH,
+                parameters: FrictionDriftParameters::PARAMETERS,
+                reason: "Table 5.2 friction was fitted on fresh anodized pads (thesis 4.5); the specimens run hours",
+                limitation: None,
             },
-            ParameterInfo {
-                name: "slip_scale_m",
-                unit: "m",
-                min: 1.0,
-                max: 1.0e4,
-                default: 100.0,
-                reason: "estimate: running-in completes within 1-1000 m of sliding for light loads (Blau, Friction and Wear Transitions, 1989)",
+            Self::FixtureCompliance => EffectInfo {
+                name: FixtureComplianceParameters::NAME,
+                letter: 'e',
+                summary: "fixture compliance: the tube (rail) mounted through a spring-damper; the drive it sees is the shaker's through the mount's base-excitation transmissibility",
+                acts: Acts::Dynamics,
+                models: BOTH,
+                parameters: FixtureComplianceParameters::PARAMETERS,
+                reason: "the thesis drives the tube rigidly (motion generator, 5.4); Figures 5.1-5.2 show a bolted fixture",
+                limitation: Some("approximation: tones (and random PSD breakpoints) are scaled by |T(f)| and phase-shifted; the cube's reaction on the mount is not modelled (a dynamic tube body needs a model-builder change); measured drives are refused"),
             },
-        ],
-        reason: "Table 5.2 friction was fitted on fresh anodized pads (thesis 4.5); the specimens run hours",
-        limitation: None,
-    },
-    EffectInfo {
-        name: "fixture_compliance",
-        letter: 'e',
-        summary: "fixture compliance: the tube (rail) mounted through a spring-damper; the drive it sees is the shaker's through the mount's base-excitation transmissibility",
-        acts: Acts::Dynamics,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "natural_period_ms",
-                unit: "ms (1 / mount natural frequency; 0 = rigid)",
-                min: 0.0,
-                max: 20.0,
-                default: 0.0,
-                reason: "fixtures are designed with their first resonance above the test band; a bolted tube on a head expander may come down to 50-200 Hz (5-20 ms)",
+            Self::CrossAxis => EffectInfo {
+                name: CrossAxisParameters::NAME,
+                letter: 'f',
+                summary: "cross-axis excitation: each drive tone repeated on the two other axes at a share of its amplitude",
+                acts: Acts::Dynamics,
+                models: BOTH,
+                parameters: CrossAxisParameters::PARAMETERS,
+                reason: "the thesis drives one axis only (15 g at 20 Hz transverse, 5.5); real shakers move on the other axes too",
+                limitation: Some("tones only: a random background stays on its own axes"),
             },
-            ParameterInfo {
-                name: "damping_ratio",
-                unit: "1",
-                min: 0.01,
-                max: 0.3,
-                default: 0.05,
-                reason: "bolted aluminium joints: 1-5 % of critical, elastomer mounts up to 30 % (Harris' Shock and Vibration Handbook)",
+            Self::SharpEdges => EffectInfo {
+                name: SharpEdgesParameters::NAME,
+                letter: 'g',
+                summary: "sharper edges than nominal: every roundover (cube, shoes, latch tooth, front pad) scaled by 1 - reduction",
+                acts: Acts::Dynamics,
+                models: BOTH,
+                parameters: SharpEdgesParameters::PARAMETERS,
+                reason: "a smaller roundover concentrates edge contacts: higher pressure, more work above the cutoff (thesis 5.4)",
+                limitation: None,
             },
-        ],
-        reason: "the thesis drives the tube rigidly (motion generator, 5.4); Figures 5.1-5.2 show a bolted fixture",
-        limitation: Some("approximation: tones (and random PSD breakpoints) are scaled by |T(f)| and phase-shifted; the cube's reaction on the mount is not modelled (a dynamic tube body needs a model-builder change); measured drives are refused"),
-    },
-    EffectInfo {
-        name: "cross_axis",
-        letter: 'f',
-        summary: "cross-axis excitation: each drive tone repeated on the two other axes at a share of its amplitude",
-        acts: Acts::Dynamics,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "share",
-                unit: "1 (cross-axis amplitude / drive amplitude, each other axis)",
-                min: 0.0,
-                max: 0.3,
-                default: 0.0,
-                reason: "shaker acceptance limits cross-axis motion to 10-30 % of the drive axis (IEST-RP-DTE012, MIL-STD-810G 514.6 Annex A)",
+            Self::PreloadLoss => EffectInfo {
+                name: PreloadLossParameters::NAME,
+                letter: 'h',
+                summary: "launcher spring preload loss: latch coil spring and rear leaf spring preloads scaled by 1 - loss",
+                acts: Acts::Dynamics,
+                models: &[ModelKind::Launcher],
+                parameters: PreloadLossParameters::PARAMETERS,
+                reason: "thesis 6.3.1: the rear leaf spring may not engage when static; a lost preload lets the missile rattle",
+                limitation: None,
             },
-            ParameterInfo {
-                name: "phase_deg",
-                unit: "degree",
-                min: -180.0,
-                max: 180.0,
-                default: 0.0,
-                reason: "rocking of the armature gives in-phase or anti-phase cross motion; any phase allowed",
+            Self::ImpactWear => EffectInfo {
+                name: ImpactWearParameters::NAME,
+                letter: 'i',
+                summary: "impact wear: a volume k_E times the energy the contact's normal (IMPACT) damping dissipates, counted while the normal speed is at least a threshold",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: ImpactWearParameters::PARAMETERS,
+                reason: "the energy account shows the contact's IMPACT damping dissipating 10-100x the friction work (rattle box C: about 1.5 W against 0.02 W); thesis 5.5 and Fig. 5.7 point at impact stresses above yield and plastic flow at the corners",
+                limitation: Some("the damping work is the IMPACT law's (c_max, STEP over the penetration depth d), not a measured restitution: it is as good as Table 5.2's damping"),
             },
-        ],
-        reason: "the thesis drives one axis only (15 g at 20 Hz transverse, 5.5); real shakers move on the other axes too",
-        limitation: Some("tones only: a random background stays on its own axes"),
-    },
-    EffectInfo {
-        name: "sharp_edges",
-        letter: 'g',
-        summary: "sharper edges than nominal: every roundover (cube, shoes, latch tooth, front pad) scaled by 1 - reduction",
-        acts: Acts::Dynamics,
-        models: BOTH,
-        parameters: &[ParameterInfo {
-            name: "roundover_reduction",
-            unit: "1 (fraction of the nominal roundover removed)",
-            min: 0.0,
-            max: 0.9,
-            default: 0.0,
-            reason: "thesis 5.4 adds a 0.02 in roundover \"to better model the real fixture\" and notes contact area and pressure depend on it; machined edges range from sharp to the nominal break",
-        }],
-        reason: "a smaller roundover concentrates edge contacts: higher pressure, more work above the cutoff (thesis 5.4)",
-        limitation: None,
-    },
-    EffectInfo {
-        name: "preload_loss",
-        letter: 'h',
-        summary: "launcher spring preload loss: latch coil spring and rear leaf spring preloads scaled by 1 - loss",
-        acts: Acts::Dynamics,
-        models: &[ModelKind::Launcher],
-        parameters: &[ParameterInfo {
-            name: "loss",
-            unit: "1 (fraction of the preload lost)",
-            min: 0.0,
-            max: 1.0,
-            default: 0.0,
-            reason: "coil and leaf springs relax by stress relaxation and set; 1 = fully lost (SPEC 7: spring preload loss or non-engagement)",
-        }],
-        reason: "thesis 6.3.1: the rear leaf spring may not engage when static; a lost preload lets the missile rattle",
-        limitation: None,
-    },
-    EffectInfo {
-        name: "impact_wear",
-        letter: 'i',
-        summary: "impact wear: a volume k_E times the energy the contact's normal (IMPACT) damping dissipates, counted while the normal speed is at least a threshold",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "k_energy_m3_per_j",
-                unit: "m³/J (wear volume per joule of normal damping work)",
-                min: 0.0,
-                max: 1.0e-11,
-                default: 0.0,
-                reason: "dissipated-energy wear (Fouvry et al., Wear 2003; Huq & Celis, Wear 2002) measures 1e-15 to 1e-13 m³/J for steels and coatings in fretting; an Archard k/(H mu) for aluminium alloys in dry contact, k = 1e-6 (mild, oxidised) to 1e-2 (severe, adhesive) (Archard 1953; Hutchings 1992), H = 1.32 GPa, mu = 0.5, spans 1.5e-15 to 1.5e-11 m³/J; Engel (Impact Wear of Materials, 1976) finds repeated normal impact removes material by the same fatigue and plastic mechanisms, so the sliding range bounds it",
+            Self::SevereWear => EffectInfo {
+                name: SevereWearParameters::NAME,
+                letter: 'j',
+                summary: "severe (plastic) wear: K raised by k_severe/H at contact points whose own pressure exceeds a multiple of the yield strength",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: SevereWearParameters::PARAMETERS,
+                reason: "thesis 5.5 and Fig. 5.7: impact stresses above yield and plastic flow at case A's corners; the lumped pressure N/A of eq. 3.11 averages over the face, the contact points' own pressures (gap::tracks) do not",
+                limitation: Some("local pressures from the contact points' share of the face law (gap::tracks), binned at 1/50 decade; on tracks recorded without points the lumped pressure stands in"),
             },
-            ParameterInfo {
-                name: "min_normal_speed_m_s",
-                unit: "m/s (|penetration rate| below which damping work does not wear)",
-                min: 0.0,
-                max: 0.5,
-                default: 0.0,
-                reason: "Engel's impact wear has a threshold below which impacts only deform elastically; a sliding contact's micro-motion (normal speeds of mm/s) dissipates without removing material; 0.5 m/s is above the rattle boxes' impact speeds (15 g at 20 Hz moves the tube at 1.2 m/s peak)",
+            Self::LocalPressure => EffectInfo {
+                name: LocalPressureParameters::NAME,
+                letter: 'k',
+                summary: "local-pressure Archard: the case's K(sigma) evaluated at each contact point's own pressure instead of the lumped N/A, for a share of the wear",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: LocalPressureParameters::PARAMETERS,
+                reason: "a tilted face or an edge loads its deeper points above the mean; Table 4.3's K rises with pressure and cuts off at 2 Sy, so local pressures can raise the wear, or lower it where points exceed the cutoff",
+                limitation: Some("on tracks recorded without points it changes nothing"),
             },
-        ],
-        reason: "the energy account shows the contact's IMPACT damping dissipating 10-100x the friction work (rattle box C: about 1.5 W against 0.02 W); thesis 5.5 and Fig. 5.7 point at impact stresses above yield and plastic flow at the corners",
-        limitation: Some("the damping work is the IMPACT law's (c_max, STEP over the penetration depth d), not a measured restitution: it is as good as Table 5.2's damping"),
-    },
-    EffectInfo {
-        name: "severe_wear",
-        letter: 'j',
-        summary: "severe (plastic) wear: K raised by k_severe/H at contact points whose own pressure exceeds a multiple of the yield strength",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "k_severe",
-                unit: "1 (dimensionless Archard k; K_add = k/H)",
-                min: 0.0,
-                max: 1.0e-2,
-                default: 0.0,
-                reason: "severe (adhesive, plastic) wear of aluminium alloys: dimensionless k of 1e-4 to 1e-2 (Archard 1953; Lim & Ashby, Acta Metall. 1987; Hutchings 1992), against 1e-7 to 1e-5 in mild wear",
+            Self::CoatingBreakthrough => EffectInfo {
+                name: CoatingBreakthroughParameters::NAME,
+                letter: 'l',
+                summary: "anodic-coating breakthrough: K raised by k_bare/H once the specimen has slid past the distance that wears the coating through",
+                acts: Acts::WearLaw,
+                models: BOTH,
+                parameters: CoatingBreakthroughParameters::PARAMETERS,
+                reason: "the thesis' cubes are anodized 7075 (5.4) and Table 4.3 was fitted on fresh anodized pads; cases C and D wore faster in their later increments (1.53 -> 2.33 and 0.17 -> 0.87 mg/h, Table 5.3), as a worn-through coating would",
+                limitation: Some("the breakthrough is a slip distance, not a worn depth: the local depth would need the wear's distribution over the face"),
             },
-            ParameterInfo {
-                name: "pressure_ratio_to_yield",
-                unit: "1 (local pressure / yield strength Sy where severe wear starts)",
-                min: 0.5,
-                max: 3.0,
-                default: 1.0,
-                reason: "the mild-to-severe transition lies where the local pressure reaches the flow stress: about Sy at first yield, up to the hardness (about 3 Sy, Tabor) at full plasticity (Lim & Ashby 1987); 0.5 Sy allows for the stress concentration of a rough surface",
-            },
-        ],
-        reason: "thesis 5.5 and Fig. 5.7: impact stresses above yield and plastic flow at case A's corners; the lumped pressure N/A of eq. 3.11 averages over the face, the contact points' own pressures (gap::tracks) do not",
-        limitation: Some("local pressures from the contact points' share of the face law (gap::tracks), binned at 1/50 decade; on tracks recorded without points the lumped pressure stands in"),
-    },
-    EffectInfo {
-        name: "local_pressure",
-        letter: 'k',
-        summary: "local-pressure Archard: the case's K(sigma) evaluated at each contact point's own pressure instead of the lumped N/A, for a share of the wear",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[ParameterInfo {
-            name: "share",
-            unit: "1 (0 = lumped N/A as the thesis, 1 = every point at its own pressure)",
-            min: 0.0,
-            max: 1.0,
-            default: 0.0,
-            reason: "eq. 3.11 was written for a face's mean pressure; whether a real contact wears at the mean or at its local pressures is the modelling question, so every share between is allowed",
-        }],
-        reason: "a tilted face or an edge loads its deeper points above the mean; Table 4.3's K rises with pressure and cuts off at 2 Sy, so local pressures can raise the wear, or lower it where points exceed the cutoff",
-        limitation: Some("on tracks recorded without points it changes nothing"),
-    },
-    EffectInfo {
-        name: "coating_breakthrough",
-        letter: 'l',
-        summary: "anodic-coating breakthrough: K raised by k_bare/H once the specimen has slid past the distance that wears the coating through",
-        acts: Acts::WearLaw,
-        models: BOTH,
-        parameters: &[
-            ParameterInfo {
-                name: "k_bare",
-                unit: "1 (dimensionless Archard k of the bare alloy; K_add = k/H)",
-                min: 0.0,
-                max: 1.0e-2,
-                default: 0.0,
-                reason: "bare aluminium alloy on anodized or bare aluminium in dry sliding wears adhesively: k of 1e-5 to 1e-2 (Archard 1953; ASM Handbook 18, 1992), against 1e-7 to 1e-6 for an intact hard anodize",
-            },
-            ParameterInfo {
-                name: "breakthrough_slip_m",
-                unit: "m (slip distance at which the coating is worn through)",
-                min: 1.0,
-                max: 1.0e5,
-                default: 1.0e3,
-                reason: "sulphuric (type II) anodize is 5-25 µm thick, hard (type III) 25-100 µm (MIL-A-8625); worn at 1e-8-1e-6 µm per N·m of the mild regime under the rattle boxes' 1-10 N loads it lasts 1 m to 100 km of sliding",
-            },
-        ],
-        reason: "the thesis' cubes are anodized 7075 (5.4) and Table 4.3 was fitted on fresh anodized pads; cases C and D wore faster in their later increments (1.53 -> 2.33 and 0.17 -> 0.87 mg/h, Table 5.3), as a worn-through coating would",
-        limitation: Some("the breakthrough is a slip distance, not a worn depth: the local depth would need the wear's distribution over the face"),
-    },
-];
+        }
+    }
+}
+
+// `EffectKind::info` indexes the library by the kind's discriminant.
+const _: () = {
+    let mut i = 0;
+    while i < EffectKind::ALL.len() {
+        assert!(EffectKind::ALL[i] as usize == i);
+        i += 1;
+    }
+};
+
+const fn library() -> [EffectInfo; EffectKind::ALL.len()] {
+    let mut out = [EffectKind::ALL[0].describe(); EffectKind::ALL.len()];
+    let mut i = 1;
+    while i < out.len() {
+        out[i] = EffectKind::ALL[i].describe();
+        i += 1;
+    }
+    out
+}
+
+/// The library, in issue order (generated from [`EffectKind`]).
+pub const LIBRARY: &[EffectInfo] = &library();
 
 /// Looks an effect up by name.
 pub fn info(name: &str) -> Option<&'static EffectInfo> {
-    LIBRARY.iter().find(|e| e.name == name)
+    EffectKind::named(name).map(EffectKind::info)
+}
+
+/// An effect with its parameters typed: one parameter struct per kind, so the code applying
+/// an effect matches on it exhaustively and reads fields, not names.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TypedEffect {
+    /// A wear-law effect (a)(b)(i)-(l): a term of the wear law.
+    Wear(WearEffect),
+    /// (c) Clearance growth.
+    ClearanceGrowth(ClearanceGrowthParameters),
+    /// (d) Friction drift.
+    FrictionDrift(FrictionDriftParameters),
+    /// (e) Fixture compliance.
+    FixtureCompliance(FixtureComplianceParameters),
+    /// (f) Cross-axis excitation.
+    CrossAxis(CrossAxisParameters),
+    /// (g) Sharper edges.
+    SharpEdges(SharpEdgesParameters),
+    /// (h) Launcher spring preload loss.
+    PreloadLoss(PreloadLossParameters),
+}
+
+impl TypedEffect {
+    /// The effect of `kind` at `values` (every parameter by its library name). A missing or
+    /// unknown name is an error whose field is that name.
+    pub fn from_values(
+        kind: EffectKind,
+        values: &BTreeMap<String, f64>,
+    ) -> Result<Self, FieldError> {
+        use WearEffect as W;
+        let v = values;
+        Ok(match kind {
+            EffectKind::WearAboveCutoff => {
+                Self::Wear(W::WearAboveCutoff(Parameters::from_values(v)?))
+            }
+            EffectKind::ThirdBody => Self::Wear(W::ThirdBody(Parameters::from_values(v)?)),
+            EffectKind::ClearanceGrowth => Self::ClearanceGrowth(Parameters::from_values(v)?),
+            EffectKind::FrictionDrift => Self::FrictionDrift(Parameters::from_values(v)?),
+            EffectKind::FixtureCompliance => Self::FixtureCompliance(Parameters::from_values(v)?),
+            EffectKind::CrossAxis => Self::CrossAxis(Parameters::from_values(v)?),
+            EffectKind::SharpEdges => Self::SharpEdges(Parameters::from_values(v)?),
+            EffectKind::PreloadLoss => Self::PreloadLoss(Parameters::from_values(v)?),
+            EffectKind::ImpactWear => Self::Wear(W::ImpactWear(Parameters::from_values(v)?)),
+            EffectKind::SevereWear => Self::Wear(W::SevereWear(Parameters::from_values(v)?)),
+            EffectKind::LocalPressure => Self::Wear(W::LocalPressure(Parameters::from_values(v)?)),
+            EffectKind::CoatingBreakthrough => {
+                Self::Wear(W::CoatingBreakthrough(Parameters::from_values(v)?))
+            }
+        })
+    }
+
+    /// Its kind.
+    pub fn kind(&self) -> EffectKind {
+        use WearEffect as W;
+        match self {
+            Self::Wear(W::WearAboveCutoff(_)) => EffectKind::WearAboveCutoff,
+            Self::Wear(W::ThirdBody(_)) => EffectKind::ThirdBody,
+            Self::ClearanceGrowth(_) => EffectKind::ClearanceGrowth,
+            Self::FrictionDrift(_) => EffectKind::FrictionDrift,
+            Self::FixtureCompliance(_) => EffectKind::FixtureCompliance,
+            Self::CrossAxis(_) => EffectKind::CrossAxis,
+            Self::SharpEdges(_) => EffectKind::SharpEdges,
+            Self::PreloadLoss(_) => EffectKind::PreloadLoss,
+            Self::Wear(W::ImpactWear(_)) => EffectKind::ImpactWear,
+            Self::Wear(W::SevereWear(_)) => EffectKind::SevereWear,
+            Self::Wear(W::LocalPressure(_)) => EffectKind::LocalPressure,
+            Self::Wear(W::CoatingBreakthrough(_)) => EffectKind::CoatingBreakthrough,
+        }
+    }
+
+    /// The values by library name.
+    pub fn values(&self) -> BTreeMap<String, f64> {
+        match self {
+            Self::Wear(w) => w.values(),
+            Self::ClearanceGrowth(p) => p.values(),
+            Self::FrictionDrift(p) => p.values(),
+            Self::FixtureCompliance(p) => p.values(),
+            Self::CrossAxis(p) => p.values(),
+            Self::SharpEdges(p) => p.values(),
+            Self::PreloadLoss(p) => p.values(),
+        }
+    }
+
+    /// The magnitude (first parameter; 0 = the nominal model).
+    pub fn magnitude(&self) -> f64 {
+        match self {
+            Self::Wear(w) => w.magnitude(),
+            Self::ClearanceGrowth(p) => p.magnitude(),
+            Self::FrictionDrift(p) => p.magnitude(),
+            Self::FixtureCompliance(p) => p.magnitude(),
+            Self::CrossAxis(p) => p.magnitude(),
+            Self::SharpEdges(p) => p.magnitude(),
+            Self::PreloadLoss(p) => p.magnitude(),
+        }
+    }
+
+    /// The wear mechanism of a wear-law effect (None for dynamics effects); `hardness_pa` is
+    /// the softer body's indentation hardness (135 HB = 1.32 GPa for 7075-T73).
+    pub fn wear_mechanism(&self, hardness_pa: f64) -> Option<WearMechanism> {
+        match self {
+            Self::Wear(w) => Some(w.mechanism(hardness_pa)),
+            Self::ClearanceGrowth(_)
+            | Self::FrictionDrift(_)
+            | Self::FixtureCompliance(_)
+            | Self::CrossAxis(_)
+            | Self::SharpEdges(_)
+            | Self::PreloadLoss(_) => None,
+        }
+    }
 }
 
 /// An effect with its parameter values.
@@ -453,32 +476,41 @@ impl Effect {
         })
     }
 
-    /// The library entry.
-    pub fn info(&self) -> Result<&'static EffectInfo, GapError> {
-        info(&self.name)
+    fn kind(&self) -> Result<EffectKind, GapError> {
+        EffectKind::named(&self.name)
             .ok_or_else(|| GapError::field("effect", format!("unknown effect `{}`", self.name)))
     }
 
-    fn get(&self, name: &str) -> f64 {
-        self.parameters.get(name).copied().unwrap_or(0.0)
+    /// The library entry.
+    pub fn info(&self) -> Result<&'static EffectInfo, GapError> {
+        self.kind().map(EffectKind::info)
     }
 
-    /// The magnitude (first parameter).
+    /// The effect with its parameters read into its kind's struct: an unknown effect, or a
+    /// parameter missing or not the effect's, is an error naming it.
+    pub fn typed(&self) -> Result<TypedEffect, GapError> {
+        TypedEffect::from_values(self.kind()?, &self.parameters)
+            .map_err(|e| GapError::field(format!("effect.{}.{}", self.name, e.field), e.rule))
+    }
+
+    /// The magnitude (first parameter); 0, the nominal model, when the effect cannot be read
+    /// ([`Effect::typed`] says why).
     pub fn magnitude(&self) -> f64 {
-        self.info().map_or(0.0, |i| self.get(i.parameters[0].name))
+        self.typed().map_or(0.0, |t| t.magnitude())
     }
 
     /// The wear-law term of a wear-law effect (None for dynamics effects). `hardness_pa` is
     /// the softer body's indentation hardness (135 HB = 1.32 GPa for 7075-T73).
-    pub fn wear_term(&self, hardness_pa: f64) -> Option<Box<dyn WearTerm>> {
-        self.wear_mechanism(hardness_pa)
-            .map(|m| Box::new(m) as Box<dyn WearTerm>)
+    pub fn wear_term(&self, hardness_pa: f64) -> Result<Option<Box<dyn WearTerm>>, GapError> {
+        Ok(self
+            .wear_mechanism(hardness_pa)?
+            .map(|m| Box::new(m) as Box<dyn WearTerm>))
     }
 
     /// The wear mechanism of a wear-law effect at its parameters (None for dynamics effects):
     /// what a run carries as `wear.mechanism` (see [`crate::wear::mechanism`]).
-    pub fn wear_mechanism(&self, hardness_pa: f64) -> Option<WearMechanism> {
-        WearMechanism::from_effect(&self.name, |p| self.get(p), hardness_pa)
+    pub fn wear_mechanism(&self, hardness_pa: f64) -> Result<Option<WearMechanism>, GapError> {
+        Ok(self.typed()?.wear_mechanism(hardness_pa))
     }
 
     /// Edits `case` for a segment of the specimen in `state`. Magnitude 0 changes nothing.
@@ -489,100 +521,95 @@ impl Effect {
         state: &SpecimenState,
         configs_dir: &Path,
     ) -> Result<(), GapError> {
-        let info = self.info()?;
+        let typed = self.typed()?;
         let field = format!("effect.{}", self.name);
-        if !info.models.contains(&case.model) {
+        if !typed.kind().info().models.contains(&case.model) {
             return Err(GapError::field(
                 field,
                 format!("does not apply to a {:?} case", case.model),
             ));
         }
-        if self.magnitude() == 0.0 || info.acts == Acts::WearLaw {
+        if typed.magnitude() == 0.0 {
             return Ok(());
         }
-        let bad = |e: crate::field_error::FieldError| {
-            GapError::field(
-                format!("effect.{}", self.name),
-                format!("{}: {}", e.field, e.rule),
-            )
-        };
-        match self.name.as_str() {
-            "clearance_growth" => {
-                let opening_m = self.get("opening_um_per_h") * 1e-6 * state.elapsed_h;
-                if let Some(rb) = case.rattle_box.as_mut() {
-                    rb.tube_inner_side_m += opening_m;
-                    rb.case = format!("{}-worn", rb.case);
-                } else if let Some(l) = case.launcher.as_mut() {
-                    // A positive material-condition offset shrinks the shoes and opens the
-                    // rail by the same amount (analysis::rattle_space).
-                    l.dimensions = l.dimensions.with_material_condition(opening_m * 1e3);
-                }
-            }
-            "friction_drift" => {
-                let d = self.get("delta_mu")
-                    * (1.0 - (-state.slip_distance_m / self.get("slip_scale_m")).exp());
-                let shift = |f: &mut crate::physics::friction::FrictionParams| {
-                    f.mu_static += d;
-                    f.mu_dynamic += d;
-                };
-                if let Some(rb) = case.rattle_box.as_mut() {
-                    shift(&mut rb.friction);
-                }
-                if let Some(l) = case.launcher.as_mut() {
-                    shift(&mut l.friction);
-                }
-            }
-            "fixture_compliance" => {
-                let spec = resolved_excitation(case, configs_dir, &field)?;
-                let period = self.get("natural_period_ms") * 1e-3;
-                let zeta = self.get("damping_ratio");
-                let spec = filter_through_mount(spec, period, zeta, &field)?;
-                set_excitation(case, &spec, &field)?;
-            }
-            "cross_axis" => {
-                let spec = resolved_excitation(case, configs_dir, &field)?;
-                let spec = add_cross_axis(spec, self.get("share"), self.get("phase_deg"), &field)?;
-                set_excitation(case, &spec, &field)?;
-            }
-            "sharp_edges" => {
-                let keep = 1.0 - self.get("roundover_reduction");
-                if let Some(rb) = case.rattle_box.as_mut() {
-                    rb.edge_radius_m *= keep;
-                }
-                if let Some(l) = case.launcher.as_mut() {
-                    l.mid_shoe.edge_radius_m *= keep;
-                    l.rear_shoe.edge_radius_m *= keep;
-                    l.front_pad.edge_radius_m *= keep;
-                    l.latch.tooth.edge_radius_m *= keep;
-                    if let Some(p) = l.mid_shoe.protrusion.as_mut() {
-                        p.edge_radius_m *= keep;
-                    }
-                }
-            }
-            "preload_loss" => {
-                let keep = 1.0 - self.get("loss");
-                if let Some(l) = case.launcher.as_mut() {
-                    l.latch_spring.preload_n *= keep;
-                    l.rear_leaf_spring.preload_n *= keep;
-                }
-            }
-            other => {
-                return Err(GapError::field(
-                    "effect",
-                    format!("no dynamics for `{other}`"),
-                ));
-            }
+        match typed {
+            TypedEffect::Wear(_) => return Ok(()),
+            TypedEffect::ClearanceGrowth(p) => p.apply(case, state),
+            TypedEffect::FrictionDrift(p) => p.apply(case, state),
+            TypedEffect::FixtureCompliance(p) => p.apply(case, configs_dir, &field)?,
+            TypedEffect::CrossAxis(p) => p.apply(case, configs_dir, &field)?,
+            TypedEffect::SharpEdges(p) => p.apply(case),
+            TypedEffect::PreloadLoss(p) => p.apply(case),
         }
-        case.validate().map_err(bad)
+        case.validate()
+            .map_err(|e| GapError::field(field, format!("{}: {}", e.field, e.rule)))
     }
 }
 
-/// What a specimen has been through when a segment starts (or at its middle, for effects of
-/// test time).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct SpecimenState {
-    /// Test time, h (the segment's middle).
-    pub elapsed_h: f64,
-    /// Slip distance accumulated before the segment, m.
-    pub slip_distance_m: f64,
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Distinct in-bounds values, one per parameter.
+    fn distinct(parameters: &[ParameterInfo]) -> BTreeMap<String, f64> {
+        let n = parameters.len() as f64;
+        parameters
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let v = p.min + (p.max - p.min) * (i as f64 + 1.0) / (n + 1.0);
+                (p.name.to_string(), v)
+            })
+            .collect()
+    }
+
+    /// A library name, a parameter and the field the code reads cannot drift apart: every
+    /// effect, parsed at its defaults or given a distinct value per parameter, reads into its
+    /// kind's struct and gives back exactly the parameters its entry lists; its kind is the
+    /// entry's, and it has a wear mechanism exactly when its entry says it acts on the wear law.
+    #[test]
+    fn every_library_parameter_is_a_field_of_its_kind() {
+        assert_eq!(LIBRARY.len(), EffectKind::ALL.len());
+        for (kind, info) in EffectKind::ALL.into_iter().zip(LIBRARY) {
+            let effect = Effect::parse(&format!("{}=0", info.name)).unwrap();
+            let typed = effect.typed().unwrap();
+            assert_eq!(typed.kind(), kind, "{}", info.name);
+            assert_eq!(EffectKind::named(info.name), Some(kind));
+            assert_eq!(typed.values(), effect.parameters, "{}", info.name);
+            assert_eq!(typed.magnitude(), 0.0, "{}", info.name);
+            let values = distinct(info.parameters);
+            let typed = TypedEffect::from_values(kind, &values).unwrap();
+            assert_eq!(typed.values(), values, "{}", info.name);
+            assert_eq!(
+                typed.magnitude(),
+                values[info.parameters[0].name],
+                "{}",
+                info.name
+            );
+            assert_eq!(
+                typed.wear_mechanism(1.32e9).is_some(),
+                info.acts == Acts::WearLaw,
+                "{}",
+                info.name
+            );
+        }
+    }
+
+    #[test]
+    fn a_missing_or_unknown_parameter_is_an_error_not_zero() {
+        let mut effect = Effect::parse("third_body=1e-3").unwrap();
+        effect.parameters.remove("min_slip_m_s");
+        let e = effect.typed().unwrap_err();
+        assert_eq!(e.field_path(), Some("effect.third_body.min_slip_m_s"));
+        assert!(effect.wear_term(1.32e9).is_err());
+        effect.parameters.insert("min_slip_m_s".into(), 1e-3);
+        effect.parameters.insert("min_slip".into(), 1e-3);
+        let e = effect.typed().unwrap_err();
+        assert_eq!(e.field_path(), Some("effect.third_body.min_slip"));
+        let unknown = Effect {
+            name: "sand".into(),
+            parameters: BTreeMap::new(),
+        };
+        assert_eq!(unknown.typed().unwrap_err().field_path(), Some("effect"));
+    }
 }

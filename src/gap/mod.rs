@@ -17,6 +17,7 @@ pub mod accel;
 pub mod campaign;
 pub mod diagnose;
 mod drive_edits;
+mod dynamics_effects;
 pub mod effects;
 mod manifest;
 pub mod point_pressure;

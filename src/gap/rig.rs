@@ -364,9 +364,9 @@ pub fn run_cached(
                 parameters: e.parameters.clone(),
             })
             .chain(options.hidden.iter().map(|e| TruthEffect {
-                name: e.name.clone(),
+                name: e.name().to_string(),
                 in_library: false,
-                parameters: e.parameters.clone(),
+                parameters: e.parameters(),
             }))
             .collect(),
         noise_rel: options.noise_rel,
@@ -439,18 +439,16 @@ pub(crate) fn simulate_test(
             }
             let run = cache.get_or_run(&case, configs_dir, window, &what, control)?;
             let scale = segment_s / run.window_s;
-            let boxed: Vec<Box<dyn WearTerm>> = o
-                .effects
-                .iter()
-                .filter(|e| e.magnitude() != 0.0)
-                .filter_map(|e| e.wear_term(run.hardness_pa))
-                .chain(
-                    o.hidden
-                        .iter()
-                        .filter(|h| h.magnitude() != 0.0)
-                        .map(|h| h.wear_term()),
-                )
-                .collect();
+            let mut boxed: Vec<Box<dyn WearTerm>> = Vec::new();
+            for e in o.effects.iter().filter(|e| e.magnitude() != 0.0) {
+                boxed.extend(e.wear_term(run.hardness_pa)?);
+            }
+            boxed.extend(
+                o.hidden
+                    .iter()
+                    .filter(|h| h.magnitude() != 0.0)
+                    .map(|h| h.wear_term()),
+            );
             let terms: Vec<&dyn WearTerm> = boxed.iter().map(|b| b.as_ref()).collect();
             let history = SlipHistory {
                 slip_start_m: slip,

@@ -9,7 +9,7 @@
 //! hardness (the dimensionless coefficients are properties of the material pair; K = k/H).
 
 use crate::field_error::FieldError;
-use crate::wear::mechanism::WearMechanism;
+use crate::wear::mechanism::{WearEffect, WearMechanism};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -40,27 +40,15 @@ impl DiagnosedWearLaw {
 
     /// The mechanism for a case whose softer body has indentation hardness `hardness_pa`.
     pub fn mechanism(&self, hardness_pa: f64) -> Result<WearMechanism, FieldError> {
-        let missing = std::cell::Cell::new(None);
-        let get = |name: &str| match self.parameters.get(name) {
-            Some(v) => *v,
-            None => {
-                missing.set(Some(name.to_string()));
-                f64::NAN
-            }
-        };
-        let mechanism =
-            WearMechanism::from_effect(&self.effect, get, hardness_pa).ok_or_else(|| {
+        let mechanism = WearEffect::from_values(&self.effect, &self.parameters)
+            .map_err(|e| e.at("wear_law.parameters"))?
+            .ok_or_else(|| {
                 FieldError::new(
                     "wear_law.effect",
                     format!("`{}` is not a wear-law effect", self.effect),
                 )
-            })?;
-        if let Some(name) = missing.take() {
-            return Err(FieldError::new(
-                format!("wear_law.parameters.{name}"),
-                "is required by the effect",
-            ));
-        }
+            })?
+            .mechanism(hardness_pa);
         mechanism
             .validate()
             .map_err(|crate::wear::WearError::Invalid(e)| {

@@ -2,8 +2,9 @@
 //! sample ([`WearSample`]), the terms ([`WearTerm`]) and the closed set a case or a sweep can
 //! carry ([`WearMechanism`]).
 //!
-//! The gap diagnosis (`gap::effects`, wear-law effects) evaluates these terms on recorded tracks
-//! and fits their coefficients; a run (`models::run`) integrates the same terms per track while
+//! The gap diagnosis (`gap::effects`, wear-law effects, typed here as [`WearEffect`] in the
+//! library's names and units) evaluates these terms on recorded tracks and fits their
+//! coefficients; a run (`models::run`) integrates the same terms per track while
 //! it goes, when its case's `wear.mechanism` names one. Both call the code here, so a fitted
 //! mechanism carried to a sweep is the mechanism the diagnosis fitted. Each term at magnitude 0
 //! changes nothing, bit for bit.
@@ -11,7 +12,9 @@
 use super::law::WearLaw;
 use super::WearError;
 use crate::field_error::FieldError;
+use crate::parameters::{parameter_struct, Parameters};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// Contact points of one track at one step whose local pressures fall in one bin (see
 /// `gap::point_pressure`).
@@ -253,46 +256,13 @@ impl WearMechanism {
     /// The mechanism's name, as the effect library names it.
     pub fn name(&self) -> &'static str {
         match self {
-            Self::WearAboveCutoff(_) => "wear_above_cutoff",
-            Self::ThirdBody(_) => "third_body",
-            Self::ImpactWear(_) => "impact_wear",
-            Self::SevereWear(_) => "severe_wear",
-            Self::LocalPressure(_) => "local_pressure",
-            Self::CoatingBreakthrough(_) => "coating_breakthrough",
+            Self::WearAboveCutoff(_) => AboveCutoffParameters::NAME,
+            Self::ThirdBody(_) => ThirdBodyParameters::NAME,
+            Self::ImpactWear(_) => ImpactWearParameters::NAME,
+            Self::SevereWear(_) => SevereWearParameters::NAME,
+            Self::LocalPressure(_) => LocalPressureParameters::NAME,
+            Self::CoatingBreakthrough(_) => CoatingBreakthroughParameters::NAME,
         }
-    }
-
-    /// The mechanism of the wear-law effect `name` (the gap library's names) at the parameter
-    /// values `get` gives (library names and units: dimensionless wear coefficients `k_*` are
-    /// divided by `hardness_pa`, the softer body's indentation hardness, to give K in m²/N).
-    /// None when `name` is not a wear-law effect.
-    pub fn from_effect(name: &str, get: impl Fn(&str) -> f64, hardness_pa: f64) -> Option<Self> {
-        Some(match name {
-            "wear_above_cutoff" => Self::WearAboveCutoff(AboveCutoff {
-                ratio: get("k_ratio_above_cutoff"),
-            }),
-            "third_body" => Self::ThirdBody(ThirdBody {
-                k_add_m2_per_n: get("k_abrasive") / hardness_pa,
-                min_pressure_pa: get("min_pressure_pa"),
-                min_slip_m_s: get("min_slip_m_s"),
-            }),
-            "impact_wear" => Self::ImpactWear(ImpactWear {
-                k_energy_m3_per_j: get("k_energy_m3_per_j"),
-                min_normal_speed_m_s: get("min_normal_speed_m_s"),
-            }),
-            "severe_wear" => Self::SevereWear(SevereWear {
-                k_add_m2_per_n: get("k_severe") / hardness_pa,
-                pressure_ratio_to_yield: get("pressure_ratio_to_yield"),
-            }),
-            "coating_breakthrough" => Self::CoatingBreakthrough(CoatingBreakthrough {
-                k_add_m2_per_n: get("k_bare") / hardness_pa,
-                breakthrough_slip_m: get("breakthrough_slip_m"),
-            }),
-            "local_pressure" => Self::LocalPressure(LocalPressure {
-                share: get("share"),
-            }),
-            _ => return None,
-        })
     }
 
     fn term(&self) -> &dyn WearTerm {
@@ -351,6 +321,219 @@ impl WearTerm for WearMechanism {
 
     fn added_volume_rate_m3_s(&self, law: &WearLaw, sample: &WearSample<'_>) -> f64 {
         self.term().added_volume_rate_m3_s(law, sample)
+    }
+}
+
+parameter_struct! {
+    /// (a) The gap library's `wear_above_cutoff`: K above the cutoff as a multiple of K there.
+    pub struct AboveCutoffParameters = "wear_above_cutoff" {
+        k_ratio_above_cutoff {
+            unit: "1 (K above the cutoff / K(cutoff))",
+            min: 0.0,
+            max: 1000.0,
+            default: 0.0,
+            reason: "wear maps (Lim & Ashby 1987) put the mild-to-severe transition at contact pressures near the hardness, with K rising 100-1000x across it; thesis 5.5 and Fig. 5.7 show plastic flow at case A's corners",
+        },
+    }
+}
+
+parameter_struct! {
+    /// (b) The gap library's `third_body`: three-body abrasion above pressure and slip
+    /// thresholds.
+    pub struct ThirdBodyParameters = "third_body" {
+        k_abrasive {
+            unit: "1 (dimensionless Archard k; K_add = k/H)",
+            min: 0.0,
+            max: 1.0e-2,
+            default: 0.0,
+            reason: "three-body abrasive wear coefficients 5e-4 to 5e-3 (Hutchings, Tribology, 1992; Rabinowicz 1995), up to 1e-2 for sharp sand",
+        },
+        min_pressure_pa {
+            unit: "Pa",
+            min: 1.0e2,
+            max: 1.0e8,
+            default: 1.0e4,
+            reason: "estimate: a few trapped particles carry the load, so they cut at nominal pressures far below the hardness; 10 kPa is above a resting rattle-box cube's own weight (0.7 kPa), so mere resting does not grind; uncertain by orders (100 Pa to 100 MPa)",
+        },
+        min_slip_m_s {
+            unit: "m/s",
+            min: 0.0,
+            max: 0.1,
+            default: 1.0e-3,
+            reason: "estimate: below about 1 mm/s (the Table 5.2 stiction speed is 6.5 mm/s) the surfaces stick and trapped particles are not dragged",
+        },
+    }
+}
+
+parameter_struct! {
+    /// (i) The gap library's `impact_wear`: volume per joule of normal damping work.
+    pub struct ImpactWearParameters = "impact_wear" {
+        k_energy_m3_per_j {
+            unit: "m³/J (wear volume per joule of normal damping work)",
+            min: 0.0,
+            max: 1.0e-11,
+            default: 0.0,
+            reason: "dissipated-energy wear (Fouvry et al., Wear 2003; Huq & Celis, Wear 2002) measures 1e-15 to 1e-13 m³/J for steels and coatings in fretting; an Archard k/(H mu) for aluminium alloys in dry contact, k = 1e-6 (mild, oxidised) to 1e-2 (severe, adhesive) (Archard 1953; Hutchings 1992), H = 1.32 GPa, mu = 0.5, spans 1.5e-15 to 1.5e-11 m³/J; Engel (Impact Wear of Materials, 1976) finds repeated normal impact removes material by the same fatigue and plastic mechanisms, so the sliding range bounds it",
+        },
+        min_normal_speed_m_s {
+            unit: "m/s (|penetration rate| below which damping work does not wear)",
+            min: 0.0,
+            max: 0.5,
+            default: 0.0,
+            reason: "Engel's impact wear has a threshold below which impacts only deform elastically; a sliding contact's micro-motion (normal speeds of mm/s) dissipates without removing material; 0.5 m/s is above the rattle boxes' impact speeds (15 g at 20 Hz moves the tube at 1.2 m/s peak)",
+        },
+    }
+}
+
+parameter_struct! {
+    /// (j) The gap library's `severe_wear`: added K where the local pressure exceeds a
+    /// multiple of the yield strength.
+    pub struct SevereWearParameters = "severe_wear" {
+        k_severe {
+            unit: "1 (dimensionless Archard k; K_add = k/H)",
+            min: 0.0,
+            max: 1.0e-2,
+            default: 0.0,
+            reason: "severe (adhesive, plastic) wear of aluminium alloys: dimensionless k of 1e-4 to 1e-2 (Archard 1953; Lim & Ashby, Acta Metall. 1987; Hutchings 1992), against 1e-7 to 1e-5 in mild wear",
+        },
+        pressure_ratio_to_yield {
+            unit: "1 (local pressure / yield strength Sy where severe wear starts)",
+            min: 0.5,
+            max: 3.0,
+            default: 1.0,
+            reason: "the mild-to-severe transition lies where the local pressure reaches the flow stress: about Sy at first yield, up to the hardness (about 3 Sy, Tabor) at full plasticity (Lim & Ashby 1987); 0.5 Sy allows for the stress concentration of a rough surface",
+        },
+    }
+}
+
+parameter_struct! {
+    /// (k) The gap library's `local_pressure`: a share of the wear at the contact points'
+    /// own pressures.
+    pub struct LocalPressureParameters = "local_pressure" {
+        share {
+            unit: "1 (0 = lumped N/A as the thesis, 1 = every point at its own pressure)",
+            min: 0.0,
+            max: 1.0,
+            default: 0.0,
+            reason: "eq. 3.11 was written for a face's mean pressure; whether a real contact wears at the mean or at its local pressures is the modelling question, so every share between is allowed",
+        },
+    }
+}
+
+parameter_struct! {
+    /// (l) The gap library's `coating_breakthrough`: added K past a slip distance.
+    pub struct CoatingBreakthroughParameters = "coating_breakthrough" {
+        k_bare {
+            unit: "1 (dimensionless Archard k of the bare alloy; K_add = k/H)",
+            min: 0.0,
+            max: 1.0e-2,
+            default: 0.0,
+            reason: "bare aluminium alloy on anodized or bare aluminium in dry sliding wears adhesively: k of 1e-5 to 1e-2 (Archard 1953; ASM Handbook 18, 1992), against 1e-7 to 1e-6 for an intact hard anodize",
+        },
+        breakthrough_slip_m {
+            unit: "m (slip distance at which the coating is worn through)",
+            min: 1.0,
+            max: 1.0e5,
+            default: 1.0e3,
+            reason: "sulphuric (type II) anodize is 5-25 µm thick, hard (type III) 25-100 µm (MIL-A-8625); worn at 1e-8-1e-6 µm per N·m of the mild regime under the rattle boxes' 1-10 N loads it lasts 1 m to 100 km of sliding",
+        },
+    }
+}
+
+/// A wear-law effect of the gap library (`gap::effects`) with its parameters in the library's
+/// names and units (dimensionless wear coefficients `k_*` before the hardness divides them):
+/// what a diagnosis fits and a sweep carries. [`WearEffect::mechanism`] gives the
+/// [`WearMechanism`] a run integrates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WearEffect {
+    /// (a) Wear above the eq. 3.11 cutoff.
+    WearAboveCutoff(AboveCutoffParameters),
+    /// (b) Third-body abrasion.
+    ThirdBody(ThirdBodyParameters),
+    /// (i) Impact wear.
+    ImpactWear(ImpactWearParameters),
+    /// (j) Severe wear.
+    SevereWear(SevereWearParameters),
+    /// (k) Local-pressure Archard.
+    LocalPressure(LocalPressureParameters),
+    /// (l) Coating breakthrough.
+    CoatingBreakthrough(CoatingBreakthroughParameters),
+}
+
+impl WearEffect {
+    /// The wear-law effect `name` at `values` (every parameter by its library name; a missing
+    /// or unknown name is an error naming it). None when `name` is not a wear-law effect.
+    pub fn from_values(
+        name: &str,
+        values: &BTreeMap<String, f64>,
+    ) -> Result<Option<Self>, FieldError> {
+        Ok(Some(match name {
+            AboveCutoffParameters::NAME => Self::WearAboveCutoff(Parameters::from_values(values)?),
+            ThirdBodyParameters::NAME => Self::ThirdBody(Parameters::from_values(values)?),
+            ImpactWearParameters::NAME => Self::ImpactWear(Parameters::from_values(values)?),
+            SevereWearParameters::NAME => Self::SevereWear(Parameters::from_values(values)?),
+            LocalPressureParameters::NAME => Self::LocalPressure(Parameters::from_values(values)?),
+            CoatingBreakthroughParameters::NAME => {
+                Self::CoatingBreakthrough(Parameters::from_values(values)?)
+            }
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The values by library name.
+    pub fn values(&self) -> BTreeMap<String, f64> {
+        match self {
+            Self::WearAboveCutoff(p) => p.values(),
+            Self::ThirdBody(p) => p.values(),
+            Self::ImpactWear(p) => p.values(),
+            Self::SevereWear(p) => p.values(),
+            Self::LocalPressure(p) => p.values(),
+            Self::CoatingBreakthrough(p) => p.values(),
+        }
+    }
+
+    /// The magnitude (first parameter; 0 = the nominal wear law).
+    pub fn magnitude(&self) -> f64 {
+        match self {
+            Self::WearAboveCutoff(p) => p.magnitude(),
+            Self::ThirdBody(p) => p.magnitude(),
+            Self::ImpactWear(p) => p.magnitude(),
+            Self::SevereWear(p) => p.magnitude(),
+            Self::LocalPressure(p) => p.magnitude(),
+            Self::CoatingBreakthrough(p) => p.magnitude(),
+        }
+    }
+
+    /// The mechanism for a contact whose softer body has indentation hardness `hardness_pa`
+    /// (dimensionless coefficients `k_*` divided by it give K in m²/N).
+    pub fn mechanism(&self, hardness_pa: f64) -> WearMechanism {
+        match *self {
+            Self::WearAboveCutoff(p) => WearMechanism::WearAboveCutoff(AboveCutoff {
+                ratio: p.k_ratio_above_cutoff,
+            }),
+            Self::ThirdBody(p) => WearMechanism::ThirdBody(ThirdBody {
+                k_add_m2_per_n: p.k_abrasive / hardness_pa,
+                min_pressure_pa: p.min_pressure_pa,
+                min_slip_m_s: p.min_slip_m_s,
+            }),
+            Self::ImpactWear(p) => WearMechanism::ImpactWear(ImpactWear {
+                k_energy_m3_per_j: p.k_energy_m3_per_j,
+                min_normal_speed_m_s: p.min_normal_speed_m_s,
+            }),
+            Self::SevereWear(p) => WearMechanism::SevereWear(SevereWear {
+                k_add_m2_per_n: p.k_severe / hardness_pa,
+                pressure_ratio_to_yield: p.pressure_ratio_to_yield,
+            }),
+            Self::LocalPressure(p) => {
+                WearMechanism::LocalPressure(LocalPressure { share: p.share })
+            }
+            Self::CoatingBreakthrough(p) => {
+                WearMechanism::CoatingBreakthrough(CoatingBreakthrough {
+                    k_add_m2_per_n: p.k_bare / hardness_pa,
+                    breakthrough_slip_m: p.breakthrough_slip_m,
+                })
+            }
+        }
     }
 }
 
@@ -443,5 +626,26 @@ mod tests {
             min_normal_speed_m_s: 0.0,
         });
         assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn each_wear_effect_reads_its_own_names_and_names_its_mechanism() {
+        fn check<P: Parameters>(wrap: fn(P) -> WearEffect) {
+            let d = P::defaults();
+            let e = WearEffect::from_values(P::NAME, &d.values()).unwrap();
+            assert_eq!(e, Some(wrap(d)), "{}", P::NAME);
+            assert_eq!(wrap(d).mechanism(1.32e9).name(), P::NAME);
+            assert_eq!(wrap(d).values(), d.values());
+        }
+        check(WearEffect::WearAboveCutoff);
+        check(WearEffect::ThirdBody);
+        check(WearEffect::ImpactWear);
+        check(WearEffect::SevereWear);
+        check(WearEffect::LocalPressure);
+        check(WearEffect::CoatingBreakthrough);
+        assert_eq!(
+            WearEffect::from_values("cross_axis", &BTreeMap::new()),
+            Ok(None)
+        );
     }
 }

@@ -14,6 +14,7 @@ use crate::support::{temp_dir, tokens_env, TempDir, ENGINEER, PLANNER, TEST_ENGI
 use railwear::config::ServiceConfig;
 use railwear::http::jobs::JobView;
 use railwear::http::RunningService;
+use railwear::jobs::JobStatus;
 use railwear_testkit::{self as testkit, Client, ClientError, Request, ServerProcess};
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -185,24 +186,39 @@ impl Api {
         r.json()["id"].as_str().expect("job id").to_string()
     }
 
-    /// The job record `GET /v1/jobs/{id}` as the engineer.
-    pub fn get_job(&self, id: &str) -> serde_json::Value {
-        self.get_json(&format!("/v1/jobs/{id}"))
-    }
-
     /// The job record `GET /v1/jobs/{id}` as the engineer, typed.
     pub fn job(&self, id: &str) -> JobView {
-        let j = self.get_job(id);
+        let j = self.get_json(&format!("/v1/jobs/{id}"));
         serde_json::from_value(j.clone()).unwrap_or_else(|e| panic!("not a job ({e}): {j}"))
     }
 
-    /// Poll the job until its status is `status` (panics if it fails first or on timeout).
-    pub fn wait_job(&self, id: &str, status: &str, timeout: Duration) -> serde_json::Value {
-        wait_for(timeout, status, || {
-            let j = self.get_job(id);
-            assert_ne!(j["status"], "failed", "job failed: {j}");
-            (j["status"] == status).then_some(j)
+    /// Polls the job until `done` holds for its record; the record (panics on timeout).
+    pub fn wait_job_until(
+        &self,
+        id: &str,
+        what: &str,
+        timeout: Duration,
+        mut done: impl FnMut(&JobView) -> bool,
+    ) -> JobView {
+        wait_for(timeout, what, || Some(self.job(id)).filter(|j| done(j)))
+    }
+
+    /// Polls the job until its status is `status` (panics if it fails first, or on timeout).
+    pub fn wait_job(&self, id: &str, status: JobStatus, timeout: Duration) -> JobView {
+        self.wait_job_until(id, status.as_str(), timeout, |j| {
+            assert!(
+                j.status != JobStatus::Failed || status == JobStatus::Failed,
+                "job failed: {j:?}"
+            );
+            j.status == status
         })
+    }
+
+    /// The child jobs of `id` (`GET /v1/jobs?parent={id}`, one page of 100).
+    pub fn children(&self, id: &str) -> Vec<JobView> {
+        let page = self.get_json(&format!("/v1/jobs?parent={id}&limit=100"));
+        serde_json::from_value(page["items"].clone())
+            .unwrap_or_else(|e| panic!("not a page of jobs ({e}): {page}"))
     }
 
     /// `POST /v1/jobs/{id}/cancel` as the engineer.
@@ -246,7 +262,7 @@ pub enum Runner {
 }
 
 /// The service in this process on port 0 with a fresh SQLite file (or the database its config
-/// names), and an [`Api`] to it (`app.get_job(..)` etc. through `Deref`).
+/// names), and an [`Api`] to it (`app.job(..)` etc. through `Deref`).
 pub struct TestApp {
     pub api: Api,
     pub service: RunningService,

@@ -5,6 +5,7 @@
 
 use crate::helpers::{wait_for, Api};
 use crate::support::{tokens_env, ENGINEER};
+use railwear::jobs::{ChildCounts, JobStatus};
 use railwear_testkit::ServerProcess;
 use std::path::Path;
 use std::process::Command;
@@ -63,12 +64,12 @@ fn api_without_workers_and_a_worker_process_complete_a_job() {
     let id = api.submit_job(SHORT);
     // The API runs no workers: the job stays queued.
     std::thread::sleep(Duration::from_millis(1500));
-    assert_eq!(api.get_job(&id)["status"], "queued");
+    assert_eq!(api.job(&id).status, JobStatus::Queued);
 
     let _worker = worker(&db.url, &[]);
-    let done = api.wait_job(&id, "succeeded", Duration::from_secs(300));
-    assert_eq!(done["attempt"], 1);
-    assert!(done["track_samples"].as_i64().unwrap() > 0);
+    let done = api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(300));
+    assert_eq!(done.attempt, 1);
+    assert!(done.track_samples > 0);
     let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
     assert_eq!(result.status, 200, "{}", result.body);
     assert!(result.json()["summary"].is_object());
@@ -77,10 +78,7 @@ fn api_without_workers_and_a_worker_process_complete_a_job() {
     assert_eq!(csv.status, 200);
     let lines: Vec<&str> = csv.body.lines().collect();
     assert_eq!(lines[0], railwear::physics::track::TrackSample::CSV_HEADER);
-    assert_eq!(
-        lines.len() as i64,
-        1 + done["track_samples"].as_i64().unwrap()
-    );
+    assert_eq!(lines.len() as i64, 1 + done.track_samples);
     drop(rt);
 }
 
@@ -96,30 +94,24 @@ fn a_worker_killed_mid_job_loses_its_lease_and_another_worker_finishes() {
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = api.submit_job(long);
     let first = worker(&db.url, &env);
-    let running = api.wait_job(&id, "running", Duration::from_secs(60));
-    assert_eq!(running["attempt"], 1);
+    let running = api.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
+    assert_eq!(running.attempt, 1);
     drop(first); // SIGKILL: no shutdown code runs, the lease is left to expire
 
     let _second = worker(&db.url, &env);
-    let retaken = wait_for(Duration::from_secs(60), "attempt 2", || {
-        let j = api.get_job(&id);
-        (j["status"] == "running" && j["attempt"] == 2).then_some(j)
+    let retaken = api.wait_job_until(&id, "attempt 2", Duration::from_secs(60), |j| {
+        j.status == JobStatus::Running && j.attempt == 2
     });
     assert_eq!(
-        retaken["error"], "attempt 1 lost its worker (lease expired)",
-        "{retaken}"
+        retaken.error.as_deref(),
+        Some("attempt 1 lost its worker (lease expired)"),
+        "{retaken:?}"
     );
     // The new owner heartbeats: its cancel request reaches it through the database.
     api.cancel_job(&id);
-    let cancelled = api.wait_job(&id, "cancelled", Duration::from_secs(30));
-    assert_eq!(cancelled["attempt"], 2);
+    let cancelled = api.wait_job(&id, JobStatus::Cancelled, Duration::from_secs(30));
+    assert_eq!(cancelled.attempt, 2);
     drop(rt);
-}
-
-fn children(api: &Api, id: &str) -> Vec<serde_json::Value> {
-    let r = api.get(&format!("/v1/jobs?parent={id}&limit=100"), Some(ENGINEER));
-    assert_eq!(r.status, 200, "{}", r.body);
-    r.json()["items"].as_array().cloned().unwrap_or_default()
 }
 
 /// Issue 6, item 1: one API process and three worker processes on PostgreSQL run a 12-point
@@ -169,10 +161,10 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
 
     // SIGKILL the worker process that holds a running child.
     let victim_worker = wait_for(Duration::from_secs(120), "a running child", || {
-        children(&api, &id).iter().find_map(|c| {
-            let worker = c["worker"].as_str()?;
-            (c["status"] == "running").then(|| worker.to_string())
-        })
+        api.children(&id)
+            .into_iter()
+            .find(|c| c.status == JobStatus::Running)
+            .and_then(|c| c.worker)
     });
     // Worker names are `<host>-<pid>-<n>`.
     let pid: u32 = victim_worker
@@ -186,14 +178,22 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
         .unwrap_or_else(|| panic!("worker {victim_worker} is not one of ours"));
     drop(workers[slot].take());
 
-    let done = api.wait_job(&id, "succeeded", Duration::from_secs(300));
+    let done = api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(300));
     assert_eq!(
-        done["children"],
-        serde_json::json!({"total": 12, "succeeded": 12, "failed": 0, "cancelled": 0})
+        done.children,
+        Some(ChildCounts {
+            total: 12,
+            succeeded: 12,
+            failed: 0,
+            cancelled: 0
+        })
     );
-    let kids = children(&api, &id);
+    let kids = api.children(&id);
     assert_eq!(kids.len(), 12);
-    assert!(kids.iter().all(|c| c["status"] == "succeeded"), "{kids:?}");
+    assert!(
+        kids.iter().all(|c| c.status == JobStatus::Succeeded),
+        "{kids:?}"
+    );
 
     let store = rt
         .block_on(railwear::store::open(&db.url))
@@ -249,8 +249,8 @@ fn a_sweep_fanned_out_to_three_worker_processes_survives_a_killed_worker() {
     // the single-process SQLite service's result.
     let (summary, outcome) = reference.join().expect("reference sweep");
     let job = rt.block_on(store.get_job(id)).expect("job").expect("job");
-    let single_done = single.wait_job(&single_id, "succeeded", Duration::from_secs(300));
-    assert_eq!(single_done["children"]["succeeded"], 12);
+    let single_done = single.wait_job(&single_id, JobStatus::Succeeded, Duration::from_secs(300));
+    assert_eq!(single_done.children.map(|c| c.succeeded), Some(12));
     let single_result = single.get(&format!("/v1/jobs/{single_id}/result"), Some(ENGINEER));
     assert_eq!(single_result.status, 200, "{}", single_result.body);
     assert_eq!(job.result, Some(single_result.json()["summary"].clone()));
@@ -314,7 +314,7 @@ fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = api.submit_job(long);
     let mut first = worker(&db.url, &env);
-    api.wait_job(&id, "running", Duration::from_secs(60));
+    api.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
     let asked = std::time::Instant::now();
     let status = std::process::Command::new("kill")
         .args(["-TERM", &first.id().to_string()])
@@ -334,15 +334,15 @@ fn sigterm_to_a_worker_process_gives_its_job_back_at_once() {
         "{:?}",
         asked.elapsed()
     );
-    let j = api.get_job(&id);
-    assert_eq!(j["status"], "queued", "{j}");
+    let j = api.job(&id);
+    assert_eq!(j.status, JobStatus::Queued, "{j:?}");
     let log = api.get_json(&format!("/v1/jobs/{id}/attempts"));
     assert_eq!(log[0]["outcome"], "released", "{log}");
 
     let _second = worker(&db.url, &env);
-    let retaken = api.wait_job(&id, "running", Duration::from_secs(10));
-    assert_eq!(retaken["attempt"], 2);
+    let retaken = api.wait_job(&id, JobStatus::Running, Duration::from_secs(10));
+    assert_eq!(retaken.attempt, 2);
     api.cancel_job(&id);
-    api.wait_job(&id, "cancelled", Duration::from_secs(30));
+    api.wait_job(&id, JobStatus::Cancelled, Duration::from_secs(30));
     drop(rt);
 }

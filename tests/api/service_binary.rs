@@ -2,6 +2,7 @@
 
 use crate::helpers::{wait_for, Binary};
 use crate::support::{temp_dir, ADMIN, ENGINEER, PLANNER};
+use railwear::jobs::JobStatus;
 use std::process::Command;
 use std::time::Duration;
 
@@ -103,18 +104,15 @@ fn simulate_job_succeeds_with_results_and_tracks_csv() {
     let dir = temp_dir("sim");
     let server = Binary::start(&dir.db_url(), &[]);
     let id = server.submit_job(SHORT_SIMULATE);
-    let job = server.wait_job(&id, "succeeded", Duration::from_secs(300));
-    assert!(job["track_samples"].as_i64().unwrap() > 0);
+    let job = server.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(300));
+    assert!(job.track_samples > 0);
     let result = server.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
     assert_eq!(result.status, 200);
     assert!(result.json()["summary"].is_object());
     let csv = server.get(&format!("/v1/jobs/{id}/tracks?format=csv"), Some(ENGINEER));
     let lines: Vec<&str> = csv.body.lines().collect();
     assert_eq!(lines[0], railwear::physics::track::TrackSample::CSV_HEADER);
-    assert_eq!(
-        lines.len() as i64,
-        1 + job["track_samples"].as_i64().unwrap()
-    );
+    assert_eq!(lines.len() as i64, 1 + job.track_samples);
 }
 
 #[test]
@@ -123,7 +121,7 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     let ref_dir = temp_dir("ref");
     let reference = Binary::start(&ref_dir.db_url(), &[]);
     let ref_id = reference.submit_job(SHORT_SIMULATE);
-    reference.wait_job(&ref_id, "succeeded", Duration::from_secs(300));
+    reference.wait_job(&ref_id, JobStatus::Succeeded, Duration::from_secs(300));
     let ref_csv = reference
         .get(&format!("/v1/jobs/{ref_id}/tracks"), Some(ENGINEER))
         .body;
@@ -136,15 +134,12 @@ fn sigkill_mid_job_then_restart_completes_once_with_the_same_result() {
     let env = [("RAILWEAR_LEASE_S", "2"), ("RAILWEAR_HEARTBEAT_S", "0.5")];
     let server = Binary::start(&dir.db_url(), &env);
     let id = server.submit_job(SHORT_SIMULATE);
-    wait_for(Duration::from_secs(60), "running", || {
-        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
-        (j["status"] == "running").then_some(())
-    });
+    server.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
     server.kill9();
 
     let server = Binary::start(&dir.db_url(), &env);
-    let job = server.wait_job(&id, "succeeded", Duration::from_secs(300));
-    assert_eq!(job["attempt"], 2, "exactly one re-run");
+    let job = server.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(300));
+    assert_eq!(job.attempt, 2, "exactly one re-run");
     let csv = server
         .get(&format!("/v1/jobs/{id}/tracks"), Some(ENGINEER))
         .body;
@@ -163,16 +158,10 @@ fn cancel_a_running_simulation() {
     let server = Binary::start(&dir.db_url(), &[]);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = server.submit_job(long);
-    wait_for(Duration::from_secs(60), "running", || {
-        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
-        (j["status"] == "running").then_some(())
-    });
+    server.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
     let asked = std::time::Instant::now();
     server.cancel_job(&id);
-    wait_for(Duration::from_secs(5), "cancelled", || {
-        let j = server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json();
-        (j["status"] == "cancelled").then_some(())
-    });
+    server.wait_job(&id, JobStatus::Cancelled, Duration::from_secs(5));
     assert!(asked.elapsed() < Duration::from_millis(1500));
 }
 
@@ -209,10 +198,6 @@ fn attempt_outcomes(server: &Binary, id: &str) -> Vec<String> {
         .collect()
 }
 
-fn job(server: &Binary, id: &str) -> serde_json::Value {
-    server.get(&format!("/v1/jobs/{id}"), Some(ENGINEER)).json()
-}
-
 /// Issue 17: SIGTERM with a 600 s simulation running: the process exits within the grace, the
 /// job is queued again at once (not left running on a dead worker for the lease), its attempt
 /// logged `released`.
@@ -227,18 +212,16 @@ fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
     let mut server = Binary::start(&dir.db_url(), &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":3,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = server.submit_job(long);
-    wait_for(Duration::from_secs(60), "running", || {
-        (job(&server, &id)["status"] == "running").then_some(())
-    });
+    server.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
     let took = sigterm(&mut server);
     assert!(took < Duration::from_secs(2 + 3), "exit took {took:?}");
     drop(server);
 
     // An API-only process reads the store: queued at once, the attempt released.
     let api = Binary::start_with_args(&dir.db_url(), &env, &["--no-workers"]);
-    let j = job(&api, &id);
-    assert_eq!(j["status"], "queued", "{j}");
-    assert_eq!(j["worker"], serde_json::Value::Null);
+    let j = api.job(&id);
+    assert_eq!(j.status, JobStatus::Queued, "{j:?}");
+    assert_eq!(j.worker, None);
     assert_eq!(attempt_outcomes(&api, &id), ["released"]);
     // The simulation stopped with a checkpoint, stored before the release.
     let attempts = api
@@ -250,9 +233,9 @@ fn sigterm_gives_a_running_simulation_back_and_exits_within_the_grace() {
         "{attempts}"
     );
     assert_eq!(
-        j["progress"]["simulated_time_s"].as_f64(),
+        j.progress.map(|p| p.simulated_time_s),
         checkpoint_s,
-        "{j}"
+        "{j:?}"
     );
 }
 
@@ -292,23 +275,15 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
     let mut server = Binary::start(&dir.db_url(), &env);
     let body = serde_json::json!({"kind": "sweep", "params": params}).to_string();
     let id = server.submit_job(&body);
-    let children = |server: &Binary| -> Vec<serde_json::Value> {
-        server
-            .get(&format!("/v1/jobs?parent={id}&limit=100"), Some(ENGINEER))
-            .json()["items"]
-            .as_array()
-            .cloned()
-            .unwrap_or_default()
-    };
     // Stop while one point is done and another runs.
     let done_before: Vec<String> = wait_for(Duration::from_secs(300), "a point done", || {
-        let kids = children(&server);
+        let kids = server.children(&id);
         let done: Vec<String> = kids
             .iter()
-            .filter(|c| c["status"] == "succeeded")
-            .filter_map(|c| c["id"].as_str().map(str::to_string))
+            .filter(|c| c.status == JobStatus::Succeeded)
+            .map(|c| c.id.to_string())
             .collect();
-        let running = kids.iter().any(|c| c["status"] == "running");
+        let running = kids.iter().any(|c| c.status == JobStatus::Running);
         (!done.is_empty() && running).then_some(done)
     });
     let took = sigterm(&mut server);
@@ -316,8 +291,8 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
     drop(server);
 
     let server = Binary::start(&dir.db_url(), &env);
-    let done = server.wait_job(&id, "succeeded", Duration::from_secs(300));
-    assert_eq!(done["children"]["succeeded"], 3);
+    let done = server.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(300));
+    assert_eq!(done.children.map(|c| c.succeeded), Some(3));
     let result = server
         .get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER))
         .json();
@@ -327,8 +302,8 @@ fn sigterm_mid_sweep_then_restart_gives_the_uninterrupted_result() {
         "bit for bit the uninterrupted sweep"
     );
     let mut released = 0;
-    for kid in children(&server) {
-        let kid_id = kid["id"].as_str().unwrap().to_string();
+    for kid in server.children(&id) {
+        let kid_id = kid.id.to_string();
         let log = attempt_outcomes(&server, &kid_id);
         if done_before.contains(&kid_id) {
             assert_eq!(log, ["succeeded"], "kept, not re-run");
@@ -348,18 +323,15 @@ fn a_restarted_service_releases_its_dead_predecessors_job_at_once() {
     let server = Binary::start(&dir.db_url(), &env);
     let long = r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":4,"overrides":{"simulation":{"duration_s":600}}}}"#;
     let id = server.submit_job(long);
-    wait_for(Duration::from_secs(60), "running", || {
-        (job(&server, &id)["status"] == "running").then_some(())
-    });
+    server.wait_job(&id, JobStatus::Running, Duration::from_secs(60));
     server.kill9();
 
     let restarted = std::time::Instant::now();
     let server = Binary::start(&dir.db_url(), &env);
-    let j = wait_for(Duration::from_secs(10), "attempt 2 running", || {
-        let j = job(&server, &id);
-        (j["status"] == "running" && j["attempt"] == 2).then_some(j)
+    let j = server.wait_job_until(&id, "attempt 2 running", Duration::from_secs(10), |j| {
+        j.status == JobStatus::Running && j.attempt == 2
     });
     assert!(restarted.elapsed() < Duration::from_secs(15));
-    assert_eq!(attempt_outcomes(&server, &id), ["lost", "running"], "{j}");
+    assert_eq!(attempt_outcomes(&server, &id), ["lost", "running"], "{j:?}");
     server.cancel_job(&id);
 }

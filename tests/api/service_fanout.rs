@@ -4,22 +4,16 @@
 //! assembled once from the children's results in index order; a failing child fails the sweep
 //! naming it and cancels the rest; cancelling the sweep cancels its children.
 
-use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::helpers::{wait_for, Runner, TestApp};
 use crate::support::runner::sample;
 use crate::support::ENGINEER;
+use railwear::http::jobs::JobView;
+use railwear::jobs::{ChildCounts, JobKind, JobStatus};
 use railwear::store::AttemptOutcome;
-use serde_json::{json, Value};
 use std::time::Duration;
 
-fn children(api: &Api, id: &str) -> Vec<Value> {
-    api.get_json(&format!("/v1/jobs?parent={id}&limit=100"))["items"]
-        .as_array()
-        .cloned()
-        .unwrap_or_default()
-}
-
-fn count(items: &[Value], status: &str) -> usize {
-    items.iter().filter(|j| j["status"] == status).count()
+fn count(jobs: &[JobView], status: JobStatus) -> i64 {
+    jobs.iter().filter(|j| j.status == status).count() as i64
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -33,36 +27,34 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
     let (id, child_ids) = tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":3,"step_ms":20,"seed":42}}"#;
         let id = api.submit_job(body);
-        let done = wait_for(Duration::from_secs(30), "sweep success", || {
-            let j = api.get_job(&id);
-            assert_ne!(j["status"], "failed", "{j}");
-            (j["status"] == "succeeded").then_some(j)
-        });
+        let done = api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(30));
         assert_eq!(
-            done["children"],
-            json!({"total": 6, "succeeded": 6, "failed": 0, "cancelled": 0})
+            done.children,
+            Some(ChildCounts {
+                total: 6,
+                succeeded: 6,
+                failed: 0,
+                cancelled: 0
+            })
         );
-        assert_eq!(done["progress"]["fraction"], 1.0);
-        assert_eq!(done["parent_id"], Value::Null);
+        assert_eq!(done.progress.map(|p| p.fraction), Some(1.0));
+        assert_eq!(done.parent_id, None);
         assert_eq!(
-            done["links"]["children"],
-            format!("/v1/jobs?parent={id}&limit=100").as_str()
+            done.links.children,
+            Some(format!("/v1/jobs?parent={id}&limit=100"))
         );
 
-        let kids = children(&api, &id);
+        let kids = api.children(&id);
         assert_eq!(kids.len(), 6);
-        let mut indices: Vec<i64> = kids
-            .iter()
-            .map(|c| c["child_index"].as_i64().unwrap())
-            .collect();
+        let mut indices: Vec<i64> = kids.iter().filter_map(|c| c.child_index).collect();
         indices.sort_unstable();
         assert_eq!(indices, [0, 1, 2, 3, 4, 5]);
         for c in &kids {
-            assert_eq!(c["kind"], "sweep_point");
-            assert_eq!(c["status"], "succeeded");
-            assert_eq!(c["parent_id"], id.as_str());
-            assert_eq!(c["seed"], 42);
-            assert_eq!(c["children"], Value::Null);
+            assert_eq!(c.kind, JobKind::SweepPoint);
+            assert_eq!(c.status, JobStatus::Succeeded);
+            assert_eq!(c.parent_id.map(|p| p.to_string()), Some(id.clone()));
+            assert_eq!(c.seed, 42);
+            assert_eq!(c.children, None);
         }
         // Submitted jobs only: the children stay out of the top-level list.
         let top = api.get_json("/v1/jobs?top_level=true")["items"].clone();
@@ -92,10 +84,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         assert_eq!(log[0]["attempt"], 1);
         assert_eq!(log[1]["attempt"], 2);
         assert!(log[1]["ended_at"].is_string(), "{log}");
-        assert_eq!(
-            done["links"]["attempts"],
-            format!("/v1/jobs/{id}/attempts").as_str()
-        );
+        assert_eq!(done.links.attempts, format!("/v1/jobs/{id}/attempts"));
         let missing = api.get(
             &format!("/v1/jobs/{}/attempts", uuid::Uuid::new_v4()),
             Some(ENGINEER),
@@ -104,10 +93,7 @@ async fn a_sweep_fans_out_to_child_jobs_and_is_assembled_once() {
         let malformed = api.get("/v1/jobs/not-a-uuid/attempts", Some(ENGINEER));
         assert_eq!(malformed.status, 400, "{}", malformed.body);
         assert!(malformed.body.contains("id"), "{}", malformed.body);
-        let child_ids: Vec<uuid::Uuid> = kids
-            .iter()
-            .map(|c| c["id"].as_str().unwrap().parse().unwrap())
-            .collect();
+        let child_ids: Vec<uuid::Uuid> = kids.iter().map(|c| c.id).collect();
         (id.parse::<uuid::Uuid>().unwrap(), child_ids)
     })
     .await
@@ -142,42 +128,50 @@ async fn a_failing_child_fails_the_sweep_naming_it_and_cancels_the_rest() {
     tokio::task::spawn_blocking(move || {
         let body = r#"{"kind":"sweep","params":{"children":6,"steps":5,"step_ms":40,"fail_point":0,"seed":1}}"#;
         let id = api.submit_job(body);
-        let failed = wait_for(Duration::from_secs(30), "sweep failure", || {
-            let j = api.get_job(&id);
-            assert_ne!(j["status"], "succeeded", "{j}");
-            (j["status"] == "failed").then_some(j)
+        let failed = api.wait_job_until(&id, "sweep failure", Duration::from_secs(30), |j| {
+            assert_ne!(j.status, JobStatus::Succeeded, "{j:?}");
+            j.status == JobStatus::Failed
         });
         let kids = wait_for(Duration::from_secs(30), "children ended", || {
-            let kids = children(&api, &id);
-            (count(&kids, "queued") + count(&kids, "running") == 0).then_some(kids)
+            let kids = api.children(&id);
+            (count(&kids, JobStatus::Queued) + count(&kids, JobStatus::Running) == 0)
+                .then_some(kids)
         });
         let first = kids
             .iter()
-            .find(|c| c["child_index"] == 0)
+            .find(|c| c.child_index == Some(0))
             .expect("child 0");
-        assert_eq!(first["status"], "failed");
-        assert_eq!(first["error"], "simulation diverged: point 0 diverged on purpose");
+        assert_eq!(first.status, JobStatus::Failed);
         assert_eq!(
-            failed["error"],
-            format!(
+            first.error.as_deref(),
+            Some("simulation diverged: point 0 diverged on purpose")
+        );
+        assert_eq!(
+            failed.error,
+            Some(format!(
                 "child 0 (job {}) failed: simulation diverged: point 0 diverged on purpose",
-                first["id"].as_str().unwrap()
-            )
-            .as_str()
+                first.id
+            ))
         );
         // The others either finished before they heard or were cancelled.
-        assert_eq!(count(&kids, "failed"), 1);
-        assert_eq!(count(&kids, "succeeded") + count(&kids, "cancelled"), 5);
-        assert!(count(&kids, "cancelled") >= 3, "queued children were not cancelled");
-        let parent = api.get_job(&id);
-        assert_eq!(parent["status"], "failed");
+        assert_eq!(count(&kids, JobStatus::Failed), 1);
         assert_eq!(
-            parent["children"],
-            json!({
-                "total": 6,
-                "succeeded": count(&kids, "succeeded"),
-                "failed": 1,
-                "cancelled": count(&kids, "cancelled"),
+            count(&kids, JobStatus::Succeeded) + count(&kids, JobStatus::Cancelled),
+            5
+        );
+        assert!(
+            count(&kids, JobStatus::Cancelled) >= 3,
+            "queued children were not cancelled"
+        );
+        let parent = api.job(&id);
+        assert_eq!(parent.status, JobStatus::Failed);
+        assert_eq!(
+            parent.children,
+            Some(ChildCounts {
+                total: 6,
+                succeeded: count(&kids, JobStatus::Succeeded),
+                failed: 1,
+                cancelled: count(&kids, JobStatus::Cancelled),
             })
         );
         let r = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
@@ -197,42 +191,38 @@ async fn cancelling_a_sweep_cancels_its_queued_and_running_children() {
         let body = r#"{"kind":"sweep","params":{"children":5,"steps":600,"step_ms":50}}"#;
         let id = api.submit_job(body);
         wait_for(Duration::from_secs(20), "two running children", || {
-            let kids = children(&api, &id);
-            (kids.len() == 5 && count(&kids, "running") == 2).then_some(())
+            let kids = api.children(&id);
+            (kids.len() == 5 && count(&kids, JobStatus::Running) == 2).then_some(())
         });
         // Issue 29: while its points run, the sweep shows their combined progress (the mean
         // of their fractions) and an ETA, not 0 until the first point succeeds.
-        let waiting = wait_for(
-            Duration::from_secs(20),
+        let waiting = api.wait_job_until(
+            &id,
             "progress of running children",
-            || {
-                let j = api.get_job(&id);
-                (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > 0.0).then_some(j)
-            },
+            Duration::from_secs(20),
+            |j| j.progress.is_some_and(|p| p.fraction > 0.0),
         );
-        assert_eq!(waiting["status"], "waiting");
-        assert_eq!(waiting["worker"], Value::Null);
+        assert_eq!(waiting.status, JobStatus::Waiting);
+        assert_eq!(waiting.worker, None);
         // Two of five points run and none is done: the fraction is below 2/5.
-        let fraction = waiting["progress"]["fraction"].as_f64().unwrap();
-        assert!(fraction > 0.0 && fraction < 0.4, "{waiting}");
+        let progress = waiting.progress.expect("progress");
         assert!(
-            waiting["progress"]["eta_s"]
-                .as_f64()
-                .is_some_and(|e| e > 0.0),
-            "{waiting}"
+            progress.fraction > 0.0 && progress.fraction < 0.4,
+            "{waiting:?}"
         );
+        assert!(progress.eta_s.is_some_and(|e| e > 0.0), "{waiting:?}");
         let r = api.cancel_job(&id);
         assert_eq!(r.status, 202, "{}", r.body);
         assert_eq!(r.json()["status"], "cancelled");
         // The running children stop at once: the cancel reaches them in this process.
         let kids = wait_for(Duration::from_secs(5), "children cancelled", || {
-            let kids = children(&api, &id);
-            (count(&kids, "cancelled") == 5).then_some(kids)
+            let kids = api.children(&id);
+            (count(&kids, JobStatus::Cancelled) == 5).then_some(kids)
         });
-        assert!(kids.iter().all(|c| c["cancel_requested"] == true));
-        let parent = api.get_job(&id);
-        assert_eq!(parent["status"], "cancelled");
-        assert_eq!(parent["children"]["cancelled"], 5);
+        assert!(kids.iter().all(|c| c.cancel_requested));
+        let parent = api.job(&id);
+        assert_eq!(parent.status, JobStatus::Cancelled);
+        assert_eq!(parent.children.map(|c| c.cancelled), Some(5));
     })
     .await
     .unwrap();
@@ -288,14 +278,12 @@ async fn the_sweep_duration_histogram_counts_whole_sweeps() {
         let failing =
             r#"{"kind":"sweep","params":{"children":3,"steps":5,"step_ms":60,"fail_point":1}}"#;
         let failed_id = api.submit_job(failing);
-        for (job, status) in [(&id, "succeeded"), (&failed_id, "failed")] {
-            wait_for(Duration::from_secs(30), "sweep end", || {
-                (api.get_job(job)["status"] == status).then_some(())
-            });
+        for (job, status) in [(&id, JobStatus::Succeeded), (&failed_id, JobStatus::Failed)] {
+            api.wait_job(job, status, Duration::from_secs(30));
         }
-        let job = api.get_job(&id);
-        let whole_s = (chrono_ms(&job["finished_at"]) - chrono_ms(&job["started_at"])) / 1000.0;
-        assert!(whole_s >= 0.6, "{job}");
+        let job = api.job(&id);
+        let whole_s = (chrono_ms(&job.finished_at) - chrono_ms(&job.started_at)) / 1000.0;
+        assert!(whole_s >= 0.6, "{job:?}");
         let text = api.get("/metrics", None).body;
         let sum = sample_value(
             &text,
@@ -335,8 +323,8 @@ async fn the_sweep_duration_histogram_counts_whole_sweeps() {
 }
 
 /// Unix ms of an RFC 3339 time as the API writes it (`2024-05-01T08:30:00.123Z`).
-fn chrono_ms(v: &Value) -> f64 {
-    let text = v.as_str().expect("a time");
+fn chrono_ms(time: &Option<String>) -> f64 {
+    let text = time.as_deref().expect("a time");
     let ms = railwear::store::clock::parse_iso8601_ms(text).expect("RFC 3339");
     ms as f64
 }

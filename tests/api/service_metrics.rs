@@ -9,6 +9,7 @@
 //! `RAILWEAR_REQUIRE_METRICS_PARSER=1` (set by `.ci/run`, which installs it): then it fails.
 
 use crate::helpers::TestApp;
+use railwear::jobs::JobStatus;
 use serde_json::Value;
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -102,7 +103,7 @@ async fn metrics_parse_as_openmetrics_with_their_names_types_and_values() {
     let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
         let id = api.submit_job(r#"{"kind":"simulate","params":{"steps":3}}"#);
-        api.wait_job(&id, "succeeded", Duration::from_secs(30));
+        api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(30));
         api.get_problem("/v1/jobs", None, 401);
 
         let r = api.get("/metrics", None);

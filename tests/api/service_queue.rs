@@ -2,7 +2,7 @@
 //! counting test runner: idempotency, cancellation, results and track export, recovery of a job
 //! whose worker died, rejected inputs leaving stored data unchanged.
 
-use crate::helpers::{wait_for, Api, TestApp};
+use crate::helpers::{Api, TestApp};
 use crate::support::runner::{sample, start, test_config};
 use crate::support::{temp_dir, ENGINEER, PLANNER};
 use railwear::jobs::JobStatus;
@@ -63,10 +63,8 @@ async fn cancel_stops_a_running_job_within_a_second() {
         // 600 steps of 50 ms = 30 s if not cancelled.
         let body = r#"{"kind":"simulate","params":{"steps":600,"step_ms":50}}"#;
         let id = api.submit_job(body);
-        wait_for(Duration::from_secs(10), "progress", || {
-            let j = api.job(&id);
-            let moving = j.progress.is_some_and(|p| p.fraction > 0.0);
-            (j.status == JobStatus::Running && moving).then_some(())
+        api.wait_job_until(&id, "progress", Duration::from_secs(10), |j| {
+            j.status == JobStatus::Running && j.progress.is_some_and(|p| p.fraction > 0.0)
         });
         let progress = api.job(&id).progress.expect("a running job's progress");
         assert!(progress.simulated_time_s > 0.0);
@@ -75,9 +73,7 @@ async fn cancel_stops_a_running_job_within_a_second() {
         let asked = Instant::now();
         let r = api.cancel_job(&id);
         assert_eq!(r.status, 202, "{}", r.body);
-        wait_for(Duration::from_secs(5), "cancelled", || {
-            (api.job(&id).status == JobStatus::Cancelled).then_some(())
-        });
+        api.wait_job(&id, JobStatus::Cancelled, Duration::from_secs(5));
         let took = asked.elapsed();
         assert!(took < Duration::from_millis(1500), "cancel took {took:?}");
         // Cancelled jobs have no results.
@@ -101,10 +97,7 @@ async fn results_and_tracks_export_with_downsampling() {
         let body =
             r#"{"kind":"simulate","params":{"steps":3,"step_ms":10,"samples":2500,"seed":99}}"#;
         let id = api.submit_job(body);
-        wait_for(Duration::from_secs(20), "success", || {
-            (api.job(&id).status == JobStatus::Succeeded).then_some(())
-        });
-        let job = api.job(&id);
+        let job = api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(20));
         assert_eq!(job.track_samples, 2500);
         assert_eq!(job.progress.map(|p| p.fraction), Some(1.0));
 
@@ -186,9 +179,7 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
         let api = api.clone();
         move || {
             let id = api.submit_job(body);
-            wait_for(Duration::from_secs(20), "reference", || {
-                (api.get_job(&id)["status"] == "succeeded").then_some(())
-            });
+            api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(20));
             let csv = api.get(&format!("/v1/jobs/{id}/tracks"), Some(ENGINEER));
             let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
             (csv.body, result.json()["summary"].clone())
@@ -221,17 +212,10 @@ async fn job_of_a_dead_worker_is_rerun_once_with_the_same_result() {
         let api = api.clone();
         let id = id.clone();
         move || {
-            let job = wait_for(Duration::from_secs(20), "recovered", || {
-                let j = api.get_job(&id);
-                (j["status"] == "succeeded").then_some(j)
-            });
+            let job = api.wait_job(&id, JobStatus::Succeeded, Duration::from_secs(20));
             let csv = api.get(&format!("/v1/jobs/{id}/tracks"), Some(ENGINEER));
             let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER));
-            (
-                csv.body,
-                result.json()["summary"].clone(),
-                job["attempt"].clone(),
-            )
+            (csv.body, result.json()["summary"].clone(), job.attempt)
         }
     })
     .await

@@ -6,7 +6,7 @@
 //! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
 //! the uninterrupted run's result.
 
-use crate::helpers::{wait_for, Api, Runner, TestApp};
+use crate::helpers::{Api, Runner, TestApp};
 use crate::support::runner::{start, start_library, test_config};
 use crate::support::{temp_dir, ENGINEER};
 use railwear::jobs::JobStatus;
@@ -39,9 +39,8 @@ fn results(api: &Api, id: &str) -> (String, Value) {
 /// Submits `body` and waits until the job's progress passes `fraction`; the job's id.
 fn submit_until_progress(api: &Api, body: &str, fraction: f64, timeout: Duration) -> String {
     let id = api.submit_job(body);
-    wait_for(timeout, "progress", || {
-        let j = api.get_job(&id);
-        (j["progress"]["fraction"].as_f64().unwrap_or(0.0) > fraction).then_some(())
+    api.wait_job_until(&id, "progress", timeout, |j| {
+        j.progress.is_some_and(|p| p.fraction > fraction)
     });
     id
 }
@@ -49,13 +48,6 @@ fn submit_until_progress(api: &Api, body: &str, fraction: f64, timeout: Duration
 /// How long the counting runner's jobs may take to reach a state, and a real simulation.
 const SHORT: Duration = Duration::from_secs(30);
 const LONG: Duration = Duration::from_secs(300);
-
-fn wait_status(api: &Api, id: &str, status: &str, timeout: Duration) -> Value {
-    wait_for(timeout, status, || {
-        let j = api.get_job(id);
-        (j["status"] == status).then_some(j)
-    })
-}
 
 const BODY: &str =
     r#"{"kind":"simulate","params":{"steps":30,"step_ms":50,"samples":400,"seed":8}}"#;
@@ -68,7 +60,7 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
         let id = api.submit_job(BODY);
-        wait_status(&api, &id, "succeeded", SHORT);
+        api.wait_job(&id, JobStatus::Succeeded, SHORT);
         results(&api, &id)
     })
     .await
@@ -105,13 +97,13 @@ async fn a_stopped_worker_gives_its_job_back_and_the_next_one_finishes_it_identi
     let (got, job) = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            let job = wait_status(&api, &id, "succeeded", SHORT);
+            let job = api.wait_job(&id, JobStatus::Succeeded, SHORT);
             (results(&api, &id), job)
         }
     })
     .await
     .unwrap();
-    assert_eq!(job["attempt"], 2);
+    assert_eq!(job.attempt, 2);
     assert_eq!(
         got.0, expected.0,
         "tracks identical to the uninterrupted run"
@@ -138,7 +130,7 @@ async fn the_grace_bounds_the_shutdown_when_the_computation_does_not_stop() {
     let id = tokio::task::spawn_blocking(move || {
         let id =
             api.submit_job(r#"{"kind":"simulate","params":{"steps":2,"step_ms":4000,"seed":1}}"#);
-        wait_status(&api, &id, "running", SHORT);
+        api.wait_job(&id, JobStatus::Running, SHORT);
         id
     })
     .await
@@ -171,7 +163,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
         let id = api.submit_job(body);
-        wait_status(&api, &id, "succeeded", SHORT);
+        api.wait_job(&id, JobStatus::Succeeded, SHORT);
         api.get_json(&format!("/v1/jobs/{id}/result"))["summary"].clone()
     })
     .await
@@ -189,9 +181,8 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let id = tokio::task::spawn_blocking(move || {
         let id = api.submit_job(body);
         // Stop once some points are done and others run.
-        wait_for(SHORT, "a point done", || {
-            let j = api.get_job(&id);
-            (j["children"]["succeeded"].as_i64().unwrap_or(0) >= 2).then_some(())
+        api.wait_job_until(&id, "a point done", SHORT, |j| {
+            j.children.is_some_and(|c| c.succeeded >= 2)
         });
         id
     })
@@ -232,7 +223,7 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     let summary = tokio::task::spawn_blocking({
         let id = id.clone();
         move || {
-            wait_status(&api, &id, "succeeded", SHORT);
+            api.wait_job(&id, JobStatus::Succeeded, SHORT);
             api.get_json(&format!("/v1/jobs/{id}/result"))["summary"].clone()
         }
     })
@@ -282,7 +273,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     let api = Api::new(&format!("http://{}", reference.addr));
     let expected = tokio::task::spawn_blocking(move || {
         let id = api.submit_job(SIMULATE_BODY);
-        wait_status(&api, &id, "succeeded", LONG);
+        api.wait_job(&id, JobStatus::Succeeded, LONG);
         results(&api, &id)
     })
     .await
@@ -345,12 +336,11 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
         let id = id.clone();
         move || {
             let mut first_progress = None;
-            let job = wait_for(LONG, "succeeded", || {
-                let j = api.get_job(&id);
-                if first_progress.is_none() && j["status"] == "running" {
-                    first_progress = j["progress"]["simulated_time_s"].as_f64();
+            let job = api.wait_job_until(&id, "succeeded", LONG, |j| {
+                if first_progress.is_none() && j.status == JobStatus::Running {
+                    first_progress = j.progress.map(|p| p.simulated_time_s);
                 }
-                (j["status"] == "succeeded").then_some(j)
+                j.status == JobStatus::Succeeded
             });
             let attempts = api.get_json(&format!("/v1/jobs/{id}/attempts"));
             (results(&api, &id), (job, attempts), first_progress)
@@ -359,7 +349,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     .await
     .unwrap();
     let (job, attempts) = job;
-    assert_eq!(job["attempt"], 2);
+    assert_eq!(job.attempt, 2);
     if let Some(t) = first_progress {
         assert!(
             t >= checkpoint_s,

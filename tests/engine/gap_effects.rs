@@ -120,6 +120,7 @@ fn term(text: &str) -> Box<dyn WearTerm> {
     match Effect::parse(text) {
         Ok(e) => e
             .wear_term(Material::aluminium_7075_t73().hardness_pa())
+            .unwrap()
             .unwrap(),
         Err(_) => HiddenEffect::parse(text).unwrap().wear_term(),
     }

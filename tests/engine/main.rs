@@ -12,6 +12,7 @@ mod face_contact_closed_form;
 mod face_contact_rules;
 mod gap_campaign;
 mod gap_diagnose;
+mod gap_diagnose_simulated;
 mod gap_effects;
 mod gap_mechanisms;
 mod gap_rig;

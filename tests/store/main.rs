@@ -5,5 +5,7 @@
 mod support;
 
 mod postgres_store;
+mod postgres_store_script;
 mod store_fanout;
+mod store_fanout_migration;
 mod worker_leases;

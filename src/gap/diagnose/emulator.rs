@@ -432,7 +432,7 @@ impl Emulator {
                             for (k, inc) in t.iter().enumerate() {
                                 let mut mass: BTreeMap<String, f64> = BTreeMap::new();
                                 for (run, history) in &inc.segments {
-                                    let term = e.wear_term(run.hardness_pa);
+                                    let term = e.wear_term(run.hardness_pa)?;
                                     let terms: Vec<&dyn WearTerm> =
                                         term.as_deref().filter(|_| m != 0.0).into_iter().collect();
                                     for (b, v) in run.masses_mg(&terms, *history)? {
