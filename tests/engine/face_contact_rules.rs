@@ -261,6 +261,9 @@ fn the_strips_damping_resultant_is_measured_against_a_converged_reference() {
     );
 }
 
+/// A rule on a part: hands each node's ball centre (world) and share to the visitor.
+type RuleNodes<'a> = dyn Fn(&mut dyn FnMut(Point3<f64>, f64)) + 'a;
+
 #[test]
 fn the_side_faces_strips_are_a_small_share_of_the_head_and_their_rule_keeps_it() {
     // The strips of the inner faces that do not face the plane (a shoe head's ends and
@@ -286,7 +289,7 @@ fn the_side_faces_strips_are_a_small_share_of_the_head_and_their_rule_keeps_it()
     };
     let step = |w: f64| impact.damping_at(w) / impact.max_damping;
     // (∫ w², ∫ w³/3, ∫ STEP(w)) in shares of each face.
-    let densities = |nodes: &dyn Fn(&mut dyn FnMut(Point3<f64>, f64))| {
+    let densities = |nodes: &RuleNodes| {
         let mut m = [0.0; 3];
         nodes(&mut |x, share| {
             let (d, _) = face.signed_distance(&x);
