@@ -96,6 +96,24 @@ impl FrictionParams {
         }
     }
 
+    /// [`FrictionParams::coefficient`] and [`FrictionParams::coefficient_derivative`] at once,
+    /// bit for bit (one `sincos` in a transition instead of a `sin` and a `cos`).
+    #[inline]
+    pub fn coefficient_with_derivative(&self, speed: f64) -> (f64, f64) {
+        let v = speed.abs();
+        let vs = self.stiction_transition_speed;
+        let vd = self.friction_transition_speed;
+        if v < vs {
+            self.step
+                .eval_with_derivative(v, -vs, -self.mu_static, vs, self.mu_static)
+        } else if v < vd {
+            self.step
+                .eval_with_derivative(v, vs, self.mu_static, vd, self.mu_dynamic)
+        } else {
+            (self.mu_dynamic, 0.0)
+        }
+    }
+
     /// d(mu)/d(speed) at `speed >= 0`.
     #[inline]
     pub fn coefficient_derivative(&self, speed: f64) -> f64 {
@@ -182,6 +200,17 @@ mod tests {
         assert!((f.coefficient(0.5 * 6.4634e-3) - 0.1799 * 0.5).abs() > 0.0);
         // Odd and monotone below v_s.
         assert!(f.coefficient(1e-3) > 0.0 && f.coefficient(1e-3) < f.coefficient(3e-3));
+    }
+
+    #[test]
+    fn coefficient_with_derivative_is_both_bit_for_bit() {
+        let f = FrictionParams::thesis_table_5_2();
+        for i in 0..3000 {
+            let v = 5e-6 * i as f64; // through both transitions and beyond
+            let (mu, dmu) = f.coefficient_with_derivative(v);
+            assert_eq!(mu.to_bits(), f.coefficient(v).to_bits(), "{v}");
+            assert_eq!(dmu.to_bits(), f.coefficient_derivative(v).to_bits(), "{v}");
+        }
     }
 
     #[test]

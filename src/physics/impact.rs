@@ -150,6 +150,37 @@ impl ImpactParams {
         )
     }
 
+    /// [`ImpactParams::force_parts`] and the damping coefficient's slope `c dSTEP/dw`
+    /// (N·s/m²) at `w > 0`, bit for bit as [`ImpactParams::unclamped_gradient`] uses it: on the
+    /// ramp one `sincos` instead of a `sin` and a `cos` (a contact point's force and Jacobian).
+    #[inline]
+    pub fn force_parts_with_slope(&self, w: f64) -> (f64, f64, f64) {
+        let spring = self.stiffness * power(w, self.exponent);
+        if w >= self.full_damping_depth {
+            return (spring, self.max_damping, 0.0);
+        }
+        let (step, slope) =
+            self.step
+                .eval_with_derivative(w, 0.0, 0.0, self.full_damping_depth, 1.0);
+        (spring, self.max_damping * step, self.max_damping * slope)
+    }
+
+    /// [`ImpactParams::unclamped_gradient`] given the damping slope from
+    /// [`ImpactParams::force_parts_with_slope`]: the same numbers without a `cos`.
+    #[inline]
+    pub fn unclamped_gradient_with_slope(
+        &self,
+        w: f64,
+        wdot: f64,
+        damping: f64,
+        slope: f64,
+    ) -> (f64, f64) {
+        (
+            self.exponent * self.stiffness * power(w, self.exponent - 1.0) + slope * wdot,
+            damping,
+        )
+    }
+
     /// Elastic energy stored at penetration `w`, J: `∫ k w^e dw = k w^(e+1) / (e+1)`.
     #[inline]
     pub fn potential(&self, w: f64) -> f64 {
@@ -214,6 +245,13 @@ mod tests {
                     let (a, b) = p.unclamped_gradient(w, wdot, damping);
                     let (c, d) = p.force_gradient(w, wdot);
                     assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
+                    let (spring2, damping2, slope) = p.force_parts_with_slope(w);
+                    assert_eq!(
+                        (spring2.to_bits(), damping2.to_bits()),
+                        (spring.to_bits(), damping.to_bits())
+                    );
+                    let (e, g) = p.unclamped_gradient_with_slope(w, wdot, damping, slope);
+                    assert_eq!((e.to_bits(), g.to_bits()), (a.to_bits(), b.to_bits()));
                 }
             }
         }

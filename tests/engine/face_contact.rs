@@ -192,7 +192,7 @@ pub(crate) fn lowest_point_depth(rot: &UnitQuaternion<f64>) -> f64 {
 }
 
 /// A random pose of the head over the lip's edge, tilted a little, up to `max_w` deep.
-fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
+pub(crate) fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
     let rot = UnitQuaternion::from_euler_angles(
         rng.gen_range(-0.01..0.01),
         rng.gen_range(-0.3..0.3),

@@ -68,6 +68,35 @@ pub struct TrackMoments {
     force_qc: Matrix3<f64>,
 }
 
+/// `M [q]×`, row by row `(m_i × q)ᵀ`: the same sums as nalgebra's product with
+/// `q.cross_matrix()` in the same order, without the products with its zeros (bit for bit up
+/// to the sign of a zero).
+#[inline]
+fn times_cross(m: &Matrix3<f64>, q: &Vector3<f64>) -> Matrix3<f64> {
+    let mut out = Matrix3::zeros();
+    for i in 0..3 {
+        let (r0, r1, r2) = (m[(i, 0)], m[(i, 1)], m[(i, 2)]);
+        out[(i, 0)] = r1 * q[2] - r2 * q[1];
+        out[(i, 1)] = r2 * q[0] - r0 * q[2];
+        out[(i, 2)] = r0 * q[1] - r1 * q[0];
+    }
+    out
+}
+
+/// `[q]× M`, column by column `q × m_j`: as [`times_cross`], nalgebra's product's sums
+/// without the products with zeros.
+#[inline]
+fn cross_times(q: &Vector3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
+    let mut out = Matrix3::zeros();
+    for j in 0..3 {
+        let (c0, c1, c2) = (m[(0, j)], m[(1, j)], m[(2, j)]);
+        out[(0, j)] = q[1] * c2 - q[2] * c1;
+        out[(1, j)] = q[2] * c0 - q[0] * c2;
+        out[(2, j)] = q[0] * c1 - q[1] * c0;
+    }
+    out
+}
+
 impl TrackMoments {
     /// Empty moments of a track between `body_a` (frame `fa`) and `body_b` (frame `fb`).
     pub(super) fn new(body_a: usize, body_b: usize, fa: &BodyFrame, fb: &BodyFrame) -> Self {
@@ -119,13 +148,12 @@ impl TrackMoments {
         self.qg_n += qg * n.transpose();
         self.qg_qn += qg * qn.transpose();
         let d = lin.dforce_slip_with_rate(&lin.dforce_dfn, &n);
-        let qx = q.cross_matrix();
-        let d_q = d * qx;
-        let q_d = qx * d;
+        let d_q = times_cross(&d, &q);
+        let q_d = cross_times(&q, &d);
         self.d += d;
         self.d_q += d_q;
         self.q_d += q_d;
-        self.q_d_q += q_d * qx;
+        self.q_d_q += times_cross(&q_d, &q);
         if self.spin != Vector3::zeros() {
             // D [u]× [q_c]× = (D q_c) uᵀ − (u·q_c) D: the sums of the two parts.
             let d_qc = d * qc;
@@ -232,6 +260,25 @@ impl TrackMoments {
                 rows += df * sign_m;
                 let mut rows = block.fixed_view_mut::<3, 12>(3, 0);
                 rows += torque;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cross_products_are_the_matrix_products_with_the_cross_matrix() {
+        // Bit for bit on non-zero results: the same three products summed in the same order,
+        // less the products with the cross matrix's zeros (which add nothing).
+        let m = Matrix3::new(0.3, -1.7, 2.2, 4.1e-3, 9.0, -0.25, 1.0 / 3.0, -7.5e2, 0.61);
+        let q = Vector3::new(-2.5e-3, 7.0e-4, 1.3e-2);
+        let qx = q.cross_matrix();
+        for (got, want) in [(times_cross(&m, &q), m * qx), (cross_times(&q, &m), qx * m)] {
+            for (a, b) in got.iter().zip(want.iter()) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{got} vs {want}");
             }
         }
     }

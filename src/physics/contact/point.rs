@@ -54,8 +54,15 @@ impl super::Contact {
         let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
         let wdot = -v_rel.dot(&normal);
         // The force's parts once (each STEP evaluated once per point): the same numbers as
-        // `ImpactParams::force`, `elastic_force` and `force_gradient`.
-        let (spring, damping) = self.impact.force_parts(w);
+        // `ImpactParams::force`, `elastic_force` and `force_gradient`. When the derivatives
+        // are taken, each STEP's value and slope come from one `sincos`.
+        let linearizing = out.linearizations.is_some() || out.moments.is_some();
+        let (spring, damping, damping_slope) = if linearizing {
+            self.impact.force_parts_with_slope(w)
+        } else {
+            let (spring, damping) = self.impact.force_parts(w);
+            (spring, damping, 0.0)
+        };
         let fn_mag = beta * (spring + damping * wdot).max(0.0);
         let elastic = beta * spring;
         let slip = v_rel - normal * v_rel.dot(&normal);
@@ -65,14 +72,21 @@ impl super::Contact {
         let mut force = normal * fn_mag;
         if let Some(fr) = &self.friction {
             if speed > 0.0 && fn_mag > 0.0 {
-                let m = fr.coefficient(speed);
-                mu = Some(m);
+                let m = if linearizing {
+                    let both = fr.coefficient_with_derivative(speed);
+                    mu = Some(both);
+                    both.0
+                } else {
+                    fr.coefficient(speed)
+                };
                 ft = m * fn_mag;
                 force -= slip * (ft / speed);
             }
         }
-        if fn_mag > 0.0 && (out.linearizations.is_some() || out.moments.is_some()) {
-            let (dfn_dw, dfn_dwdot) = self.impact.unclamped_gradient(w, wdot, damping);
+        if fn_mag > 0.0 && linearizing {
+            let (dfn_dw, dfn_dwdot) =
+                self.impact
+                    .unclamped_gradient_with_slope(w, wdot, damping, damping_slope);
             let (dforce_dfn, dforce_dslip) =
                 friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag, mu);
             let lin = TrackLinearization {
@@ -192,7 +206,7 @@ impl TrackSum {
 }
 
 /// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
-/// and slip `slip` (tangential; `mu` = μ(|s|) when already known): `∂F/∂f_n = n − μ ŝ` and
+/// and slip `slip` (tangential; `mu` = (μ(|s|), μ'(|s|)) when already known): `∂F/∂f_n = n − μ ŝ` and
 /// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
 /// `μ/|s| → μ'(0)` is used.
 pub(super) fn friction_derivatives(
@@ -200,7 +214,7 @@ pub(super) fn friction_derivatives(
     normal: &Vector3<f64>,
     slip: &Vector3<f64>,
     fn_mag: f64,
-    mu: Option<f64>,
+    mu: Option<(f64, f64)>,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let Some(fr) = friction else {
         return (*normal, Matrix3::zeros());
@@ -210,8 +224,7 @@ pub(super) fn friction_derivatives(
     if speed > 0.0 {
         let dir = slip / speed;
         let along = dir * dir.transpose();
-        let mu = mu.unwrap_or_else(|| fr.coefficient(speed));
-        let dmu = fr.coefficient_derivative(speed);
+        let (mu, dmu) = mu.unwrap_or_else(|| fr.coefficient_with_derivative(speed));
         (
             normal - dir * mu,
             -(along * dmu + (tangent - along) * (mu / speed)) * fn_mag,
