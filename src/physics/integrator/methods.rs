@@ -1,73 +1,9 @@
-//! One attempt of each method: TR-BDF2 (ESDIRK tableau, third-order companion for the error),
-//! SDIRK2 and Dopri5, and the energy account's stage quadrature.
+//! One attempt of Dopri5 (explicit tableau), and the energy account's stage quadrature for the
+//! implicit methods (whose tableaus and stage loop are in `dirk.rs`).
 
 use super::*;
 
 impl Integrator {
-    pub(super) fn attempt_trbdf2(
-        &mut self,
-        sys: &MultibodySystem,
-        ws: &mut Workspace,
-        t: f64,
-        y: &[f64],
-        h: f64,
-    ) -> Result<Attempt, IntegratorError> {
-        self.ensure_newton_matrix(sys, ws, t, y, h, TRB_D)?;
-        let n = self.n;
-        let hd = h * TRB_D;
-        // Stage 2 (trapezoidal to t + γh).
-        // Predictor: Taylor to second order, f' from the last two step starts (first order on
-        // the first step). Only Newton's starting point: the stage solves the same equation.
-        let gh = TRB_GAMMA * h;
-        let curvature = if self.prev_h > 0.0 {
-            0.5 * gh * gh / self.prev_h
-        } else {
-            0.0
-        };
-        for i in 0..n {
-            self.rhs[i] = y[i] + hd * self.k[0][i];
-            self.z[i] = y[i] + gh * self.k[0][i] + curvature * (self.k[0][i] - self.k_prev[i]);
-        }
-        if !self.newton(sys, ws, t + TRB_GAMMA * h, hd, y, 1) {
-            return Ok(Attempt {
-                err_norm: f64::INFINITY,
-                newton_failed: true,
-            });
-        }
-        self.capture_stage(sys, ws);
-        // Stage 3 (BDF2 to t + h).
-        for i in 0..n {
-            self.rhs[i] = y[i] + h * TRB_W * (self.k[0][i] + self.k[1][i]);
-            // Predictor: the quadratic through y with slopes k0 at t and k1 at t + γh.
-            self.z[i] = y[i] + h * ((1.0 - STAGE3_K1) * self.k[0][i] + STAGE3_K1 * self.k[1][i]);
-        }
-        if !self.newton(sys, ws, t + h, hd, y, 2) {
-            return Ok(Attempt {
-                err_norm: f64::INFINITY,
-                newton_failed: true,
-            });
-        }
-        let b1 = (1.0 - TRB_W) / 3.0;
-        let b2 = (3.0 * TRB_W + 1.0) / 3.0;
-        let b3 = TRB_D / 3.0;
-        for i in 0..n {
-            self.ynew[i] = self.z[i];
-            self.err[i] = h
-                * ((TRB_W - b1) * self.k[0][i]
-                    + (TRB_W - b2) * self.k[1][i]
-                    + (TRB_D - b3) * self.k[2][i]);
-        }
-        let mut e = std::mem::take(&mut self.err);
-        self.solve_in_place(&mut e);
-        let norm = self.error_norm(&e, y, h);
-        self.err = e;
-        let energy = self.energy_error_norm(ws, h, [TRB_W - b1, TRB_W - b2, TRB_D - b3]);
-        Ok(Attempt {
-            err_norm: norm.max(energy),
-            newton_failed: false,
-        })
-    }
-
     /// The energy account's quadrature error on this attempt over its tolerance
     /// ([`Tolerances::energy_rel`]): the embedded estimate `h Σ (w_i − b_i) P_i` of the
     /// dissipated and the drive power against the step's work. `ws.power` holds the attempt's
@@ -95,9 +31,14 @@ impl Integrator {
 
     /// Keeps the power terms of the stage just solved (the workspace holds its last Newton
     /// iterate's evaluation).
-    pub(super) fn capture_stage(&mut self, sys: &MultibodySystem, ws: &Workspace) {
+    pub(super) fn capture_stage(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &Workspace,
+        weights: [f64; 3],
+    ) {
         let stage = self.stage.get_or_insert_with(InteriorStage::default);
-        stage.weights = [TRB_W, TRB_W, TRB_D];
+        stage.weights = weights;
         stage.power = ws.power;
         stage.contacts.clear();
         stage.contacts.resize(sys.contacts.len(), [0.0; 2]);
@@ -107,51 +48,6 @@ impl Integrator {
                 c[1] += tr.friction_power;
             }
         }
-    }
-
-    pub(super) fn attempt_sdirk2(
-        &mut self,
-        sys: &MultibodySystem,
-        ws: &mut Workspace,
-        t: f64,
-        y: &[f64],
-        h: f64,
-    ) -> Result<Attempt, IntegratorError> {
-        self.ensure_newton_matrix(sys, ws, t, y, h, SD_GAMMA)?;
-        let n = self.n;
-        let hg = h * SD_GAMMA;
-        for i in 0..n {
-            self.rhs[i] = y[i];
-            self.z[i] = y[i] + hg * self.k[0][i];
-        }
-        if !self.newton(sys, ws, t + hg, hg, y, 1) {
-            return Ok(Attempt {
-                err_norm: f64::INFINITY,
-                newton_failed: true,
-            });
-        }
-        for i in 0..n {
-            self.rhs[i] = y[i] + h * (1.0 - SD_GAMMA) * self.k[1][i];
-            self.z[i] = y[i] + h * self.k[1][i];
-        }
-        if !self.newton(sys, ws, t + h, hg, y, 2) {
-            return Ok(Attempt {
-                err_norm: f64::INFINITY,
-                newton_failed: true,
-            });
-        }
-        for i in 0..n {
-            self.ynew[i] = self.z[i];
-            self.err[i] = hg * (self.k[2][i] - self.k[1][i]);
-        }
-        let mut e = std::mem::take(&mut self.err);
-        self.solve_in_place(&mut e);
-        let norm = self.error_norm(&e, y, h);
-        self.err = e;
-        Ok(Attempt {
-            err_norm: norm,
-            newton_failed: false,
-        })
     }
 
     pub(super) fn attempt_dopri5(

@@ -28,17 +28,20 @@
 //! piece, which is what the contact-aware matrix assumes anyway.
 //!
 //! Files: `settings.rs` (method, tolerances, Newton and patch choices, counters, errors),
-//! `methods.rs` (the tableaus and one attempt of each method), `newton.rs` (the stage
-//! equations' Newton iteration), `jacobian.rs` (Newton matrix: finite-difference and
-//! contact-aware parts, factorisation), `diagnostics.rs` (where the steps go), `checkpoint.rs`
-//! (what carries over between steps, for a run's checkpoint), `step_control.rs` (error norms
-//! and step-size factors); this file holds the integrator's state and the step loop.
+//! `dirk.rs` (TR-BDF2 and SDIRK2 as tableaus, their predictors, and the stage loop both run
+//! on), `methods.rs` (Dopri5's tableau and attempt, the energy account's stage quadrature),
+//! `newton.rs` (the stage equations' Newton iteration), `jacobian.rs` (Newton matrix:
+//! finite-difference and contact-aware parts, factorisation), `diagnostics.rs` (where the steps
+//! go), `checkpoint.rs` (what carries over between steps, for a run's checkpoint),
+//! `step_control.rs` (error norms and step-size factors); this file holds the integrator's
+//! state and the step loop.
 
 // Stage updates index several parallel state arrays at once; index loops read clearest.
 #![allow(clippy::needless_range_loop)]
 
 mod checkpoint;
 mod diagnostics;
+mod dirk;
 mod jacobian;
 mod methods;
 mod newton;
@@ -62,17 +65,6 @@ use step_control::{
     HOLD_STEPS_AFTER_NEWTON_FAILURE,
 };
 
-// TR-BDF2 coefficients (ESDIRK form).
-const SQRT2: f64 = std::f64::consts::SQRT_2;
-const TRB_GAMMA: f64 = 2.0 - SQRT2;
-const TRB_D: f64 = 1.0 - SQRT2 / 2.0;
-const TRB_W: f64 = SQRT2 / 4.0;
-/// Stage-3 predictor weight of k1: the quadratic with slope k0 at t and k1 at t + γh reaches
-/// `y + h ((1 - 1/(2γ)) k0 + 1/(2γ) k1)` at t + h (measured on the 2 s windows: -14 % / -10 %
-/// right-hand sides on rattle box C / launcher against `y + h k1`).
-const STAGE3_K1: f64 = 1.0 / (2.0 * TRB_GAMMA);
-// SDIRK2 (Alexander 1977).
-const SD_GAMMA: f64 = 1.0 - 1.0 / SQRT2;
 /// A Newton failure with a Jacobian at most this many steps old is blamed on the step size
 /// (an impact or a stick-slip reversal inside the step), not on the Jacobian: the step is cut
 /// without refreshing it (measured alone on rattle box C: -50 % Jacobians, -20 % rejections).
@@ -328,8 +320,8 @@ impl Integrator {
                 return Err(IntegratorError::StepSizeUnderflow { t, h });
             }
             let attempt = match self.settings.kind {
-                IntegratorKind::Trbdf2 => self.attempt_trbdf2(sys, ws, t, y, h)?,
-                IntegratorKind::Sdirk2 => self.attempt_sdirk2(sys, ws, t, y, h)?,
+                IntegratorKind::Trbdf2 => self.attempt_dirk(&dirk::TRBDF2, sys, ws, t, y, h)?,
+                IntegratorKind::Sdirk2 => self.attempt_dirk(&dirk::SDIRK2, sys, ws, t, y, h)?,
                 IntegratorKind::Dopri5 => self.attempt_dopri5(sys, ws, t, y, h),
             };
             let passed = attempt.err_norm.is_finite() && attempt.err_norm <= 1.0;
