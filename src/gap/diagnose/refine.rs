@@ -275,6 +275,8 @@ fn profile_secondary(
     };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
     for p in &info.parameters[1..] {
+        let mut values = profile_values(p, first);
+        let mut tables = Vec::new();
         let add = |emulator: &mut Emulator, v: f64| {
             emulator.add_variant(
                 campaign,
@@ -286,11 +288,30 @@ fn profile_secondary(
                 cache,
             )
         };
-        let best = |emulator: &Emulator, tables: &[usize]| {
-            best_value(campaign, emulator, options, tables, p.name)
-        };
-        let value = bisect(emulator, p, (first, bisections), add, best)?;
-        bests.insert(p.name.to_string(), value);
+        for &v in &values {
+            tables.push(add(emulator, v)?);
+        }
+        let mut best = best_value(campaign, emulator, options, &tables, p.name);
+        // Further passes: midway to the best value's neighbours among the values tried.
+        for _ in 0..bisections {
+            values.sort_by(f64::total_cmp);
+            let Some(i) = values.iter().position(|v| *v == best) else {
+                break;
+            };
+            let mut more = Vec::new();
+            if i > 0 {
+                more.push(midpoint(p, values[i - 1], best));
+            }
+            if i + 1 < values.len() {
+                more.push(midpoint(p, best, values[i + 1]));
+            }
+            for v in more {
+                tables.push(add(emulator, v)?);
+                values.push(v);
+            }
+            best = best_value(campaign, emulator, options, &tables, p.name);
+        }
+        bests.insert(p.name.to_string(), best);
     }
     let non_default: BTreeMap<String, f64> = bests
         .into_iter()
@@ -311,98 +332,6 @@ fn profile_secondary(
             control,
             cache,
         )?;
-    }
-    Ok(())
-}
-
-/// One secondary parameter's profile: variant tables (`add`) at `first` [`profile_values`],
-/// then `bisections` passes midway to the best value's neighbours among the values tried
-/// (`best` reads the best value among the tables). Returns the best value.
-fn bisect(
-    emulator: &mut Emulator,
-    p: &ParameterInfo,
-    (first, bisections): (usize, usize),
-    add: impl Fn(&mut Emulator, f64) -> Result<usize, GapError>,
-    best: impl Fn(&Emulator, &[usize]) -> f64,
-) -> Result<f64, GapError> {
-    let mut values = profile_values(p, first);
-    let mut tables = Vec::new();
-    for &v in &values {
-        tables.push(add(emulator, v)?);
-    }
-    let mut value = best(emulator, &tables);
-    for _ in 0..bisections {
-        values.sort_by(f64::total_cmp);
-        let Some(i) = values.iter().position(|v| *v == value) else {
-            break;
-        };
-        let mut more = Vec::new();
-        if i > 0 {
-            more.push(midpoint(p, values[i - 1], value));
-        }
-        if i + 1 < values.len() {
-            more.push(midpoint(p, value, values[i + 1]));
-        }
-        for v in more {
-            tables.push(add(emulator, v)?);
-            values.push(v);
-        }
-        value = best(emulator, &tables);
-    }
-    Ok(value)
-}
-
-/// A dynamics + wear-law pair's wear law profiled on the pair's own tracks: each secondary
-/// parameter of the wear law of table `w`, in library order at the values chosen before it,
-/// over nine values and four bisections (as a single's wear law), each variant made an exact
-/// pair with the dynamics table `d` and judged by the pair's full-data fit. A single's
-/// profile judges a wear law's threshold on the nominal tracks; beside a cross-axis drive the
-/// pressures it sees are others (bench seed 1042: third-body abrasion above 76 MPa, whose
-/// single profile settled where the nominal tracks put it).
-#[allow(clippy::too_many_arguments)]
-fn profile_pair_wear(
-    campaign: &Campaign,
-    emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
-    d: usize,
-    w: usize,
-) -> Result<(), GapError> {
-    let Some(&default_table) = emulator.family(w).first() else {
-        return Ok(());
-    };
-    let info = emulator.effects[default_table].info;
-    let mut chosen: BTreeMap<String, f64> = BTreeMap::new();
-    for p in &info.parameters[1..] {
-        let add = |emulator: &mut Emulator, v: f64| -> Result<usize, GapError> {
-            let mut secondary = chosen.clone();
-            secondary.insert(p.name.to_string(), v);
-            let t = emulator.add_variant(
-                campaign,
-                configs_dir,
-                default_table,
-                secondary,
-                &[],
-                control,
-                cache,
-            )?;
-            if emulator.pair(d, t).is_none() {
-                emulator.add_pair(campaign, configs_dir, d, t, control, cache)?;
-            }
-            Ok(t)
-        };
-        let best = |emulator: &Emulator, tables: &[usize]| {
-            let problem = FitProblem::new(campaign, emulator, options);
-            tables
-                .iter()
-                .map(|&t| (t, problem.fit_pair_tables(d, t, &|_| true).1))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .map_or(f64::NAN, |(t, _)| emulator.effects[t].parameter(p.name))
-        };
-        let value = bisect(emulator, p, (9, 4), add, best)?;
-        chosen.insert(p.name.to_string(), value);
     }
     Ok(())
 }
@@ -513,11 +442,10 @@ const PAIR_VARIANT_CONTENDERS: usize = 2;
 /// nominal, each member's variant tables get an exact pair table with the other member's
 /// (the wear law on the dynamics effect's own windows); the pair's fit then chooses among
 /// them (`FitProblem::pair_combinations`). For the as many best pairs of two dynamics
-/// effects, each member's tables are simulated with the other at the magnitudes the two
-/// tables fit together (where that fit leaves one at 0, the pair's fit, or a member the pair
-/// left at 0 at its single's fit): the product of their ratios may hide what one adds beside
-/// the other, and a joint point corrects it; the refinement rounds then simulate the chosen
-/// two together where the fits land.
+/// effects, each member's tables are simulated with the other at the pair's fit (a member
+/// the fit left at 0 at its single's fit): the product of their ratios may hide what one
+/// adds beside the other, and a joint point corrects it; the refinement rounds then simulate
+/// the chosen two together where the fits land.
 fn pair_variants(
     campaign: &Campaign,
     emulator: &mut Emulator,
@@ -566,63 +494,30 @@ fn pair_variants(
                 .first()
                 .map_or(0.0, |s| s.1)
         };
-        // Each variant beside the other member's table at the magnitudes the two tables fit
-        // together: a secondary value and its magnitude trade off (a friction drift's slip
-        // scale and its size), so a variant simulated at the pair's own magnitude would sit
-        // off the ridge it fits along.
-        let at_fit = |ta: usize, tb: usize, (ma, mb): (f64, f64)| -> [(usize, f64); 2] {
-            let fit = problem.fit_pair_tables(ta, tb, &|_| true).0;
-            let m = |i: usize, fallback: f64| match fit.get(i) {
-                Some(&(_, m)) if m != 0.0 => m,
-                _ => fallback,
-            };
-            [(ta, m(0, ma)), (tb, m(1, mb))]
-        };
         let dynamics = pairs
             .iter()
             .filter(|(both, _)| *both)
             .take(PAIR_VARIANT_CONTENDERS)
             .filter_map(|(_, c)| match c.spec[..] {
-                [(a, ma), (b, mb)] => Some((
-                    a,
-                    b,
-                    (
-                        if ma != 0.0 { ma } else { single_magnitude(a) },
-                        if mb != 0.0 { mb } else { single_magnitude(b) },
-                    ),
-                )),
+                [(a, ma), (b, mb)] => Some([
+                    (a, if ma != 0.0 { ma } else { single_magnitude(a) }),
+                    (b, if mb != 0.0 { mb } else { single_magnitude(b) }),
+                ]),
                 _ => None,
             })
-            .flat_map(|(a, b, m)| {
-                let variants_a = problem.families[problem.family_of(a)]
-                    .iter()
-                    .map(move |&a2| (a2, b));
-                let variants_b = problem.families[problem.family_of(b)]
-                    .iter()
-                    .map(move |&b2| (a, b2));
-                variants_a
-                    .chain(variants_b)
-                    .map(move |(ta, tb)| at_fit(ta, tb, m))
-                    .collect::<Vec<_>>()
-            })
-            .collect::<Vec<_>>();
+            .collect();
         (mixed, dynamics)
     };
-    // Two dynamics effects: each member's tables simulated with the other where they fit.
-    for [a, b] in dynamics {
-        emulator.add_joint(campaign, configs_dir, a, b, control, cache)?;
+    // Two dynamics effects: each member's tables simulated with the other at the pair's fit.
+    for [(a, ma), (b, mb)] in dynamics {
+        for a2 in emulator.family(a) {
+            emulator.add_joint(campaign, configs_dir, (a2, ma), (b, mb), control, cache)?;
+        }
+        for b2 in emulator.family(b) {
+            emulator.add_joint(campaign, configs_dir, (a, ma), (b2, mb), control, cache)?;
+        }
     }
     for (d, w) in contenders {
-        profile_pair_wear(
-            campaign,
-            emulator,
-            options,
-            configs_dir,
-            control,
-            cache,
-            d,
-            w,
-        )?;
         // Each member's own table is paired already (round 0 of `exact_pairs`).
         for w2 in emulator.family(w) {
             if emulator.pair(d, w2).is_none() {
