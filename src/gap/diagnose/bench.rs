@@ -27,7 +27,8 @@
 //! uncertainty, *at every magnitude and secondary value of the other member*. The bench
 //! searches the other member's values that come closest (its magnitude over eight fractions
 //! of its bound and three golden-section steps; then each secondary parameter over five values
-//! within its bounds, and the magnitude again) and scores the member against that. A member
+//! within its bounds, each with the magnitude over the eight fractions again) and scores the
+//! member against that. A member
 //! that the other, at other values, stands in for within the noise is not seen by any
 //! diagnosis: a friction drift at 0.045 with the default slip scale fits a drift of 0.18 over
 //! 997 m with a 6 ms fixture compliance within the noise (bench seed 2045). The older measure,
@@ -487,8 +488,9 @@ type TryAt<'a> = dyn Fn(f64, &BTreeMap<String, f64>, &mut StandIn) -> Result<f64
 /// values (`at_drawn`, their readings and score): the magnitude over [`STAND_IN_FRACTIONS`]
 /// of its bound on the drawn magnitude's side and three golden-section steps between the best
 /// one's neighbours; then, while the stand-in is still told apart (score > 2), each secondary
-/// parameter over [`STAND_IN_SECONDARY_VALUES`] values within its bounds, and the magnitude's
-/// golden-section steps again if one moved. Returns the closest readings and their score.
+/// parameter over [`STAND_IN_SECONDARY_VALUES`] values within its bounds, each with the
+/// magnitude over the same fractions, and the golden-section steps at the value that came
+/// closest. Returns the closest readings and their score.
 fn closest_alone(
     other: &Effect,
     alone_at: &AloneAt,
@@ -529,37 +531,29 @@ fn closest_alone(
         if best.3 <= 2.0 {
             break;
         }
-        let before = best.1.get(p.name).copied();
+        // Each value with the magnitude searched over the same fractions: a secondary value
+        // and the magnitude trade off (a friction drift's slip scale and its size), so a
+        // value judged at another value's best magnitude would look worse than it is.
+        let drawn_value = best.1.get(p.name).copied();
+        let mut by_value: Vec<(f64, Vec<(f64, f64)>)> = Vec::new();
         for v in super::refine::profile_values(p, STAND_IN_SECONDARY_VALUES) {
+            if Some(v) == drawn_value {
+                continue;
+            }
             let mut sec = best.1.clone();
             sec.insert(p.name.to_string(), v);
-            let m = best.0;
-            try_at(m, &sec, &mut best)?;
-        }
-        if best.1.get(p.name).copied() != before {
-            // The magnitude's search again, around the best, at the new secondary values.
-            let sec = best.1.clone();
-            let m = best.0;
-            let mut around: Vec<(f64, f64)> = vec![(m, best.3)];
+            let mut tried = Vec::new();
             for f in STAND_IN_FRACTIONS {
-                let neighbour = f * bound;
-                if (neighbour - m).abs() > 0.0 {
-                    around.push((neighbour, f64::INFINITY));
-                }
+                tried.push((f * bound, try_at(f * bound, &sec, &mut best)?));
             }
-            // Only the best's two neighbours bracket it; the rest are not run.
-            around.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let i = around.iter().position(|t| t.0 == m).unwrap_or(0);
-            let lo = around[i.saturating_sub(1)].0;
-            let hi = around[(i + 1).min(around.len() - 1)].0;
-            let mut bracket = vec![(m, best.3)];
-            for n in [lo, hi] {
-                if n != m {
-                    let d = try_at(n, &sec, &mut best)?;
-                    bracket.push((n, d));
-                }
+            by_value.push((v, tried));
+        }
+        // The golden-section steps at the value that came closest, if it moved.
+        if best.1.get(p.name).copied() != drawn_value {
+            let chosen = best.1.get(p.name).copied();
+            if let Some((_, tried)) = by_value.iter_mut().find(|(v, _)| Some(*v) == chosen) {
+                golden_steps(tried, &mut best, &try_at)?;
             }
-            golden_steps(&mut bracket, &mut best, &try_at)?;
         }
     }
     Ok((best.2, best.3))
