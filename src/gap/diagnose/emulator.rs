@@ -637,34 +637,21 @@ impl Emulator {
         if targets.is_empty() {
             return Ok(0);
         }
-        let (cases, increments) = plan(campaign, configs_dir)?;
-        let slots: Vec<Slot> = targets
+        let sets = targets
             .iter()
             .map(|&(e, m)| {
                 let t = &self.effects[e];
-                (vec![effect_with(t.info, m, &t.parameters)], 1.0, 0.0, 0.0)
+                vec![effect_with(t.info, m, &t.parameters)]
             })
             .collect();
-        let before = cache.len();
-        let total = slots.len() * campaign.tests.len();
-        let by_slot = simulate_slots(
-            &slots,
-            campaign,
-            (&cases, &increments),
-            configs_dir,
-            &self.options,
-            control,
-            cache,
-            progress,
-            (0, total),
-        )?;
-        for (&(e, m), slot) in targets.iter().zip(&by_slot) {
+        let predictions =
+            self.simulate_sets(campaign, configs_dir, sets, control, cache, progress)?;
+        for (&(e, m), p) in targets.iter().zip(predictions) {
             let t = &mut self.effects[e];
             let at = t.magnitudes.partition_point(|x| *x < m);
             t.magnitudes.insert(at, m);
-            t.predictions.insert(at, predictions_of(slot));
+            t.predictions.insert(at, p);
         }
-        self.simulations += cache.len() - before;
         // Exact pairs on a refined dynamics table follow it.
         let stale: Vec<(usize, usize)> = self
             .pairs
@@ -705,7 +692,8 @@ impl Emulator {
             effect_with(ta.info, ma, &ta.parameters),
             effect_with(tb.info, mb, &tb.parameters),
         ];
-        let mut p = self.simulate_sets(campaign, configs_dir, vec![set], control, cache)?;
+        let mut p =
+            self.simulate_sets(campaign, configs_dir, vec![set], control, cache, &|_, _| {})?;
         let predictions = p.pop().unwrap_or_default();
         self.joints.push(JointPoint {
             tables: [a, b],
@@ -741,6 +729,7 @@ impl Emulator {
         sets: Vec<Vec<Effect>>,
         control: &RunControl,
         cache: &WindowCache,
+        progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Vec<TestPredictions>, GapError> {
         let (cases, increments) = plan(campaign, configs_dir)?;
         let slots: Vec<Slot> = sets.into_iter().map(|e| (e, 1.0, 0.0, 0.0)).collect();
@@ -754,7 +743,7 @@ impl Emulator {
             &self.options,
             control,
             cache,
-            &|_, _| {},
+            progress,
             (0, total),
         )?;
         self.simulations += cache.len() - before;
@@ -806,7 +795,8 @@ impl Emulator {
                 }
             })
             .collect();
-        let predictions = self.simulate_sets(campaign, configs_dir, sets, control, cache)?;
+        let predictions =
+            self.simulate_sets(campaign, configs_dir, sets, control, cache, &|_, _| {})?;
         self.effects.push(EffectTable {
             info,
             magnitudes: grid,
@@ -858,7 +848,8 @@ impl Emulator {
                     set
                 })
                 .collect();
-            let predictions = this.simulate_sets(campaign, configs_dir, sets, control, cache)?;
+            let predictions =
+                this.simulate_sets(campaign, configs_dir, sets, control, cache, &|_, _| {})?;
             Ok(EffectTable {
                 predictions,
                 ..d.clone()
@@ -874,7 +865,7 @@ impl Emulator {
             if m != 0.0 {
                 set.push(effect_with(d.info, m, &d.parameters));
             }
-            self.simulate_sets(campaign, configs_dir, vec![set], control, cache)?
+            self.simulate_sets(campaign, configs_dir, vec![set], control, cache, &|_, _| {})?
         };
         let linear = eighth.first().is_some_and(|e| {
             e.iter().enumerate().all(|(ti, t)| {
