@@ -521,11 +521,18 @@ fn closest_alone(
             }
             Ok(d)
         };
-    for f in STAND_IN_FRACTIONS {
-        let sec = best.1.clone();
-        let d = try_at(f * bound, &sec, &mut best)?;
-        tried.push((f * bound, d));
-    }
+    // The magnitude over the fractions of its bound at secondary values `sec`: (magnitude,
+    // score) each.
+    let sweep =
+        |sec: &BTreeMap<String, f64>, best: &mut StandIn| -> Result<Vec<(f64, f64)>, GapError> {
+            let mut tried = Vec::new();
+            for f in STAND_IN_FRACTIONS {
+                tried.push((f * bound, try_at(f * bound, sec, best)?));
+            }
+            Ok(tried)
+        };
+    let drawn_secondary = best.1.clone();
+    tried.extend(sweep(&drawn_secondary, &mut best)?);
     golden_steps(&mut tried, &mut best, &try_at)?;
     for p in &info.parameters[1..] {
         if best.3 <= 2.0 {
@@ -542,11 +549,7 @@ fn closest_alone(
             }
             let mut sec = best.1.clone();
             sec.insert(p.name.to_string(), v);
-            let mut tried = Vec::new();
-            for f in STAND_IN_FRACTIONS {
-                tried.push((f * bound, try_at(f * bound, &sec, &mut best)?));
-            }
-            by_value.push((v, tried));
+            by_value.push((v, sweep(&sec, &mut best)?));
         }
         // The golden-section steps at the value that came closest, if it moved.
         if best.1.get(p.name).copied() != drawn_value {
