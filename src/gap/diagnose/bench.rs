@@ -49,6 +49,7 @@
 
 use super::emulator::{effect_with, Emulator, EmulatorOptions};
 use super::noise::{gaussian, observations, NoiseModel, Observation, Term};
+use super::truth_fit::{truth_fit, TruthFit};
 use super::{diagnose_refining, stats, DiagnoseOptions, Report, Verdict};
 use crate::gap::effects::{Acts, Effect, EffectInfo, LIBRARY};
 use crate::gap::rig::{run_cached, RigOptions, Truth};
@@ -200,6 +201,11 @@ pub struct Outcome {
     pub nominal_p_value: f64,
     /// Groups flagged in `where`.
     pub flagged: Vec<String>,
+    /// The truth simulated in the emulator at its drawn values and scored on the campaign
+    /// (library effects only): whether the library's model of the truth itself fits within
+    /// the noise ([`truth_fit`]).
+    #[serde(default)]
+    pub truth_fit: Option<TruthFit>,
 }
 
 /// One parameter of a named effect.
@@ -258,6 +264,13 @@ pub struct Scores {
     /// Of those, the share `explained` by exactly their two effects.
     #[serde(default)]
     pub pairs_at_drawn_both_named: f64,
+    /// Detectable pairs whose truth, simulated in the emulator at its drawn values, passes
+    /// the lack-of-fit test (`Outcome::truth_fit`): the pairs a search could name.
+    #[serde(default)]
+    pub pairs_truth_fits: usize,
+    /// Detectable single effects whose truth passes the lack-of-fit test.
+    #[serde(default)]
+    pub singles_truth_fits: usize,
     /// Campaigns `explained` by an effect that is not (part of) the truth.
     #[serde(default)]
     pub wrong_names: usize,
@@ -807,6 +820,16 @@ pub fn run(
             &|_, _| {},
         )?;
         let refinements = refined.simulations - emulator.simulations;
+        // On the campaign's refined copy, after its diagnosis: the truth's own fit.
+        let truth = truth_fit(
+            &noisy,
+            &mut refined,
+            &o.diagnose,
+            configs_dir,
+            control,
+            &cache,
+            &s.effects,
+        )?;
         if let Some(dir) = &o.reports_dir {
             write_report(dir, s, &report)?;
         }
@@ -850,10 +873,12 @@ pub fn run(
                 .filter(|g| g.flagged)
                 .map(|g| format!("{}: {} (z {:+.1})", g.by, g.label, g.z))
                 .collect(),
+            truth_fit: truth,
         });
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
+        let truth_p = truth.map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
         progress(format!(
-            "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows)",
+            "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows; the truth's own lack-of-fit p {truth_p})",
             last.as_ref().map(|l| l.0),
             last.and_then(|l| l.1)
         ));
@@ -926,6 +951,10 @@ fn led_right(o: &Outcome) -> bool {
 }
 
 /// A confident name that is not the truth: explained by an effect the rig did not inject.
+fn truth_fits(o: &Outcome) -> bool {
+    o.truth_fit.is_some_and(|t| t.fits)
+}
+
 fn named_wrong(o: &Outcome) -> bool {
     if o.verdict != Verdict::Explained {
         return false;
@@ -1023,6 +1052,8 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             drawn_pairs.iter().filter(|o| named_right(o)).count(),
             drawn_pairs.len(),
         ),
+        pairs_truth_fits: det_pairs.iter().filter(|o| truth_fits(o)).count(),
+        singles_truth_fits: det_lib.iter().filter(|o| truth_fits(o)).count(),
         wrong_names: wrong,
         wrong_name_rate: share(wrong, outcomes.len()),
         partly_explained: outcomes
@@ -1103,6 +1134,13 @@ impl Scores {
             "| of them detectable in two or more tests on their own ({}) | {} | >= 60 % |\n",
             self.confirmable_pairs,
             pct(self.confirmable_pairs_both_named)
+        ));
+        s.push_str(&format!(
+            "| detectable singles / pairs whose truth, simulated in the emulator, passes the lack-of-fit test | {} of {} / {} of {} | |\n",
+            self.singles_truth_fits,
+            self.detectable_in_library,
+            self.pairs_truth_fits,
+            self.detectable_pairs
         ));
         s.push_str(&format!(
             "| pairs detectable at the drawn magnitudes, explained by both members ({}) | {} | |\n",
@@ -1258,6 +1296,7 @@ mod tests {
             fitted: Vec::new(),
             nominal_p_value: 0.0,
             flagged: Vec::new(),
+            truth_fit: None,
         }
     }
 

@@ -46,6 +46,7 @@ mod refine;
 mod report;
 pub mod stats;
 pub mod table;
+pub mod truth_fit;
 
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
