@@ -529,38 +529,32 @@ impl Emulator {
                     p.at(*mb, *ma)
                 }
             }
-            [(a, ma), (b, mb)] if self.joint_near(*a, *ma, *b, *mb).is_some() => {
-                let mut out = self.product(effects);
-                if let Some(j) = self.joint_near(*a, *ma, *b, *mb) {
-                    // The product corrected by the simulator at the nearest joint point (exact
-                    // there): joint / product, per quantity.
-                    let at = [
-                        (j.tables[0], j.magnitudes[0]),
-                        (j.tables[1], j.magnitudes[1]),
-                    ];
-                    let base = self.product(&at);
-                    for (ti, t) in out.iter_mut().enumerate() {
-                        for (k, q) in t.iter_mut().enumerate() {
-                            let (b, e) = (&base[ti][k], &j.predictions[ti][k]);
-                            let ratio = b.zip(e, |b, e| if b > 0.0 { e / b } else { f64::NAN });
-                            // Where the product is 0 at the joint point, add the difference.
-                            let added = q.zip(&b.zip(e, |b, e| e - b), |x, d| x + d);
-                            let scaled = q.zip(&ratio, |x, r| x * r);
-                            *q = scaled.zip(&added, |x, a| if x.is_nan() { a } else { x });
-                        }
-                    }
-                }
-                out
-            }
+            [(a, ma), (b, mb)] if self.has_joint(*a, *b) => self.interacting(*a, *ma, *b, *mb),
             many => self.product(many),
         }
     }
 
-    /// The nearest joint point of tables `a` and `b` (distance in fractions of each
-    /// magnitude's bound), if any.
-    fn joint_near(&self, a: usize, ma: f64, b: usize, mb: f64) -> Option<&JointPoint> {
-        let scale = |t: usize, m: f64| self.effects[t].bound_for(m).abs().max(1e-300);
+    /// Whether tables `a` and `b` were simulated together anywhere.
+    fn has_joint(&self, a: usize, b: usize) -> bool {
         self.joints
+            .iter()
+            .any(|j| j.tables == [a, b] || j.tables == [b, a])
+    }
+
+    /// Tables `a` at `ma` and `b` at `mb` together: the product of their ratios times an
+    /// interaction the joint simulations measure (docs/diagnosis.md, "Two dynamics effects
+    /// together"). With `u`, `v` each magnitude over its bound, the interaction of a quantity
+    /// is `exp(u v h(u, v))` (a product that is 0 at the joint points: `+ u v h`), where
+    /// `h_i = ln(joint_i / product_i) / (u_i v_i)` at each joint point is interpolated by
+    /// inverse squared distance in `(u, v)`. So it is exact at every joint point, vanishes
+    /// where either member is off (the product is exact there), and is smooth in both
+    /// magnitudes: a fit moving between joint points sees no jump.
+    fn interacting(&self, a: usize, ma: f64, b: usize, mb: f64) -> TestPredictions {
+        let unit = |t: usize, m: f64| m / self.effects[t].bound_for(m).abs().max(1e-300);
+        let (u, v) = (unit(a, ma), unit(b, mb));
+        // (u_i, v_i, joint, product) at each joint point of the two tables, in (a, b) order.
+        let points: Vec<(f64, f64, &TestPredictions, TestPredictions)> = self
+            .joints
             .iter()
             .filter_map(|j| {
                 let (x, y) = if j.tables == [a, b] {
@@ -570,13 +564,53 @@ impl Emulator {
                 } else {
                     return None;
                 };
-                Some((
-                    j,
-                    (x - ma).abs() / scale(a, ma) + (y - mb).abs() / scale(b, mb),
-                ))
+                let (ui, vi) = (unit(a, x), unit(b, y));
+                (ui * vi != 0.0).then(|| (ui, vi, &j.predictions, self.product(&[(a, x), (b, y)])))
             })
-            .min_by(|p, q| p.1.total_cmp(&q.1))
-            .map(|(j, _)| j)
+            .collect();
+        let mut out = self.product(&[(a, ma), (b, mb)]);
+        // Weights: one at a joint point (exact there), inverse squared distance otherwise.
+        let d2: Vec<f64> = points
+            .iter()
+            .map(|(ui, vi, _, _)| (u - ui).powi(2) + (v - vi).powi(2))
+            .collect();
+        let weights: Vec<f64> = match d2.iter().position(|d| *d < 1e-24) {
+            Some(k) => (0..d2.len()).map(|i| f64::from(u8::from(i == k))).collect(),
+            None => d2.iter().map(|d| 1.0 / d).collect(),
+        };
+        let total: f64 = weights.iter().sum();
+        if points.is_empty() || !(total > 0.0) {
+            return out;
+        }
+        let uv = u * v;
+        for (ti, t) in out.iter_mut().enumerate() {
+            for (k, q) in t.iter_mut().enumerate() {
+                let at = |i: usize| (&points[i].2[ti][k], &points[i].3[ti][k]);
+                // Multiplicative where every joint point and its product are positive.
+                let mut h_log = q.zip(q, |_, _| 0.0);
+                let mut h_add = h_log.clone();
+                let mut positive = q.zip(q, |x, _| if x > 0.0 { 1.0 } else { 0.0 });
+                for (i, (ui, vi, _, _)) in points.iter().enumerate() {
+                    let (joint, base) = at(i);
+                    let w = weights[i] / total / (ui * vi);
+                    let log = joint.zip(base, |j, p| {
+                        if j > 0.0 && p > 0.0 {
+                            (j / p).ln()
+                        } else {
+                            f64::NAN
+                        }
+                    });
+                    positive = positive.zip(&log, |s, l| if l.is_nan() { 0.0 } else { s });
+                    h_log = h_log.zip(&log, |h, l| if l.is_nan() { h } else { h + w * l });
+                    h_add = h_add.zip(&joint.zip(base, |j, p| j - p), |h, d| h + w * d);
+                }
+                let scaled = q.zip(&h_log, |x, h| x * (uv * h).exp());
+                let added = q.zip(&h_add, |x, h| x + uv * h);
+                let mixed = scaled.zip(&positive, |x, s| if s > 0.0 { x } else { f64::NAN });
+                *q = mixed.zip(&added, |x, a| if x.is_nan() { a } else { x });
+            }
+        }
+        out
     }
 
     /// The nominal times each effect's ratio to the nominal.

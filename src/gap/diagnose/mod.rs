@@ -37,6 +37,8 @@ pub mod budget;
 pub mod carry;
 pub mod emulator;
 mod how_far;
+#[cfg(test)]
+mod interaction_tests;
 pub mod location;
 pub mod noise;
 mod pairs;
@@ -919,7 +921,7 @@ pub fn diagnose_with(
             approximations: vec![
                 "each increment is represented by one simulated window (wear scaled by increment / window); dynamics effects of time or slip see the state at the increment's middle".into(),
                 "dynamics effects are simulated on a grid of magnitudes and interpolated log-linearly between grid points".into(),
-                "a dynamics effect with a wear-law effect is exact once refined (the wear law on the dynamics effect's own tracks); two dynamics effects combine as the nominal times each one's ratio to the nominal".into(),
+                "a dynamics effect with a wear-law effect is exact once refined (the wear law on the dynamics effect's own tracks); two dynamics effects combine as the product of their ratios to the nominal times an interaction the joint simulations measure (exact at each joint point, interpolated between them, none where either is off)".into(),
                 "secondary parameters are fitted only for the leading effects that leave lack-of-fit (profiled over a few values within their bounds); otherwise they are held at the library defaults".into(),
                 "specimen scatter is common to a specimen's increments; that correlation is not modelled".into(),
             ],

@@ -456,8 +456,12 @@ fn pair_variants(
 ) -> Result<(), GapError> {
     // (dynamics table, wear-law table) of each mixed pair to profile, and (table,
     // magnitude) twice for each pair of dynamics effects.
-    type Contenders = (Vec<(usize, usize)>, Vec<[(usize, f64); 2]>);
-    let (contenders, dynamics): Contenders = {
+    type Contenders = (
+        Vec<(usize, usize)>,
+        Vec<[(usize, f64); 2]>,
+        Vec<[(usize, f64); 2]>,
+    );
+    let (contenders, dynamics, beside_leader): Contenders = {
         let problem = FitProblem::new(campaign, emulator, options);
         let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
             return Ok(());
@@ -506,7 +510,35 @@ fn pair_variants(
                 _ => None,
             })
             .collect();
-        (mixed, dynamics)
+        // The leading dynamics single (at its single's fit), and every other dynamics effect
+        // a pair puts beside it (at the pair's fit, or its single's when the pair left it
+        // at 0).
+        let leader = pairs
+            .iter()
+            .flat_map(|(_, c)| c.spec.iter().map(|s| problem.family_of(s.0)))
+            .filter(|&f| emulator.effects[problem.families[f][0]].info.acts == Acts::Dynamics)
+            .max_by(|x, y| singles[*x].held_ll().total_cmp(&singles[*y].held_ll()))
+            .and_then(|f| singles[f].spec.first().copied());
+        let mut beside_leader: Vec<[(usize, f64); 2]> = Vec::new();
+        if let Some(l) = leader {
+            let lf = problem.family_of(l.0);
+            for (both, c) in &pairs {
+                let [x, y] = match c.spec[..] {
+                    [x, y] if *both => [x, y],
+                    _ => continue,
+                };
+                let (t, m) = match (problem.family_of(x.0) == lf, problem.family_of(y.0) == lf) {
+                    (true, false) => y,
+                    (false, true) => x,
+                    _ => continue,
+                };
+                let m = if m != 0.0 { m } else { single_magnitude(t) };
+                if !beside_leader.iter().any(|p| p[1].0 == t) {
+                    beside_leader.push([l, (t, m)]);
+                }
+            }
+        }
+        (mixed, dynamics, beside_leader)
     };
     // Two dynamics effects: each member's tables simulated with the other at the pair's fit.
     for [(a, ma), (b, mb)] in dynamics {
@@ -515,6 +547,21 @@ fn pair_variants(
         }
         for b2 in emulator.family(b) {
             emulator.add_joint(campaign, configs_dir, (a, ma), (b2, mb), control, cache)?;
+        }
+    }
+    // Each partner of the leading dynamics effect: its secondary value bisected beside it.
+    for [leader, (partner, m)] in beside_leader {
+        if m != 0.0 && leader.1 != 0.0 {
+            bisect_beside(
+                campaign,
+                emulator,
+                options,
+                configs_dir,
+                control,
+                cache,
+                (partner, m),
+                leader,
+            )?;
         }
     }
     for (d, w) in contenders {
@@ -531,4 +578,117 @@ fn pair_variants(
         }
     }
     Ok(())
+}
+
+/// Bisection passes of a dynamics pair member's secondary value with the other member on.
+const PAIR_BISECTIONS: usize = 3;
+
+/// The secondary value of dynamics table `member`'s effect (one secondary parameter) chosen
+/// with table `other` on at its magnitude: a single's profile chose it without the other,
+/// and the other may move it (a cross-axis drive adds sliding, so a friction drift over slip
+/// runs its course over less test time: its slip scale fitted alone is not the pair's).
+/// Every table of the member's family (seeded with the profile's five values when it holds
+/// fewer than three, each simulated at `m`) is simulated beside `other` and fitted with it;
+/// [`PAIR_BISECTIONS`] times, variants midway between the best value and its neighbours are
+/// added, each simulated alone and beside `other` where the best table's pair fit lands (two
+/// simulations per value: the pair's fit moves the member's magnitude along the variant's
+/// table from 0 to there, and the joint point makes it exact there). Returns the
+/// best table and the magnitude its pair fit takes (`member` unchanged when its effect has
+/// no single secondary parameter).
+#[allow(clippy::too_many_arguments)]
+fn bisect_beside(
+    campaign: &Campaign,
+    emulator: &mut Emulator,
+    options: &DiagnoseOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+    (member, m): (usize, f64),
+    (other, mo): (usize, f64),
+) -> Result<(usize, f64), GapError> {
+    let info = emulator.effects[member].info;
+    let [_, p] = info.parameters else {
+        return Ok((member, m));
+    };
+    let Some(default_table) = emulator
+        .family(member)
+        .into_iter()
+        .find(|&t| emulator.effects[t].parameters.is_empty())
+    else {
+        return Ok((member, m));
+    };
+    let add = |emulator: &mut Emulator, v: f64, grid: &[f64], at: f64| -> Result<(), GapError> {
+        let t = emulator.add_variant(
+            campaign,
+            configs_dir,
+            default_table,
+            BTreeMap::from([(p.name.to_string(), v)]),
+            grid,
+            control,
+            cache,
+        )?;
+        emulator.add_joint(campaign, configs_dir, (t, at), (other, mo), control, cache)?;
+        Ok(())
+    };
+    if emulator.family(member).len() < 3 {
+        let grid = [m];
+        for v in profile_values(p, 5) {
+            if v != p.default {
+                add(emulator, v, &grid, m)?;
+            }
+        }
+    }
+    // Every table of the family simulated beside `other` once, so none is judged on the
+    // product of ratios alone.
+    for t in emulator.family(member) {
+        emulator.add_joint(campaign, configs_dir, (t, m), (other, mo), control, cache)?;
+    }
+    // Each table's value and its pair fit beside `other` (full data), by value.
+    let tried = |emulator: &Emulator| -> Vec<(f64, usize, f64, f64)> {
+        let problem = FitProblem::new(campaign, emulator, options);
+        let mut tried: Vec<(f64, usize, f64, f64)> = emulator
+            .family(member)
+            .into_iter()
+            .map(|t| {
+                let (spec, nll) = problem.fit_pair_tables(t, other, &|_| true);
+                let at = spec.first().map_or(m, |s| if s.1 != 0.0 { s.1 } else { m });
+                (emulator.effects[t].parameter(p.name), t, at, nll)
+            })
+            .collect();
+        tried.sort_by(|x, y| x.0.total_cmp(&y.0));
+        tried
+    };
+    let best_of = |tried: &[(f64, usize, f64, f64)]| {
+        tried
+            .iter()
+            .enumerate()
+            .min_by(|x, y| x.1 .3.total_cmp(&y.1 .3))
+            .map(|(i, _)| i)
+    };
+    for _ in 0..PAIR_BISECTIONS {
+        let tried = tried(emulator);
+        let Some(i) = best_of(&tried) else {
+            break;
+        };
+        let (best, _, at, _) = tried[i];
+        // A bisection's variant is simulated where the best table's pair fit lands, alone
+        // and beside `other`: two simulations per value.
+        let grid = [at];
+        let mut more = Vec::new();
+        if i > 0 {
+            more.push(midpoint(p, tried[i - 1].0, best));
+        }
+        if i + 1 < tried.len() {
+            more.push(midpoint(p, best, tried[i + 1].0));
+        }
+        let before = emulator.effects.len();
+        for v in more {
+            add(emulator, v, &grid, at)?;
+        }
+        if emulator.effects.len() == before {
+            break;
+        }
+    }
+    let tried = tried(emulator);
+    Ok(best_of(&tried).map_or((member, m), |i| (tried[i].1, tried[i].2)))
 }
