@@ -873,10 +873,12 @@ pub fn run(
                 .filter(|g| g.flagged)
                 .map(|g| format!("{}: {} (z {:+.1})", g.by, g.label, g.z))
                 .collect(),
-            truth_fit: truth,
+            truth_fit: truth.clone(),
         });
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
-        let truth_p = truth.map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
+        let truth_p = truth
+            .as_ref()
+            .map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
         progress(format!(
             "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows; the truth's own lack-of-fit p {truth_p})",
             last.as_ref().map(|l| l.0),
@@ -952,7 +954,7 @@ fn led_right(o: &Outcome) -> bool {
 
 /// A confident name that is not the truth: explained by an effect the rig did not inject.
 fn truth_fits(o: &Outcome) -> bool {
-    o.truth_fit.is_some_and(|t| t.fits)
+    o.truth_fit.as_ref().is_some_and(|t| t.fits)
 }
 
 fn named_wrong(o: &Outcome) -> bool {

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// How the truth, simulated in the emulator, fits the campaign (full data).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TruthFit {
     /// Squared standardized residuals (a chi-square with `dof - parameters` degrees of
     /// freedom when the model holds).
@@ -31,6 +31,10 @@ pub struct TruthFit {
     pub nll: f64,
     /// The lack-of-fit test passes at the diagnosis' `alpha`.
     pub fits: bool,
+    /// Chi-square and weighted count of each held-out group (test) alone: where a truth that
+    /// does not fit misses.
+    #[serde(default)]
+    pub by_group: Vec<(String, f64, f64)>,
 }
 
 /// The truth `effects` (one or two library effects, every parameter given) fitted as they
@@ -122,6 +126,12 @@ pub fn truth_fit(
     let t = problem.totals(&spec, &|_| true);
     let dof = (t.w - parameters as f64).round().max(1.0) as usize;
     let p_value = stats::chi2_sf(t.r2, dof);
+    let by_group = (0..problem.groups)
+        .map(|g| {
+            let one = problem.totals(&spec, &|h| h == g);
+            (problem.group_labels[g].clone(), one.r2, one.w)
+        })
+        .collect();
     Ok(Some(TruthFit {
         chi2: t.r2,
         dof: t.w,
@@ -129,5 +139,6 @@ pub fn truth_fit(
         p_value,
         nll: t.nll,
         fits: p_value >= options.alpha,
+        by_group,
     }))
 }
