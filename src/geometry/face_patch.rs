@@ -368,15 +368,23 @@ impl FacePatch {
     /// Sutherland–Hodgman clip of the polygon by `line` (keeping `line >= 0`); false when
     /// nothing of positive area is left.
     fn clip(&mut self, line: &Line) -> bool {
-        if self.verts[..self.len].iter().all(|&p| line.at(p) >= 0.0) {
+        // `line` at each vertex once (it was taken up to three times per vertex).
+        let len = self.len;
+        let mut at = [0.0; MAX_VERTICES];
+        let mut kept = true;
+        for (g, &p) in at.iter_mut().zip(&self.verts[..len]) {
+            *g = line.at(p);
+            kept &= *g >= 0.0;
+        }
+        if kept {
             return true;
         }
         let mut out = [[0.0; 2]; MAX_VERTICES];
         let mut m = 0;
-        for i in 0..self.len {
-            let p = self.verts[i];
-            let q = self.verts[(i + 1) % self.len];
-            let (gp, gq) = (line.at(p), line.at(q));
+        for i in 0..len {
+            let j = next(i, len);
+            let (p, q) = (self.verts[i], self.verts[j]);
+            let (gp, gq) = (at[i], at[j]);
             let crossing = || {
                 let t = gp / (gp - gq);
                 [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
@@ -406,7 +414,7 @@ impl FacePatch {
         let mut twice = 0.0;
         for i in 0..self.len {
             let p = self.verts[i];
-            let q = self.verts[(i + 1) % self.len];
+            let q = self.verts[next(i, self.len)];
             twice += p[0] * q[1] - q[0] * p[1];
         }
         0.5 * twice
@@ -567,7 +575,7 @@ impl FacePatch {
         let mut upper: Option<(f64, f64)> = None;
         for i in 0..self.len {
             let p = self.verts[i];
-            let q = self.verts[(i + 1) % self.len];
+            let q = self.verts[next(i, self.len)];
             if (p[0] - u) * (q[0] - u) >= 0.0 {
                 continue;
             }
@@ -581,6 +589,17 @@ impl FacePatch {
             }
         }
         Some((lower?, upper?))
+    }
+}
+
+/// The vertex after `i` of a polygon of `len` vertices: `(i + 1) % len` without the
+/// integer division (clipping and slicing walk every edge of every part).
+#[inline]
+fn next(i: usize, len: usize) -> usize {
+    if i + 1 == len {
+        0
+    } else {
+        i + 1
     }
 }
 

@@ -153,6 +153,9 @@ impl Contact {
     /// ([`PartRule::Unloaded`]). Every part's rule is exact for the
     /// elastic densities, so the stored energy and its gradient are the patch's exact integrals
     /// whatever the cuts.
+    ///
+    /// Each part goes to `push` as it is cut (up to five, in a fixed order), not through a
+    /// returned array: a part is 360 bytes, and an array of them was copied twice per patch.
     fn damping_parts(
         &self,
         patch: &FacePatch,
@@ -160,15 +163,10 @@ impl Contact {
         fb: &BodyFrame,
         radius: f64,
         normal: &Vector3<f64>,
-    ) -> [Option<(FacePatch, PartRule)>; 5] {
-        let mut parts = [None; 5];
-        let mut count = 0;
-        let mut push = |part: FacePatch, rule: PartRule| {
-            parts[count] = Some((part, rule));
-            count += 1;
-        };
+        push: &mut impl FnMut(&FacePatch, PartRule),
+    ) {
         if self.impact.max_damping == 0.0 {
-            push(*patch, PartRule::Patch);
+            push(patch, PartRule::Patch);
         } else {
             let rate = penetration_rate(patch, fa, fb, radius, normal);
             let (core, ramp) = patch.split(&patch.depth().minus(self.impact.full_damping_depth));
@@ -177,13 +175,13 @@ impl Contact {
                 if let Some(closing) = closing {
                     // No clamp: along the ramp `w` is constant and the density affine.
                     push(
-                        closing.aligned_with(&patch.depth()),
+                        &closing.aligned_with(&patch.depth()),
                         PartRule::Fixed(CLOSING_RAMP_RULE),
                     );
                 }
                 if let Some(opening) = opening {
                     push(
-                        opening.aligned_with(&patch.depth()),
+                        &opening.aligned_with(&patch.depth()),
                         PartRule::Clamped(RAMP_RULE),
                     );
                 }
@@ -191,7 +189,7 @@ impl Contact {
             if let Some(core) = core {
                 let (closing, opening) = core.split(&rate);
                 if let Some(closing) = closing {
-                    push(closing, PartRule::Patch);
+                    push(&closing, PartRule::Patch);
                 }
                 if let Some(opening) = opening {
                     // Where ẇ <= −k w_max^e / c the force is clamped to zero at every point
@@ -203,17 +201,16 @@ impl Contact {
                     let (band, clamped) = opening.split(&rate.minus(dead));
                     if let Some(band) = band {
                         push(
-                            band.aligned_with(&patch.depth()),
+                            &band.aligned_with(&patch.depth()),
                             PartRule::Clamped(CLAMP_RULE),
                         );
                     }
                     if let Some(clamped) = clamped {
-                        push(clamped, PartRule::Unloaded);
+                        push(&clamped, PartRule::Unloaded);
                     }
                 }
             }
         }
-        parts
     }
 
     /// Evaluates the six faces of the inner box `inner` (half extents, m) of a rounded box of
@@ -239,15 +236,14 @@ impl Contact {
                 if deepest.is_none_or(|best| d.0 > best.0) {
                     deepest = Some(d);
                 }
-                let parts = self.damping_parts(&patch, fa, fb, radius, &normal);
-                for (part, rule) in parts.into_iter().flatten() {
+                let mut each_part = |part: &FacePatch, rule: PartRule| {
                     if matches!(rule, PartRule::Unloaded)
-                        && self.unloaded_part(&part, fa, fb, radius, &normal, out)
+                        && self.unloaded_part(part, fa, fb, radius, &normal, out)
                     {
-                        continue;
+                        return;
                     }
                     let integrate = |rule: PartRule, scale: f64, out: &mut PointOutputs<'_, '_>| {
-                        self.integrate_part(&part, rule, scale, fa, fb, radius, face, out)
+                        self.integrate_part(part, rule, scale, fa, fb, radius, face, out)
                     };
                     match rule.on_side_face() {
                         Some(side) if fine < 1.0 => {
@@ -259,7 +255,8 @@ impl Contact {
                         // `scale` 1: the nodes' shares unchanged, bit for bit.
                         _ => integrate(rule, 1.0, out),
                     }
-                }
+                };
+                self.damping_parts(&patch, fa, fb, radius, &normal, &mut each_part);
             }
             if !face.is_bounded() {
                 continue;
