@@ -206,6 +206,11 @@ pub struct Outcome {
     /// the noise ([`truth_fit`]).
     #[serde(default)]
     pub truth_fit: Option<TruthFit>,
+    /// A pair: the lowest AICc the diagnosis found for either member alone. The pair is
+    /// identifiable from the campaign only when its truth fits and beats this: otherwise the
+    /// data prefer one member alone, whatever the search.
+    #[serde(default)]
+    pub best_member_aicc: Option<f64>,
 }
 
 /// One parameter of a named effect.
@@ -268,6 +273,13 @@ pub struct Scores {
     /// the lack-of-fit test (`Outcome::truth_fit`): the pairs a search could name.
     #[serde(default)]
     pub pairs_truth_fits: usize,
+    /// Detectable pairs the campaign identifies: the truth fits and its AICc beats each
+    /// member alone as the diagnosis fitted it (`Outcome::best_member_aicc`).
+    #[serde(default)]
+    pub identifiable_pairs: usize,
+    /// Of those, the share `explained` by exactly their two effects.
+    #[serde(default)]
+    pub identifiable_pairs_both_named: f64,
     /// Detectable single effects whose truth passes the lack-of-fit test.
     #[serde(default)]
     pub singles_truth_fits: usize,
@@ -874,6 +886,16 @@ pub fn run(
                 .map(|g| format!("{}: {} (z {:+.1})", g.by, g.label, g.z))
                 .collect(),
             truth_fit: truth.clone(),
+            best_member_aicc: (s.effects.len() == 2)
+                .then(|| {
+                    report
+                        .ranking
+                        .iter()
+                        .filter(|r| s.effects.iter().any(|e| e.name == r.name))
+                        .map(|r| r.aicc)
+                        .min_by(f64::total_cmp)
+                })
+                .flatten(),
         });
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
         let truth_p = truth
@@ -957,6 +979,15 @@ fn truth_fits(o: &Outcome) -> bool {
     o.truth_fit.as_ref().is_some_and(|t| t.fits)
 }
 
+/// A pair whose truth fits and beats each member alone by AICc.
+fn identifiable(o: &Outcome) -> bool {
+    truth_fits(o)
+        && o.truth_fit
+            .as_ref()
+            .zip(o.best_member_aicc)
+            .is_some_and(|(t, single)| t.aicc < single)
+}
+
 fn named_wrong(o: &Outcome) -> bool {
     if o.verdict != Verdict::Explained {
         return false;
@@ -998,6 +1029,7 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .filter(|o| o.scenario.truth.contains('+') && o.detectable_at_drawn)
         .collect();
     let conf_pairs: Vec<&&&Outcome> = det_pairs.iter().filter(|o| confirmable(o)).collect();
+    let identifiable: Vec<&&&Outcome> = det_pairs.iter().filter(|o| identifiable(o)).collect();
     let conf: Vec<&&&&Outcome> = det_lib.iter().filter(|o| confirmable(o)).collect();
     let one_test: Vec<&&&&Outcome> = det_lib.iter().filter(|o| !confirmable(o)).collect();
     let undet: Vec<&&&Outcome> = singles.iter().filter(|o| !o.detectable).collect();
@@ -1055,6 +1087,11 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             drawn_pairs.len(),
         ),
         pairs_truth_fits: det_pairs.iter().filter(|o| truth_fits(o)).count(),
+        identifiable_pairs: identifiable.len(),
+        identifiable_pairs_both_named: share(
+            identifiable.iter().filter(|o| named_right(o)).count(),
+            identifiable.len(),
+        ),
         singles_truth_fits: det_lib.iter().filter(|o| truth_fits(o)).count(),
         wrong_names: wrong,
         wrong_name_rate: share(wrong, outcomes.len()),
@@ -1143,6 +1180,11 @@ impl Scores {
             self.detectable_in_library,
             self.pairs_truth_fits,
             self.detectable_pairs
+        ));
+        s.push_str(&format!(
+            "| of them identifiable: the truth fits and beats each member alone by AICc ({}) | {} | |\n",
+            self.identifiable_pairs,
+            pct(self.identifiable_pairs_both_named)
         ));
         s.push_str(&format!(
             "| pairs detectable at the drawn magnitudes, explained by both members ({}) | {} | |\n",
@@ -1299,6 +1341,7 @@ mod tests {
             nominal_p_value: 0.0,
             flagged: Vec::new(),
             truth_fit: None,
+            best_member_aicc: None,
         }
     }
 
@@ -1347,6 +1390,41 @@ mod tests {
         assert_eq!(s.wrong_names, 2);
         assert_eq!(s.partly_explained, 1);
         assert_eq!(s.controls_clean, 0.0);
+    }
+
+    /// A pair counts as identifiable only when its truth fits and beats each member alone by
+    /// AICc: a truth that does not fit, or that a member alone beats, no search can name.
+    #[test]
+    fn a_pair_is_identifiable_when_its_truth_fits_and_beats_each_member_alone() {
+        let with = |fits: bool, truth_aicc: f64, member_aicc: f64, chosen: &str| Outcome {
+            truth_fit: Some(TruthFit {
+                chi2: 0.0,
+                dof: 84.0,
+                parameters: 4,
+                p_value: if fits { 0.5 } else { 1e-30 },
+                nll: 0.0,
+                aicc: truth_aicc,
+                fits,
+                by_group: Vec::new(),
+            }),
+            best_member_aicc: Some(member_aicc),
+            ..outcome(
+                "friction_drift+cross_axis",
+                true,
+                Verdict::Explained,
+                Some(chosen),
+            )
+        };
+        let s = score(vec![
+            with(true, 500.0, 640.0, "friction_drift+cross_axis"),
+            with(true, 500.0, 640.0, "cross_axis"),
+            with(false, 500.0, 640.0, "cross_axis"),
+            with(true, 650.0, 640.0, "cross_axis"),
+        ]);
+        assert_eq!(s.detectable_pairs, 4);
+        assert_eq!(s.pairs_truth_fits, 3);
+        assert_eq!(s.identifiable_pairs, 2);
+        assert_eq!(s.identifiable_pairs_both_named, 0.5);
     }
 
     /// A single effect one test alone carries counts apart: in the top-1 over every detectable

@@ -29,6 +29,10 @@ pub struct TruthFit {
     pub p_value: f64,
     /// Negative log-likelihood (the diagnosis' scale, calibration scales integrated out).
     pub nll: f64,
+    /// Corrected Akaike information criterion of the full-data fit (the diagnosis' formula,
+    /// with the truth's parameters counted).
+    #[serde(default)]
+    pub aicc: f64,
     /// The lack-of-fit test passes at the diagnosis' `alpha`.
     pub fits: bool,
     /// Chi-square and weighted count of each held-out group (test) alone: where a truth that
@@ -126,6 +130,8 @@ pub fn truth_fit(
     let t = problem.totals(&spec, &|_| true);
     let dof = (t.w - parameters as f64).round().max(1.0) as usize;
     let p_value = stats::chi2_sf(t.r2, dof);
+    let k = parameters as f64;
+    let aicc = 2.0 * k + 2.0 * t.nll + 2.0 * k * (k + 1.0) / (t.w - k - 1.0).max(1.0);
     let by_group = (0..problem.groups)
         .map(|g| {
             let one = problem.totals(&spec, &|h| h == g);
@@ -138,6 +144,7 @@ pub fn truth_fit(
         parameters,
         p_value,
         nll: t.nll,
+        aicc,
         fits: p_value >= options.alpha,
         by_group,
     }))
