@@ -44,6 +44,15 @@
 //! detectable campaign and over those two or more tests carry; for the singles one test
 //! carries, the share whose leading candidate (`explained` or `partly_explained`) is right.
 //!
+//! **The truth's own fit** ([`truth_fit`](super::truth_fit)). After each diagnosis, the
+//! injected effects are simulated in the emulator at their drawn values (a pair together) and
+//! scored on the campaign as any candidate is: its lack-of-fit p-value and AICc. A truth that
+//! does not fit says the emulator's model of it (its window, settle and uncertainty) cannot
+//! match this campaign, and no search could name it; a pair whose truth a member alone beats
+//! by AICc (as the diagnosis fitted that member) is not identifiable from the campaign. The
+//! pairs left, whose truth fits and beats each member alone, are scored apart
+//! (`identifiable_pairs`): there a miss is the search's.
+//!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
 
