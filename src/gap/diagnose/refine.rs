@@ -689,7 +689,10 @@ fn bisect_beside(
                 (emulator.effects[t].parameter(p.name), t, at, nll)
             })
             .collect();
-        tried.sort_by(|x, y| x.0.total_cmp(&y.0));
+        // By value; of two tables at one value (a variant at the default beside the
+        // default itself), the better fit.
+        tried.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.3.total_cmp(&y.3)));
+        tried.dedup_by(|later, first| later.0 == first.0);
         tried
     };
     let best_of = |tried: &[(f64, usize, f64, f64)]| {
@@ -709,7 +712,7 @@ fn bisect_beside(
             parameter = p.name,
             beside = emulator.effects[other].info.name,
             tried = ?tried.iter().map(|x| (x.0, x.2, x.3)).collect::<Vec<_>>(),
-            "a pair member's secondary value, bisected beside the leading dynamics effect"
+            "a dynamics pair member's secondary value, bisected beside its partner"
         );
         let (best, _, at, _) = tried[i];
         // A bisection's variant is simulated where the best table's pair fit lands, alone
