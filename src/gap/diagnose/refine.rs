@@ -554,12 +554,9 @@ fn pair_variants(
         ?beside_leader,
         "dynamics partners of the leading dynamics effect"
     );
-    // The partner that fits best beside the leader: (pair nll, its best table, magnitude).
-    let mut best_partner: Option<(f64, (usize, f64))> = None;
-    let mut leader_at = None;
     for [leader, (partner, m)] in beside_leader {
         if m != 0.0 && leader.1 != 0.0 {
-            let (t, at, nll) = bisect_beside(
+            bisect_beside(
                 campaign,
                 emulator,
                 options,
@@ -569,26 +566,7 @@ fn pair_variants(
                 (partner, m),
                 leader,
             )?;
-            leader_at = Some(leader);
-            if best_partner.is_none_or(|b| nll < b.0) {
-                best_partner = Some((nll, (t, at)));
-            }
         }
-    }
-    // Then the leader's own secondary value, beside that partner's best: the leader's single
-    // chose it without the partner (a cross-axis phase fitted alone carries what a friction
-    // drift explains beside it).
-    if let (Some(leader), Some((_, partner))) = (leader_at, best_partner) {
-        bisect_beside(
-            campaign,
-            emulator,
-            options,
-            configs_dir,
-            control,
-            cache,
-            leader,
-            partner,
-        )?;
     }
     for (d, w) in contenders {
         // Each member's own table is paired already (round 0 of `exact_pairs`).
@@ -618,9 +596,8 @@ const PAIR_BISECTIONS: usize = 3;
 /// [`PAIR_BISECTIONS`] times, variants midway between the best value and its neighbours are
 /// added, each simulated alone and beside `other` where the best table's pair fit lands (two
 /// simulations per value: the pair's fit moves the member's magnitude along the variant's
-/// table from 0 to there, and the joint point makes it exact there). Returns the best
-/// table, the magnitude its pair fit takes and that fit's negative log-likelihood (`member`
-/// unchanged when its effect has no single secondary parameter).
+/// table from 0 to there, and the joint point makes it exact there). Nothing is done when
+/// the effect has no single secondary parameter.
 #[allow(clippy::too_many_arguments)]
 fn bisect_beside(
     campaign: &Campaign,
@@ -631,25 +608,17 @@ fn bisect_beside(
     cache: &WindowCache,
     (member, m): (usize, f64),
     (other, mo): (usize, f64),
-) -> Result<(usize, f64, f64), GapError> {
+) -> Result<(), GapError> {
     let info = emulator.effects[member].info;
-    let unchanged = |emulator: &Emulator| {
-        let problem = FitProblem::new(campaign, emulator, options);
-        (
-            member,
-            m,
-            problem.fit_pair_tables(member, other, &|_| true).1,
-        )
-    };
     let [_, p] = info.parameters else {
-        return Ok(unchanged(emulator));
+        return Ok(());
     };
     let Some(default_table) = emulator
         .family(member)
         .into_iter()
         .find(|&t| emulator.effects[t].parameters.is_empty())
     else {
-        return Ok(unchanged(emulator));
+        return Ok(());
     };
     let add = |emulator: &mut Emulator, v: f64, grid: &[f64], at: f64| -> Result<(), GapError> {
         let t = emulator.add_variant(
@@ -733,9 +702,5 @@ fn bisect_beside(
             break;
         }
     }
-    let tried = tried(emulator);
-    Ok(best_of(&tried).map_or_else(
-        || unchanged(emulator),
-        |i| (tried[i].1, tried[i].2, tried[i].3),
-    ))
+    Ok(())
 }
