@@ -550,10 +550,6 @@ fn pair_variants(
         }
     }
     // Each partner of the leading dynamics effect: its secondary value bisected beside it.
-    tracing::debug!(
-        ?beside_leader,
-        "dynamics partners of the leading dynamics effect"
-    );
     for [leader, (partner, m)] in beside_leader {
         if m != 0.0 && leader.1 != 0.0 {
             bisect_beside(
@@ -676,13 +672,6 @@ fn bisect_beside(
         let Some(i) = best_of(&tried) else {
             break;
         };
-        tracing::debug!(
-            effect = info.name,
-            parameter = p.name,
-            beside = emulator.effects[other].info.name,
-            tried = ?tried.iter().map(|x| (x.0, x.2, x.3)).collect::<Vec<_>>(),
-            "a dynamics pair member's secondary value, bisected beside its partner"
-        );
         let (best, _, at, _) = tried[i];
         // A bisection's variant is simulated where the best table's pair fit lands, alone
         // and beside `other`: two simulations per value.
