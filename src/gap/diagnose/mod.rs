@@ -357,7 +357,7 @@ impl<'a> FitProblem<'a> {
             .sum::<usize>() as f64;
         let n = full.w;
         let chi2 = full.r2;
-        let residual_p = stats::chi2_sf(chi2, (n - k).round().max(1.0) as usize);
+        let residual_p = stats::lack_of_fit_p(chi2, n, k);
         let families = match model {
             Model::Nominal => Vec::new(),
             Model::Single(f) => vec![f],
@@ -370,7 +370,7 @@ impl<'a> FitProblem<'a> {
             held_nll,
             held_r2,
             held_w,
-            aicc: 2.0 * k + 2.0 * nll_full + 2.0 * k * (k + 1.0) / (n - k - 1.0).max(1.0),
+            aicc: stats::aicc(k, nll_full, n),
             bic: k * n.max(1.0).ln() + 2.0 * nll_full,
             residual_p,
             chi2,
@@ -675,7 +675,7 @@ pub fn diagnose_with(
     let nominal = problem.evaluate(Model::Nominal, alpha);
     let nominal_score = problem.totals(&[], &|_| true);
     let (chi2, dof) = (nominal_score.r2, nominal_score.w);
-    let nominal_p = stats::chi2_sf(chi2, dof.round().max(1.0) as usize);
+    let nominal_p = stats::lack_of_fit_p(chi2, dof, 0.0);
     let location = location::locate(campaign, &problem);
     let any_flag = location.any_flagged();
 

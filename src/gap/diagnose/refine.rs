@@ -104,7 +104,7 @@ fn singles_if_gap(
         return None;
     }
     let nominal = problem.evaluate(Model::Nominal, options.alpha);
-    let nominal_p = stats::chi2_sf(nominal.chi2, nominal.dof.round().max(1.0) as usize);
+    let nominal_p = stats::lack_of_fit_p(nominal.chi2, nominal.dof, 0.0);
     if nominal_p >= options.alpha && !location::locate(campaign, problem).any_flagged() {
         return None;
     }

@@ -13,6 +13,18 @@ pub fn chi2_sf(x: f64, dof: usize) -> f64 {
     ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(x.max(0.0)))
 }
 
+/// Lack-of-fit p-value of a fit with `k` parameters leaving `chi2` over a weighted
+/// observation count `n`: the chi-square tail at `n - k` degrees of freedom (at least 1).
+pub fn lack_of_fit_p(chi2: f64, n: f64, k: f64) -> f64 {
+    chi2_sf(chi2, (n - k).round().max(1.0) as usize)
+}
+
+/// Corrected Akaike information criterion of a fit with `k` parameters, negative
+/// log-likelihood `nll`, over a weighted observation count `n`.
+pub fn aicc(k: f64, nll: f64, n: f64) -> f64 {
+    2.0 * k + 2.0 * nll + 2.0 * k * (k + 1.0) / (n - k - 1.0).max(1.0)
+}
+
 /// Two-sided p-value of a standard normal score.
 pub fn normal_two_sided(z: f64) -> f64 {
     if !z.is_finite() {

@@ -128,10 +128,8 @@ pub fn truth_fit(
     }
     let problem = FitProblem::new(campaign, emulator, options);
     let t = problem.totals(&spec, &|_| true);
-    let dof = (t.w - parameters as f64).round().max(1.0) as usize;
-    let p_value = stats::chi2_sf(t.r2, dof);
     let k = parameters as f64;
-    let aicc = 2.0 * k + 2.0 * t.nll + 2.0 * k * (k + 1.0) / (t.w - k - 1.0).max(1.0);
+    let p_value = stats::lack_of_fit_p(t.r2, t.w, k);
     let by_group = (0..problem.groups)
         .map(|g| {
             let one = problem.totals(&spec, &|h| h == g);
@@ -144,7 +142,7 @@ pub fn truth_fit(
         parameters,
         p_value,
         nll: t.nll,
-        aicc,
+        aicc: stats::aicc(k, t.nll, t.w),
         fits: p_value >= options.alpha,
         by_group,
     }))
