@@ -841,7 +841,8 @@ pub fn run(
             &|_, _| {},
         )?;
         let refinements = refined.simulations - emulator.simulations;
-        // On the campaign's refined copy, after its diagnosis: the truth's own fit.
+        // On the campaign's refined copy, after its diagnosis (not counted in `refinements`):
+        // the truth's own fit.
         let truth = truth_fit(
             &noisy,
             &mut refined,
@@ -851,6 +852,9 @@ pub fn run(
             &cache,
             &s.effects,
         )?;
+        let truth_p = truth
+            .as_ref()
+            .map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
         if let Some(dir) = &o.reports_dir {
             write_report(dir, s, &report)?;
         }
@@ -894,7 +898,7 @@ pub fn run(
                 .filter(|g| g.flagged)
                 .map(|g| format!("{}: {} (z {:+.1})", g.by, g.label, g.z))
                 .collect(),
-            truth_fit: truth.clone(),
+            truth_fit: truth,
             best_member_aicc: (s.effects.len() == 2)
                 .then(|| {
                     report
@@ -907,9 +911,6 @@ pub fn run(
                 .flatten(),
         });
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
-        let truth_p = truth
-            .as_ref()
-            .map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
         progress(format!(
             "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows; the truth's own lack-of-fit p {truth_p})",
             last.as_ref().map(|l| l.0),
@@ -990,11 +991,10 @@ fn truth_fits(o: &Outcome) -> bool {
 
 /// A pair whose truth fits and beats each member alone by AICc.
 fn identifiable(o: &Outcome) -> bool {
-    truth_fits(o)
-        && o.truth_fit
-            .as_ref()
-            .zip(o.best_member_aicc)
-            .is_some_and(|(t, single)| t.aicc < single)
+    o.truth_fit
+        .as_ref()
+        .zip(o.best_member_aicc)
+        .is_some_and(|(t, single)| t.fits && t.aicc < single)
 }
 
 fn named_wrong(o: &Outcome) -> bool {

@@ -51,6 +51,19 @@ fn midpoint(p: &ParameterInfo, a: f64, b: f64) -> f64 {
     }
 }
 
+/// The values midway between `values[i]` and each of its neighbours in the ascending
+/// `values` (on `p`'s profile scale): a bisection's next values toward the best.
+fn midpoints_beside(p: &ParameterInfo, values: &[f64], i: usize) -> Vec<f64> {
+    let mut more = Vec::new();
+    if i > 0 {
+        more.push(midpoint(p, values[i - 1], values[i]));
+    }
+    if i + 1 < values.len() {
+        more.push(midpoint(p, values[i], values[i + 1]));
+    }
+    more
+}
+
 /// The diagnosis after adaptive refinement of the emulator (module documentation): the
 /// verdict rests on the simulator at the fitted magnitudes and secondary values rather than
 /// on interpolation. Nothing is refined when the nominal model shows no gap.
@@ -298,14 +311,7 @@ fn profile_secondary(
             let Some(i) = values.iter().position(|v| *v == best) else {
                 break;
             };
-            let mut more = Vec::new();
-            if i > 0 {
-                more.push(midpoint(p, values[i - 1], best));
-            }
-            if i + 1 < values.len() {
-                more.push(midpoint(p, best, values[i + 1]));
-            }
-            for v in more {
+            for v in midpoints_beside(p, &values, i) {
                 tables.push(add(emulator, v)?);
                 values.push(v);
             }
@@ -672,19 +678,13 @@ fn bisect_beside(
         let Some(i) = best_of(&tried) else {
             break;
         };
-        let (best, _, at, _) = tried[i];
+        let at = tried[i].2;
         // A bisection's variant is simulated where the best table's pair fit lands, alone
         // and beside `other`: two simulations per value.
         let grid = [at];
-        let mut more = Vec::new();
-        if i > 0 {
-            more.push(midpoint(p, tried[i - 1].0, best));
-        }
-        if i + 1 < tried.len() {
-            more.push(midpoint(p, best, tried[i + 1].0));
-        }
+        let values: Vec<f64> = tried.iter().map(|x| x.0).collect();
         let before = emulator.effects.len();
-        for v in more {
+        for v in midpoints_beside(p, &values, i) {
             add(emulator, v, &grid, at)?;
         }
         if emulator.effects.len() == before {
