@@ -108,6 +108,10 @@ pub struct Emulator {
     /// Two dynamics effects simulated together at the magnitudes a pair's fits landed on.
     #[serde(default)]
     pub joints: Vec<JointPoint>,
+    /// Secondary values the campaign's data measure (`measured`): tables that contradict
+    /// them are left out of every family.
+    #[serde(default)]
+    pub measured: Vec<super::measured::MeasuredValue>,
     /// Windows simulated to build it.
     pub simulations: usize,
     /// Options used.
@@ -508,6 +512,7 @@ impl Emulator {
             effects,
             pairs: Vec::new(),
             joints: Vec::new(),
+            measured: Vec::new(),
             simulations: cache.len() - before,
             options: options.clone(),
         })
@@ -738,12 +743,23 @@ impl Emulator {
     }
 
     /// Every table of the effect of table `t` (its library defaults and its variants), in
-    /// table order.
+    /// table order; when a measurement of the effect's secondary values is held and some
+    /// table agrees with it, only the tables that agree (`measured`).
     pub fn family(&self, t: usize) -> Vec<usize> {
         let name = self.effects[t].info.name;
-        (0..self.effects.len())
+        let all: Vec<usize> = (0..self.effects.len())
             .filter(|&i| self.effects[i].info.name == name)
-            .collect()
+            .collect();
+        let agreeing: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|&i| self.agrees_with_measurements(i))
+            .collect();
+        if agreeing.is_empty() {
+            all
+        } else {
+            agreeing
+        }
     }
 
     /// Index of the exact pair table of tables `a` and `b` (either order), if built.

@@ -77,6 +77,25 @@ pub(super) fn best_effect(
                     interval: Some(interval),
                     bounds: [p.min, p.max],
                     fitted: true,
+                    measured_from: None,
+                });
+                continue;
+            }
+            let value = table.parameter(p.name);
+            if let Some(mv) = problem
+                .emulator
+                .measured_value(info.name, p.name)
+                .filter(|mv| mv.agrees(value))
+            {
+                parameters.push(FittedParameter {
+                    effect: info.name.to_string(),
+                    name: p.name.to_string(),
+                    unit: p.unit.to_string(),
+                    value,
+                    interval: Some([mv.value - 1.96 * mv.sd, mv.value + 1.96 * mv.sd]),
+                    bounds: [p.min, p.max],
+                    fitted: false,
+                    measured_from: Some(mv.source.clone()),
                 });
                 continue;
             }
@@ -85,10 +104,11 @@ pub(super) fn best_effect(
                 effect: info.name.to_string(),
                 name: p.name.to_string(),
                 unit: p.unit.to_string(),
-                value: table.parameter(p.name),
+                value,
                 interval: profiled,
                 bounds: [p.min, p.max],
                 fitted: profiled.is_some(),
+                measured_from: None,
             });
         }
     }

@@ -46,6 +46,7 @@ fn emulator(c: f64, joints: &[(f64, f64)]) -> Emulator {
         effects: vec![a, b],
         pairs: Vec::new(),
         joints: Vec::new(),
+        measured: Vec::new(),
         simulations: 0,
         options: EmulatorOptions::default(),
     };

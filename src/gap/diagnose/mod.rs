@@ -40,6 +40,7 @@ mod how_far;
 #[cfg(test)]
 mod interaction_tests;
 pub mod location;
+pub mod measured;
 pub mod noise;
 mod pairs;
 pub mod plots;
@@ -350,10 +351,11 @@ impl<'a> FitProblem<'a> {
         }
         let (spec, nll_full) = self.fit(model, &|_| true);
         let full = self.totals(&spec, &|_| true);
-        // Parameters fitted: each magnitude, and the secondary parameters of a variant.
+        // Parameters fitted: each magnitude, and the secondary parameters of a variant that
+        // the data do not measure.
         let k = spec
             .iter()
-            .map(|(t, _)| 1 + self.emulator.effects[*t].parameters.len())
+            .map(|(t, _)| 1 + self.emulator.fitted_secondaries(*t))
             .sum::<usize>() as f64;
         let n = full.w;
         let chi2 = full.r2;

@@ -79,6 +79,9 @@ pub fn diagnose_refining(
     // `progress` counts the test simulations of every round: a round's are added to those
     // done before it, so the count never goes back (the total grows by what a round adds).
     let mut done_before = 0;
+    if options.refine_rounds > 0 {
+        emulator.take_measurements(campaign, configs_dir, control, cache)?;
+    }
     for _ in 0..options.refine_rounds {
         let requests = refinement_requests(campaign, emulator, options);
         if requests.is_empty() {
@@ -287,7 +290,12 @@ fn profile_secondary(
         Acts::Dynamics => (5, 1),
     };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
-    for p in &info.parameters[1..] {
+    let measured = |p: &&ParameterInfo| emulator.measured_value(info.name, p.name).is_some();
+    let unmeasured: Vec<&ParameterInfo> = info.parameters[1..]
+        .iter()
+        .filter(|p| !measured(p))
+        .collect();
+    for p in unmeasured {
         let mut values = profile_values(p, first);
         let mut tables = Vec::new();
         let add = |emulator: &mut Emulator, v: f64| {

@@ -36,8 +36,12 @@ pub struct FittedParameter {
     pub interval: Option<[f64; 2]>,
     /// Physical bounds.
     pub bounds: [f64; 2],
-    /// True when fitted; false when held at the library default.
+    /// True when fitted; false when held at the library default or measured.
     pub fitted: bool,
+    /// Where a measured value comes from (the campaign's data measure it before any fit; its
+    /// interval is the measurement's 95 %).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_from: Option<String>,
 }
 
 /// The chosen effect and how far it closes the gap.

@@ -1,0 +1,407 @@
+//! Secondary values the data measure before any fit (docs/diagnosis.md, "Measured secondary
+//! values"): a campaign's input accelerometer records (on the driven tube or rail) carry the
+//! drive itself, so a cross-axis drive's phase is read from them, not profiled.
+//!
+//! At each drive tone's frequency, each record's phasor on each axis is taken (a Hann-window
+//! projection); the cross-axis phase is `arg(P_cross / P_drive)` on each other axis that
+//! moves (the phasor at least [`MIN_SNR`] times its noise), with the noise from the record's
+//! residual after the tones are taken out. The phases of every record, tone and cross axis
+//! are combined by a weighted circular mean. When they disagree beyond their noise (and
+//! [`CHANNEL_PHASE_DEG`]), one phase does not describe the drive and nothing is measured.
+//!
+//! Why it is exact for the library's effect: `cross_axis` repeats each tone on the other axes
+//! at `share` times its amplitude and `phase_deg` later, and the tube is driven rigidly, so
+//! the input records see that relative phase. A compliant fixture (`fixture_compliance`)
+//! shifts every axis' tone by the same transmissibility phase and leaves the relative phase.
+
+use super::emulator::Emulator;
+use crate::excitation::{ExcitationSpec, Tone};
+use crate::gap::accel::AccelLocation;
+use crate::gap::window::WindowCache;
+use crate::gap::{Campaign, GapError};
+use crate::physics::control::RunControl;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// Fewest noise standard deviations a cross axis' phasor must reach to carry a phase.
+pub const MIN_SNR: f64 = 10.0;
+
+/// Phase match between a triaxial accelerometer's channels, degrees: the measurement's
+/// systematic floor (data sheets give 1-2° at tens of Hz; the records' own noise is far
+/// smaller at these amplitudes).
+pub const CHANNEL_PHASE_DEG: f64 = 2.0;
+
+/// A secondary parameter the data measure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasuredValue {
+    /// Library effect.
+    pub effect: String,
+    /// Its secondary parameter.
+    pub parameter: String,
+    /// Measured value, in the parameter's unit.
+    pub value: f64,
+    /// Standard deviation from the records' noise, in the parameter's unit.
+    pub sd: f64,
+    /// Tables whose value lies farther than this from `value` contradict the measurement:
+    /// 3 standard deviations with the channel floor ([`CHANNEL_PHASE_DEG`]) added in
+    /// quadrature.
+    pub tolerance: f64,
+    /// Where it comes from.
+    pub source: String,
+}
+
+impl MeasuredValue {
+    /// Whether `v` agrees with the measurement (angles compared modulo 360°).
+    pub fn agrees(&self, v: f64) -> bool {
+        wrap_deg(v - self.value).abs() <= self.tolerance
+    }
+}
+
+/// `d` wrapped into [-180°, 180°).
+pub fn wrap_deg(d: f64) -> f64 {
+    (d + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// One phase reading: degrees and its standard deviation.
+type Reading = (f64, f64);
+
+/// The secondary values `campaign`'s input records measure (empty without input records or
+/// without cross-axis motion). An error only when a test's case cannot be resolved.
+pub fn measure(campaign: &Campaign, configs_dir: &Path) -> Result<Vec<MeasuredValue>, GapError> {
+    let mut readings: Vec<Reading> = Vec::new();
+    let mut records = 0;
+    for (ti, test) in campaign.tests.iter().enumerate() {
+        let inputs: Vec<_> = test
+            .specimens
+            .iter()
+            .flat_map(|s| s.accelerometers.iter())
+            .filter(|r| r.location == AccelLocation::Input && r.samples.len() > 16)
+            .collect();
+        if inputs.is_empty() {
+            continue;
+        }
+        let case = test.case(ti, configs_dir)?;
+        let excitation = crate::models::case::resolve_excitation(&case, configs_dir)
+            .map_err(|e| GapError::field(format!("tests[{ti}].config"), e.to_string()))?;
+        let tones = match excitation {
+            ExcitationSpec::Sine { tones, .. } | ExcitationSpec::SineOnRandom { tones, .. } => {
+                tones
+            }
+            _ => continue,
+        };
+        for r in inputs {
+            let before = readings.len();
+            readings.extend(record_readings(&r.samples, &tones));
+            records += usize::from(readings.len() > before);
+        }
+    }
+    Ok(combine(&readings)
+        .map(|(value, sd)| MeasuredValue {
+            effect: "cross_axis".into(),
+            parameter: "phase_deg".into(),
+            value,
+            sd,
+            tolerance: 3.0 * sd.hypot(CHANNEL_PHASE_DEG),
+            source: format!(
+                "input accelerometer records ({records} records, {} readings: drive tones x moving cross axes)",
+                readings.len()
+            ),
+        })
+        .into_iter()
+        .collect())
+}
+
+/// The cross-axis phase readings of one record `[t, ax, ay, az]` at each drive tone whose
+/// frequency no other axis' tone shares.
+fn record_readings(samples: &[[f64; 4]], tones: &[Tone]) -> Vec<Reading> {
+    let t: Vec<f64> = samples.iter().map(|s| s[0] - samples[0][0]).collect();
+    let span = t.last().copied().unwrap_or(0.0);
+    let mut out = Vec::new();
+    // Each axis' phasor at every tone frequency, and its residual after they are removed.
+    let freqs: Vec<f64> = tones.iter().map(|x| x.frequency_hz).collect();
+    let fits: Vec<Vec<(f64, f64)>> = (0..3)
+        .map(|a| {
+            freqs
+                .iter()
+                .map(|&f| phasor(&t, samples, a + 1, f))
+                .collect()
+        })
+        .collect();
+    let noise: Vec<f64> = (0..3)
+        .map(|a| phasor_sd(&t, samples, a + 1, &freqs, &fits[a]))
+        .collect();
+    for (k, tone) in tones.iter().enumerate() {
+        // A frequency another axis' tone shares: the drive moves two axes there already.
+        let shared = tones
+            .iter()
+            .any(|o| o.axis != tone.axis && (o.frequency_hz - tone.frequency_hz).abs() < 1e-9);
+        // At least two cycles in the record for the projection to separate the tones.
+        if shared || tone.frequency_hz * span < 2.0 {
+            continue;
+        }
+        let d = tone.axis.index();
+        let pd = fits[d][k];
+        let md = pd.0.hypot(pd.1);
+        if md < MIN_SNR * noise[d] {
+            continue;
+        }
+        for c in (0..3).filter(|&c| c != d) {
+            let pc = fits[c][k];
+            let mc = pc.0.hypot(pc.1);
+            if mc < MIN_SNR * noise[c] {
+                continue;
+            }
+            let phase = (pc.1.atan2(pc.0) - pd.1.atan2(pd.0)).to_degrees();
+            let sd = (noise[c] / mc).hypot(noise[d] / md).to_degrees();
+            out.push((wrap_deg(phase), sd));
+        }
+    }
+    out
+}
+
+/// Hann weight of sample time `t` over `[0, span]`.
+fn hann(t: f64, span: f64) -> f64 {
+    if span > 0.0 {
+        0.5 - 0.5 * (2.0 * PI * t / span).cos()
+    } else {
+        1.0
+    }
+}
+
+/// Complex amplitude `(re, im)` of column `col` at `f` Hz: `x(t) ≈ re cos ωt - im sin ωt`
+/// (a Hann-weighted projection, the mean removed), so its argument is the tone's phase.
+fn phasor(t: &[f64], samples: &[[f64; 4]], col: usize, f: f64) -> (f64, f64) {
+    let span = t.last().copied().unwrap_or(0.0);
+    let n = samples.len() as f64;
+    let mean = samples.iter().map(|s| s[col]).sum::<f64>() / n;
+    let w = 2.0 * PI * f;
+    let (mut re, mut im, mut sw) = (0.0, 0.0, 0.0);
+    for (ti, s) in t.iter().zip(samples) {
+        let h = hann(*ti, span);
+        let x = s[col] - mean;
+        re += h * x * (w * ti).cos();
+        im -= h * x * (w * ti).sin();
+        sw += h;
+    }
+    (2.0 * re / sw, 2.0 * im / sw)
+}
+
+/// Standard deviation of one component of [`phasor`] from the residual after every tone is
+/// removed: white noise of variance `s²` gives `s sqrt(2 Σ h²) / Σ h` (each component takes
+/// half the noise power at the tone's frequency).
+fn phasor_sd(
+    t: &[f64],
+    samples: &[[f64; 4]],
+    col: usize,
+    freqs: &[f64],
+    fits: &[(f64, f64)],
+) -> f64 {
+    let span = t.last().copied().unwrap_or(0.0);
+    let n = samples.len() as f64;
+    let mean = samples.iter().map(|s| s[col]).sum::<f64>() / n;
+    let (mut r2, mut sh, mut sh2) = (0.0, 0.0, 0.0);
+    for (ti, s) in t.iter().zip(samples) {
+        let model: f64 = freqs
+            .iter()
+            .zip(fits)
+            .map(|(f, p)| {
+                let w = 2.0 * PI * f * ti;
+                p.0 * w.cos() - p.1 * w.sin()
+            })
+            .sum();
+        let h = hann(*ti, span);
+        let r = s[col] - mean - model;
+        r2 += h * r * r;
+        sh += h;
+        sh2 += h * h;
+    }
+    let s = (r2 / sh).sqrt();
+    s * (2.0 * sh2).sqrt() / sh
+}
+
+/// Weighted circular mean of the readings and its standard deviation; None without readings
+/// or when one reading lies more than 3 of its deviations (with the channel floor) from the
+/// mean: one phase does not describe the drive.
+fn combine(readings: &[Reading]) -> Option<(f64, f64)> {
+    if readings.is_empty() {
+        return None;
+    }
+    let (mut c, mut s, mut w) = (0.0, 0.0, 0.0);
+    for &(p, sd) in readings {
+        let wi = 1.0 / (sd * sd).max(1e-300);
+        c += wi * p.to_radians().cos();
+        s += wi * p.to_radians().sin();
+        w += wi;
+    }
+    let mean = s.atan2(c).to_degrees();
+    let agree = readings
+        .iter()
+        .all(|&(p, sd)| wrap_deg(p - mean).abs() <= 3.0 * sd.hypot(CHANNEL_PHASE_DEG));
+    if !agree {
+        tracing::info!(
+            readings = readings.len(),
+            "input records' cross-axis phases disagree beyond their noise: not measured"
+        );
+        return None;
+    }
+    Some((wrap_deg(mean), w.sqrt().recip()))
+}
+
+impl Emulator {
+    /// The measurement of `effect`'s `parameter`, if the campaign's data gave one.
+    pub fn measured_value(&self, effect: &str, parameter: &str) -> Option<&MeasuredValue> {
+        self.measured
+            .iter()
+            .find(|m| m.effect == effect && m.parameter == parameter)
+    }
+
+    /// Secondary parameters of table `t` off their defaults that no measurement fixes (the
+    /// fit chose them).
+    pub fn fitted_secondaries(&self, t: usize) -> usize {
+        let table = &self.effects[t];
+        table
+            .parameters
+            .keys()
+            .filter(|p| self.measured_value(table.info.name, p).is_none())
+            .count()
+    }
+
+    /// The campaign's measurements taken (`measure`), and for each a variant of its effect at
+    /// the measured value on the default table's grid when no table agrees with it yet. A
+    /// measurement whose effect is not tabulated is dropped.
+    pub fn take_measurements(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        control: &RunControl,
+        cache: &WindowCache,
+    ) -> Result<(), GapError> {
+        let measured = measure(campaign, configs_dir)?;
+        self.measured.clear();
+        for mv in measured {
+            let Some(default) = (0..self.effects.len()).find(|&t| {
+                self.effects[t].info.name == mv.effect && self.effects[t].parameters.is_empty()
+            }) else {
+                continue;
+            };
+            tracing::info!(
+                effect = %mv.effect, parameter = %mv.parameter, value = mv.value, sd = mv.sd,
+                "measured from the campaign's records"
+            );
+            let (value, parameter) = (mv.value, mv.parameter.clone());
+            self.measured.push(mv);
+            if !self
+                .family(default)
+                .iter()
+                .any(|&t| self.agrees_with_measurements(t))
+            {
+                let grid: Vec<f64> = self.effects[default]
+                    .magnitudes
+                    .iter()
+                    .copied()
+                    .filter(|m| *m != 0.0)
+                    .collect();
+                self.add_variant(
+                    campaign,
+                    configs_dir,
+                    default,
+                    BTreeMap::from([(parameter, value)]),
+                    &grid,
+                    control,
+                    cache,
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether table `t`'s secondary values agree with every measurement of its effect.
+    pub fn agrees_with_measurements(&self, t: usize) -> bool {
+        let table = &self.effects[t];
+        self.measured
+            .iter()
+            .filter(|m| m.effect == table.info.name)
+            .all(|m| m.agrees(table.parameter(&m.parameter)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::excitation::Axis;
+
+    /// A record of a 20 Hz drive on y with a cross-axis share on x and z at `phase` degrees
+    /// later, white noise of `noise` m/s² on every axis (a fixed-seed generator).
+    fn record(phase: f64, share: f64, noise: f64, seed: u64) -> Vec<[f64; 4]> {
+        let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+        let mut gauss = move || {
+            let mut u = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+            };
+            let (a, b) = (u(), u());
+            (-2.0 * a.ln()).sqrt() * (2.0 * PI * b).cos()
+        };
+        let (a, w, th) = (147.0, 2.0 * PI * 20.0, 0.3);
+        (0..1000)
+            .map(|i| {
+                let t = i as f64 / 2000.0;
+                let cross = share * a * (w * t + th + phase.to_radians()).sin();
+                [
+                    t,
+                    cross + noise * gauss(),
+                    a * (w * t + th).sin() + noise * gauss(),
+                    cross + noise * gauss(),
+                ]
+            })
+            .collect()
+    }
+
+    fn tones() -> Vec<Tone> {
+        vec![Tone {
+            axis: Axis::Y,
+            frequency_hz: 20.0,
+            amplitude_g: 15.0,
+            phase_deg: 17.0,
+        }]
+    }
+
+    #[test]
+    fn a_cross_axis_phase_is_read_back_within_its_stated_deviation() {
+        // 200 records at a noise that makes the deviation about a degree: the phase is
+        // unbiased, and the stated deviation is the scatter's (a z-score's mean square near
+        // 1, within what 200 draws allow: chi-square 200 dof, 99.9 % band 145-266).
+        let (phase, share, noise) = (158.0, 0.021, 1.0);
+        let mut z2 = 0.0;
+        let mut n = 0;
+        for seed in 0..100 {
+            for (p, sd) in record_readings(&record(phase, share, noise, seed), &tones()) {
+                z2 += (wrap_deg(p - phase) / sd).powi(2);
+                n += 1;
+            }
+        }
+        assert_eq!(n, 200, "both cross axes read on every record");
+        assert!((145.0..266.0).contains(&z2), "sum of z² {z2} on {n}");
+    }
+
+    #[test]
+    fn the_combined_phase_agrees_across_the_wrap_and_noise_free_records_are_exact() {
+        for phase in [-179.0, -90.0, 0.0, 56.0, 179.5] {
+            let readings = record_readings(&record(phase, 0.09, 1e-3, 1), &tones());
+            let (v, sd) = combine(&readings).expect("readings agree");
+            assert!(wrap_deg(v - phase).abs() < 1e-3, "{v} for {phase}");
+            assert!(sd < 1e-3);
+        }
+    }
+
+    #[test]
+    fn no_cross_motion_measures_nothing_and_disagreeing_phases_measure_nothing() {
+        assert!(record_readings(&record(40.0, 0.0, 0.05, 2), &tones()).is_empty());
+        assert_eq!(combine(&[(10.0, 0.1), (40.0, 0.1)]), None);
+        assert!(combine(&[(179.0, 0.1), (-179.0, 0.1)]).is_some());
+    }
+}
