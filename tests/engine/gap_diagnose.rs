@@ -13,6 +13,7 @@ use railwear::gap::campaign::{Campaign, Increment, Specimen};
 use railwear::gap::diagnose::emulator::{
     Bands, EffectTable, Emulator, EmulatorOptions, Prediction, TestPredictions,
 };
+use railwear::gap::diagnose::measured::MeasuredValue;
 use railwear::gap::diagnose::{diagnose_with, DiagnoseOptions, Verdict};
 use railwear::gap::effects;
 use rand::{Rng, SeedableRng};
@@ -110,6 +111,7 @@ fn emulator() -> Emulator {
         ],
         pairs: Vec::new(),
         joints: Vec::new(),
+        measured: Vec::new(),
         simulations: 0,
         options: EmulatorOptions::default(),
     }
@@ -511,6 +513,53 @@ fn a_secondary_parameter_is_fitted_with_its_interval() {
     assert!(lo <= 120.0 && 120.0 <= hi && hi - lo < 360.0, "{phase:?}");
     // The ranking counts the phase as a fitted parameter.
     assert_eq!(r.ranking[0].parameters, 2);
+}
+
+/// A phase the input records measure is not fitted: with a measurement of 120° held, the
+/// family keeps only the variant that agrees with it (the default at 0° and the variants at
+/// ±60° and 180° contradict it), the effect explains at 120°, and the report gives the phase
+/// as measured (not fitted, the measurement's interval, its source), counting one fitted
+/// parameter (the share) where the profiled phase counted two.
+#[test]
+fn a_measured_phase_is_held_not_fitted() {
+    let c = campaign(|t, k| truth_phase(t, k, 0.3, 120.0), 5);
+    let mut em = emulator();
+    for phase in [-180.0, -60.0, 60.0, 120.0, 180.0] {
+        em.effects.push(cross_variant(phase));
+    }
+    em.measured.push(MeasuredValue {
+        effect: "cross_axis".into(),
+        parameter: "phase_deg".into(),
+        value: 120.4,
+        sd: 0.5,
+        tolerance: 3.0 * 0.5f64.hypot(2.0),
+        source: "input accelerometer records".into(),
+    });
+    let cross: Vec<usize> = (0..em.effects.len())
+        .filter(|&t| em.effects[t].info.name == "cross_axis")
+        .collect();
+    assert_eq!(
+        em.family(cross[0]),
+        vec![cross[4]],
+        "only the 120° variant agrees"
+    );
+    let r = diagnose_with(&c, &em, &options()).unwrap();
+    assert_eq!(r.verdict, Verdict::Explained, "{}", r.summary);
+    let best = r.best_effect.as_ref().unwrap();
+    let phase = best
+        .parameters
+        .iter()
+        .find(|p| p.name == "phase_deg")
+        .unwrap();
+    assert!(!phase.fitted, "{phase:?}");
+    assert_eq!(phase.value, 120.0);
+    assert_eq!(
+        phase.measured_from.as_deref(),
+        Some("input accelerometer records")
+    );
+    let [lo, hi] = phase.interval.unwrap();
+    assert!((lo - (120.4 - 1.96 * 0.5)).abs() < 1e-12 && (hi - (120.4 + 1.96 * 0.5)).abs() < 1e-12);
+    assert_eq!(r.ranking[0].parameters, 1);
 }
 
 /// Issue 26 item 3: an effect that fits only at its physical bound is not `explained`
