@@ -139,20 +139,28 @@ pub(super) fn best_effect(
 
 /// 95 % profile-likelihood interval of member `i`'s magnitude around the full-data optimum
 /// `spec` (the other member, for a pair, held at its fitted magnitude: a conditional interval).
+/// The member's secondary values are profiled out: each magnitude takes the best of its
+/// family's tables (the variants the diagnosis simulated), so a slip scale and a magnitude
+/// that trade off along a ridge widen the interval rather than pin it to the chosen variant.
 fn profile_interval(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> [f64; 2] {
     let (t, best) = spec[i];
-    let nll = |m: f64| {
+    let tables = &problem.families[problem.family_of(t)];
+    let nll = |table: usize, m: f64| {
         let mut s = spec.to_vec();
-        s[i].1 = m;
+        s[i] = (table, m);
         problem.nll_of(&s, |_| true)
     };
-    let floor = nll(best);
-    let cands = problem.candidates(t);
-    let inside: Vec<f64> = cands
-        .iter()
-        .copied()
-        .filter(|m| nll(*m) <= floor + PROFILE_95)
-        .collect();
+    let floor = nll(t, best);
+    let mut cands: Vec<f64> = Vec::new();
+    let mut inside: Vec<f64> = Vec::new();
+    for &table in tables {
+        for m in problem.candidates(table) {
+            cands.push(m);
+            if nll(table, m) <= floor + PROFILE_95 {
+                inside.push(m);
+            }
+        }
+    }
     let lo = inside.iter().copied().fold(best, f64::min);
     let hi = inside.iter().copied().fold(best, f64::max);
     widen_to_grid(&cands, [lo, hi])
