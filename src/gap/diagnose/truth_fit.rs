@@ -23,7 +23,8 @@ pub struct TruthFit {
     pub chi2: f64,
     /// Weighted observation count.
     pub dof: f64,
-    /// Parameters the truth has (each effect's magnitude and secondary parameters).
+    /// Parameters the truth has (each effect's magnitude and secondary parameters, less those
+    /// the campaign's data measure).
     pub parameters: usize,
     /// Lack-of-fit p-value.
     pub p_value: f64,
@@ -103,7 +104,12 @@ pub fn truth_fit(
             cache,
             &|_, _| {},
         )?;
-        parameters += info.parameters.len();
+        // A secondary value the campaign's data measure is not the truth's to fit.
+        let measured = info.parameters[1..]
+            .iter()
+            .filter(|p| emulator.measured_value(info.name, p.name).is_some())
+            .count();
+        parameters += info.parameters.len() - measured;
         spec.push((table, m));
     }
     if let [(a, ma), (b, mb)] = spec[..] {
