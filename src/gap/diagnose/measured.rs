@@ -137,8 +137,10 @@ fn record_readings(samples: &[[f64; 4]], tones: &[Tone]) -> Vec<Reading> {
         let shared = tones
             .iter()
             .any(|o| o.axis != tone.axis && (o.frequency_hz - tone.frequency_hz).abs() < 1e-9);
-        // At least two cycles in the record for the projection to separate the tones.
-        if shared || tone.frequency_hz * span < 2.0 {
+        // At least two cycles in the record for the projection to separate the tones, and
+        // below the record's Nyquist frequency.
+        let dt = span / (t.len() - 1).max(1) as f64;
+        if shared || tone.frequency_hz * span < 2.0 || 2.0 * tone.frequency_hz * dt >= 1.0 {
             continue;
         }
         let d = tone.axis.index();
