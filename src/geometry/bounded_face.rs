@@ -81,10 +81,33 @@ impl PlacedFace {
     /// outward normal of the solid at the nearest boundary point (the distance's gradient).
     #[inline]
     pub fn signed_distance(&self, x: &Point3<f64>) -> (f64, Vector3<f64>) {
+        let (dist, dir, outside) = self.nearest(x);
+        (dist, if outside { dir / dist } else { dir })
+    }
+
+    /// [`PlacedFace::signed_distance`] of `x` when it is below `reach` (the same distance and
+    /// normal, bit for bit), `None` otherwise: a ball of radius `reach` centred at `x` that
+    /// does not penetrate the solid, whose normal (a division per component outside the
+    /// solid) is then not taken. For the contact nodes beyond a bounded face's side.
+    #[inline]
+    pub fn signed_distance_within(
+        &self,
+        x: &Point3<f64>,
+        reach: f64,
+    ) -> Option<(f64, Vector3<f64>)> {
+        let (dist, dir, outside) = self.nearest(x);
+        (reach - dist > 0.0).then(|| (dist, if outside { dir / dist } else { dir }))
+    }
+
+    /// The signed distance of `x`, and either the unit normal (`false`) or, outside the solid
+    /// beyond an edge (`true`), the vector from the nearest point to `x`, whose length is the
+    /// distance.
+    #[inline]
+    fn nearest(&self, x: &Point3<f64>) -> (f64, Vector3<f64>, bool) {
         let n = self.plane.normal.into_inner();
         let u = n.dot(&x.coords) - self.plane.offset;
         if !self.bounded {
-            return (u, n);
+            return (u, n, false);
         }
         let d = x - self.origin;
         let s = self.tangent.dot(&d);
@@ -94,20 +117,19 @@ impl PlacedFace {
         let (qt, dt) = side(t, self.t_range, &self.bitangent);
         if qs <= 0.0 && qt <= 0.0 && u >= qs.max(qt) {
             // Over the face (above or below it), nearer the face than any of its edges.
-            return (u, n);
+            return (u, n, false);
         }
         if u > 0.0 || qs > 0.0 || qt > 0.0 {
             let v = n * u.max(0.0) + ds * qs.max(0.0) + dt * qt.max(0.0);
-            let dist = v.norm();
-            return (dist, v / dist);
+            return (v.norm(), v, true);
         }
         // Inside: the nearest face of the prism.
         if u >= qs && u >= qt {
-            (u, n)
+            (u, n, false)
         } else if qs >= qt {
-            (qs, ds)
+            (qs, ds, false)
         } else {
-            (qt, dt)
+            (qt, dt, false)
         }
     }
 

@@ -215,7 +215,33 @@ impl FacePatch {
         radius: f64,
         face: &PlacedFace,
     ) -> Option<Self> {
-        let mut patch = Self::square(centre, axis_u, axis_v, radius, face)?;
+        Self::pressed(Self::square(centre, axis_u, axis_v, radius, face)?, face)
+    }
+
+    /// [`FacePatch::new`] and [`FacePatch::beyond_sides`] of the same inner face at once,
+    /// each part handed to `each(part, beyond_side)` as it is cut: first the pressed polygon
+    /// (`beyond_side` false), then the strips in the sides' order (true). The whole face's
+    /// pressed square, which all start from, is clipped by the plane once instead of once for
+    /// each and again for each side, and no array of patches is moved.
+    pub fn for_each_part(
+        centre: Point3<f64>,
+        axis_u: Vector3<f64>,
+        axis_v: Vector3<f64>,
+        radius: f64,
+        face: &PlacedFace,
+        mut each: impl FnMut(&Self, bool),
+    ) {
+        let Some(square) = Self::square(centre, axis_u, axis_v, radius, face) else {
+            return;
+        };
+        if let Some(patch) = Self::pressed(square, face) {
+            each(&patch, false);
+        }
+        Self::beyond_sides_of(&square, radius, face, |_, part| each(part, true));
+    }
+
+    /// The part of `square` (the pressed square of [`FacePatch::square`]) over `face`'s extent.
+    fn pressed(mut patch: Self, face: &PlacedFace) -> Option<Self> {
         for side in face.sides() {
             let line = patch.side_line(&side);
             if !patch.clip(&line) {
@@ -239,6 +265,20 @@ impl FacePatch {
         face: &PlacedFace,
     ) -> [Option<Self>; MAX_SIDES] {
         let mut out = [None; MAX_SIDES];
+        if let Some(square) = Self::square(centre, axis_u, axis_v, radius, face) {
+            Self::beyond_sides_of(&square, radius, face, |k, strip| out[k] = Some(*strip));
+        }
+        out
+    }
+
+    /// [`FacePatch::beyond_sides`] from the inner face's pressed square (each side's strip
+    /// starts from a copy of it), each strip to `each` with its side's index as it is cut.
+    fn beyond_sides_of(
+        square: &Self,
+        radius: f64,
+        face: &PlacedFace,
+        mut each: impl FnMut(usize, &Self),
+    ) {
         let sides: [_; MAX_SIDES] = {
             let mut all = [None; MAX_SIDES];
             for (slot, side) in all.iter_mut().zip(face.sides()) {
@@ -248,9 +288,7 @@ impl FacePatch {
         };
         for (k, side) in sides.iter().enumerate() {
             let Some(side) = side else { continue };
-            let Some(mut patch) = Self::square(centre, axis_u, axis_v, radius, face) else {
-                return out;
-            };
+            let mut patch = *square;
             let g = patch.side_line(side);
             let beyond = Line {
                 alpha: -g.alpha,
@@ -294,10 +332,9 @@ impl FacePatch {
                 // one vertex interval (a face's axis only nearly across the edge cut thin
                 // end slices off it, each with the whole rule), and the integrand's kink at
                 // `w = 0` lies in few slices.
-                out[k] = Some(patch.aligned_with(&g));
+                each(k, &patch.aligned_with(&g));
             }
         }
-        out
     }
 
     /// The penetration `w(ξ)` of the patch's balls into the face's plane (affine).
@@ -346,22 +383,32 @@ impl FacePatch {
     /// The parts of the patch where `line >= 0` and where `line <= 0` (each `None` when of
     /// zero area): together they cover the patch once.
     pub fn split(&self, line: &Line) -> (Option<Self>, Option<Self>) {
-        let verts = &self.verts[..self.len];
-        if verts.iter().all(|&p| line.at(p) >= 0.0) {
+        // `line` at each vertex once for both parts: the opposite line `−line` is `−g` at
+        // each vertex (negating every operand negates each rounded result), up to the sign of
+        // a zero, which no comparison of the clip and no crossing (taken only between values
+        // of strictly opposite signs) sees.
+        let len = self.len;
+        let mut at = [0.0; MAX_VERTICES];
+        let (mut above, mut below) = (true, true);
+        for (g, &p) in at.iter_mut().zip(&self.verts[..len]) {
+            *g = line.at(p);
+            above &= *g >= 0.0;
+            below &= *g <= 0.0;
+        }
+        if above {
             return (Some(*self), None);
         }
-        if verts.iter().all(|&p| line.at(p) <= 0.0) {
+        if below {
             return (None, Some(*self));
         }
-        let mut above = *self;
-        let mut below = *self;
-        let opposite = Line {
-            alpha: -line.alpha,
-            beta: [-line.beta[0], -line.beta[1]],
-        };
+        let mut opposite = [0.0; MAX_VERTICES];
+        for (o, g) in opposite.iter_mut().zip(&at[..len]) {
+            *o = -g;
+        }
+        let (mut above, mut below) = (*self, *self);
         (
-            above.clip(line).then_some(above),
-            below.clip(&opposite).then_some(below),
+            above.clip_at(&at).then_some(above),
+            below.clip_at(&opposite).then_some(below),
         )
     }
 
@@ -376,9 +423,13 @@ impl FacePatch {
             *g = line.at(p);
             kept &= *g >= 0.0;
         }
-        if kept {
-            return true;
-        }
+        kept || self.clip_at(&at)
+    }
+
+    /// The clip of [`FacePatch::clip`] given the line's value `at[i]` at each vertex, some of
+    /// them negative.
+    fn clip_at(&mut self, at: &[f64; MAX_VERTICES]) -> bool {
+        let len = self.len;
         let mut out = [[0.0; 2]; MAX_VERTICES];
         let mut m = 0;
         for i in 0..len {
@@ -404,7 +455,8 @@ impl FacePatch {
                 }
             }
         }
-        self.verts = out;
+        // Only the kept vertices: the rest of the array is never read (`len` bounds it).
+        self.verts[..m].copy_from_slice(&out[..m]);
         self.len = m;
         m >= 3 && self.area_xi() > 0.0
     }
@@ -442,6 +494,13 @@ impl FacePatch {
         self.centre + self.axis_u * p[0] + self.axis_v * p[1]
     }
 
+    /// `centre + u axis_u`, the part of [`FacePatch::point`] shared by a column's nodes (the
+    /// same sum in the same order: `point([u, v])` is `column_base(u) + v axis_v`, bit for bit).
+    #[inline]
+    fn column_base(&self, u: f64) -> Point3<f64> {
+        self.centre + self.axis_u * u
+    }
+
     /// The deepest vertex of the patch: its penetration (m) and ball centre (world).
     pub fn deepest(&self) -> (f64, Point3<f64>) {
         let mut best = (f64::NEG_INFINITY, [0.0; 2]);
@@ -472,9 +531,10 @@ impl FacePatch {
         let (xs_v, ws_v) = rule(order.across);
         self.for_each_column(order.along, parts, |u, half_u, wu, lo, hi| {
             let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+            let base = self.column_base(u);
             for (xv, wv) in xs_v.iter().zip(ws_v) {
                 let v = vm + half_v * xv;
-                visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+                visit(base + self.axis_v * v, 0.25 * half_u * wu * half_v * wv);
             }
         });
     }
@@ -507,16 +567,17 @@ impl FacePatch {
             } else {
                 (hi, hi, 0.5 * (lo + hi))
             };
+            let base = self.column_base(u);
             if phi > plo {
                 let (vm, half_v) = (0.5 * (plo + phi), 0.5 * (phi - plo));
                 for (xv, wv) in xs_v.iter().zip(ws_v) {
                     let v = vm + half_v * xv;
-                    visit(self.point([u, v]), 0.25 * half_u * wu * half_v * wv);
+                    visit(base + self.axis_v * v, 0.25 * half_u * wu * half_v * wv);
                 }
             }
             let rest = (hi - lo) - (phi - plo);
             if rest > 0.0 {
-                visit(self.point([u, rest_mid]), 0.25 * half_u * wu * rest);
+                visit(base + self.axis_v * rest_mid, 0.25 * half_u * wu * rest);
             }
         });
     }

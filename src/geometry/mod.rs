@@ -22,6 +22,8 @@
 pub mod bounded_face;
 mod disk_polygon;
 pub mod face_patch;
+#[cfg(test)]
+mod face_patch_tests;
 pub mod halfspace_overlap;
 pub mod lattice;
 pub mod polygon_moments;

@@ -231,7 +231,12 @@ impl Contact {
         for (centre, axis_u, axis_v) in inner_box_faces(inner, pose) {
             // The share of the facing rules on this face ([`FACING`]).
             let fine = facing_share(axis_u.cross(&axis_v).normalize().dot(&normal).abs());
-            if let Some(patch) = FacePatch::new(centre, axis_u, axis_v, radius, face) {
+            let mut each = |part: &FacePatch, beyond_side: bool| {
+                if beyond_side {
+                    self.integrate_strip(part, fine, fa, fb, radius, face, out);
+                    return;
+                }
+                let patch = part;
                 let d = patch.deepest();
                 if deepest.is_none_or(|best| d.0 > best.0) {
                     deepest = Some(d);
@@ -256,33 +261,10 @@ impl Contact {
                         _ => integrate(rule, 1.0, out),
                     }
                 };
-                self.damping_parts(&patch, fa, fb, radius, &normal, &mut each_part);
-            }
-            if !face.is_bounded() {
-                continue;
-            }
-            for strip in FacePatch::beyond_sides(centre, axis_u, axis_v, radius, face)
-                .iter()
-                .flatten()
-            {
-                let mut visit = |x: Point3<f64>, share: f64| {
-                    let (distance, normal) = face.signed_distance(&x);
-                    self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
-                };
-                if fine > 0.0 {
-                    // `fine` is exactly 1 on a facing face: its nodes' shares unchanged.
-                    let order = QuadratureOrder::ROUNDED_EDGE;
-                    strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
-                        visit(x, fine * share)
-                    });
-                }
-                if fine < 1.0 {
-                    let order = QuadratureOrder::SIDE_EDGE;
-                    strip.for_each_node_sliced(order, 1, &mut |x, share| {
-                        visit(x, (1.0 - fine) * share)
-                    });
-                }
-            }
+                self.damping_parts(patch, fa, fb, radius, &normal, &mut each_part);
+            };
+            // The strips beyond a side come only from a bounded face.
+            FacePatch::for_each_part(centre, axis_u, axis_v, radius, face, &mut each);
         }
         // The track's penetration is the patch's deepest vertex (the exact maximum of the
         // linear `w`), not the deepest node.
@@ -298,6 +280,39 @@ impl Contact {
 }
 
 impl Contact {
+    /// Integrates `strip`, beyond a side of the bounded `face`, at its nodes: the facing
+    /// rule's nodes with the share `fine` ([`FACING`]) and the side rule's with `1 − fine`.
+    #[allow(clippy::too_many_arguments)]
+    fn integrate_strip(
+        &self,
+        strip: &FacePatch,
+        fine: f64,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        radius: f64,
+        face: &PlacedFace,
+        out: &mut PointOutputs<'_, '_>,
+    ) {
+        let mut visit = |x: Point3<f64>, share: f64| {
+            // A ball that does not reach the solid adds nothing (`evaluate_point` returns at
+            // `w <= 0` before using anything): its normal is not taken.
+            if let Some((distance, normal)) = face.signed_distance_within(&x, radius) {
+                self.evaluate_point(fa, fb, &x, radius, share, distance, &normal, out);
+            }
+        };
+        if fine > 0.0 {
+            // `fine` is exactly 1 on a facing face: its nodes' shares unchanged.
+            let order = QuadratureOrder::ROUNDED_EDGE;
+            strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
+                visit(x, fine * share)
+            });
+        }
+        if fine < 1.0 {
+            let order = QuadratureOrder::SIDE_EDGE;
+            strip.for_each_node_sliced(order, 1, &mut |x, share| visit(x, (1.0 - fine) * share));
+        }
+    }
+
     /// Integrates `part` of a pressed polygon of `face` with `rule` at the nodes, each node's
     /// share times `scale` (1 but where two rules are blended, [`FACING`]).
     #[allow(clippy::too_many_arguments)]

@@ -412,6 +412,7 @@ impl Contact {
                     points: points.as_deref_mut(),
                     energy: &mut energy,
                     sum: TrackSum::default(),
+                    tangent: PointOutputs::NO_TANGENT,
                 };
                 match (self.face_contact, shape) {
                     (

@@ -25,6 +25,29 @@ pub(super) struct PointOutputs<'s, 'p> {
     pub(super) energy: &'s mut f64,
     /// The track's sums.
     pub(super) sum: TrackSum,
+    /// The tangent projector `I − n nᵀ` of the last normal `n` the friction's derivatives
+    /// used ([`PointOutputs::tangent`]).
+    pub(super) tangent: (Vector3<f64>, Matrix3<f64>),
+}
+
+impl PointOutputs<'_, '_> {
+    /// The value of [`PointOutputs::tangent`] before any point: no normal equals it.
+    pub(super) const NO_TANGENT: (Vector3<f64>, Matrix3<f64>) = (
+        Vector3::new(f64::NAN, f64::NAN, f64::NAN),
+        Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    );
+
+    /// `I − n nᵀ` for the normal `n`, computed again only when `n` differs from the last
+    /// one's (the points of a face's polygon share the plane's normal). Equal normals give the
+    /// same matrix bit for bit: an entry `δ_ij − n_i n_j` does not depend on the sign of a
+    /// zero product.
+    #[inline]
+    fn tangent(&mut self, normal: &Vector3<f64>) -> Matrix3<f64> {
+        if self.tangent.0 != *normal {
+            self.tangent = (*normal, Matrix3::identity() - normal * normal.transpose());
+        }
+        self.tangent.1
+    }
 }
 
 impl super::Contact {
@@ -87,8 +110,12 @@ impl super::Contact {
             let (dfn_dw, dfn_dwdot) =
                 self.impact
                     .unclamped_gradient_with_slope(w, wdot, damping, damping_slope);
+            let tangent = match self.friction {
+                Some(_) => out.tangent(&normal),
+                None => Matrix3::zeros(),
+            };
             let (dforce_dfn, dforce_dslip) =
-                friction_derivatives(self.friction.as_ref(), &normal, &slip, fn_mag, mu);
+                friction_derivatives(self.friction.as_ref(), &normal, &tangent, &slip, fn_mag, mu);
             let lin = TrackLinearization {
                 body_a: self.body_a,
                 body_b: self.body_b,
@@ -208,10 +235,11 @@ impl TrackSum {
 /// `(∂F/∂f_n, ∂F/∂s)` of the contact force `F = n f_n − μ(|s|) f_n ŝ` at normal force `fn_mag`
 /// and slip `slip` (tangential; `mu` = (μ(|s|), μ'(|s|)) when already known): `∂F/∂f_n = n − μ ŝ` and
 /// `∂F/∂s = −f_n (μ' ŝŝᵀ + μ/|s| (P − ŝŝᵀ))` with `P = I − nnᵀ`; at zero slip the limit
-/// `μ/|s| → μ'(0)` is used.
+/// `μ/|s| → μ'(0)` is used. `tangent` is `P = I − nnᵀ` (read only with friction).
 pub(super) fn friction_derivatives(
     friction: Option<&FrictionParams>,
     normal: &Vector3<f64>,
+    tangent: &Matrix3<f64>,
     slip: &Vector3<f64>,
     fn_mag: f64,
     mu: Option<(f64, f64)>,
@@ -219,7 +247,6 @@ pub(super) fn friction_derivatives(
     let Some(fr) = friction else {
         return (*normal, Matrix3::zeros());
     };
-    let tangent = Matrix3::identity() - normal * normal.transpose();
     let speed = slip.norm();
     if speed > 0.0 {
         let dir = slip / speed;
