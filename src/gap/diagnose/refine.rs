@@ -290,12 +290,7 @@ fn profile_secondary(
         Acts::Dynamics => (5, 1),
     };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
-    let measured = |p: &&ParameterInfo| emulator.measured_value(info.name, p.name).is_some();
-    let unmeasured: Vec<&ParameterInfo> = info.parameters[1..]
-        .iter()
-        .filter(|p| !measured(p))
-        .collect();
-    for p in unmeasured {
+    for p in emulator.unmeasured_secondaries(info) {
         let mut values = profile_values(p, first);
         let mut tables = Vec::new();
         let add = |emulator: &mut Emulator, v: f64| {
