@@ -2,7 +2,8 @@
 //! physics says (third-body abrasion only adds wear; cross-axis drive puts response on the
 //! other axes), an effect at magnitude 0 is the nominal bit for bit, refinement simulates the
 //! magnitude it asks for, a rig-only effect is not explained, an exact pair table is the
-//! simulator, and the CLI writes the report and its plots. The method on a hand-built model is
+//! simulator, the input records measure a cross-axis phase, and the CLI writes the report and
+//! its plots. The method on a hand-built model is
 //! in `gap_diagnose.rs`.
 
 use railwear::gap::campaign::Campaign;
@@ -319,4 +320,58 @@ fn an_exact_pair_is_the_simulator() {
     }
     // The composition of ratios is another number (abrasion acts on the drive's own tracks).
     assert!(product_off > 1e-6, "{product_off}");
+}
+
+/// The rig's input records carry a cross-axis drive's phase: it is read back within the
+/// measurement's tolerance, alone and through a compliant fixture (which shifts every axis'
+/// tone by the same transmissibility phase and leaves the relative phase), and a drive without
+/// cross-axis motion measures nothing. The 5 % calibration spread of each channel scales
+/// amplitudes only.
+#[test]
+fn the_input_records_measure_a_cross_axis_phase() {
+    use railwear::gap::diagnose::measured::{measure, wrap_deg};
+    use railwear::gap::rig::{parse_effects, run, RigOptions};
+    let rig = |effects: &[&str]| {
+        let args: Vec<String> = effects.iter().map(|s| s.to_string()).collect();
+        let (effects, hidden) = parse_effects(&args).unwrap();
+        let options = RigOptions {
+            effects,
+            hidden,
+            noise_rel: 0.02,
+            seed: 5,
+            window_s: 0.25,
+            settle_s: 0.05,
+            accelerometer_rate_hz: Some(2000.0),
+            sensor_noise_m_s2: 0.5,
+            calibration_rel: 0.05,
+            ..RigOptions::default()
+        };
+        let (campaign, _) = run(
+            &small_campaign(),
+            &configs(),
+            &options,
+            &RunControl::silent(),
+        )
+        .unwrap();
+        measure(&campaign, &configs()).unwrap()
+    };
+    for effects in [
+        vec!["cross_axis=0.05,phase_deg=-123"],
+        vec![
+            "cross_axis=0.05,phase_deg=-123",
+            "fixture_compliance=5,damping_ratio=0.1",
+        ],
+    ] {
+        let m = rig(&effects);
+        assert_eq!(m.len(), 1, "{effects:?}: {m:?}");
+        assert_eq!(
+            (m[0].effect.as_str(), m[0].parameter.as_str()),
+            ("cross_axis", "phase_deg")
+        );
+        assert!(
+            wrap_deg(m[0].value + 123.0).abs() <= m[0].tolerance,
+            "{effects:?}: {m:?}"
+        );
+    }
+    assert!(rig(&["none"]).is_empty());
 }
