@@ -59,7 +59,7 @@
 use super::emulator::{effect_with, Emulator, EmulatorOptions};
 use super::noise::{gaussian, observations, NoiseModel, Observation, Term};
 use super::truth_fit::{truth_fit, TruthFit};
-use super::{diagnose_refining, stats, DiagnoseOptions, Report, Verdict};
+use super::{diagnose_refining, stats, DiagnoseOptions, Report, Simulating, Verdict};
 use crate::gap::effects::{Acts, Effect, EffectInfo, LIBRARY};
 use crate::gap::rig::{run_cached, RigOptions, Truth};
 use crate::gap::rig_effects::{HiddenEffect, RIG_ONLY};
@@ -843,15 +843,14 @@ pub fn run(
         let refinements = refined.simulations - emulator.simulations;
         // On the campaign's refined copy, after its diagnosis (not counted in `refinements`):
         // the truth's own fit.
-        let truth = truth_fit(
-            &noisy,
-            &mut refined,
-            &o.diagnose,
+        let sim = Simulating {
+            campaign: &noisy,
+            options: &o.diagnose,
             configs_dir,
             control,
-            &cache,
-            &s.effects,
-        )?;
+            cache: &cache,
+        };
+        let truth = truth_fit(sim, &mut refined, &s.effects)?;
         let truth_p = truth
             .as_ref()
             .map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));

@@ -91,6 +91,22 @@ pub const SECONDARY_CONTENDERS: usize = 3;
 /// Profile-likelihood drop of a 95 % interval for one parameter (chi-square 1 dof: 3.84 / 2).
 pub const PROFILE_95: f64 = 1.920_729_410_347_062;
 
+/// What the refinement steps and the truth's own fit simulate with: the campaign, the
+/// diagnosis' options, the reference configs, the run's control and the window cache.
+#[derive(Clone, Copy)]
+pub struct Simulating<'a> {
+    /// The campaign diagnosed.
+    pub campaign: &'a Campaign,
+    /// The diagnosis' options.
+    pub options: &'a DiagnoseOptions,
+    /// Directory of reference configs and profiles.
+    pub configs_dir: &'a Path,
+    /// Cancellation and progress of the simulations.
+    pub control: &'a RunControl,
+    /// Windows simulated already.
+    pub cache: &'a WindowCache,
+}
+
 /// How the diagnosis runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiagnoseOptions {

@@ -13,7 +13,7 @@
 
 use super::{
     diagnose_with, location, stats, Candidate, DiagnoseOptions, FitProblem, Model, Report,
-    REFINE_CONTENDERS, SECONDARY_CONTENDERS,
+    Simulating, REFINE_CONTENDERS, SECONDARY_CONTENDERS,
 };
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::effects::{Acts, ParameterInfo};
@@ -103,8 +103,15 @@ pub fn diagnose_refining(
         }
     }
     if options.refine_rounds > 0 {
-        secondary(campaign, emulator, options, configs_dir, control, cache)?;
-        exact_pairs(campaign, emulator, options, configs_dir, control, cache)?;
+        let sim = Simulating {
+            campaign,
+            options,
+            configs_dir,
+            control,
+            cache,
+        };
+        secondary(sim, emulator)?;
+        exact_pairs(sim, emulator)?;
     }
     diagnose_with(campaign, emulator, options)
 }
@@ -169,14 +176,14 @@ fn refinement_requests(
 /// beat the nominal held out but leave lack-of-fit get their secondary parameters profiled
 /// (variant tables), then the chosen variant is refined at its fitted magnitudes. Every
 /// wear-law effect with a secondary parameter is profiled as well (no simulation needed).
-fn secondary(
-    campaign: &Campaign,
-    emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
-) -> Result<(), GapError> {
+fn secondary(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     // (default table, fitted magnitude at the defaults) of each effect to profile.
     let leaders: Vec<(usize, f64)> = {
         let problem = FitProblem::new(campaign, emulator, options);
@@ -226,16 +233,7 @@ fn secondary(
         leaders
     };
     for (default_table, m) in &leaders {
-        profile_secondary(
-            campaign,
-            emulator,
-            options,
-            configs_dir,
-            control,
-            cache,
-            *default_table,
-            *m,
-        )?;
+        profile_secondary(sim, emulator, *default_table, *m)?;
     }
     if leaders.is_empty() {
         return Ok(());
@@ -257,17 +255,19 @@ fn secondary(
 /// at the defaults): variants at [`profile_values`], then at the midpoints between the best
 /// value and its neighbours (once for a dynamics effect, four times for a wear law); with two
 /// or more secondary parameters, a variant at every best value together.
-#[allow(clippy::too_many_arguments)]
 fn profile_secondary(
-    campaign: &Campaign,
+    sim: Simulating,
     emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
     default_table: usize,
     m: f64,
 ) -> Result<(), GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     let info = emulator.effects[default_table].info;
     let magnitudes: Vec<f64> = match info.acts {
         Acts::WearLaw => Vec::new(),
@@ -364,14 +364,14 @@ fn best_value(
 /// Step 3: when no single effect explains cleanly, the pairs of the best singles: each
 /// dynamics + wear-law pair made exact, and the dynamics members of every pair refined at
 /// the magnitudes the pair's fits land on (the exact pairs follow their refined tables).
-fn exact_pairs(
-    campaign: &Campaign,
-    emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
-) -> Result<(), GapError> {
+fn exact_pairs(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     for round in 0..=PAIR_ROUNDS {
         let (models, requests) = {
             let problem = FitProblem::new(campaign, emulator, options);
@@ -424,7 +424,7 @@ fn exact_pairs(
                     }
                 }
             }
-            pair_variants(campaign, emulator, options, configs_dir, control, cache)?;
+            pair_variants(sim, emulator)?;
             continue;
         }
         let mut added =
@@ -455,14 +455,14 @@ const PAIR_VARIANT_CONTENDERS: usize = 2;
 /// the fit left at 0 at its single's fit): the product of their ratios may hide what one
 /// adds beside the other, and a joint point corrects it; the refinement rounds then simulate
 /// the chosen two together where the fits land.
-fn pair_variants(
-    campaign: &Campaign,
-    emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
-) -> Result<(), GapError> {
+fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     // (dynamics table, wear-law table) of each mixed pair to profile, and (table,
     // magnitude) twice for each pair of dynamics effects.
     type Contenders = (
@@ -561,16 +561,7 @@ fn pair_variants(
     // Each partner of the leading dynamics effect: its secondary value bisected beside it.
     for [leader, (partner, m)] in beside_leader {
         if m != 0.0 && leader.1 != 0.0 {
-            bisect_beside(
-                campaign,
-                emulator,
-                options,
-                configs_dir,
-                control,
-                cache,
-                (partner, m),
-                leader,
-            )?;
+            bisect_beside(sim, emulator, (partner, m), leader)?;
         }
     }
     for (d, w) in contenders {
@@ -603,17 +594,19 @@ const PAIR_BISECTIONS: usize = 3;
 /// simulations per value: the pair's fit moves the member's magnitude along the variant's
 /// table from 0 to there, and the joint point makes it exact there). Nothing is done when
 /// the effect has no single secondary parameter.
-#[allow(clippy::too_many_arguments)]
 fn bisect_beside(
-    campaign: &Campaign,
+    sim: Simulating,
     emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
     (member, m): (usize, f64),
     (other, mo): (usize, f64),
 ) -> Result<(), GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     let info = emulator.effects[member].info;
     let [_, p] = info.parameters else {
         return Ok(());

@@ -6,14 +6,11 @@
 //! and the search did not reach it.
 
 use super::emulator::Emulator;
-use super::{stats, DiagnoseOptions, FitProblem};
+use super::{stats, FitProblem, Simulating};
 use crate::gap::effects::{Acts, Effect};
-use crate::gap::window::WindowCache;
-use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
+use crate::gap::GapError;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
 
 /// How the truth, simulated in the emulator, fits the campaign (full data).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,16 +45,18 @@ pub struct TruthFit {
 /// simulated together; a dynamics effect with a wear law, the law on the dynamics effect's
 /// windows). None when the truth is empty, has more than two effects or holds an effect the
 /// emulator does not tabulate (not applicable to the campaign).
-#[allow(clippy::too_many_arguments)]
 pub fn truth_fit(
-    campaign: &Campaign,
+    sim: Simulating,
     emulator: &mut Emulator,
-    options: &DiagnoseOptions,
-    configs_dir: &Path,
-    control: &RunControl,
-    cache: &WindowCache,
     effects: &[Effect],
 ) -> Result<Option<TruthFit>, GapError> {
+    let Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    } = sim;
     if effects.is_empty() || effects.len() > 2 {
         return Ok(None);
     }
