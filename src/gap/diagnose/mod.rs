@@ -107,6 +107,27 @@ pub struct Simulating<'a> {
     pub cache: &'a WindowCache,
 }
 
+impl<'a> Simulating<'a> {
+    /// `(campaign, options, configs_dir, control, cache)`.
+    pub fn parts(
+        self,
+    ) -> (
+        &'a Campaign,
+        &'a DiagnoseOptions,
+        &'a Path,
+        &'a RunControl,
+        &'a WindowCache,
+    ) {
+        (
+            self.campaign,
+            self.options,
+            self.configs_dir,
+            self.control,
+            self.cache,
+        )
+    }
+}
+
 /// How the diagnosis runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiagnoseOptions {

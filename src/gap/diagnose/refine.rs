@@ -177,13 +177,7 @@ fn refinement_requests(
 /// (variant tables), then the chosen variant is refined at its fitted magnitudes. Every
 /// wear-law effect with a secondary parameter is profiled as well (no simulation needed).
 fn secondary(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     // (default table, fitted magnitude at the defaults) of each effect to profile.
     let leaders: Vec<(usize, f64)> = {
         let problem = FitProblem::new(campaign, emulator, options);
@@ -261,13 +255,7 @@ fn profile_secondary(
     default_table: usize,
     m: f64,
 ) -> Result<(), GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     let info = emulator.effects[default_table].info;
     let magnitudes: Vec<f64> = match info.acts {
         Acts::WearLaw => Vec::new(),
@@ -365,13 +353,7 @@ fn best_value(
 /// dynamics + wear-law pair made exact, and the dynamics members of every pair refined at
 /// the magnitudes the pair's fits land on (the exact pairs follow their refined tables).
 fn exact_pairs(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     for round in 0..=PAIR_ROUNDS {
         let (models, requests) = {
             let problem = FitProblem::new(campaign, emulator, options);
@@ -456,13 +438,7 @@ const PAIR_VARIANT_CONTENDERS: usize = 2;
 /// adds beside the other, and a joint point corrects it; the refinement rounds then simulate
 /// the chosen two together where the fits land.
 fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     // (dynamics table, wear-law table) of each mixed pair to profile, and (table,
     // magnitude) twice for each pair of dynamics effects.
     type Contenders = (
@@ -600,13 +576,7 @@ fn bisect_beside(
     (member, m): (usize, f64),
     (other, mo): (usize, f64),
 ) -> Result<(), GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     let info = emulator.effects[member].info;
     let [_, p] = info.parameters else {
         return Ok(());

@@ -50,13 +50,7 @@ pub fn truth_fit(
     emulator: &mut Emulator,
     effects: &[Effect],
 ) -> Result<Option<TruthFit>, GapError> {
-    let Simulating {
-        campaign,
-        options,
-        configs_dir,
-        control,
-        cache,
-    } = sim;
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
     if effects.is_empty() || effects.len() > 2 {
         return Ok(None);
     }
