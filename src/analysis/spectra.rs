@@ -67,7 +67,8 @@ pub enum Window {
     Hann,
 }
 
-fn window_values(window: Window, n: usize) -> Vec<f64> {
+/// The window's `n` weights (Hann: periodic, `0.5 (1 - cos(2π i / n))`).
+pub fn window_values(window: Window, n: usize) -> Vec<f64> {
     match window {
         Window::Rectangular => vec![1.0; n],
         Window::Hann => (0..n)

@@ -3,7 +3,7 @@
 //! drive itself, so a cross-axis drive's phase is read from them, not profiled.
 //!
 //! At each drive tone's frequency, each record's phasor on each axis is taken (a Hann-window
-//! projection); the cross-axis phase is `arg(P_cross / P_drive)` on each other axis that
+//! projection, the window of `analysis::spectra`); the cross-axis phase is `arg(P_cross / P_drive)` on each other axis that
 //! moves (the phasor at least [`MIN_SNR`] times its noise), with the noise from the record's
 //! residual after the tones are taken out. The phases of every record, tone and cross axis
 //! are combined by a weighted circular mean. When they disagree beyond their noise (and
@@ -14,6 +14,7 @@
 //! the input records see that relative phase. A compliant fixture (`fixture_compliance`)
 //! shifts every axis' tone by the same transmissibility phase and leaves the relative phase.
 
+use crate::analysis::spectra::{window_values, Window};
 use crate::excitation::{ExcitationSpec, Tone};
 use crate::gap::accel::AccelLocation;
 use crate::gap::{Campaign, GapError};
@@ -114,20 +115,19 @@ pub fn measure(campaign: &Campaign, configs_dir: &Path) -> Result<Vec<MeasuredVa
 fn record_readings(samples: &[[f64; 4]], tones: &[Tone]) -> Vec<Reading> {
     let t: Vec<f64> = samples.iter().map(|s| s[0] - samples[0][0]).collect();
     let span = t.last().copied().unwrap_or(0.0);
+    let h = window_values(Window::Hann, samples.len());
     let mut out = Vec::new();
-    // Each axis' phasor at every tone frequency, and its residual after they are removed.
+    // Each axis' samples less their mean, its phasor at every tone frequency, and the
+    // phasor's noise from the residual after they are removed.
     let freqs: Vec<f64> = tones.iter().map(|x| x.frequency_hz).collect();
-    let fits: Vec<Vec<(f64, f64)>> = (0..3)
-        .map(|a| {
-            freqs
-                .iter()
-                .map(|&f| phasor(&t, samples, a + 1, f))
-                .collect()
-        })
-        .collect();
-    let noise: Vec<f64> = (0..3)
-        .map(|a| phasor_sd(&t, samples, a + 1, &freqs, &fits[a]))
-        .collect();
+    let (mut fits, mut noise) = (Vec::with_capacity(3), Vec::with_capacity(3));
+    for col in 1..4 {
+        let mean = samples.iter().map(|s| s[col]).sum::<f64>() / samples.len() as f64;
+        let x: Vec<f64> = samples.iter().map(|s| s[col] - mean).collect();
+        let fit: Vec<(f64, f64)> = freqs.iter().map(|&f| phasor(&t, &x, &h, f)).collect();
+        noise.push(phasor_sd(&t, &x, &h, &freqs, &fit));
+        fits.push(fit);
+    }
     for (k, tone) in tones.iter().enumerate() {
         // A frequency another axis' tone shares: the drive moves two axes there already.
         let shared = tones
@@ -159,48 +159,26 @@ fn record_readings(samples: &[[f64; 4]], tones: &[Tone]) -> Vec<Reading> {
     out
 }
 
-/// Hann weight of sample time `t` over `[0, span]`.
-fn hann(t: f64, span: f64) -> f64 {
-    if span > 0.0 {
-        0.5 - 0.5 * (2.0 * PI * t / span).cos()
-    } else {
-        1.0
-    }
-}
-
-/// Complex amplitude `(re, im)` of column `col` at `f` Hz: `x(t) ≈ re cos ωt - im sin ωt`
-/// (a Hann-weighted projection, the mean removed), so its argument is the tone's phase.
-fn phasor(t: &[f64], samples: &[[f64; 4]], col: usize, f: f64) -> (f64, f64) {
-    let span = t.last().copied().unwrap_or(0.0);
-    let n = samples.len() as f64;
-    let mean = samples.iter().map(|s| s[col]).sum::<f64>() / n;
+/// Complex amplitude `(re, im)` of the zero-mean samples `x` at times `t` at `f` Hz:
+/// `x(t) ≈ re cos ωt - im sin ωt` (a projection weighted by the window `h`), so its argument
+/// is the tone's phase.
+fn phasor(t: &[f64], x: &[f64], h: &[f64], f: f64) -> (f64, f64) {
     let w = 2.0 * PI * f;
-    let (mut re, mut im, mut sw) = (0.0, 0.0, 0.0);
-    for (ti, s) in t.iter().zip(samples) {
-        let h = hann(*ti, span);
-        let x = s[col] - mean;
-        re += h * x * (w * ti).cos();
-        im -= h * x * (w * ti).sin();
-        sw += h;
+    let (mut re, mut im) = (0.0, 0.0);
+    for ((ti, xi), hi) in t.iter().zip(x).zip(h) {
+        re += hi * xi * (w * ti).cos();
+        im -= hi * xi * (w * ti).sin();
     }
+    let sw: f64 = h.iter().sum();
     (2.0 * re / sw, 2.0 * im / sw)
 }
 
-/// Standard deviation of one component of [`phasor`] from the residual after every tone is
-/// removed: white noise of variance `s²` gives `s sqrt(2 Σ h²) / Σ h` (each component takes
-/// half the noise power at the tone's frequency).
-fn phasor_sd(
-    t: &[f64],
-    samples: &[[f64; 4]],
-    col: usize,
-    freqs: &[f64],
-    fits: &[(f64, f64)],
-) -> f64 {
-    let span = t.last().copied().unwrap_or(0.0);
-    let n = samples.len() as f64;
-    let mean = samples.iter().map(|s| s[col]).sum::<f64>() / n;
+/// Standard deviation of one component of [`phasor`] from the residual after every tone
+/// (`fits` at `freqs`) is removed: white noise of variance `s²` gives `s sqrt(2 Σ h²) / Σ h`
+/// (each component takes half the noise power at the tone's frequency).
+fn phasor_sd(t: &[f64], x: &[f64], h: &[f64], freqs: &[f64], fits: &[(f64, f64)]) -> f64 {
     let (mut r2, mut sh, mut sh2) = (0.0, 0.0, 0.0);
-    for (ti, s) in t.iter().zip(samples) {
+    for ((ti, xi), hi) in t.iter().zip(x).zip(h) {
         let model: f64 = freqs
             .iter()
             .zip(fits)
@@ -209,11 +187,10 @@ fn phasor_sd(
                 p.0 * w.cos() - p.1 * w.sin()
             })
             .sum();
-        let h = hann(*ti, span);
-        let r = s[col] - mean - model;
-        r2 += h * r * r;
-        sh += h;
-        sh2 += h * h;
+        let r = xi - model;
+        r2 += hi * r * r;
+        sh += hi;
+        sh2 += hi * hi;
     }
     let s = (r2 / sh).sqrt();
     s * (2.0 * sh2).sqrt() / sh
