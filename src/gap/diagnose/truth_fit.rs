@@ -97,12 +97,8 @@ pub fn truth_fit(
             cache,
             &|_, _| {},
         )?;
-        // A secondary value the campaign's data measure is not the truth's to fit.
-        let measured = info.parameters[1..]
-            .iter()
-            .filter(|p| emulator.measured_value(info.name, p.name).is_some())
-            .count();
-        parameters += info.parameters.len() - measured;
+        // The magnitude and every secondary value but those the campaign's data measure.
+        parameters += 1 + emulator.unmeasured_secondaries(info).len();
         spec.push((table, m));
     }
     if let [(a, ma), (b, mb)] = spec[..] {
