@@ -129,6 +129,12 @@ pub struct JointPoint {
     pub magnitudes: [f64; 2],
     /// The simulated predictions.
     pub predictions: TestPredictions,
+    /// The same two effects entering the excitation [`SETTLE_SHIFT_S`] later: the spread of
+    /// a window's wear over initial states with both on (docs/diagnosis.md, "Two dynamics
+    /// effects together"). Two effects together may make the motion depend on the state it
+    /// starts from where neither alone does; None in an emulator saved before it was kept.
+    #[serde(default)]
+    pub initial_state: Option<TestPredictions>,
 }
 
 /// Friction work of one increment's window by band, J.
@@ -540,6 +546,11 @@ impl Emulator {
         }
     }
 
+    /// Magnitude `m` of table `t` over the table's bound on its side of 0.
+    pub fn unit(&self, t: usize, m: f64) -> f64 {
+        m / self.effects[t].bound_for(m).abs().max(1e-300)
+    }
+
     /// Whether tables `a` and `b` were simulated together anywhere.
     fn has_joint(&self, a: usize, b: usize) -> bool {
         self.joints
@@ -556,7 +567,7 @@ impl Emulator {
     /// where either member is off (the product is exact there), and is smooth in both
     /// magnitudes: a fit moving between joint points sees no jump.
     fn interacting(&self, a: usize, ma: f64, b: usize, mb: f64) -> TestPredictions {
-        let unit = |t: usize, m: f64| m / self.effects[t].bound_for(m).abs().max(1e-300);
+        let unit = |t: usize, m: f64| self.unit(t, m);
         let (u, v) = (unit(a, ma), unit(b, mb));
         // (u_i, v_i, joint, product) at each joint point of the two tables, in (a, b) order.
         let points: Vec<(f64, f64, &TestPredictions, TestPredictions)> = self
@@ -732,13 +743,19 @@ impl Emulator {
             effect_with(ta.info, ma, &ta.parameters),
             effect_with(tb.info, mb, &tb.parameters),
         ];
-        let mut p =
-            self.simulate_sets(campaign, configs_dir, vec![set], control, cache, &|_, _| {})?;
-        let predictions = p.pop().unwrap_or_default();
+        let slots = vec![
+            (set.clone(), 1.0, 0.0, 0.0),
+            (set, 1.0, 0.0, SETTLE_SHIFT_S),
+        ];
+        let mut p = self
+            .run_slots(campaign, configs_dir, slots, control, cache, &|_, _| {})?
+            .into_iter();
+        let predictions = p.next().unwrap_or_default();
         self.joints.push(JointPoint {
             tables: [a, b],
             magnitudes: [ma, mb],
             predictions,
+            initial_state: p.next(),
         });
         Ok(true)
     }
@@ -782,8 +799,22 @@ impl Emulator {
         cache: &WindowCache,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Vec<TestPredictions>, GapError> {
-        let (cases, increments) = plan(campaign, configs_dir)?;
         let slots: Vec<Slot> = sets.into_iter().map(|e| (e, 1.0, 0.0, 0.0)).collect();
+        self.run_slots(campaign, configs_dir, slots, control, cache, progress)
+    }
+
+    /// [`Self::simulate_sets`] with each slot's tolerance scale, friction step and settle shift
+    /// given.
+    fn run_slots(
+        &mut self,
+        campaign: &Campaign,
+        configs_dir: &Path,
+        slots: Vec<Slot>,
+        control: &RunControl,
+        cache: &WindowCache,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Vec<TestPredictions>, GapError> {
+        let (cases, increments) = plan(campaign, configs_dir)?;
         let before = cache.len();
         let total = slots.len() * campaign.tests.len();
         let by_slot = simulate_slots(

@@ -58,6 +58,7 @@ fn emulator(c: f64, joints: &[(f64, f64)]) -> Emulator {
             tables: [0, 1],
             magnitudes: [x, y],
             predictions: one(product.0 * k, product.1 * k),
+            initial_state: None,
         });
     }
     e

@@ -39,6 +39,7 @@ pub mod emulator;
 mod how_far;
 #[cfg(test)]
 mod interaction_tests;
+mod joint_spread;
 pub mod location;
 pub mod measured;
 pub mod noise;
@@ -181,6 +182,9 @@ pub struct FitProblem<'a> {
     /// The emulator's tables by effect: the first is the effect at its library defaults, the
     /// others its variants at other values of its secondary parameters.
     families: Vec<Vec<usize>>,
+    /// The initial-state spread of each joint point of two dynamics effects, added to a pair's
+    /// variance where both are on.
+    joint_spreads: Vec<joint_spread::JointSpread>,
 }
 
 /// What a candidate fits.
@@ -240,10 +244,12 @@ impl<'a> FitProblem<'a> {
             .filter(|(i, f)| f[0] == *i)
             .map(|(_, f)| f)
             .collect();
+        let joint_spreads = joint_spread::joint_spreads(emulator, &obs);
         Self {
             obs,
             noise,
             emulator,
+            joint_spreads,
             roughness,
             group,
             groups,
@@ -272,11 +278,14 @@ impl<'a> FitProblem<'a> {
             .enumerate()
             .filter(|(i, _)| mask(self.group[*i]))
             .map(|(i, o)| {
-                let extra: f64 = spec
+                let mut extra: f64 = spec
                     .iter()
                     .filter(|(_, m)| *m != 0.0)
                     .map(|(e, _)| self.roughness[*e][i])
                     .sum();
+                if let [a, b] = spec[..] {
+                    extra += joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i);
+                }
                 self.noise.term(o, o.predicted(p), extra)
             });
         noise::gaussian(terms, self.noise.scale_var)

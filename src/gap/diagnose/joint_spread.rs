@@ -1,0 +1,113 @@
+//! The initial-state spread of two dynamics effects together: what a joint point's
+//! settle-shifted twin adds to the model's uncertainty (docs/diagnosis.md, "Two dynamics
+//! effects together").
+//!
+//! The noise model takes the spread of a window's wear over initial states from the
+//! nominal's settle-shift run, and an effect's own spread from its table's roughness. Two
+//! effects together can make the motion depend on the state it enters the excitation in where
+//! neither alone does (bench 2035: friction drift 0.48 with a cross-axis drive, test A's
+//! increments moving by -46 % and +144 % between two settles, every mass of the drift alone
+//! unchanged). Each joint point simulated twice, [`super::emulator::SETTLE_SHIFT_S`] apart,
+//! measures that spread; the pair carries it wherever both members are on.
+
+use super::emulator::Emulator;
+use super::noise::{Observation, Quantity};
+use std::collections::BTreeMap;
+
+/// One joint point with its settle-shifted twin: its tables, each magnitude over its bound,
+/// and the relative variance it adds to each observation.
+pub(super) struct JointSpread {
+    tables: [usize; 2],
+    units: [f64; 2],
+    rel_var: Vec<f64>,
+}
+
+/// The spread of every joint point that has a twin. Per test, the two runs' relative
+/// differences are pooled (RMS) over the test's increments and components for masses, and
+/// over its increments for each accelerometer quantity: two runs are one draw each, so one
+/// observation's difference alone would be a variance estimate on one degree of freedom,
+/// zero wherever the two draws happen to agree.
+pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<JointSpread> {
+    let kind = |o: &Observation| match &o.quantity {
+        Quantity::Mass(_) => (o.test, "mass".to_string()),
+        q => (o.test, q.label()),
+    };
+    emulator
+        .joints
+        .iter()
+        .filter_map(|j| {
+            let shifted = j.initial_state.as_ref()?;
+            let mut pooled: BTreeMap<(usize, String), (f64, usize)> = BTreeMap::new();
+            for o in obs {
+                let (x, y) = (o.predicted(&j.predictions), o.predicted(shifted));
+                let scale = x.abs().max(y.abs());
+                if scale > 0.0 && scale.is_finite() {
+                    let e = pooled.entry(kind(o)).or_insert((0.0, 0));
+                    e.0 += ((x - y) / scale).powi(2);
+                    e.1 += 1;
+                }
+            }
+            let rel_var = obs
+                .iter()
+                .map(|o| pooled.get(&kind(o)).map_or(0.0, |(s, n)| s / *n as f64))
+                .collect();
+            let [a, b] = j.tables;
+            Some(JointSpread {
+                tables: j.tables,
+                units: [
+                    emulator.unit(a, j.magnitudes[0]),
+                    emulator.unit(b, j.magnitudes[1]),
+                ],
+                rel_var,
+            })
+        })
+        .collect()
+}
+
+/// The relative variance tables `a` at `ma` and `b` at `mb` together add to observation `i`:
+/// the joint points' spreads weighted as the interaction is (one at a joint point, inverse
+/// squared distance in magnitude over bound otherwise), each faded by the product of the
+/// magnitudes over the point's (capped at 1), so that it vanishes as either member goes off
+/// and the pair becomes a single, whose own spread its table's roughness carries.
+pub(super) fn rel_var(
+    spreads: &[JointSpread],
+    emulator: &Emulator,
+    (a, ma): (usize, f64),
+    (b, mb): (usize, f64),
+    i: usize,
+) -> f64 {
+    if ma == 0.0 || mb == 0.0 {
+        return 0.0;
+    }
+    let (u, v) = (emulator.unit(a, ma), emulator.unit(b, mb));
+    let points: Vec<(f64, f64, f64)> = spreads
+        .iter()
+        .filter_map(|s| {
+            let [x, y] = if s.tables == [a, b] {
+                s.units
+            } else if s.tables == [b, a] {
+                [s.units[1], s.units[0]]
+            } else {
+                return None;
+            };
+            let fade = (u * v / (x * y)).abs().min(1.0);
+            Some((x, y, fade * s.rel_var[i]))
+        })
+        .collect();
+    if points.is_empty() {
+        return 0.0;
+    }
+    let d2: Vec<f64> = points
+        .iter()
+        .map(|(x, y, _)| (u - x).powi(2) + (v - y).powi(2))
+        .collect();
+    if let Some(k) = d2.iter().position(|d| *d < 1e-24) {
+        return points[k].2;
+    }
+    let total: f64 = d2.iter().map(|d| 1.0 / d).sum();
+    points
+        .iter()
+        .zip(&d2)
+        .map(|((_, _, s), d)| s / d / total)
+        .sum()
+}
