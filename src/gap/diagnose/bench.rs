@@ -1414,6 +1414,7 @@ mod tests {
                 aicc: truth_aicc,
                 fits,
                 by_group: Vec::new(),
+                worst: Vec::new(),
             }),
             best_member_aicc: Some(member_aicc),
             ..outcome(

@@ -15,18 +15,24 @@ use super::noise::{Observation, Quantity};
 use std::collections::BTreeMap;
 
 /// One joint point with its settle-shifted twin: its tables, each magnitude over its bound,
-/// and the relative variance it adds to each observation.
+/// and per observation the pooled relative variance and the squared difference of the two
+/// runs.
 pub(super) struct JointSpread {
     tables: [usize; 2],
     units: [f64; 2],
     rel_var: Vec<f64>,
+    abs_var: Vec<f64>,
 }
 
 /// The spread of every joint point that has a twin. Per test, the two runs' relative
 /// differences are pooled (RMS) over the test's increments and components for masses, and
 /// over its increments for each accelerometer quantity: two runs are one draw each, so one
 /// observation's difference alone would be a variance estimate on one degree of freedom,
-/// zero wherever the two draws happen to agree.
+/// zero wherever the two draws happen to agree. Each observation's own squared difference is
+/// kept too: a relative variance is applied to the prediction, and where the prediction is
+/// the smaller of two draws far apart (bench 2035: test A's second-increment response y, a
+/// mean square of 290 m²/s⁴ at one settle and 4921 at the other) the pooled relative spread
+/// of a few tens of per cent would still leave the other draw many deviations away.
 pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<JointSpread> {
     let kind = |o: &Observation| match &o.quantity {
         Quantity::Mass(_) => (o.test, "mass".to_string()),
@@ -51,6 +57,17 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
                 .iter()
                 .map(|o| pooled.get(&kind(o)).map_or(0.0, |(s, n)| s / *n as f64))
                 .collect();
+            let abs_var = obs
+                .iter()
+                .map(|o| {
+                    let d = o.predicted(&j.predictions) - o.predicted(shifted);
+                    if d.is_finite() {
+                        d * d
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
             let [a, b] = j.tables;
             Some(JointSpread {
                 tables: j.tables,
@@ -59,22 +76,26 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
                     emulator.unit(b, j.magnitudes[1]),
                 ],
                 rel_var,
+                abs_var,
             })
         })
         .collect()
 }
 
-/// The relative variance tables `a` at `ma` and `b` at `mb` together add to observation `i`:
-/// the joint points' spreads weighted as the interaction is (one at a joint point, inverse
-/// squared distance in magnitude over bound otherwise), each faded by the product of the
-/// magnitudes over the point's (capped at 1), so that it vanishes as either member goes off
-/// and the pair becomes a single, whose own spread its table's roughness carries.
+/// The relative variance (of the prediction `mu`) tables `a` at `ma` and `b` at `mb` together
+/// add to observation `i`: at each joint point the larger of its pooled relative variance and
+/// its own squared difference over `mu²`; the joint points weighted as the interaction is (one
+/// at a joint point, inverse squared distance in magnitude over bound otherwise), each faded
+/// by the product of the magnitudes over the point's (capped at 1), so that it vanishes as
+/// either member goes off and the pair becomes a single, whose own spread its table's
+/// roughness carries.
 pub(super) fn rel_var(
     spreads: &[JointSpread],
     emulator: &Emulator,
     (a, ma): (usize, f64),
     (b, mb): (usize, f64),
     i: usize,
+    mu: f64,
 ) -> f64 {
     if ma == 0.0 || mb == 0.0 {
         return 0.0;
@@ -91,7 +112,12 @@ pub(super) fn rel_var(
                 return None;
             };
             let fade = (u * v / (x * y)).abs().min(1.0);
-            Some((x, y, fade * s.rel_var[i]))
+            let own = if mu != 0.0 {
+                s.abs_var[i] / (mu * mu)
+            } else {
+                0.0
+            };
+            Some((x, y, fade * s.rel_var[i].max(own)))
         })
         .collect();
     if points.is_empty() {

@@ -272,23 +272,34 @@ impl<'a> FitProblem<'a> {
         spec: &[(usize, f64)],
         mask: &dyn Fn(usize) -> bool,
     ) -> Totals {
-        let terms = self
-            .obs
+        let terms = self.terms_of(p, spec, mask).map(|(_, t)| t);
+        noise::gaussian(terms, self.noise.scale_var)
+    }
+
+    /// Each kept observation's index and likelihood term under `spec`'s predictions `p`.
+    fn terms_of<'b>(
+        &'b self,
+        p: &'b emulator::TestPredictions,
+        spec: &'b [(usize, f64)],
+        mask: &'b dyn Fn(usize) -> bool,
+    ) -> impl Iterator<Item = (usize, noise::Term)> + 'b {
+        self.obs
             .iter()
             .enumerate()
             .filter(|(i, _)| mask(self.group[*i]))
-            .map(|(i, o)| {
+            .map(move |(i, o)| {
                 let mut extra: f64 = spec
                     .iter()
                     .filter(|(_, m)| *m != 0.0)
                     .map(|(e, _)| self.roughness[*e][i])
                     .sum();
+                let mu = o.predicted(p);
                 if let [a, b] = spec[..] {
-                    extra += joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i);
+                    extra +=
+                        joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i, mu);
                 }
-                self.noise.term(o, o.predicted(p), extra)
-            });
-        noise::gaussian(terms, self.noise.scale_var)
+                (i, self.noise.term(o, mu, extra))
+            })
     }
 
     fn nll_of(&self, spec: &[(usize, f64)], mask: impl Fn(usize) -> bool) -> f64 {

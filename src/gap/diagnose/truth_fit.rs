@@ -37,7 +37,15 @@ pub struct TruthFit {
     /// does not fit misses.
     #[serde(default)]
     pub by_group: Vec<(String, f64, f64)>,
+    /// The observations it misses most: test, increment, quantity, reading, prediction and
+    /// standardized residual (the residual over its independent uncertainty, the channel's
+    /// shared calibration scale left out), largest first.
+    #[serde(default)]
+    pub worst: Vec<String>,
 }
+
+/// How many of the largest standardized residuals [`TruthFit::worst`] lists.
+const WORST: usize = 8;
 
 /// The truth `effects` (one or two library effects, every parameter given) fitted as they
 /// were drawn: each effect's table at its drawn secondary values holds its drawn magnitude
@@ -131,6 +139,27 @@ pub fn truth_fit(
             (problem.group_labels[g].clone(), one.r2, one.w)
         })
         .collect();
+    let p = emulator.predict(&spec);
+    let all = |_: usize| true;
+    let mut z: Vec<(f64, String)> = problem
+        .terms_of(&p, &spec, &all)
+        .map(|(i, t)| {
+            let o = &problem.obs[i];
+            let z = t.residual / t.var.sqrt();
+            let label = format!(
+                "{} increment {} {}: {:.4e} read, {:.4e} predicted, z {:+.1}",
+                problem.group_labels[problem.group[i]],
+                o.increment + 1,
+                o.quantity.label(),
+                o.value,
+                t.predicted,
+                z
+            );
+            (z.abs(), label)
+        })
+        .collect();
+    z.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let worst = z.into_iter().take(WORST).map(|(_, l)| l).collect();
     Ok(Some(TruthFit {
         chi2: t.r2,
         dof: t.w,
@@ -140,5 +169,6 @@ pub fn truth_fit(
         aicc: stats::aicc(k, t.nll, t.w),
         fits: p_value >= options.alpha,
         by_group,
+        worst,
     }))
 }
