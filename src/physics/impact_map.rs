@@ -431,6 +431,8 @@ pub fn impact_map(
     let (mut steps, mut rejected, mut max_penetration) = (0usize, 0usize, 0.0f64);
     let mut err_old: f64 = 1e-4;
     let mut last_rejected = false;
+    // Just landed on the turning point (ẇ there is 0 up to the location's residual, either sign).
+    let mut at_turning = false;
     let mut end = ContactEnd::TimeLimit;
 
     loop {
@@ -467,7 +469,7 @@ pub fn impact_map(
         let (w1, wd1, a1) = (step.y[W], step.y[WDOT], step.dydt[WDOT]);
         let mut first: Option<(f64, Event)> = None;
         for event in EVENTS {
-            if event == Event::Turning && wd0 <= 0.0 {
+            if event == Event::Turning && (wd0 <= 0.0 || at_turning) {
                 continue;
             }
             let Some(g1) = contact.event_value(event, piece, w1, wd1) else {
@@ -515,6 +517,7 @@ pub fn impact_map(
         err_old = fac_old;
         last_rejected = false;
         h = h_try / fac;
+        at_turning = landed == Some(Event::Turning);
         let Some(event) = landed else {
             continue;
         };
