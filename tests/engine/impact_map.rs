@@ -216,3 +216,258 @@ fn damped_drop_matches_a_fine_fixed_step_reference() {
     println!("exit speeds {exit_speeds:?}");
     assert!(hi / lo < 1.01, "one slow manifold: {exit_speeds:?}");
 }
+
+fn sliding(approach_speed: f64, slip_velocity: [f64; 2]) -> ContactApproach {
+    ContactApproach {
+        slip_velocity,
+        ..head_on(CUBE_MASS, approach_speed)
+    }
+}
+
+/// A slip the normal impulse cannot stop (`μ_s P_n < m_t (|v_t| − v_d)`) stays above the
+/// friction transition speed `v_d`, where the regularized law is exactly `μ_d`: the tangential
+/// impulse is `μ_d P_n` against the slip, with no regularization error (1-D and 2-D).
+#[test]
+fn fast_slip_takes_the_dynamic_coefficient_times_the_normal_impulse() {
+    let p = ImpactParams::thesis_table_5_2();
+    let f = FrictionParams::thesis_table_5_2();
+    for slip in [[1.0, 0.0], [0.6, -0.8]] {
+        let a = sliding(0.1, slip);
+        let map = run(&a, &p, 1e-3);
+        let speed_in = slip[0].hypot(slip[1]);
+        assert!(f.mu_static * map.normal_impulse < a.tangential_mass * (speed_in - 0.012));
+        let [px, py] = map.tangential_impulse;
+        let expected = f.mu_dynamic * map.normal_impulse;
+        let error = px.hypot(py) / expected - 1.0;
+        println!("slip {slip:?}: |P_t| / (mu_d P_n) - 1 = {error:.2e}");
+        assert!(error.abs() < 1e-8, "{error}");
+        // Against the slip, and the slip's loss is the impulse over the mass.
+        assert!((px * slip[1] - py * slip[0]).abs() < 1e-9 * expected * speed_in);
+        assert!(px * slip[0] + py * slip[1] < 0.0);
+        let speed_out = map.exit_slip_velocity[0].hypot(map.exit_slip_velocity[1]);
+        let loss = expected / a.tangential_mass;
+        assert!((speed_in - speed_out - loss).abs() < 1e-8 * loss);
+        // ∫N|v_t| dt is the friction work over μ_d.
+        assert!(
+            (map.normal_force_slip_integral * f.mu_dynamic / map.friction_dissipation - 1.0).abs()
+                < 1e-8
+        );
+    }
+}
+
+/// A slow slip (below `v_s`, no tangential force) is stopped. The law is regularized (μ(0) = 0,
+/// no true stick): on `[0, v_s]` the cycloidal step is concave, so `μ(v) >= μ_s v / v_s` and
+/// `m_t d|v|/dt <= −(μ_s/v_s) N |v|`, hence `|v_out| <= |v_in| exp(−μ_s P_n / (m_t v_s))`.
+#[test]
+fn slow_slip_is_stopped_within_the_regularization_bound() {
+    let p = ImpactParams::thesis_table_5_2();
+    let f = FrictionParams::thesis_table_5_2();
+    for slip in [[1e-3, 0.0], [6e-4, -8e-4]] {
+        let a = sliding(0.3, slip);
+        let map = run(&a, &p, 1e-3);
+        let speed_in = slip[0].hypot(slip[1]);
+        let bound = speed_in
+            * (-f.mu_static * map.normal_impulse
+                / (a.tangential_mass * f.stiction_transition_speed))
+                .exp();
+        let speed_out = map.exit_slip_velocity[0].hypot(map.exit_slip_velocity[1]);
+        println!("slip {speed_in:.1e} m/s: out {speed_out:.3e} m/s, bound {bound:.3e} m/s");
+        assert!(bound < 1e-3 * speed_in, "the bound itself is a stop");
+        // Slack: the error control's absolute scale on speeds (1e-10 of 0.3 m/s).
+        assert!(speed_out <= bound + 1e-9, "{speed_out} > {bound}");
+        // The friction never exceeds μ_s N.
+        let [px, py] = map.tangential_impulse;
+        assert!(px.hypot(py) <= f.mu_static * map.normal_impulse * (1.0 + 1e-9));
+    }
+}
+
+/// Never creates energy: over seeded random contacts (masses, speeds, 2-D slip, external forces,
+/// both STEP shapes, clamp and no ramp, friction laws), the exit kinetic plus stored energy
+/// stays below the entry kinetic energy plus the external work, the dissipations are >= 0, and
+/// the account closes.
+#[test]
+fn random_transients_are_passive() {
+    use railwear::physics::step::StepKind;
+    let mut rng = ChaCha8Rng::seed_from_u64(28);
+    let log_uniform = |rng: &mut ChaCha8Rng, lo: f64, hi: f64| 10f64.powf(rng.gen_range(lo..hi));
+    let mut separated = 0;
+    for case in 0..200 {
+        let mass = log_uniform(&mut rng, -2.0, 0.0);
+        let a = ContactApproach {
+            normal_mass: mass,
+            tangential_mass: mass * rng.gen_range(0.3..1.0),
+            approach_speed: log_uniform(&mut rng, -3.0, 0.3),
+            slip_velocity: [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)],
+            external_normal_force: mass * 9.81 * rng.gen_range(-1.0..2.0),
+            external_tangential_force: [
+                mass * rng.gen_range(-3.0..3.0),
+                mass * rng.gen_range(-3.0..3.0),
+            ],
+        };
+        let step = if rng.gen_bool(0.5) {
+            StepKind::Cycloidal
+        } else {
+            StepKind::Cubic
+        };
+        let p = ImpactParams {
+            stiffness: log_uniform(&mut rng, 8.0, 10.0),
+            exponent: [1.0, 1.5, 2.0, 2.4][rng.gen_range(0..4)],
+            max_damping: if rng.gen_bool(0.2) {
+                0.0
+            } else {
+                log_uniform(&mut rng, 0.0, 5.7)
+            },
+            full_damping_depth: if rng.gen_bool(0.2) {
+                0.0
+            } else {
+                log_uniform(&mut rng, -6.0, -4.0)
+            },
+            step,
+        };
+        let vs = log_uniform(&mut rng, -3.5, -2.0);
+        let f = FrictionParams {
+            mu_static: rng.gen_range(0.0..0.5),
+            mu_dynamic: rng.gen_range(0.0..0.5),
+            stiction_transition_speed: vs,
+            friction_transition_speed: vs * rng.gen_range(1.2..3.0),
+            step,
+        };
+        let settings = ImpactMapSettings {
+            time_limit: 1e-3,
+            ..ImpactMapSettings::default()
+        };
+        let map = impact_map(&a, &p, &f, &settings).expect("valid input");
+        separated += usize::from(map.end == ContactEnd::Separated);
+        let entry = kinetic_energy(&a, a.approach_speed, a.slip_velocity);
+        let exit = kinetic_energy(&a, map.exit_normal_velocity, map.exit_slip_velocity)
+            + p.potential(map.end_penetration);
+        let scale = entry + map.external_work.abs();
+        assert!(
+            exit <= entry + map.external_work + 1e-9 * scale,
+            "case {case}: {exit} > {entry} + {}",
+            map.external_work
+        );
+        assert!(map.damping_dissipation >= -1e-9 * scale, "case {case}");
+        assert!(map.friction_dissipation >= -1e-9 * scale, "case {case}");
+        assert!(energy_residual(&a, &p, &map).abs() < 1e-8 * scale, "case {case}");
+        let mu_max = f.mu_static.max(f.mu_dynamic);
+        let [px, py] = map.tangential_impulse;
+        assert!(px.hypot(py) <= mu_max * map.normal_impulse * (1.0 + 1e-9) + 1e-12 * scale);
+    }
+    println!("{separated} of 200 separated within 1 ms");
+    assert!(separated > 0 && separated < 200, "both endings exercised");
+}
+
+/// Bad input is a typed error naming the field, never a panic.
+#[test]
+fn bad_input_names_the_field() {
+    let a = head_on(CUBE_MASS, 0.1);
+    let p = ImpactParams::thesis_table_5_2();
+    let f = FrictionParams::thesis_table_5_2();
+    let s = ImpactMapSettings::default();
+    let cases: Vec<(ImpactMapError, &str)> = vec![
+        (
+            impact_map(&ContactApproach { normal_mass: 0.0, ..a }, &p, &f, &s).unwrap_err(),
+            "normal_mass",
+        ),
+        (
+            impact_map(
+                &ContactApproach {
+                    tangential_mass: f64::NAN,
+                    ..a
+                },
+                &p,
+                &f,
+                &s,
+            )
+            .unwrap_err(),
+            "tangential_mass",
+        ),
+        (
+            impact_map(
+                &ContactApproach {
+                    approach_speed: -0.1,
+                    ..a
+                },
+                &p,
+                &f,
+                &s,
+            )
+            .unwrap_err(),
+            "approach_speed",
+        ),
+        (
+            impact_map(
+                &ContactApproach {
+                    slip_velocity: [f64::INFINITY, 0.0],
+                    ..a
+                },
+                &p,
+                &f,
+                &s,
+            )
+            .unwrap_err(),
+            "slip_velocity",
+        ),
+        (
+            impact_map(
+                &ContactApproach {
+                    external_normal_force: f64::NAN,
+                    ..a
+                },
+                &p,
+                &f,
+                &s,
+            )
+            .unwrap_err(),
+            "external_normal_force",
+        ),
+        (
+            impact_map(
+                &a,
+                &ImpactParams {
+                    stiffness: -1.0,
+                    ..p
+                },
+                &f,
+                &s,
+            )
+            .unwrap_err(),
+            "stiffness",
+        ),
+        (
+            impact_map(
+                &a,
+                &p,
+                &FrictionParams {
+                    mu_static: f64::NAN,
+                    ..f
+                },
+                &s,
+            )
+            .unwrap_err(),
+            "mu_static",
+        ),
+        (
+            impact_map(
+                &a,
+                &p,
+                &f,
+                &ImpactMapSettings {
+                    time_limit: 0.0,
+                    ..s
+                },
+            )
+            .unwrap_err(),
+            "time_limit",
+        ),
+    ];
+    for (error, field) in cases {
+        assert_eq!(error.field(), Some(field), "{error}");
+        assert!(error.to_string().contains(field), "{error}");
+    }
+    assert!(matches!(
+        impact_map(&ContactApproach { normal_mass: -1.0, ..a }, &p, &f, &s),
+        Err(ImpactMapError::Approach(_))
+    ));
+}
