@@ -58,9 +58,10 @@ pub(crate) fn impact_map_cost(batches: usize, per_batch: usize) -> Result<Vec<Ta
         ),
     ];
     let mut t = Table::new(
-        "Contact-local impulse map: CPU cost of one evaluation (46 g cube, default tolerance 1e-10)",
+        "Contact-local impulse map: CPU cost of one evaluation (46 g cube)",
         &[
             ("case", "case"),
+            ("relative_tolerance", "relative tolerance"),
             ("end", "end"),
             ("steps", "accepted steps"),
             ("rejected", "rejected"),
@@ -68,9 +69,13 @@ pub(crate) fn impact_map_cost(batches: usize, per_batch: usize) -> Result<Vec<Ta
             ("us_per_step", "µs per step"),
         ],
     );
-    for (name, approach, impact, time_limit) in cases {
+    for ((name, approach, impact, time_limit), relative_tolerance) in cases
+        .into_iter()
+        .flat_map(|case| [(case, 1e-10), (case, 1e-7)])
+    {
         let settings = ImpactMapSettings {
             time_limit,
+            relative_tolerance,
             ..ImpactMapSettings::default()
         };
         let map = impact_map(&approach, &impact, &friction, &settings)?;
@@ -91,6 +96,7 @@ pub(crate) fn impact_map_cost(batches: usize, per_batch: usize) -> Result<Vec<Ta
         let median = per_map[per_map.len() / 2];
         t.row(vec![
             Cell::text(name),
+            Cell::Num(relative_tolerance),
             Cell::text(format!("{:?}", map.end)),
             Cell::Int(map.steps as u64),
             Cell::Int(map.rejected_steps as u64),
