@@ -455,10 +455,7 @@ fn main() -> Result<()> {
                 every: *every,
             },
         )?,
-        Command::ImpactMap {
-            batches,
-            per_batch,
-        } => impact_map_cost(*batches, *per_batch)?,
+        Command::ImpactMap { batches, per_batch } => impact_map_cost(*batches, *per_batch)?,
         Command::Missiles {
             settle,
             window,

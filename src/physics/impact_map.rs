@@ -180,10 +180,7 @@ impl ContactApproach {
         let finite = [
             ("slip_velocity", self.slip_velocity),
             ("external_tangential_force", self.external_tangential_force),
-            (
-                "external_normal_force",
-                [self.external_normal_force, 0.0],
-            ),
+            ("external_normal_force", [self.external_normal_force, 0.0]),
         ];
         for (field, [x, y]) in finite {
             if !(x.is_finite() && y.is_finite()) {

@@ -6,11 +6,9 @@
 //! no allocation and no system, so the same tableau is written here for arrays (an ODE crate
 //! would allocate per call and cannot stop at the damping ramp's ends on our terms).
 
-/// Nodes `c_i` of the Dormand–Prince tableau (Hairer, Nørsett & Wanner, *Solving ODEs I*,
-/// table 5.2).
-const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-
-/// Coupling coefficients `a_ij`; the last row is the fifth-order weights (FSAL).
+/// Coupling coefficients `a_ij` of the Dormand–Prince tableau (Hairer, Nørsett & Wanner,
+/// *Solving ODEs I*, II.5); the last row is the fifth-order weights (FSAL). The system is
+/// autonomous, so the nodes `c_i` are not needed.
 const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -72,7 +70,6 @@ pub fn dopri5_step<const N: usize>(
     f0: &[f64; N],
     h: f64,
 ) -> Dopri5Step<N> {
-    debug_assert!(C[6] == 1.0);
     let mut k = [[0.0; N]; 7];
     k[0] = *f0;
     let mut z = *y0;

@@ -3,13 +3,13 @@
 //! passivity over random inputs, typed input errors. Every number is fixed by physics (a closed
 //! form, a bound, the issue's 1 %), never copied from the map's output.
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::impact_map::{
     impact_map, ContactApproach, ContactEnd, ImpactMap, ImpactMapError, ImpactMapSettings,
 };
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use statrs::function::gamma::gamma;
 
 /// The rattle box's cube, kg (thesis Table 5.1).
@@ -92,7 +92,11 @@ fn undamped_impact_matches_the_closed_form() {
         assert!(duration_error < 1e-6, "e {e}: t {} vs {t_c}", map.duration);
         assert!((restitution - 1.0).abs() < 1e-9, "e {e}: COR {restitution}");
         assert!(energy_error < 1e-9, "e {e}");
-        assert!(peak_error < 1e-9, "e {e}: {} vs {w_max}", map.max_penetration);
+        assert!(
+            peak_error < 1e-9,
+            "e {e}: {} vs {w_max}",
+            map.max_penetration
+        );
         assert!(map.end_penetration.abs() < 1e-9 * w_max);
         assert_eq!(map.damping_dissipation, 0.0);
     }
@@ -205,7 +209,10 @@ fn damped_drop_matches_a_fine_fixed_step_reference() {
              dissipation vs reference {full_error:.2e}, {} steps",
             full.duration, -full.exit_normal_velocity, full.steps
         );
-        assert!(restitution > 0.0 && restitution < last_restitution, "v0 {v0}");
+        assert!(
+            restitution > 0.0 && restitution < last_restitution,
+            "v0 {v0}"
+        );
         assert!(full_error.abs() < 0.01, "v0 {v0}: {full_error}");
         last_restitution = restitution;
         exit_speeds.push(-full.exit_normal_velocity);
@@ -349,7 +356,10 @@ fn random_transients_are_passive() {
         );
         assert!(map.damping_dissipation >= -1e-9 * scale, "case {case}");
         assert!(map.friction_dissipation >= -1e-9 * scale, "case {case}");
-        assert!(energy_residual(&a, &p, &map).abs() < 1e-8 * scale, "case {case}");
+        assert!(
+            energy_residual(&a, &p, &map).abs() < 1e-8 * scale,
+            "case {case}"
+        );
         let mu_max = f.mu_static.max(f.mu_dynamic);
         let [px, py] = map.tangential_impulse;
         assert!(px.hypot(py) <= mu_max * map.normal_impulse * (1.0 + 1e-9) + 1e-12 * scale);
@@ -367,7 +377,16 @@ fn bad_input_names_the_field() {
     let s = ImpactMapSettings::default();
     let cases: Vec<(ImpactMapError, &str)> = vec![
         (
-            impact_map(&ContactApproach { normal_mass: 0.0, ..a }, &p, &f, &s).unwrap_err(),
+            impact_map(
+                &ContactApproach {
+                    normal_mass: 0.0,
+                    ..a
+                },
+                &p,
+                &f,
+                &s,
+            )
+            .unwrap_err(),
             "normal_mass",
         ),
         (
@@ -467,7 +486,15 @@ fn bad_input_names_the_field() {
         assert!(error.to_string().contains(field), "{error}");
     }
     assert!(matches!(
-        impact_map(&ContactApproach { normal_mass: -1.0, ..a }, &p, &f, &s),
+        impact_map(
+            &ContactApproach {
+                normal_mass: -1.0,
+                ..a
+            },
+            &p,
+            &f,
+            &s
+        ),
         Err(ImpactMapError::Approach(_))
     ));
 }
