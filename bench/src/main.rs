@@ -29,6 +29,7 @@ mod convergence;
 mod engine;
 mod face_states;
 mod faces;
+mod impact_map;
 mod launcher;
 mod load;
 mod missiles;
@@ -40,6 +41,7 @@ mod table;
 use budget::*;
 use convergence::*;
 use engine::*;
+use impact_map::*;
 use launcher::*;
 use load::*;
 use missiles::*;
@@ -133,6 +135,15 @@ enum Command {
         /// Windows (s) of the duration-linearity table, comma list (empty: no table).
         #[arg(long, default_value = "")]
         durations: String,
+    },
+    /// Issue 28's contact-local impulse map: CPU cost of one evaluation (median over batches).
+    ImpactMap {
+        /// Timed batches (the median is reported).
+        #[arg(long, default_value_t = 201)]
+        batches: usize,
+        /// Evaluations per batch.
+        #[arg(long, default_value_t = 20)]
+        per_batch: usize,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -444,6 +455,7 @@ fn main() -> Result<()> {
                 every: *every,
             },
         )?,
+        Command::ImpactMap { batches, per_batch } => impact_map_cost(*batches, *per_batch)?,
         Command::Missiles {
             settle,
             window,

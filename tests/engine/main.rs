@@ -16,6 +16,7 @@ mod gap_diagnose_simulated;
 mod gap_effects;
 mod gap_mechanisms;
 mod gap_rig;
+mod impact_map;
 mod launcher_model;
 mod launcher_trend;
 mod multi_missile;
