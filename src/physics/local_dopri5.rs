@@ -8,8 +8,9 @@
 
 /// Coupling coefficients `a_ij` of the Dormand–Prince tableau (Hairer, Nørsett & Wanner,
 /// *Solving ODEs I*, II.5); the last row is the fifth-order weights (FSAL). The system is
-/// autonomous, so the nodes `c_i` are not needed.
-const A: [[f64; 6]; 7] = [
+/// autonomous, so the nodes `c_i` are not needed here. The engine's Dopri5 reads the same
+/// table.
+pub const DOPRI5_A: [[f64; 6]; 7] = [
     [0.0; 6],
     [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
@@ -41,7 +42,7 @@ const A: [[f64; 6]; 7] = [
 ];
 
 /// Fifth- minus fourth-order weights: the embedded local error estimate `h Σ e_i k_i`.
-const E: [f64; 7] = [
+pub const DOPRI5_E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
     -71.0 / 16695.0,
@@ -76,7 +77,7 @@ pub fn dopri5_step<const N: usize>(
     for s in 1..7 {
         for i in 0..N {
             let mut acc = 0.0;
-            for (j, a) in A[s].iter().enumerate().take(s) {
+            for (j, a) in DOPRI5_A[s].iter().enumerate().take(s) {
                 acc += a * k[j][i];
             }
             z[i] = y0[i] + h * acc;
@@ -86,7 +87,7 @@ pub fn dopri5_step<const N: usize>(
     let mut error = [0.0; N];
     for (i, e) in error.iter_mut().enumerate() {
         let mut acc = 0.0;
-        for (j, ej) in E.iter().enumerate() {
+        for (j, ej) in DOPRI5_E.iter().enumerate() {
             acc += ej * k[j][i];
         }
         *e = h * acc;

@@ -295,8 +295,7 @@ impl<'a> FitProblem<'a> {
                     .sum();
                 let mu = o.predicted(p);
                 if let [a, b] = spec[..] {
-                    extra +=
-                        joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i, mu);
+                    extra += joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i, mu);
                 }
                 (i, self.noise.term(o, mu, extra))
             })
