@@ -12,14 +12,7 @@ pub(crate) fn impact_map_cost(batches: usize, per_batch: usize) -> Result<Vec<Ta
     let mass = 0.046;
     let thesis = ImpactParams::thesis_table_5_2();
     let friction = FrictionParams::thesis_table_5_2();
-    let head_on = |speed: f64| ContactApproach {
-        normal_mass: mass,
-        tangential_mass: mass,
-        approach_speed: speed,
-        slip_velocity: [0.0, 0.0],
-        external_normal_force: 0.0,
-        external_tangential_force: [0.0, 0.0],
-    };
+    let head_on = |speed: f64| ContactApproach::head_on(mass, speed);
     let sliding = ContactApproach {
         slip_velocity: [0.2, 0.05],
         external_normal_force: mass * 9.81,

@@ -157,25 +157,27 @@ impl ImpactMapError {
 }
 
 impl ContactApproach {
+    /// A point of mass `mass` (both effective masses) meeting the surface head-on at `speed`,
+    /// with no slip and no external force.
+    pub fn head_on(mass: f64, speed: f64) -> Self {
+        Self {
+            normal_mass: mass,
+            tangential_mass: mass,
+            approach_speed: speed,
+            slip_velocity: [0.0, 0.0],
+            external_normal_force: 0.0,
+            external_tangential_force: [0.0, 0.0],
+        }
+    }
+
     /// Checks every field: masses finite and > 0, approach speed finite and > 0, the rest finite.
     pub fn validate(&self) -> Result<(), FieldError> {
-        for (field, m) in [
+        for (field, x) in [
             ("normal_mass", self.normal_mass),
             ("tangential_mass", self.tangential_mass),
+            ("approach_speed", self.approach_speed),
         ] {
-            if !(m.is_finite() && m > 0.0) {
-                return Err(FieldError::new(
-                    field,
-                    format!("must be a finite number > 0, got {m}"),
-                ));
-            }
-        }
-        let v = self.approach_speed;
-        if !(v.is_finite() && v > 0.0) {
-            return Err(FieldError::new(
-                "approach_speed",
-                format!("must be a finite number > 0, got {v}"),
-            ));
+            positive(field, x)?;
         }
         let finite = [
             ("slip_velocity", self.slip_velocity),
@@ -191,6 +193,18 @@ impl ContactApproach {
     }
 }
 
+/// `x` finite and > 0, or the field's error.
+fn positive(field: &str, x: f64) -> Result<(), FieldError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(FieldError::new(
+            field,
+            format!("must be a finite number > 0, got {x}"),
+        ))
+    }
+}
+
 impl ImpactMapSettings {
     /// Checks the tolerance (finite, in (0, 1)), the time limit (finite, > 0) and the step count.
     pub fn validate(&self) -> Result<(), FieldError> {
@@ -201,13 +215,7 @@ impl ImpactMapSettings {
                 format!("must be a finite number in (0, 1), got {r}"),
             ));
         }
-        let t = self.time_limit;
-        if !(t.is_finite() && t > 0.0) {
-            return Err(FieldError::new(
-                "time_limit",
-                format!("must be a finite number > 0, got {t}"),
-            ));
-        }
+        positive("time_limit", self.time_limit)?;
         if self.max_steps == 0 {
             return Err(FieldError::new("max_steps", "must be at least 1"));
         }

@@ -16,14 +16,7 @@ use statrs::function::gamma::gamma;
 const CUBE_MASS: f64 = 0.046;
 
 fn head_on(mass: f64, speed: f64) -> ContactApproach {
-    ContactApproach {
-        normal_mass: mass,
-        tangential_mass: mass,
-        approach_speed: speed,
-        slip_velocity: [0.0, 0.0],
-        external_normal_force: 0.0,
-        external_tangential_force: [0.0, 0.0],
-    }
+    ContactApproach::head_on(mass, speed)
 }
 
 fn undamped(exponent: f64) -> ImpactParams {
