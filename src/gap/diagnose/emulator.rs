@@ -567,8 +567,7 @@ impl Emulator {
     /// where either member is off (the product is exact there), and is smooth in both
     /// magnitudes: a fit moving between joint points sees no jump.
     fn interacting(&self, a: usize, ma: f64, b: usize, mb: f64) -> TestPredictions {
-        let unit = |t: usize, m: f64| self.unit(t, m);
-        let (u, v) = (unit(a, ma), unit(b, mb));
+        let (u, v) = (self.unit(a, ma), self.unit(b, mb));
         // (u_i, v_i, joint, product) at each joint point of the two tables, in (a, b) order.
         let points: Vec<(f64, f64, &TestPredictions, TestPredictions)> = self
             .joints
@@ -581,7 +580,7 @@ impl Emulator {
                 } else {
                     return None;
                 };
-                let (ui, vi) = (unit(a, x), unit(b, y));
+                let (ui, vi) = (self.unit(a, x), self.unit(b, y));
                 (ui * vi != 0.0).then(|| (ui, vi, &j.predictions, self.product(&[(a, x), (b, y)])))
             })
             .collect();

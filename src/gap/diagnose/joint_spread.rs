@@ -43,9 +43,13 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
         .iter()
         .filter_map(|j| {
             let shifted = j.initial_state.as_ref()?;
+            // Each observation's two draws, taken once.
+            let draws: Vec<(f64, f64)> = obs
+                .iter()
+                .map(|o| (o.predicted(&j.predictions), o.predicted(shifted)))
+                .collect();
             let mut pooled: BTreeMap<(usize, String), (f64, usize)> = BTreeMap::new();
-            for o in obs {
-                let (x, y) = (o.predicted(&j.predictions), o.predicted(shifted));
+            for (o, &(x, y)) in obs.iter().zip(&draws) {
                 let scale = x.abs().max(y.abs());
                 if scale > 0.0 && scale.is_finite() {
                     let e = pooled.entry(kind(o)).or_insert((0.0, 0));
@@ -57,10 +61,10 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
                 .iter()
                 .map(|o| pooled.get(&kind(o)).map_or(0.0, |(s, n)| s / *n as f64))
                 .collect();
-            let abs_var = obs
+            let abs_var = draws
                 .iter()
-                .map(|o| {
-                    let d = o.predicted(&j.predictions) - o.predicted(shifted);
+                .map(|(x, y)| {
+                    let d = x - y;
                     if d.is_finite() {
                         d * d
                     } else {
@@ -82,26 +86,31 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
         .collect()
 }
 
-/// The relative variance (of the prediction `mu`) tables `a` at `ma` and `b` at `mb` together
-/// add to observation `i`: at each joint point the larger of its pooled relative variance and
-/// its own squared difference over `mu²`; the joint points weighted as the interaction is (one
+/// The joint points of tables `a` at `ma` and `b` at `mb`, weighted as the interaction is (one
 /// at a joint point, inverse squared distance in magnitude over bound otherwise), each faded
-/// by the product of the magnitudes over the point's (capped at 1), so that it vanishes as
-/// either member goes off and the pair becomes a single, whose own spread its table's
-/// roughness carries.
-pub(super) fn rel_var(
-    spreads: &[JointSpread],
+/// by the product of the magnitudes over the point's (capped at 1), so that the spread
+/// vanishes as either member goes off and the pair becomes a single, whose own spread its
+/// table's roughness carries. They depend on the pair's magnitudes only, so a likelihood
+/// evaluation takes them once for all its observations ([`PairSpread::rel_var`]).
+pub(super) struct PairSpread<'s> {
+    /// (joint point, fade, squared distance, sum of inverse squared distances); at a joint
+    /// point itself only that point, with both divisors 1.
+    points: Vec<(&'s JointSpread, f64, f64, f64)>,
+}
+
+/// [`PairSpread`] of tables `a` at `ma` and `b` at `mb` (no point when either is off).
+pub(super) fn pair_spread<'s>(
+    spreads: &'s [JointSpread],
     emulator: &Emulator,
     (a, ma): (usize, f64),
     (b, mb): (usize, f64),
-    i: usize,
-    mu: f64,
-) -> f64 {
+) -> PairSpread<'s> {
     if ma == 0.0 || mb == 0.0 {
-        return 0.0;
+        return PairSpread { points: Vec::new() };
     }
     let (u, v) = (emulator.unit(a, ma), emulator.unit(b, mb));
-    let points: Vec<(f64, f64, f64)> = spreads
+    // (point, fade, squared distance) of each joint point of the two tables.
+    let near: Vec<(&JointSpread, f64, f64)> = spreads
         .iter()
         .filter_map(|s| {
             let [x, y] = if s.tables == [a, b] {
@@ -112,28 +121,38 @@ pub(super) fn rel_var(
                 return None;
             };
             let fade = (u * v / (x * y)).abs().min(1.0);
-            let own = if mu != 0.0 {
-                s.abs_var[i] / (mu * mu)
-            } else {
-                0.0
-            };
-            Some((x, y, fade * s.rel_var[i].max(own)))
+            Some((s, fade, (u - x).powi(2) + (v - y).powi(2)))
         })
         .collect();
-    if points.is_empty() {
-        return 0.0;
+    if let Some(&(s, fade, _)) = near.iter().find(|(_, _, d)| *d < 1e-24) {
+        return PairSpread {
+            points: vec![(s, fade, 1.0, 1.0)],
+        };
     }
-    let d2: Vec<f64> = points
-        .iter()
-        .map(|(x, y, _)| (u - x).powi(2) + (v - y).powi(2))
-        .collect();
-    if let Some(k) = d2.iter().position(|d| *d < 1e-24) {
-        return points[k].2;
+    let total: f64 = near.iter().map(|(_, _, d)| 1.0 / d).sum();
+    PairSpread {
+        points: near
+            .into_iter()
+            .map(|(s, fade, d)| (s, fade, d, total))
+            .collect(),
     }
-    let total: f64 = d2.iter().map(|d| 1.0 / d).sum();
-    points
-        .iter()
-        .zip(&d2)
-        .map(|((_, _, s), d)| s / d / total)
-        .sum()
+}
+
+impl PairSpread<'_> {
+    /// The relative variance (of the prediction `mu`) the pair adds to observation `i`: at
+    /// each joint point the larger of its pooled relative variance and its own squared
+    /// difference over `mu²`, faded and weighted.
+    pub(super) fn rel_var(&self, i: usize, mu: f64) -> f64 {
+        self.points
+            .iter()
+            .map(|(s, fade, d, total)| {
+                let own = if mu != 0.0 {
+                    s.abs_var[i] / (mu * mu)
+                } else {
+                    0.0
+                };
+                fade * s.rel_var[i].max(own) / d / total
+            })
+            .sum()
+    }
 }

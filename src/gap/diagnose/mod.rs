@@ -283,6 +283,17 @@ impl<'a> FitProblem<'a> {
         spec: &'b [(usize, f64)],
         mask: &'b dyn Fn(usize) -> bool,
     ) -> impl Iterator<Item = (usize, noise::Term)> + 'b {
+        // Two effects: their joint points' initial-state spread, weighted once for every
+        // observation.
+        let pair = match spec {
+            [a, b] => Some(joint_spread::pair_spread(
+                &self.joint_spreads,
+                self.emulator,
+                *a,
+                *b,
+            )),
+            _ => None,
+        };
         self.obs
             .iter()
             .enumerate()
@@ -294,8 +305,8 @@ impl<'a> FitProblem<'a> {
                     .map(|(e, _)| self.roughness[*e][i])
                     .sum();
                 let mu = o.predicted(p);
-                if let [a, b] = spec[..] {
-                    extra += joint_spread::rel_var(&self.joint_spreads, self.emulator, a, b, i, mu);
+                if let Some(pair) = &pair {
+                    extra += pair.rel_var(i, mu);
                 }
                 (i, self.noise.term(o, mu, extra))
             })
