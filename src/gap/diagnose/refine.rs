@@ -495,9 +495,8 @@ fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapErro
                 _ => None,
             })
             .collect();
-        // The leading dynamics single (at its single's fit), and every other dynamics effect
-        // a pair puts beside it (at the pair's fit, or its single's when the pair left it
-        // at 0).
+        // The leading dynamics single, and every other dynamics effect a pair puts beside
+        // it: both at the pair's fit (each at its single's when the pair left it at 0).
         let leader = pairs
             .iter()
             .flat_map(|(_, c)| c.spec.iter().map(|s| problem.family_of(s.0)))
@@ -512,14 +511,18 @@ fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapErro
                     [x, y] if *both => [x, y],
                     _ => continue,
                 };
-                let (t, m) = match (problem.family_of(x.0) == lf, problem.family_of(y.0) == lf) {
-                    (true, false) => y,
-                    (false, true) => x,
-                    _ => continue,
-                };
+                let (at, (t, m)) =
+                    match (problem.family_of(x.0) == lf, problem.family_of(y.0) == lf) {
+                        (true, false) => (x, y),
+                        (false, true) => (y, x),
+                        _ => continue,
+                    };
                 let m = if m != 0.0 { m } else { single_magnitude(t) };
+                // The leader where this pair's fit puts it: a single pushed to its bound
+                // by what its partner carries is no place to bisect the partner.
+                let leader = if at.1 != 0.0 { at } else { l };
                 if !beside_leader.iter().any(|p| p[1].0 == t) {
-                    beside_leader.push([l, (t, m)]);
+                    beside_leader.push([leader, (t, m)]);
                 }
             }
         }
@@ -537,7 +540,15 @@ fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapErro
     // Each partner of the leading dynamics effect: its secondary value bisected beside it.
     for [leader, (partner, m)] in beside_leader {
         if m != 0.0 && leader.1 != 0.0 {
-            bisect_beside(sim, emulator, (partner, m), leader)?;
+            let landed = bisect_beside(sim, emulator, (partner, m), leader)?;
+            // The leader's magnitude where the partner's best table lands beside it, far from
+            // where the bisection put it (the product of the two ratios misplaced the pair):
+            // bisected again there.
+            if let Some([(t, at), (o, ao)]) = landed {
+                if (ao / leader.1).abs().ln().abs() > LEADER_MOVE.ln() {
+                    bisect_beside(sim, emulator, (t, at), (o, ao))?;
+                }
+            }
         }
     }
     for (d, w) in contenders {
@@ -558,6 +569,9 @@ fn pair_variants(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapErro
 
 /// Bisection passes of a dynamics pair member's secondary value with the other member on.
 const PAIR_BISECTIONS: usize = 3;
+/// Factor by which the leader's magnitude where a bisected partner lands may differ from
+/// where it was bisected before the partner is bisected again there.
+const LEADER_MOVE: f64 = 2.0;
 
 /// The secondary value of dynamics table `member`'s effect (one secondary parameter) chosen
 /// with table `other` on at its magnitude: a single's profile chose it without the other,
@@ -569,24 +583,26 @@ const PAIR_BISECTIONS: usize = 3;
 /// added, each simulated alone and beside `other` where the best table's pair fit lands (two
 /// simulations per value: the pair's fit moves the member's magnitude along the variant's
 /// table from 0 to there, and the joint point makes it exact there). Nothing is done when
-/// the effect has no single secondary parameter.
+/// the effect has no single secondary parameter. Then [`land_beside`]; returns where the
+/// member's best table lands beside `other` (None when nothing was bisected or no fit puts
+/// both on).
 fn bisect_beside(
     sim: Simulating,
     emulator: &mut Emulator,
     (member, m): (usize, f64),
     (other, mo): (usize, f64),
-) -> Result<(), GapError> {
+) -> Result<Option<[(usize, f64); 2]>, GapError> {
     let (campaign, options, configs_dir, control, cache) = sim.parts();
     let info = emulator.effects[member].info;
     let [_, p] = info.parameters else {
-        return Ok(());
+        return Ok(None);
     };
     let Some(default_table) = emulator
         .family(member)
         .into_iter()
         .find(|&t| emulator.effects[t].parameters.is_empty())
     else {
-        return Ok(());
+        return Ok(None);
     };
     let add = |emulator: &mut Emulator, v: f64, grid: &[f64], at: f64| -> Result<(), GapError> {
         let t = emulator.add_variant(
@@ -641,6 +657,7 @@ fn bisect_beside(
     };
     for _ in 0..PAIR_BISECTIONS {
         let tried = tried(emulator);
+        tracing::debug!(member, other, mo, ?tried, "bisection beside the leader");
         let Some(i) = best_of(&tried) else {
             break;
         };
@@ -657,5 +674,85 @@ fn bisect_beside(
             break;
         }
     }
-    Ok(())
+    land_beside(sim, emulator, member, other)
+}
+
+/// Landing passes of [`land_beside`].
+const LANDING_PASSES: usize = 2;
+/// Tables of a pair member's family a landing pass simulates where their own pair fit lands.
+const LANDING_TABLES: usize = 3;
+/// A joint point held within this relative distance of a landing, in both magnitudes, is
+/// taken as there.
+const LANDING_TOLERANCE: f64 = 0.05;
+
+/// The [`LANDING_TABLES`] tables of dynamics table `member`'s family whose pair fit beside
+/// table `other` is best, each simulated where its own pair fit lands: both members alone
+/// there (refinement) and together (a joint point), [`LANDING_PASSES`] times or until every
+/// such landing holds a joint point. The bisection simulated each variant beside `other`
+/// only where the best table's fit landed; between there and 0 a variant's fit rests on the
+/// product of the two ratios, while a secondary value that makes the effect act sooner (a
+/// friction drift's shorter slip scale) lands well inside that range (docs/diagnosis.md,
+/// "A pair's landing"). Returns where the best table's pair fit lands after the passes.
+fn land_beside(
+    sim: Simulating,
+    emulator: &mut Emulator,
+    member: usize,
+    other: usize,
+) -> Result<Option<[(usize, f64); 2]>, GapError> {
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
+    for pass in 0..=LANDING_PASSES {
+        let (best, landings): (Option<[(usize, f64); 2]>, Vec<[(usize, f64); 2]>) = {
+            let problem = FitProblem::new(campaign, emulator, options);
+            let mut fits: Vec<(f64, [(usize, f64); 2])> = emulator
+                .family(member)
+                .into_iter()
+                .filter_map(|t| {
+                    let (spec, nll) = problem.fit_pair_tables(t, other, &|_| true);
+                    match spec[..] {
+                        [a, b] if a.1 != 0.0 && b.1 != 0.0 => Some((nll, [a, b])),
+                        _ => None,
+                    }
+                })
+                .collect();
+            fits.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for (nll, [a, b]) in &fits {
+                tracing::debug!(
+                    table = a.0,
+                    parameters = ?emulator.effects[a.0].parameters,
+                    magnitude = a.1,
+                    other = b.1,
+                    nll,
+                    grid = ?emulator.effects[a.0].magnitudes,
+                    "pair landing beside the leader"
+                );
+            }
+            let landings = fits
+                .iter()
+                .take(LANDING_TABLES)
+                .map(|(_, l)| *l)
+                .filter(|l| !joint_near(emulator, *l, LANDING_TOLERANCE))
+                .collect();
+            (fits.first().map(|f| f.1), landings)
+        };
+        if landings.is_empty() || pass == LANDING_PASSES {
+            return Ok(best);
+        }
+        let alone: Vec<(usize, f64)> = landings.iter().flatten().copied().collect();
+        emulator.refine(campaign, configs_dir, &alone, control, cache, &|_, _| {})?;
+        for [a, b] in landings {
+            emulator.add_joint(campaign, configs_dir, a, b, control, cache)?;
+        }
+    }
+    Ok(None)
+}
+
+/// Whether `emulator` holds a joint point of the two tables of `point` (either order) within
+/// relative distance `tolerance` of its two magnitudes.
+fn joint_near(emulator: &Emulator, [(a, ma), (b, mb)]: [(usize, f64); 2], tolerance: f64) -> bool {
+    let near = |x: f64, y: f64| (x - y).abs() <= tolerance * y.abs();
+    emulator.joints.iter().any(|j| match j.tables {
+        [ja, jb] if [ja, jb] == [a, b] => near(j.magnitudes[0], ma) && near(j.magnitudes[1], mb),
+        [ja, jb] if [ja, jb] == [b, a] => near(j.magnitudes[1], ma) && near(j.magnitudes[0], mb),
+        _ => false,
+    })
 }
