@@ -55,6 +55,7 @@ impl Works {
 /// A track's powers and penetration rate at an accepted state.
 #[derive(Clone, Copy, Default)]
 struct Powers {
+    normal: f64,
     normal_slip: f64,
     friction: f64,
     damping: f64,
@@ -70,6 +71,8 @@ struct TrackMemory {
     /// and the resolved damping work (J) and `∫N|v_slip| dt` (N·m) from the touch to the
     /// arrest so far.
     touch: Option<(ContactApproach, f64, f64)>,
+    /// The touch's approach speed, m/s (from the state before it).
+    approach_speed: Option<f64>,
 }
 
 /// One touch of the full run against its impulse map.
@@ -145,6 +148,18 @@ struct Split {
     cpu_s: Option<f64>,
     mean_friction_power_w: f64,
     touch_maps: Vec<TouchMap>,
+    /// Per separated episode: (duration from touch to the last active state, s, exit speed /
+    /// approach speed).
+    episodes: Vec<(f64, f64)>,
+    /// Accepted steps in which some track is between its touch and its arrest, and in which
+    /// some track's step starts within the approach window of its touch.
+    approach_steps: u64,
+    window_steps: u64,
+    /// Accepted steps in which no track is before its arrest but some track is within 1 ms of
+    /// its touch (the start of the creep on the slow manifold).
+    creep_steps: u64,
+    /// Per track (contact, track): ∫N·|v_slip| dt over the window, N·m.
+    per_track: std::collections::BTreeMap<(u32, u32), (f64, f64)>,
 }
 
 fn run_split(
@@ -186,6 +201,7 @@ fn run_split(
                 (
                     (tr.contact, tr.track),
                     Powers {
+                        normal: tr.normal_force,
                         normal_slip: tr.normal_force * tr.slip_speed,
                         friction: tr.friction_power,
                         damping: tr.damping_power,
@@ -203,6 +219,7 @@ fn run_split(
                 arrested: false,
                 last: None,
                 touch: None,
+                approach_speed: None,
             });
             if m.last.is_none() {
                 // A touch (or the track was active when the window opened).
@@ -210,15 +227,20 @@ fn run_split(
                 m.arrested = false;
                 split.touches += 1;
                 m.touch = None;
-                if maps.is_some() && !y_before.is_empty() {
+                m.approach_speed = None;
+                if !y_before.is_empty() {
                     if let Some(tr) = v.tracks.iter().find(|tr| (tr.contact, tr.track) == *key) {
-                        m.touch = touch_approach(v.system, v.t_prev, &y_before, tr)
-                            .map(|a| (a, 0.0, 0.0));
+                        let approach = touch_approach(v.system, v.t_prev, &y_before, tr);
+                        m.approach_speed = approach.map(|a| a.approach_speed);
+                        if maps.is_some() {
+                            m.touch = approach.map(|a| (a, 0.0, 0.0));
+                        }
                     }
                 }
             }
         }
         let zero = Powers::default();
+        let (mut in_approach_step, mut in_window_step, mut in_creep_step) = (false, false, false);
         for (key, m) in memory.iter_mut() {
             let after = now.get(key);
             let before = m.last.as_ref();
@@ -228,10 +250,23 @@ fn run_split(
             let a = before.unwrap_or(&zero);
             let e = after.unwrap_or(&zero);
             let first_step = before.is_none();
+            if let (None, Some(last), Some(v_in)) = (after, before, m.approach_speed) {
+                // A separation: the episode's duration and its exit speed over the approach
+                // speed (the last active state's −ẇ).
+                split
+                    .episodes
+                    .push((v.t_prev - m.touch_s, (-last.rate).max(0.0) / v_in));
+            }
             let in_window = usize::from(v.t_prev >= m.touch_s + b.approach_s);
             let in_approach = usize::from(m.arrested);
             let fast =
                 first_step || a.rate.abs() > b.fast_rate_m_s || e.rate.abs() > b.fast_rate_m_s;
+            in_approach_step |= in_approach == 0;
+            in_window_step |= in_window == 0;
+            in_creep_step |= in_approach == 1 && v.t_prev < m.touch_s + 1e-3;
+            let track = split.per_track.entry(*key).or_default();
+            track.0 += 0.5 * dt * (a.normal_slip + e.normal_slip);
+            track.1 += 0.5 * dt * (a.normal + e.normal);
             split.window[in_window].add(dt, a, e);
             split.arrest[in_approach].add(dt, a, e);
             split.fast[usize::from(!fast)].add(dt, a, e);
@@ -269,6 +304,11 @@ fn run_split(
             }
             m.last = after.copied();
         }
+        if dt > 0.0 {
+            split.approach_steps += u64::from(in_approach_step);
+            split.window_steps += u64::from(in_window_step);
+            split.creep_steps += u64::from(in_creep_step && !in_approach_step);
+        }
         y_before.clear();
         y_before.extend_from_slice(v.state);
     })
@@ -277,6 +317,20 @@ fn run_split(
     split.accepted = report.integrator.accepted;
     split.mean_friction_power_w = report.mean_friction_power_w;
     Ok(split)
+}
+
+/// One definition of the approach transient: a run's [approach, rest] works.
+type SplitPart = fn(&Split) -> &[Works; 2];
+/// One integral of a [`Works`].
+type WorkOf = fn(&Works) -> f64;
+
+/// The `q` quantile (nearest rank) of `x`, None when empty.
+fn quantile(mut x: Vec<f64>, q: f64) -> Option<f64> {
+    if x.is_empty() {
+        return None;
+    }
+    x.sort_by(f64::total_cmp);
+    Some(x[((x.len() - 1) as f64 * q).round() as usize])
 }
 
 pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<Vec<Table>> {
@@ -304,8 +358,19 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("variant", "variant"),
             ("accepted", "accepted"),
             ("cpu_s", "CPU s"),
+            ("approach_steps", "steps touch → arrest"),
+            ("window_steps", "steps within the window after touch"),
+            ("creep_steps", "other steps within 1 ms after a touch"),
             ("touches_per_s", "touches per s"),
             ("mean_friction_power_w", "mean N·|v_slip| W (report)"),
+            ("episodes", "separations"),
+            ("short", "separations within 10 ms of the touch"),
+            ("duration", "median contact duration s"),
+            ("restitution", "median exit / approach speed"),
+            (
+                "restitution_short",
+                "median exit / approach speed, within 10 ms",
+            ),
         ],
     );
     let mut parts = Table::new(
@@ -355,6 +420,21 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("map_slip", "Σ map ∫N|v_slip| (N·m)"),
         ],
     );
+    let mut tracks = Table::new(
+        "Impact split: ∫N·|v_slip| dt per contact track (N·m)",
+        &[
+            ("case", "case"),
+            ("track", "contact/track (face)"),
+            ("full", "full, tol"),
+            ("positions", "positions, no work test"),
+            ("reference", "full, tol/4"),
+            ("share", "share of the total difference"),
+            ("mean_n_full", "mean N full (N)"),
+            ("mean_n_positions", "mean N positions (N)"),
+            ("slip_full", "N-weighted mean slip full (m/s)"),
+            ("slip_positions", "N-weighted mean slip positions (m/s)"),
+        ],
+    );
     for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let mut measured = Vec::new();
         for (label, mode, work_test, factor) in variants {
@@ -366,10 +446,50 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 Cell::text(label),
                 Cell::Int(s.accepted),
                 Cell::opt(s.cpu_s),
+                Cell::Int(s.approach_steps),
+                Cell::Int(s.window_steps),
+                Cell::Int(s.creep_steps),
                 Cell::Num(s.touches as f64 / b.window),
                 Cell::Num(s.mean_friction_power_w),
+                Cell::Int(s.episodes.len() as u64),
+                Cell::Int(s.episodes.iter().filter(|e| e.0 < 0.01).count() as u64),
+                Cell::opt(quantile(s.episodes.iter().map(|e| e.0).collect(), 0.5)),
+                Cell::opt(quantile(s.episodes.iter().map(|e| e.1).collect(), 0.5)),
+                Cell::opt(quantile(
+                    s.episodes
+                        .iter()
+                        .filter(|e| e.0 < 0.01)
+                        .map(|e| e.1)
+                        .collect(),
+                    0.5,
+                )),
             ]);
             measured.push(s);
+        }
+        let total_of = |s: &Split| s.per_track.values().map(|t| t.0).sum::<f64>();
+        let total_diff = total_of(&measured[1]) - total_of(&measured[0]);
+        let keys: std::collections::BTreeSet<(u32, u32)> = measured
+            .iter()
+            .flat_map(|s| s.per_track.keys().copied())
+            .collect();
+        for key in keys {
+            let at = |s: &Split| s.per_track.get(&key).map_or(0.0, |t| t.0);
+            let mean_n = |s: &Split| s.per_track.get(&key).map_or(0.0, |t| t.1) / b.window;
+            tracks.row(vec![
+                Cell::text(case_name),
+                Cell::text(format!("{}/{}", key.0, key.1)),
+                Cell::Num(at(&measured[0])),
+                Cell::Num(at(&measured[1])),
+                Cell::Num(at(&measured[2])),
+                Cell::text(format!(
+                    "{:.1} %",
+                    100.0 * (at(&measured[1]) - at(&measured[0])) / total_diff
+                )),
+                Cell::Num(mean_n(&measured[0])),
+                Cell::Num(mean_n(&measured[1])),
+                Cell::Num(at(&measured[0]) / b.window / mean_n(&measured[0])),
+                Cell::Num(at(&measured[1]) / b.window / mean_n(&measured[1])),
+            ]);
         }
         let maps = &measured[0].touch_maps;
         if !maps.is_empty() {
@@ -434,14 +554,14 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 Cell::Num(sum(|t| t.map_normal_slip)),
             ]);
         }
-        let splits: [(&str, fn(&Split) -> &[Works; 2]); 3] = [
+        let splits: [(&str, SplitPart); 3] = [
             ("steps starting within the window after touch", |s| {
                 &s.window
             }),
             ("touch until arrest (first ẇ <= 0)", |s| &s.arrest),
             ("touch step or |ẇ| > fast rate", |s| &s.fast),
         ];
-        let quantities: [(&str, fn(&Works) -> f64); 3] = [
+        let quantities: [(&str, WorkOf); 3] = [
             ("∫N·|v_slip| dt (N·m)", |w| w.normal_slip),
             ("friction work ∫μN|v_slip| dt (J)", |w| w.friction),
             ("damping work (J)", |w| w.damping),
@@ -491,5 +611,5 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
          horizon = the approach window; resolved: trapezoid of the track's damping power over \
          the accepted steps from the touch to the first state with ẇ <= 0",
     );
-    Ok(vec![runs, parts, touches])
+    Ok(vec![runs, parts, touches, tracks])
 }
