@@ -362,7 +362,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("window_steps", "steps within the window after touch"),
             ("creep_steps", "other steps within 1 ms after a touch"),
             ("touches_per_s", "touches per s"),
-            ("mean_friction_power_w", "mean N·|v_slip| W (report)"),
+            ("mean_friction_power_w", "mean N·\\|v_slip\\| W (report)"),
             ("episodes", "separations"),
             ("short", "separations within 10 ms of the touch"),
             ("duration", "median contact duration s"),
@@ -401,7 +401,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("map_damping", "Σ map damping (J)"),
             ("plastic", "Σ ½ m_n v_n² (J)"),
             ("damping_diff", "Σ map / Σ resolved − 1"),
-            ("median_abs", "median |map/resolved − 1| per touch"),
+            ("median_abs", "median \\|map/resolved − 1\\| per touch"),
             ("p90_abs", "90th percentile"),
             (
                 "map_translational",
@@ -410,14 +410,14 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("translational_diff", "Σ map (body mass) / Σ resolved − 1"),
             (
                 "translational_median",
-                "median |map (body mass)/resolved − 1| per touch",
+                "median \\|map (body mass)/resolved − 1\\| per touch",
             ),
             (
                 "translational_max",
-                "largest |map (body mass)/resolved − 1|",
+                "largest \\|map (body mass)/resolved − 1\\|",
             ),
-            ("resolved_slip", "Σ resolved ∫N|v_slip| (N·m)"),
-            ("map_slip", "Σ map ∫N|v_slip| (N·m)"),
+            ("resolved_slip", "Σ resolved ∫N\\|v_slip\\| (N·m)"),
+            ("map_slip", "Σ map ∫N\\|v_slip\\| (N·m)"),
         ],
     );
     let mut tracks = Table::new(
