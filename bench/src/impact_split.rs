@@ -73,7 +73,19 @@ struct TrackMemory {
     touch: Option<(ContactApproach, f64, f64)>,
     /// The touch's approach speed, m/s (from the state before it).
     approach_speed: Option<f64>,
+    /// The state before the touch, kept until the arrested state is recorded too.
+    before: Option<(f64, Vec<f64>)>,
 }
+
+/// Touches of the full run restarted from (the first ones of the window).
+const RESTARTS: usize = 24;
+/// Time after a touch by which its arrest is complete (the map: 1e-6..1e-5 s), s.
+const ARRESTED_AFTER_S: f64 = 2e-5;
+/// Tolerance factor of the loose full-control restarts (the ladder's loosest passing factor on
+/// rattle box D; C passes at 100).
+const LOOSE_FACTOR: f64 = 64.0;
+/// Horizon of each restarted run, s (a wall episode of the full run lasts 12.6 ms at the median).
+const RESTART_HORIZON_S: f64 = 0.02;
 
 /// One touch of the full run against its impulse map.
 struct TouchMap {
@@ -158,6 +170,9 @@ struct Split {
     /// Accepted steps in which no track is before its arrest but some track is within 1 ms of
     /// its touch (the start of the creep on the slow manifold).
     creep_steps: u64,
+    /// States to restart from, per touch (at most [`RESTARTS`]): the accepted state before the
+    /// touch and the first accepted state at least [`ARRESTED_AFTER_S`] after it.
+    restarts: Vec<[(f64, Vec<f64>); 2]>,
     /// Per track (contact, track): ∫N·|v_slip| dt over the window, N·m.
     per_track: std::collections::BTreeMap<(u32, u32), (f64, f64)>,
 }
@@ -220,6 +235,7 @@ fn run_split(
                 last: None,
                 touch: None,
                 approach_speed: None,
+                before: None,
             });
             if m.last.is_none() {
                 // A touch (or the track was active when the window opened).
@@ -231,6 +247,9 @@ fn run_split(
                 if !y_before.is_empty() {
                     if let Some(tr) = v.tracks.iter().find(|tr| (tr.contact, tr.track) == *key) {
                         let approach = touch_approach(v.system, v.t_prev, &y_before, tr);
+                        if maps.is_some() && split.restarts.len() < RESTARTS {
+                            m.before = Some((v.t_prev, y_before.clone()));
+                        }
                         m.approach_speed = approach.map(|a| a.approach_speed);
                         if maps.is_some() {
                             m.touch = approach.map(|a| (a, 0.0, 0.0));
@@ -302,6 +321,16 @@ fn run_split(
                     }
                 }
             }
+            if after.is_some() && v.t >= m.touch_s + ARRESTED_AFTER_S {
+                if let Some(before) = m.before.take() {
+                    if split.restarts.len() < RESTARTS {
+                        split.restarts.push([before, (v.t, v.state.to_vec())]);
+                    }
+                }
+            }
+            if after.is_none() {
+                m.before = None;
+            }
             m.last = after.copied();
         }
         if dt > 0.0 {
@@ -317,6 +346,89 @@ fn run_split(
     split.accepted = report.integrator.accepted;
     split.mean_friction_power_w = report.mean_friction_power_w;
     Ok(split)
+}
+
+/// What the restarted runs of one mode measured, summed over the restarts.
+#[derive(Default)]
+struct Restarted {
+    accepted: u64,
+    touches: u64,
+    separations: u64,
+    normal_slip: f64,
+    damping_j: f64,
+    residual_j: f64,
+    dissipated_j: f64,
+}
+
+/// Runs `model` from each restart state (`which`: 0 before the touch, 1 arrested) over
+/// [`RESTART_HORIZON_S`] with the given error control, counting the tracks' touches and
+/// separations and integrating `N·|v_slip|` and damping power (trapezoid over accepted steps).
+fn restarted(
+    model: &BuiltModel,
+    options: &RunOptions,
+    restarts: &[[(f64, Vec<f64>); 2]],
+    which: usize,
+    mode: ErrorControl,
+    work_test: bool,
+) -> Result<Restarted> {
+    let mut settings = options.integrator;
+    settings.tolerances.error_control = mode;
+    if !work_test {
+        settings.tolerances.energy_rel = 0.0;
+    }
+    let mut out = Restarted::default();
+    for starts in restarts {
+        let (t0, y0) = &starts[which];
+        let mut y = y0.clone();
+        let mut last: HashMap<(u32, u32), (f64, f64)> = HashMap::new();
+        let mut first = true;
+        let stats = simulate(
+            &model.system,
+            &mut y,
+            *t0,
+            t0 + RESTART_HORIZON_S,
+            settings,
+            options.limits,
+            &RunControl::silent(),
+            &mut |v: &StepView| {
+                let now: HashMap<(u32, u32), (f64, f64)> = v
+                    .tracks
+                    .iter()
+                    .map(|tr| {
+                        (
+                            (tr.contact, tr.track),
+                            (tr.normal_force * tr.slip_speed, tr.damping_power),
+                        )
+                    })
+                    .collect();
+                if !first {
+                    let dt = v.t - v.t_prev;
+                    for (key, p) in &now {
+                        let a = last.get(key).copied().unwrap_or((0.0, 0.0));
+                        out.normal_slip += 0.5 * dt * (a.0 + p.0);
+                        out.damping_j += 0.5 * dt * (a.1 + p.1);
+                        out.touches += u64::from(!last.contains_key(key));
+                    }
+                    for (key, a) in &last {
+                        if !now.contains_key(key) {
+                            out.normal_slip += 0.5 * dt * a.0;
+                            out.damping_j += 0.5 * dt * a.1;
+                            out.separations += 1;
+                        }
+                    }
+                }
+                first = false;
+                last = now;
+            },
+        )
+        .map_err(|e| anyhow!("restart at {t0} s: {e}"))?;
+        out.accepted += stats.integrator.accepted;
+        if let Some(e) = stats.energy {
+            out.residual_j += e.residual_j;
+            out.dissipated_j += e.dissipated_j;
+        }
+    }
+    Ok(out)
 }
 
 /// One definition of the approach transient: a run's [approach, rest] works.
@@ -420,6 +532,22 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("map_slip", "Σ map ∫N\\|v_slip\\| (N·m)"),
         ],
     );
+    let mut restart_table = Table::new(
+        "Impact split: the full run's touches restarted, from before the touch and from the arrested state, in each mode",
+        &[
+            ("case", "case"),
+            ("from", "restarted from"),
+            ("mode", "mode"),
+            ("restarts", "restarts"),
+            ("accepted", "accepted steps"),
+            ("touches", "touches"),
+            ("separations", "separations"),
+            ("normal_slip", "Σ ∫N·\\|v_slip\\| dt (N·m)"),
+            ("normal_slip_diff", "vs full"),
+            ("damping", "Σ damping work (J)"),
+            ("residual", "Σ energy residual / Σ dissipated"),
+        ],
+    );
     let mut tracks = Table::new(
         "Impact split: ∫N·|v_slip| dt per contact track (N·m)",
         &[
@@ -465,6 +593,49 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 )),
             ]);
             measured.push(s);
+        }
+        {
+            let mut case = load_case(&configs_dir.join(format!("{case_name}.toml")))?;
+            case.simulation.settle_s = b.settle;
+            case.simulation.duration_s = b.window;
+            let model = build(&case, configs_dir)?;
+            let options = run_options(&case)?;
+            // The tolerance ladder's loosest passing factor on C (docs/benchmarks.md).
+            let mut loose_case = case.clone();
+            loose_case.simulation.rel_tolerance *= LOOSE_FACTOR;
+            loose_case.simulation.abs_tolerance_m *= LOOSE_FACTOR;
+            let loose = run_options(&loose_case)?;
+            let restarts = &measured[0].restarts;
+            for (which, from) in [(0, "before the touch"), (1, "arrested (touch + 20 µs)")] {
+                let mut full_slip = None;
+                for (label, mode, work_test, opts) in [
+                    ("full", ErrorControl::Full, true, &options),
+                    ("full, tol × 64", ErrorControl::Full, true, &loose),
+                    (
+                        "positions, no work test",
+                        ErrorControl::Positions,
+                        false,
+                        &options,
+                    ),
+                ] {
+                    eprintln!("impact-split: {case_name} restarts {from}, {label} ...");
+                    let r = restarted(&model, opts, restarts, which, mode, work_test)?;
+                    let base = *full_slip.get_or_insert(r.normal_slip);
+                    restart_table.row(vec![
+                        Cell::text(case_name),
+                        Cell::text(from),
+                        Cell::text(label),
+                        Cell::Int(restarts.len() as u64),
+                        Cell::Int(r.accepted),
+                        Cell::Int(r.touches),
+                        Cell::Int(r.separations),
+                        Cell::Num(r.normal_slip),
+                        Cell::text(format!("{:+.2} %", 100.0 * (r.normal_slip / base - 1.0))),
+                        Cell::Num(r.damping_j),
+                        Cell::Num(r.residual_j.abs() / r.dissipated_j.max(1e-30)),
+                    ]);
+                }
+            }
         }
         let total_of = |s: &Split| s.per_track.values().map(|t| t.0).sum::<f64>();
         let total_diff = total_of(&measured[1]) - total_of(&measured[0]);
@@ -611,5 +782,13 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
          horizon = the approach window; resolved: trapezoid of the track's damping power over \
          the accepted steps from the touch to the first state with ẇ <= 0",
     );
-    Ok(vec![runs, parts, touches, tracks])
+    restart_table.note(format!(
+        "the first {RESTARTS} touches of the full run at the case tolerance; each restart runs \
+         {} s from the state before the touch or from the first accepted state {} µs after it; \
+         touches and separations count tracks appearing and disappearing; integrals by the \
+         trapezoid over the accepted steps",
+        RESTART_HORIZON_S,
+        ARRESTED_AFTER_S * 1e6
+    ));
+    Ok(vec![runs, parts, touches, tracks, restart_table])
 }
