@@ -75,8 +75,26 @@ struct TrackMemory {
     touch: Option<(ContactApproach, f64, f64)>,
     /// The touch's approach speed, m/s (from the state before it).
     approach_speed: Option<f64>,
-    /// The state before the touch, kept until the arrested state is recorded too.
-    before: Option<(f64, Vec<f64>)>,
+    /// The state before the touch and the touch, kept until the arrested state is recorded too.
+    before: Option<(
+        (f64, Vec<f64>),
+        (f64, Vec<f64>),
+        railwear::physics::contact::TrackState,
+        f64,
+    )>,
+}
+
+/// One touch of the full run to restart from.
+struct Restart {
+    /// The accepted state before the touch.
+    before: (f64, Vec<f64>),
+    /// The first accepted state with the track active (the touch, `w` ~ 1e-7 m).
+    touch: (f64, Vec<f64>),
+    /// The touching track at `touch`, and the other tracks' `N·|v_slip|` there, W.
+    track: railwear::physics::contact::TrackState,
+    others_normal_slip: f64,
+    /// The first accepted state at least [`ARRESTED_AFTER_S`] after the touch.
+    arrested: (f64, Vec<f64>),
 }
 
 /// Touches of the full run restarted from (the first ones of the window).
@@ -171,7 +189,7 @@ struct Split {
     creep_steps: u64,
     /// States to restart from, per touch (at most [`RESTARTS`]): the accepted state before the
     /// touch and the first accepted state at least [`ARRESTED_AFTER_S`] after it.
-    restarts: Vec<[(f64, Vec<f64>); 2]>,
+    restarts: Vec<Restart>,
     /// Per track (contact, track): ∫N·|v_slip| dt over the window, N·m.
     per_track: std::collections::BTreeMap<(u32, u32), (f64, f64)>,
 }
@@ -247,7 +265,18 @@ fn run_split(
                     if let Some(tr) = v.tracks.iter().find(|tr| (tr.contact, tr.track) == *key) {
                         let approach = touch_approach(v.system, v.t_prev, &y_before, tr);
                         if maps.is_some() && split.restarts.len() < RESTARTS {
-                            m.before = Some((v.t_prev, y_before.clone()));
+                            let others: f64 = v
+                                .tracks
+                                .iter()
+                                .filter(|o| (o.contact, o.track) != *key)
+                                .map(|o| o.normal_force * o.slip_speed)
+                                .sum();
+                            m.before = Some((
+                                (v.t_prev, y_before.clone()),
+                                (v.t, v.state.to_vec()),
+                                *tr,
+                                others,
+                            ));
                         }
                         m.approach_speed = approach.map(|a| a.approach_speed);
                         if maps.is_some() {
@@ -321,9 +350,15 @@ fn run_split(
                 }
             }
             if after.is_some() && v.t >= m.touch_s + ARRESTED_AFTER_S {
-                if let Some(before) = m.before.take() {
+                if let Some((before, touch, track, others_normal_slip)) = m.before.take() {
                     if split.restarts.len() < RESTARTS {
-                        split.restarts.push([before, (v.t, v.state.to_vec())]);
+                        split.restarts.push(Restart {
+                            before,
+                            touch,
+                            track,
+                            others_normal_slip,
+                            arrested: (v.t, v.state.to_vec()),
+                        });
                     }
                 }
             }
@@ -359,14 +394,12 @@ struct Restarted {
     dissipated_j: f64,
 }
 
-/// Runs `model` from each restart state (`which`: 0 before the touch, 1 arrested) over
-/// [`RESTART_HORIZON_S`] with the given error control, counting the tracks' touches and
+/// Runs `model` from each start `(t0, y0)` to its `t_end` with the given error control, counting the tracks' touches and
 /// separations and integrating `N·|v_slip|` and damping power (trapezoid over accepted steps).
 fn restarted(
     model: &BuiltModel,
     options: &RunOptions,
-    restarts: &[[(f64, Vec<f64>); 2]],
-    which: usize,
+    starts: &[(f64, Vec<f64>, f64)],
     mode: ErrorControl,
     work_test: bool,
 ) -> Result<Restarted> {
@@ -376,8 +409,7 @@ fn restarted(
         settings.tolerances.energy_rel = 0.0;
     }
     let mut out = Restarted::default();
-    for starts in restarts {
-        let (t0, y0) = &starts[which];
+    for (t0, y0, t_end) in starts {
         let mut y = y0.clone();
         let mut last: HashMap<(u32, u32), (f64, f64)> = HashMap::new();
         let mut first = true;
@@ -385,7 +417,7 @@ fn restarted(
             &model.system,
             &mut y,
             *t0,
-            t0 + RESTART_HORIZON_S,
+            *t_end,
             settings,
             options.limits,
             &RunControl::silent(),
@@ -428,6 +460,95 @@ fn restarted(
         }
     }
     Ok(out)
+}
+
+/// The hybrid's start for one touch: the impulse map of the touching track over
+/// [`ARRESTED_AFTER_S`] with the body's translational mass (a flat landing) and the external
+/// force frozen at the touch (gravity and the body's other tracks' forces, less the mass times
+/// the kinematic body's acceleration, by central differences), its impulses applied to body a
+/// as a velocity jump and its penetration written into a's position, at the end of the map;
+/// the body's rotation frozen over the map. Returns the start and the map's `∫N|v_slip| dt` and
+/// damping work plus the other tracks' `N·|v_slip|` frozen over the horizon (N·m, J). None when
+/// the touch has no approach or the map fails.
+fn hybrid_start(model: &BuiltModel, r: &Restart) -> Option<((f64, Vec<f64>), f64, f64)> {
+    let system = &model.system;
+    let (t, y) = &r.touch;
+    let c = &system.contacts[r.track.contact as usize];
+    let BodyKind::Dynamic { offset } = system.bodies[c.body_a].kind else {
+        return None;
+    };
+    let mass = system.bodies[c.body_a].mass.mass;
+    let n = r.track.normal;
+    let p = r.track.point;
+    let a = frame_from_state(y, offset);
+    let mut ws = system.workspace();
+    let mut wall_velocity = |time: f64| {
+        system.frames(time, y, &mut ws);
+        ws.frames[c.body_b].point_velocity(&p)
+    };
+    let dt = 1e-7;
+    let wall_acceleration = (wall_velocity(t + dt) - wall_velocity(t - dt)) / (2.0 * dt);
+    let v_rel = a.point_velocity(&p) - wall_velocity(*t);
+    let approach_speed = -n.dot(&v_rel);
+    let slip = v_rel - n * n.dot(&v_rel);
+    let e1 = slip.try_normalize(0.0).unwrap_or_else(|| {
+        n.cross(&Vector3::x())
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| n.cross(&Vector3::y()).normalize())
+    });
+    let e2 = n.cross(&e1);
+    // The body's force from everything but this track, frozen: gravity and the other tracks.
+    let mut others = Vector3::zeros();
+    system.tracks(*t, y, &mut ws, &mut |o| {
+        if (o.contact, o.track) != (r.track.contact, r.track.track)
+            && system.contacts[o.contact as usize].body_a == c.body_a
+        {
+            let s = o
+                .slip_velocity
+                .try_normalize(0.0)
+                .unwrap_or_else(Vector3::zeros);
+            others += o.normal * o.normal_force - s * o.friction_force;
+        }
+    });
+    let body_force = system.gravity * mass + others;
+    let relative_force = body_force - wall_acceleration * mass;
+    let approach = ContactApproach {
+        normal_mass: mass,
+        tangential_mass: mass,
+        approach_speed,
+        slip_velocity: [slip.norm(), 0.0],
+        external_normal_force: -n.dot(&relative_force),
+        external_tangential_force: [e1.dot(&relative_force), e2.dot(&relative_force)],
+    };
+    let no_friction = FrictionParams {
+        mu_static: 0.0,
+        mu_dynamic: 0.0,
+        ..FrictionParams::thesis_table_5_2()
+    };
+    let friction = c.friction.as_ref().unwrap_or(&no_friction);
+    let settings = ImpactMapSettings {
+        time_limit: ARRESTED_AFTER_S,
+        ..ImpactMapSettings::default()
+    };
+    let map = impact_map(&approach, &c.impact, friction, &settings).ok()?;
+    let tau = map.duration;
+    let impulse =
+        n * map.normal_impulse + e1 * map.tangential_impulse[0] + e2 * map.tangential_impulse[1];
+    // The impulse's displacement along n: what the frozen relative motion would have
+    // penetrated beyond the map's end penetration.
+    let pushed_out = approach_speed * tau + 0.5 * approach.external_normal_force / mass * tau * tau
+        - (map.end_penetration - r.track.penetration);
+    let mut y_new = y.clone();
+    for i in 0..3 {
+        y_new[offset + i] +=
+            a.velocity[i] * tau + 0.5 * body_force[i] / mass * tau * tau + n[i] * pushed_out;
+        y_new[offset + 7 + i] += body_force[i] / mass * tau + impulse[i] / mass;
+    }
+    Some((
+        (t + tau, y_new),
+        map.normal_force_slip_integral + r.others_normal_slip * tau,
+        map.damping_dissipation,
+    ))
 }
 
 /// One definition of the approach transient: a run's [approach, rest] works.
@@ -605,7 +726,52 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             loose_case.simulation.abs_tolerance_m *= LOOSE_FACTOR;
             let loose = run_options(&loose_case)?;
             let restarts = &measured[0].restarts;
-            for (which, from) in [(0, "before the touch"), (1, "arrested (touch + 20 µs)")] {
+            let horizon = |t: f64| t + RESTART_HORIZON_S;
+            let mut groups: Vec<(&str, Vec<(f64, Vec<f64>, f64)>, f64, f64)> = vec![
+                (
+                    "before the touch",
+                    restarts
+                        .iter()
+                        .map(|r| (r.before.0, r.before.1.clone(), horizon(r.before.0)))
+                        .collect(),
+                    0.0,
+                    0.0,
+                ),
+                (
+                    "arrested (touch + 20 µs)",
+                    restarts
+                        .iter()
+                        .map(|r| (r.arrested.0, r.arrested.1.clone(), horizon(r.arrested.0)))
+                        .collect(),
+                    0.0,
+                    0.0,
+                ),
+            ];
+            // The hybrid against the resolved run from the same touch state to the same end.
+            let hybrid: Vec<_> = restarts
+                .iter()
+                .filter_map(|r| Some((r, hybrid_start(&model, r)?)))
+                .collect();
+            groups.push((
+                "the touch (first active state), resolved",
+                hybrid
+                    .iter()
+                    .map(|(r, _)| (r.touch.0, r.touch.1.clone(), horizon(r.touch.0)))
+                    .collect(),
+                0.0,
+                0.0,
+            ));
+            groups.push((
+                "hybrid: map over 20 µs at the touch, then",
+                hybrid
+                    .iter()
+                    .map(|(r, ((t, y), _, _))| (*t, y.clone(), horizon(r.touch.0)))
+                    .collect(),
+                hybrid.iter().map(|(_, h)| h.1).sum(),
+                hybrid.iter().map(|(_, h)| h.2).sum(),
+            ));
+            let mut touch_full = None;
+            for (from, starts, map_slip, map_damping) in &groups {
                 let mut full_slip = None;
                 for (label, mode, work_test, opts) in [
                     ("full", ErrorControl::Full, true, &options),
@@ -618,19 +784,27 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                     ),
                 ] {
                     eprintln!("impact-split: {case_name} restarts {from}, {label} ...");
-                    let r = restarted(&model, opts, restarts, which, mode, work_test)?;
-                    let base = *full_slip.get_or_insert(r.normal_slip);
+                    let r = restarted(&model, opts, starts, mode, work_test)?;
+                    let normal_slip = r.normal_slip + map_slip;
+                    let base = if from.starts_with("hybrid") {
+                        touch_full.unwrap_or(f64::NAN)
+                    } else {
+                        *full_slip.get_or_insert(normal_slip)
+                    };
+                    if from.starts_with("the touch") && touch_full.is_none() {
+                        touch_full = Some(normal_slip);
+                    }
                     restart_table.row(vec![
                         Cell::text(case_name),
-                        Cell::text(from),
+                        Cell::text(*from),
                         Cell::text(label),
-                        Cell::Int(restarts.len() as u64),
+                        Cell::Int(starts.len() as u64),
                         Cell::Int(r.accepted),
                         Cell::Int(r.touches),
                         Cell::Int(r.separations),
-                        Cell::Num(r.normal_slip),
-                        Cell::text(format!("{:+.2} %", 100.0 * (r.normal_slip / base - 1.0))),
-                        Cell::Num(r.damping_j),
+                        Cell::Num(normal_slip),
+                        Cell::text(format!("{:+.2} %", 100.0 * (normal_slip / base - 1.0))),
+                        Cell::Num(r.damping_j + map_damping),
                         Cell::Num(r.residual_j.abs() / r.dissipated_j.max(1e-30)),
                     ]);
                 }
@@ -782,12 +956,18 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
          the accepted steps from the touch to the first state with ẇ <= 0",
     );
     restart_table.note(format!(
-        "the first {RESTARTS} touches of the full run at the case tolerance; each restart runs \
-         {} s from the state before the touch or from the first accepted state {} µs after it; \
-         touches and separations count tracks appearing and disappearing; integrals by the \
-         trapezoid over the accepted steps",
-        RESTART_HORIZON_S,
-        ARRESTED_AFTER_S * 1e6
+        "the first {RESTARTS} touches of the full run at the case tolerance; \"before the touch\" \
+         and \"arrested\" run {h} s from the accepted state before the touch and from the first \
+         accepted state {a} µs after it; \"the touch\" runs from the first accepted state with \
+         the track active to {h} s after it, and the hybrid over the same span: the impulse map \
+         over {a} µs at that state (the cube's translational mass, the external force frozen \
+         there), its impulses applied as a velocity jump and its penetration written into the \
+         pose, then the global integrator in the row's mode; the hybrid's integrals include the \
+         map's and the other tracks' N·|v_slip| frozen over the map, and its Δ is against the \
+         resolved full run from the touch; touches and separations count tracks appearing and \
+         disappearing; integrals by the trapezoid over the accepted steps",
+        h = RESTART_HORIZON_S,
+        a = ARRESTED_AFTER_S * 1e6
     ));
     Ok(vec![runs, parts, touches, tracks, restart_table])
 }
