@@ -76,12 +76,7 @@ struct TrackMemory {
     /// The touch's approach speed, m/s (from the state before it).
     approach_speed: Option<f64>,
     /// The state before the touch and the touch, kept until the arrested state is recorded too.
-    before: Option<(
-        (f64, Vec<f64>),
-        (f64, Vec<f64>),
-        railwear::physics::contact::TrackState,
-        f64,
-    )>,
+    before: Option<PendingRestart>,
 }
 
 /// One touch of the full run to restart from.
@@ -96,6 +91,17 @@ struct Restart {
     /// The first accepted state at least [`ARRESTED_AFTER_S`] after the touch.
     arrested: (f64, Vec<f64>),
 }
+
+/// A [`Restart`] whose arrested state is not reached yet.
+struct PendingRestart {
+    before: (f64, Vec<f64>),
+    touch: (f64, Vec<f64>),
+    track: railwear::physics::contact::TrackState,
+    others_normal_slip: f64,
+}
+
+/// A restarted run's start: time, state, end time.
+type Start = (f64, Vec<f64>, f64);
 
 /// Touches of the full run restarted from (the first ones of the window).
 const RESTARTS: usize = 24;
@@ -271,12 +277,12 @@ fn run_split(
                                 .filter(|o| (o.contact, o.track) != *key)
                                 .map(|o| o.normal_force * o.slip_speed)
                                 .sum();
-                            m.before = Some((
-                                (v.t_prev, y_before.clone()),
-                                (v.t, v.state.to_vec()),
-                                *tr,
-                                others,
-                            ));
+                            m.before = Some(PendingRestart {
+                                before: (v.t_prev, y_before.clone()),
+                                touch: (v.t, v.state.to_vec()),
+                                track: *tr,
+                                others_normal_slip: others,
+                            });
                         }
                         m.approach_speed = approach.map(|a| a.approach_speed);
                         if maps.is_some() {
@@ -350,13 +356,13 @@ fn run_split(
                 }
             }
             if after.is_some() && v.t >= m.touch_s + ARRESTED_AFTER_S {
-                if let Some((before, touch, track, others_normal_slip)) = m.before.take() {
+                if let Some(pending) = m.before.take() {
                     if split.restarts.len() < RESTARTS {
                         split.restarts.push(Restart {
-                            before,
-                            touch,
-                            track,
-                            others_normal_slip,
+                            before: pending.before,
+                            touch: pending.touch,
+                            track: pending.track,
+                            others_normal_slip: pending.others_normal_slip,
                             arrested: (v.t, v.state.to_vec()),
                         });
                     }
@@ -399,7 +405,7 @@ struct Restarted {
 fn restarted(
     model: &BuiltModel,
     options: &RunOptions,
-    starts: &[(f64, Vec<f64>, f64)],
+    starts: &[Start],
     mode: ErrorControl,
     work_test: bool,
 ) -> Result<Restarted> {
@@ -727,7 +733,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             let loose = run_options(&loose_case)?;
             let restarts = &measured[0].restarts;
             let horizon = |t: f64| t + RESTART_HORIZON_S;
-            let mut groups: Vec<(&str, Vec<(f64, Vec<f64>, f64)>, f64, f64)> = vec![
+            let mut groups: Vec<(&str, Vec<Start>, f64, f64)> = vec![
                 (
                     "before the touch",
                     restarts
