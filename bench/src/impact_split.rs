@@ -391,6 +391,8 @@ fn run_split(
 /// What the restarted runs of one mode measured, summed over the restarts.
 #[derive(Default)]
 struct Restarted {
+    /// `∫N·|v_slip| dt` of all tracks over the first [`ARRESTED_AFTER_S`] of each run, N·m.
+    early_normal_slip: f64,
     accepted: u64,
     touches: u64,
     separations: u64,
@@ -440,9 +442,13 @@ fn restarted(
                     .collect();
                 if !first {
                     let dt = v.t - v.t_prev;
+                    let early = v.t <= t0 + ARRESTED_AFTER_S;
                     for (key, p) in &now {
                         let a = last.get(key).copied().unwrap_or((0.0, 0.0));
                         out.normal_slip += 0.5 * dt * (a.0 + p.0);
+                        if early {
+                            out.early_normal_slip += 0.5 * dt * (a.0 + p.0);
+                        }
                         out.damping_j += 0.5 * dt * (a.1 + p.1);
                         out.touches += u64::from(!last.contains_key(key));
                     }
@@ -670,6 +676,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("separations", "separations"),
             ("normal_slip", "Σ ∫N·\\|v_slip\\| dt (N·m)"),
             ("normal_slip_diff", "vs full"),
+            ("early", "of which in the first 20 µs (N·m)"),
             ("damping", "Σ damping work (J)"),
             ("residual", "Σ energy residual / Σ dissipated"),
         ],
@@ -810,6 +817,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         Cell::Int(r.separations),
                         Cell::Num(normal_slip),
                         Cell::text(format!("{:+.2} %", 100.0 * (normal_slip / base - 1.0))),
+                        Cell::Num(r.early_normal_slip),
                         Cell::Num(r.damping_j + map_damping),
                         Cell::Num(r.residual_j.abs() / r.dissipated_j.max(1e-30)),
                     ]);
