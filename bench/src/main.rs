@@ -30,6 +30,7 @@ mod engine;
 mod face_states;
 mod faces;
 mod impact_map;
+mod impact_split;
 mod launcher;
 mod load;
 mod missiles;
@@ -144,6 +145,25 @@ enum Command {
         /// Evaluations per batch.
         #[arg(long, default_value_t = 20)]
         per_batch: usize,
+    },
+    /// Issue 28's study: where position-only error control's difference in friction power
+    /// comes from, split into each contact's approach transient after touch and the rest.
+    ImpactSplit {
+        /// Cases (config names, comma list).
+        #[arg(long, default_value = "rattle-box-c")]
+        cases: String,
+        /// Settle time, s.
+        #[arg(long, default_value_t = 0.5)]
+        settle: f64,
+        /// Averaging window after the settle, s.
+        #[arg(long, default_value_t = 8.0)]
+        window: f64,
+        /// Approach window after each touch, µs.
+        #[arg(long, default_value_t = 10.0)]
+        window_us: f64,
+        /// |ẇ| above which a step counts as fast normal motion, m/s.
+        #[arg(long, default_value_t = 1e-3)]
+        fast_rate: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -456,6 +476,22 @@ fn main() -> Result<()> {
             },
         )?,
         Command::ImpactMap { batches, per_batch } => impact_map_cost(*batches, *per_batch)?,
+        Command::ImpactSplit {
+            cases,
+            settle,
+            window,
+            window_us,
+            fast_rate,
+        } => impact_split::impact_split(
+            &cli.configs_dir,
+            &impact_split::ImpactSplitBench {
+                cases: cases.clone(),
+                settle: *settle,
+                window: *window,
+                approach_s: *window_us * 1e-6,
+                fast_rate_m_s: *fast_rate,
+            },
+        )?,
         Command::Missiles {
             settle,
             window,

@@ -3,10 +3,13 @@
 //! passivity over random inputs, typed input errors. Every number is fixed by physics (a closed
 //! form, a bound, the 1 %), never copied from the map's output.
 
+use nalgebra::{UnitQuaternion, Vector3};
+use railwear::physics::body::MassProperties;
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::impact_map::{
-    impact_map, ContactApproach, ContactEnd, ImpactMap, ImpactMapError, ImpactMapSettings,
+    effective_mass, impact_map, ContactApproach, ContactEnd, ImpactMap, ImpactMapError,
+    ImpactMapSettings,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -490,4 +493,56 @@ fn bad_input_names_the_field() {
         ),
         Err(ImpactMapError::Approach(_))
     ));
+}
+
+/// The effective mass a touching point meets, against the rigid-body closed forms of a solid
+/// cube of side `a` (inertia `m a²/6` about every axis): `1/m + |r × u|² · 6/(m a²)`.
+#[test]
+fn effective_mass_matches_the_cube_closed_forms() {
+    let a = 0.0254;
+    let cube = MassProperties::solid_box(Vector3::new(a, a, a), 2810.0);
+    let m = cube.mass;
+    let identity = UnitQuaternion::identity();
+    let close = |x: Option<f64>, expected: f64| {
+        let x = x.expect("an effective mass");
+        assert!(
+            (x - expected).abs() <= 1e-12 * expected,
+            "{x} != {expected}"
+        );
+    };
+    let corner = Vector3::new(a / 2.0, a / 2.0, a / 2.0);
+    let face_centre = Vector3::new(a / 2.0, 0.0, 0.0);
+    // At the centre of mass, and along the lever arm: no rotation is excited, the mass is m.
+    close(
+        effective_mass(&cube, &identity, &Vector3::zeros(), &Vector3::y()),
+        m,
+    );
+    close(effective_mass(&cube, &identity, &corner, &corner), m);
+    close(
+        effective_mass(&cube, &identity, &face_centre, &Vector3::x()),
+        m,
+    );
+    // A corner struck along a face normal: |r × x|² = a²/2, so 1/m + 3/m, a quarter of m.
+    close(
+        effective_mass(&cube, &identity, &corner, &Vector3::x()),
+        m / 4.0,
+    );
+    // A face centre pushed in the face's plane: |r × y|² = a²/4, so 1/m + 1.5/m.
+    close(
+        effective_mass(&cube, &identity, &face_centre, &Vector3::y()),
+        m / 2.5,
+    );
+    // The direction's length does not matter.
+    close(
+        effective_mass(&cube, &identity, &corner, &(3.0 * Vector3::x())),
+        m / 4.0,
+    );
+    // Turning the body, its lever arm and the direction together changes nothing.
+    let turn = UnitQuaternion::from_euler_angles(0.3, -1.1, 2.0);
+    close(
+        effective_mass(&cube, &turn, &(turn * corner), &(turn * Vector3::x())),
+        m / 4.0,
+    );
+    // No direction, no mass.
+    assert!(effective_mass(&cube, &identity, &corner, &Vector3::zeros()).is_none());
 }
