@@ -591,7 +591,7 @@ fn bisect_beside(
     emulator: &mut Emulator,
     (member, m): (usize, f64),
     (other, mo): (usize, f64),
-) -> Result<Option<[(usize, f64); 2]>, GapError> {
+) -> Result<Option<Landing>, GapError> {
     let (campaign, options, configs_dir, control, cache) = sim.parts();
     let info = emulator.effects[member].info;
     let [_, p] = info.parameters else {
@@ -677,6 +677,9 @@ fn bisect_beside(
     land_beside(sim, emulator, member, other)
 }
 
+/// Two dynamics tables at their magnitudes, as a pair's fit puts them.
+type Landing = [(usize, f64); 2];
+
 /// Landing passes of [`land_beside`].
 const LANDING_PASSES: usize = 2;
 /// Tables of a pair member's family a landing pass simulates where their own pair fit lands.
@@ -698,12 +701,12 @@ fn land_beside(
     emulator: &mut Emulator,
     member: usize,
     other: usize,
-) -> Result<Option<[(usize, f64); 2]>, GapError> {
+) -> Result<Option<Landing>, GapError> {
     let (campaign, options, configs_dir, control, cache) = sim.parts();
     for pass in 0..=LANDING_PASSES {
-        let (best, landings): (Option<[(usize, f64); 2]>, Vec<[(usize, f64); 2]>) = {
+        let (best, landings): (Option<Landing>, Vec<Landing>) = {
             let problem = FitProblem::new(campaign, emulator, options);
-            let mut fits: Vec<(f64, [(usize, f64); 2])> = emulator
+            let mut fits: Vec<(f64, Landing)> = emulator
                 .family(member)
                 .into_iter()
                 .filter_map(|t| {
@@ -748,7 +751,7 @@ fn land_beside(
 
 /// Whether `emulator` holds a joint point of the two tables of `point` (either order) within
 /// relative distance `tolerance` of its two magnitudes.
-fn joint_near(emulator: &Emulator, [(a, ma), (b, mb)]: [(usize, f64); 2], tolerance: f64) -> bool {
+fn joint_near(emulator: &Emulator, [(a, ma), (b, mb)]: Landing, tolerance: f64) -> bool {
     let near = |x: f64, y: f64| (x - y).abs() <= tolerance * y.abs();
     emulator.joints.iter().any(|j| match j.tables {
         [ja, jb] if [ja, jb] == [a, b] => near(j.magnitudes[0], ma) && near(j.magnitudes[1], mb),
