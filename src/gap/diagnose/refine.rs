@@ -681,7 +681,7 @@ fn bisect_beside(
 type Landing = [(usize, f64); 2];
 
 /// Landing passes of [`land_beside`].
-const LANDING_PASSES: usize = 2;
+const LANDING_PASSES: usize = 6;
 /// Tables of a pair member's family a landing pass simulates where their own pair fit lands.
 const LANDING_TABLES: usize = 3;
 /// A joint point held within this relative distance of a landing, in both magnitudes, is
