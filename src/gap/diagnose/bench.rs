@@ -577,7 +577,7 @@ fn closest_alone(
         // value judged at another value's best magnitude would look worse than it is.
         let drawn_value = best.1.get(p.name).copied();
         let mut by_value: Vec<(f64, Vec<(f64, f64)>)> = Vec::new();
-        for v in super::refine::profile_values(p, STAND_IN_SECONDARY_VALUES) {
+        for v in super::secondary_values::profile_values(p, STAND_IN_SECONDARY_VALUES) {
             if Some(v) == drawn_value {
                 continue;
             }

@@ -43,11 +43,13 @@ mod joint_spread;
 pub mod location;
 pub mod measured;
 pub mod noise;
+mod pair_search;
 mod pairs;
 pub mod plots;
 pub mod prediction;
 mod refine;
 mod report;
+mod secondary_values;
 pub mod stats;
 pub mod table;
 pub mod truth_fit;
@@ -999,6 +1001,37 @@ pub fn diagnose_with(
         partly_explained: partly,
         code_version: crate::models::case::code_version().to_string(),
     })
+}
+
+/// The nominal model and every single effect evaluated, when the nominal model shows a gap
+/// (None otherwise).
+fn singles_if_gap(
+    campaign: &Campaign,
+    problem: &FitProblem,
+    options: &DiagnoseOptions,
+) -> Option<(Candidate, Vec<Candidate>)> {
+    if problem.obs.is_empty() {
+        return None;
+    }
+    let nominal = problem.evaluate(Model::Nominal, options.alpha);
+    let nominal_p = stats::lack_of_fit_p(nominal.chi2, nominal.dof, 0.0);
+    if nominal_p >= options.alpha && !location::locate(campaign, problem).any_flagged() {
+        return None;
+    }
+    let singles = (0..problem.families.len())
+        .map(|f| problem.evaluate(Model::Single(f), options.alpha))
+        .collect();
+    Some((nominal, singles))
+}
+
+/// Requests `(table, magnitude)` of a candidate's simulated tables at its full-data and every
+/// fold's fitted magnitudes.
+fn requests_of(emulator: &Emulator, c: &Candidate) -> Vec<(usize, f64)> {
+    std::iter::once(&c.spec)
+        .chain(c.fold_specs.iter())
+        .flat_map(|s| s.iter().copied())
+        .filter(|(t, m)| *m != 0.0 && emulator.effects[*t].simulated)
+        .collect()
 }
 
 #[cfg(test)]
