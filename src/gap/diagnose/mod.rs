@@ -1024,6 +1024,22 @@ fn singles_if_gap(
     Some((nominal, singles))
 }
 
+/// [`singles_if_gap`] when no single effect explains cleanly (None otherwise): where the
+/// refinement's secondary and pair steps start (a single that explains only partly leaves
+/// room for them).
+fn singles_unexplained(
+    campaign: &Campaign,
+    problem: &FitProblem,
+    options: &DiagnoseOptions,
+    emulator: &Emulator,
+) -> Option<(Candidate, Vec<Candidate>)> {
+    let (nominal, singles) = singles_if_gap(campaign, problem, options)?;
+    let clean = singles
+        .iter()
+        .any(|c| c.explains_cleanly(&nominal, emulator));
+    (!clean).then_some((nominal, singles))
+}
+
 /// Requests `(table, magnitude)` of a candidate's simulated tables at its full-data and every
 /// fold's fitted magnitudes.
 fn requests_of(emulator: &Emulator, c: &Candidate) -> Vec<(usize, f64)> {

@@ -5,7 +5,9 @@
 //! beside it and followed to where its fits land.
 
 use super::secondary_values::{midpoints_beside, profile_values};
-use super::{requests_of, singles_if_gap, Candidate, FitProblem, Model, Simulating};
+use super::{
+    requests_of, singles_if_gap, singles_unexplained, Candidate, FitProblem, Model, Simulating,
+};
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::effects::Acts;
 use crate::gap::GapError;
@@ -22,16 +24,12 @@ pub(super) fn exact_pairs(sim: Simulating, emulator: &mut Emulator) -> Result<()
     for round in 0..=PAIR_ROUNDS {
         let (models, requests) = {
             let problem = FitProblem::new(campaign, emulator, options);
-            let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
+            // Pairs are tried beside a single that explains only partly too.
+            let Some((nominal, singles)) =
+                singles_unexplained(campaign, &problem, options, emulator)
+            else {
                 return Ok(());
             };
-            // Pairs are tried beside a single that explains only partly too.
-            if singles
-                .iter()
-                .any(|c| c.explains_cleanly(&nominal, emulator))
-            {
-                return Ok(());
-            }
             let models = problem.pair_models(&singles, &nominal);
             let mut requests: Vec<(usize, f64)> = Vec::new();
             let mut joints: Vec<[(usize, f64); 2]> = Vec::new();

@@ -13,8 +13,9 @@
 
 use super::secondary_values::{midpoints_beside, profile_values};
 use super::{
-    diagnose_with, pair_search, requests_of, singles_if_gap, Candidate, DiagnoseOptions,
-    FitProblem, Model, Report, Simulating, REFINE_CONTENDERS, SECONDARY_CONTENDERS,
+    diagnose_with, pair_search, requests_of, singles_if_gap, singles_unexplained, Candidate,
+    DiagnoseOptions, FitProblem, Model, Report, Simulating, REFINE_CONTENDERS,
+    SECONDARY_CONTENDERS,
 };
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::effects::Acts;
@@ -110,15 +111,10 @@ fn secondary(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
     // (default table, fitted magnitude at the defaults) of each effect to profile.
     let leaders: Vec<(usize, f64)> = {
         let problem = FitProblem::new(campaign, emulator, options);
-        let Some((nominal, singles)) = singles_if_gap(campaign, &problem, options) else {
+        let Some((nominal, singles)) = singles_unexplained(campaign, &problem, options, emulator)
+        else {
             return Ok(());
         };
-        if singles
-            .iter()
-            .any(|c| c.explains_cleanly(&nominal, emulator))
-        {
-            return Ok(());
-        }
         let mut order: Vec<&Candidate> = singles
             .iter()
             .filter(|c| c.held_ll() > nominal.held_ll())
