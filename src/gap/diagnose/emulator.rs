@@ -730,11 +730,7 @@ impl Emulator {
         if ma == 0.0 || mb == 0.0 || !ma.is_finite() || !mb.is_finite() {
             return Ok(false);
         }
-        let held = self.joints.iter().any(|j| {
-            (j.tables == [a, b] && j.magnitudes == [ma, mb])
-                || (j.tables == [b, a] && j.magnitudes == [mb, ma])
-        });
-        if held {
+        if self.joint_near([(a, ma), (b, mb)], 0.0) {
             return Ok(false);
         }
         let (ta, tb) = (&self.effects[a], &self.effects[b]);
@@ -757,6 +753,16 @@ impl Emulator {
             initial_state: p.next(),
         });
         Ok(true)
+    }
+
+    /// Whether a joint point of tables `a` and `b` (either order) is held within relative
+    /// distance `tolerance` of magnitudes `ma` and `mb` (0: at exactly them).
+    pub fn joint_near(&self, [(a, ma), (b, mb)]: [(usize, f64); 2], tolerance: f64) -> bool {
+        let near = |x: f64, y: f64| (x - y).abs() <= tolerance * y.abs();
+        self.joints.iter().any(|j| {
+            (j.tables == [a, b] && near(j.magnitudes[0], ma) && near(j.magnitudes[1], mb))
+                || (j.tables == [b, a] && near(j.magnitudes[1], ma) && near(j.magnitudes[0], mb))
+        })
     }
 
     /// Every table of the effect of table `t` (its library defaults and its variants), in

@@ -93,9 +93,11 @@ pub(super) fn joint_spreads(emulator: &Emulator, obs: &[Observation]) -> Vec<Joi
 /// table's roughness carries. They depend on the pair's magnitudes only, so a likelihood
 /// evaluation takes them once for all its observations ([`PairSpread::rel_var`]).
 pub(super) struct PairSpread<'s> {
-    /// (joint point, fade, squared distance, sum of inverse squared distances); at a joint
-    /// point itself only that point, with both divisors 1.
-    points: Vec<(&'s JointSpread, f64, f64, f64)>,
+    /// (joint point, fade, squared distance); at a joint point itself only that point, with
+    /// distance 1.
+    points: Vec<(&'s JointSpread, f64, f64)>,
+    /// Sum of the points' inverse squared distances (1 at a joint point itself).
+    total: f64,
 }
 
 /// [`PairSpread`] of tables `a` at `ma` and `b` at `mb` (no point when either is off).
@@ -106,7 +108,10 @@ pub(super) fn pair_spread<'s>(
     (b, mb): (usize, f64),
 ) -> PairSpread<'s> {
     if ma == 0.0 || mb == 0.0 {
-        return PairSpread { points: Vec::new() };
+        return PairSpread {
+            points: Vec::new(),
+            total: 1.0,
+        };
     }
     let (u, v) = (emulator.unit(a, ma), emulator.unit(b, mb));
     // (point, fade, squared distance) of each joint point of the two tables.
@@ -126,15 +131,14 @@ pub(super) fn pair_spread<'s>(
         .collect();
     if let Some(&(s, fade, _)) = near.iter().find(|(_, _, d)| *d < 1e-24) {
         return PairSpread {
-            points: vec![(s, fade, 1.0, 1.0)],
+            points: vec![(s, fade, 1.0)],
+            total: 1.0,
         };
     }
     let total: f64 = near.iter().map(|(_, _, d)| 1.0 / d).sum();
     PairSpread {
-        points: near
-            .into_iter()
-            .map(|(s, fade, d)| (s, fade, d, total))
-            .collect(),
+        points: near,
+        total,
     }
 }
 
@@ -145,13 +149,13 @@ impl PairSpread<'_> {
     pub(super) fn rel_var(&self, i: usize, mu: f64) -> f64 {
         self.points
             .iter()
-            .map(|(s, fade, d, total)| {
+            .map(|(s, fade, d)| {
                 let own = if mu != 0.0 {
                     s.abs_var[i] / (mu * mu)
                 } else {
                     0.0
                 };
-                fade * s.rel_var[i].max(own) / d / total
+                fade * s.rel_var[i].max(own) / d / self.total
             })
             .sum()
     }

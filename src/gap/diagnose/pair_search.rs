@@ -366,7 +366,8 @@ fn land_beside(
     other: usize,
 ) -> Result<Option<Landing>, GapError> {
     let (campaign, options, configs_dir, control, cache) = sim.parts();
-    for pass in 0..=LANDING_PASSES {
+    let mut pass = 0;
+    loop {
         let (best, landings): (Option<Landing>, Vec<Landing>) = {
             let problem = FitProblem::new(campaign, emulator, options);
             let mut fits: Vec<(f64, Landing)> = emulator
@@ -396,29 +397,18 @@ fn land_beside(
                 .iter()
                 .take(LANDING_TABLES)
                 .map(|(_, l)| *l)
-                .filter(|l| !joint_near(emulator, *l, LANDING_TOLERANCE))
+                .filter(|l| !emulator.joint_near(*l, LANDING_TOLERANCE))
                 .collect();
             (fits.first().map(|f| f.1), landings)
         };
         if landings.is_empty() || pass == LANDING_PASSES {
             return Ok(best);
         }
+        pass += 1;
         let alone: Vec<(usize, f64)> = landings.iter().flatten().copied().collect();
         emulator.refine(campaign, configs_dir, &alone, control, cache, &|_, _| {})?;
         for [a, b] in landings {
             emulator.add_joint(campaign, configs_dir, a, b, control, cache)?;
         }
     }
-    Ok(None)
-}
-
-/// Whether `emulator` holds a joint point of the two tables of `point` (either order) within
-/// relative distance `tolerance` of its two magnitudes.
-fn joint_near(emulator: &Emulator, [(a, ma), (b, mb)]: Landing, tolerance: f64) -> bool {
-    let near = |x: f64, y: f64| (x - y).abs() <= tolerance * y.abs();
-    emulator.joints.iter().any(|j| match j.tables {
-        [ja, jb] if [ja, jb] == [a, b] => near(j.magnitudes[0], ma) && near(j.magnitudes[1], mb),
-        [ja, jb] if [ja, jb] == [b, a] => near(j.magnitudes[1], ma) && near(j.magnitudes[0], mb),
-        _ => false,
-    })
 }
