@@ -311,6 +311,19 @@ pub struct Scores {
     pub rig_only_flagged: f64,
     /// Median held-out shrink where the right effect was found.
     pub median_shrink: f64,
+    /// Fitted parameters with a 95 % interval, of the campaigns named right: the magnitudes
+    /// and secondary values the diagnosis fitted (measured ones included).
+    #[serde(default)]
+    pub intervals_checked: usize,
+    /// Of those, the share whose interval holds the drawn value ([`interval_hits`]).
+    #[serde(default)]
+    pub interval_coverage: f64,
+    /// The magnitudes alone: checked and the share held.
+    #[serde(default)]
+    pub magnitude_intervals_checked: usize,
+    /// Of those, the share whose interval holds the drawn magnitude.
+    #[serde(default)]
+    pub magnitude_interval_coverage: f64,
     /// Undetectable in-library campaigns reported no_gap (share).
     pub undetectable_no_gap: f64,
     /// Detectable single effects drawn without accelerometer records.
@@ -972,6 +985,26 @@ fn named_right(o: &Outcome) -> bool {
     o.verdict == Verdict::Explained && o.scenario.in_library && truth == chosen
 }
 
+/// Every fitted parameter of `o` with an interval whose effect the rig injected: (is it the
+/// effect's magnitude, does the interval hold the drawn value). The check the issue asks of
+/// every effect ("the diagnosis recovers its magnitude within the reported interval"), on
+/// campaigns drawn unlike the bench's defaults.
+fn interval_hits(o: &Outcome) -> Vec<(bool, bool)> {
+    o.fitted
+        .iter()
+        .filter(|f| f.fitted)
+        .filter_map(|f| {
+            let [lo, hi] = f.interval?;
+            let (effect, parameter) = f.name.split_once('.')?;
+            let drawn = o.scenario.effects.iter().find(|e| e.name == effect)?;
+            let info = crate::gap::effects::info(effect)?;
+            let value = *drawn.parameters.get(parameter)?;
+            let magnitude = info.parameters.first().is_some_and(|p| p.name == parameter);
+            Some((magnitude, lo <= value && value <= hi))
+        })
+        .collect()
+}
+
 /// Two or more tests carry the effect, so held-out tests can confirm it.
 fn confirmable(o: &Outcome) -> bool {
     o.detectable && o.detectable_tests >= 2
@@ -1071,6 +1104,12 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .chain(det_pairs.iter().map(|o| **o).filter(|o| named_right(o)))
         .filter_map(|o| o.shrink)
         .collect();
+    let hits: Vec<(bool, bool)> = outcomes
+        .iter()
+        .filter(|o| named_right(o))
+        .flat_map(interval_hits)
+        .collect();
+    let magnitude_hits: Vec<bool> = hits.iter().filter(|h| h.0).map(|h| h.1).collect();
     Scores {
         campaigns: outcomes.len(),
         detectable_in_library: det_lib.len(),
@@ -1128,6 +1167,13 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         } else {
             stats::median(&shrinks)
         },
+        intervals_checked: hits.len(),
+        interval_coverage: share(hits.iter().filter(|h| h.1).count(), hits.len()),
+        magnitude_intervals_checked: magnitude_hits.len(),
+        magnitude_interval_coverage: share(
+            magnitude_hits.iter().filter(|h| **h).count(),
+            magnitude_hits.len(),
+        ),
         undetectable_no_gap: share(
             undet.iter().filter(|o| o.verdict == Verdict::NoGap).count(),
             undet.len(),
@@ -1222,6 +1268,13 @@ impl Scores {
         s.push_str(&format!(
             "| median held-out shrink where the right effect (or pair) was found | {} | >= 50 % |\n",
             pct(self.median_shrink)
+        ));
+        s.push_str(&format!(
+            "| 95 % intervals of the fitted parameters holding the drawn value, where named right ({}; magnitudes {}) | {} (magnitudes {}) | 95 % |\n",
+            self.intervals_checked,
+            self.magnitude_intervals_checked,
+            pct(self.interval_coverage),
+            pct(self.magnitude_interval_coverage)
         ));
         s.push_str(&format!(
             "| undetectable in-library effects reported no_gap | {} | (right answer) |\n\n",
@@ -1434,6 +1487,47 @@ mod tests {
         assert_eq!(s.pairs_truth_fits, 3);
         assert_eq!(s.identifiable_pairs, 2);
         assert_eq!(s.identifiable_pairs_both_named, 0.5);
+    }
+
+    /// Interval coverage counts the fitted parameters of the campaigns named right, against
+    /// the values the rig drew: a magnitude and a slip scale whose intervals hold the drawn
+    /// ones, a magnitude whose interval misses it; parameters held at their default and
+    /// campaigns not named right are not counted.
+    #[test]
+    fn intervals_are_scored_against_the_drawn_values() {
+        let drift = |delta: f64, slip: f64| Effect {
+            name: "friction_drift".into(),
+            parameters: BTreeMap::from([
+                ("delta_mu".to_string(), delta),
+                ("slip_scale_m".to_string(), slip),
+            ]),
+        };
+        let fitted = |name: &str, lo: f64, hi: f64, fitted: bool| FittedValue {
+            name: format!("friction_drift.{name}"),
+            value: 0.5 * (lo + hi),
+            interval: Some([lo, hi]),
+            fitted,
+        };
+        let named = |delta: f64, verdict| {
+            let mut o = outcome("friction_drift", true, verdict, Some("friction_drift"));
+            o.scenario.effects = vec![drift(delta, 7143.0)];
+            o.fitted = vec![
+                fitted("delta_mu", 0.4838, 0.4886, true),
+                fitted("slip_scale_m", 3162.0, 7499.0, true),
+            ];
+            o
+        };
+        let mut held = named(0.485, Verdict::Explained);
+        held.fitted.push(fitted("slip_scale_m", 0.0, 1.0, false));
+        let s = score(vec![
+            held,
+            named(0.48, Verdict::Explained),
+            named(0.48, Verdict::NotExplained),
+        ]);
+        assert_eq!(s.intervals_checked, 4);
+        assert_eq!(s.interval_coverage, 0.75);
+        assert_eq!(s.magnitude_intervals_checked, 2);
+        assert_eq!(s.magnitude_interval_coverage, 0.5);
     }
 
     /// A single effect one test alone carries counts apart: in the top-1 over every detectable
