@@ -17,6 +17,9 @@ pub(crate) struct BodyHybrid {
     pub(crate) transient: BodyTransient,
     /// Wall-clock time of one evaluation, s (the median of [`TIMED_REPEATS`]).
     pub(crate) wall_s: f64,
+    /// This thread's CPU time over the [`TIMED_REPEATS`] evaluations, s (10 ms ticks: read
+    /// as a sum over many touches).
+    pub(crate) cpu_repeats_s: Option<f64>,
 }
 
 /// Evaluations of each transient for its wall-clock time.
@@ -53,6 +56,7 @@ pub(crate) fn body_hybrid_start(
     };
     let mut walls = Vec::with_capacity(TIMED_REPEATS);
     let mut last = None;
+    let cpu0 = thread_cpu_s();
     for _ in 0..TIMED_REPEATS {
         let clock = Instant::now();
         let r = body_transient(system, body, t, y, &settings);
@@ -66,12 +70,14 @@ pub(crate) fn body_hybrid_start(
             return None;
         }
     };
+    let cpu_repeats_s = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
     walls.sort_by(f64::total_cmp);
     let mut y_end = y.to_vec();
     transient.write_end_state(&mut y_end, offset);
     Some(BodyHybrid {
         start: (t + transient.duration, y_end),
         wall_s: walls[TIMED_REPEATS / 2],
+        cpu_repeats_s,
         transient,
     })
 }
@@ -93,6 +99,9 @@ pub(crate) fn body_hybrid_table() -> Table {
             ("map_damping", "map hybrid: damping work vs resolved"),
             ("body_damping", "body hybrid: damping work vs resolved"),
             ("transient_us", "µs per body transient (median wall)"),
+            ("transient_cpu_us", "µs per body transient (mean CPU)"),
+            ("resolved_cpu", "resolved: CPU s"),
+            ("body_cpu", "body hybrid: CPU s, transients included"),
             (
                 "transient_steps",
                 "transient steps (accepted + rejected) per touch",
@@ -115,6 +124,8 @@ pub(crate) struct GroupResult {
     pub(crate) accepted: u64,
     pub(crate) normal_slip: f64,
     pub(crate) damping_j: f64,
+    /// CPU time of the group's global integration, s.
+    pub(crate) cpu_s: Option<f64>,
 }
 
 /// One summary row: the resolved, the map's and the body transient's hybrid in one mode.
@@ -129,6 +140,10 @@ pub(crate) fn body_hybrid_row(
     let mut walls: Vec<f64> = hybrids.iter().map(|(_, h)| h.wall_s).collect();
     walls.sort_by(f64::total_cmp);
     let wall = walls.get(walls.len() / 2).copied();
+    let cpu: Option<f64> = hybrids
+        .iter()
+        .map(|(_, h)| h.cpu_repeats_s.map(|s| s / TIMED_REPEATS as f64))
+        .sum();
     let steps: usize = hybrids
         .iter()
         .map(|(_, h)| h.transient.steps + h.transient.rejected_steps)
@@ -159,6 +174,9 @@ pub(crate) fn body_hybrid_row(
         diff(map.damping_j, resolved.damping_j),
         diff(body.damping_j, resolved.damping_j),
         Cell::opt(wall.map(|s| s * 1e6)),
+        Cell::opt(cpu.map(|s| s * 1e6 / n)),
+        Cell::opt(resolved.cpu_s),
+        Cell::opt(body.cpu_s.zip(cpu).map(|(a, b)| a + b)),
         Cell::Num(steps as f64 / n),
         Cell::Num(residual),
         Cell::Num(off_track / total),

@@ -833,7 +833,9 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         continue;
                     }
                     eprintln!("impact-split: {case_name} restarts {from}, {label} ...");
+                    let cpu0 = thread_cpu_s();
                     let r = restarted(&model, opts, starts, mode, work_test)?;
+                    let cpu_s = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
                     let normal_slip = r.normal_slip + map_slip;
                     let base = if from.starts_with("hybrid") {
                         touch_full.unwrap_or(f64::NAN)
@@ -863,6 +865,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                             accepted: r.accepted,
                             normal_slip,
                             damping_j: r.damping_j + map_damping,
+                            cpu_s,
                         },
                     );
                 }

@@ -8,9 +8,7 @@
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 use railwear::geometry::{ConvexShape, HalfSpace};
 use railwear::models::case::{build, load_case};
-use railwear::physics::body::{
-    write_state, BodyKind, Fixed, KinematicMotion, MassProperties, RigidBody,
-};
+use railwear::physics::body::{write_state, BodyKind, Fixed, MassProperties, RigidBody};
 use railwear::physics::body_transient::{
     body_transient, BodyTransient, BodyTransientError, BodyTransientSettings,
 };
@@ -25,6 +23,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 const GRAVITY: f64 = 9.80665;
+/// The bound of every closed form and account below: ten times the transients' relative
+/// tolerance (1e-8, [`BodyTransientSettings::default`]).
+const BOUND: f64 = 10.0 * 1e-8;
 const RADIUS: f64 = 0.01;
 
 fn configs() -> &'static Path {
@@ -120,23 +121,23 @@ fn an_undamped_ball_impact_matches_the_closed_form() {
         let track = &r.tracks[0];
         let relative = |a: f64, b: f64| (a / b - 1.0).abs();
         assert!(
-            relative(v_out, v0) < 1e-8,
+            relative(v_out, v0) < BOUND,
             "e {e}: exit speed {v_out} against {v0}"
         );
         assert!(
-            relative(track.normal_impulse, 2.0 * m * v0) < 1e-8,
+            relative(track.normal_impulse, 2.0 * m * v0) < BOUND,
             "e {e}: impulse {} against {}",
             track.normal_impulse,
             2.0 * m * v0
         );
         assert!(
-            relative(t_contact, t_c) < 1e-6,
+            relative(t_contact, t_c) < BOUND,
             "e {e}: contact time {t_contact:e} against {t_c:e}"
         );
         let turning = track.arrest_s.expect("the approach ends");
         assert!(turning >= 0.5 * t_c && turning < 0.6 * t_c);
         assert!(!track.active_at_end);
-        assert!(r.energy_residual().abs() < 1e-9 * 0.5 * m * v0 * v0);
+        assert!(r.energy_residual().abs() < BOUND * 0.5 * m * v0 * v0);
         assert_eq!(r.damping_dissipation, 0.0);
     }
 }
@@ -144,7 +145,9 @@ fn an_undamped_ball_impact_matches_the_closed_form() {
 /// A ball pressed by its weight at the static penetration and sliding at 1 m/s: the slip stays
 /// above the dynamic transition speed, so `μ = μ_d` throughout, `N = m g`, and the contact
 /// point's slip falls at `μ_d g (1 + m R²/I) = 3.5 μ_d g`:
-/// `P_t = −μ_d m g T`, `∫N|v_t| dt = m g (v0 T − 1.75 μ_d g T²)`, friction work μ_d times it.
+/// `P_t = −μ_d P_n`, `P_n = m g T`, `∫N|v_t| dt = (P_n/T) (v0 T − 1.75 μ_d g T²)`, friction work
+/// μ_d times it. `P_n` differs from `m g T` by `m Δv_y`, the vertical speed the error control
+/// leaves (its tolerance is relative to the 1 m/s slide: `10 rtol · 1 m/s` bounds it).
 #[test]
 fn a_sliding_ball_matches_coulomb_friction_in_closed_form() {
     let impact = ImpactParams::thesis_table_5_2();
@@ -159,19 +162,27 @@ fn a_sliding_ball_matches_coulomb_friction_in_closed_form() {
     let track = &r.tracks[0];
     let mu = friction.mu_dynamic;
     let load = m * GRAVITY;
-    let slip_integral = load * (v0 * horizon - 1.75 * mu * GRAVITY * horizon * horizon);
     let relative = |a: f64, b: f64| (a / b - 1.0).abs();
-    assert!(relative(track.normal_impulse, load * horizon) < 1e-8);
-    assert!(relative(-track.tangential_impulse.x, mu * load * horizon) < 1e-8);
-    assert!(track.tangential_impulse.yz().norm() < 1e-12 * load * horizon);
+    let p_n = track.normal_impulse;
+    assert!((p_n - load * horizon).abs() < BOUND * m * v0);
+    let dv_y = r.end_state[8] - y[8];
+    assert!((m * dv_y - (p_n - load * horizon)).abs() < 1e-3 * BOUND * m * v0);
+    let slip_integral = p_n / horizon * (v0 * horizon - 1.75 * mu * GRAVITY * horizon * horizon);
+    assert!(relative(-track.tangential_impulse.x, mu * p_n) < 1e-10);
+    assert!(track.tangential_impulse.yz().norm() < 1e-12 * p_n);
     assert!(
-        relative(track.normal_force_slip_integral, slip_integral) < 1e-8,
+        relative(track.normal_force_slip_integral, slip_integral) < BOUND,
         "∫N|v_t| dt {} against {slip_integral}",
         track.normal_force_slip_integral
     );
-    assert!(relative(r.friction_dissipation, mu * slip_integral) < 1e-8);
-    assert!(relative(r.end_state[7], v0 - mu * GRAVITY * horizon) < 1e-9);
-    assert!(r.energy_residual().abs() < 1e-9 * r.dissipated());
+    assert!(
+        relative(
+            r.friction_dissipation,
+            mu * track.normal_force_slip_integral
+        ) < 1e-10
+    );
+    assert!(relative(r.end_state[7], v0 - mu * p_n / m) < BOUND);
+    assert!(r.energy_residual().abs() < BOUND * r.dissipated());
 }
 
 /// No contact: the centre of mass falls on `x0 + v0 T + ½ g T²`, gravity's work is
@@ -209,7 +220,7 @@ fn a_free_body_keeps_its_energy_and_angular_momentum() {
         (x - x_end).norm()
     );
     let m = system.bodies[0].mass.mass;
-    assert!((r.gravity_work / (m * g.dot(&(x - x0))) - 1.0).abs() < 1e-9);
+    assert!((r.gravity_work / (m * g.dot(&(x - x0))) - 1.0).abs() < BOUND);
     let momentum = |s: &[f64]| {
         let q = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(s[3], s[4], s[5], s[6]));
         q * (inertia * Vector3::new(s[10], s[11], s[12]))
@@ -217,7 +228,7 @@ fn a_free_body_keeps_its_energy_and_angular_momentum() {
     let l0 = momentum(&y);
     let l1 = momentum(&r.end_state);
     assert!(
-        (l1 - l0).norm() < 1e-8 * l0.norm(),
+        (l1 - l0).norm() < BOUND * l0.norm(),
         "ΔL {:e}",
         (l1 - l0).norm() / l0.norm()
     );
@@ -225,8 +236,8 @@ fn a_free_body_keeps_its_energy_and_angular_momentum() {
         let w = Vector3::new(s[10], s[11], s[12]);
         0.5 * w.dot(&(inertia * w))
     };
-    assert!((rotation(&r.end_state) / rotation(&y) - 1.0).abs() < 1e-9);
-    assert!(r.energy_residual().abs() < 1e-9 * r.kinetic_energy[0]);
+    assert!((rotation(&r.end_state) / rotation(&y) - 1.0).abs() < BOUND);
+    assert!(r.energy_residual().abs() < BOUND * r.kinetic_energy[0]);
 }
 
 /// Rattle box C with the tube driven: the cube resting on the floor at its static penetration,
@@ -251,8 +262,8 @@ fn rattle_box_c_touch(offset_m: f64, approach_m_s: f64) -> (MultibodySystem, f64
 /// A wall arrest in rattle box C with the floor pressed and the tube driven: the energy account
 /// (kinetic and stored at the end, plus damping and friction, minus the work of gravity and of
 /// the tube's motion, against the start) and the momentum account (`m Δv = m g T + Σ (n P_n +
-/// P_t)` over the tracks) close. Bounds: 1e-6 of the dissipated work (the issue asks 0.5 %),
-/// 1e-7 of the approach momentum.
+/// P_t)` over the tracks) close. Bounds: [`BOUND`] of the dissipated work (the issue asks
+/// 0.5 %) and of the approach momentum.
 #[test]
 fn a_wall_arrest_with_the_floor_pressed_closes_its_energy_and_momentum_accounts() {
     for (offset, approach, horizon) in [(0.0, 0.3, 2e-5), (1e-6, 1.0, 2e-5), (0.0, 0.3, 1e-4)] {
@@ -260,8 +271,9 @@ fn a_wall_arrest_with_the_floor_pressed_closes_its_energy_and_momentum_accounts(
         let r = body_transient(&system, 0, t, &y, &settings(horizon)).expect("valid");
         let m = system.bodies[0].mass.mass;
         let residual = r.energy_residual() / r.dissipated();
+        eprintln!("wall arrest {approach} m/s over {horizon} s: residual {residual:e}");
         assert!(
-            residual.abs() < 1e-6,
+            residual.abs() < BOUND,
             "{approach} m/s over {horizon} s: energy residual {residual:e} of the dissipated work"
         );
         // The wall (face 0, at +x) and the floor (face 3) both carry load.
@@ -288,7 +300,7 @@ fn a_wall_arrest_with_the_floor_pressed_closes_its_energy_and_momentum_accounts(
         );
         let momentum = m * dv - system.gravity * m * r.duration - impulses;
         assert!(
-            momentum.norm() < 1e-7 * m * approach,
+            momentum.norm() < BOUND * m * approach,
             "momentum account off by {:e} of m v",
             momentum.norm() / (m * approach)
         );
@@ -297,7 +309,7 @@ fn a_wall_arrest_with_the_floor_pressed_closes_its_energy_and_momentum_accounts(
 
 /// Random transients of rattle box C's cube (near the walls and the floor, small tilts, speeds
 /// and spins, the tube driven): each dissipation term is >= 0, the cube never leaves with more
-/// energy than it had plus the work done on it, and the account closes within 1e-6 of the
+/// energy than it had plus the work done on it, and the account closes within `BOUND` of the
 /// energy turned over.
 #[test]
 fn random_transients_are_passive() {
@@ -311,6 +323,10 @@ fn random_transients_are_passive() {
     let l = 0.5 * 1.25 * 0.0254;
     let mut rng = ChaCha8Rng::seed_from_u64(28);
     let mut touching = 0;
+    let mut worst = 0.0f64;
+    let turnover_of = |r: &BodyTransient| {
+        r.kinetic_energy[0] + r.stored_energy[0] + r.external_work().abs() + r.dissipated()
+    };
     for trial in 0..30 {
         let t = model.excitation_start_s + rng.gen_range(0.0..0.05);
         let base = tube.pose(t).translation.vector;
@@ -351,6 +367,7 @@ fn random_transients_are_passive() {
         let r: BodyTransient =
             body_transient(system, 0, t, &y, &settings(2e-5)).expect("valid start");
         touching += usize::from(!r.tracks.is_empty());
+        worst = worst.max(r.energy_residual().abs() / turnover_of(&r));
         assert!(r.damping_dissipation >= 0.0 && r.friction_dissipation >= 0.0);
         for tr in &r.tracks {
             assert!(tr.damping_dissipation >= 0.0 && tr.friction_dissipation >= 0.0);
@@ -359,17 +376,18 @@ fn random_transients_are_passive() {
         let end = r.kinetic_energy[1] + r.stored_energy[1];
         let turnover = start + r.external_work().abs() + r.dissipated();
         assert!(
-            end <= start + r.external_work() + 1e-6 * turnover,
+            end <= start + r.external_work() + BOUND * turnover,
             "trial {trial}: energy rose by {:e} J past the work done",
             end - start - r.external_work()
         );
         assert!(
-            r.energy_residual().abs() <= 1e-6 * turnover,
+            r.energy_residual().abs() <= BOUND * turnover,
             "trial {trial}: residual {:e} of the turnover",
             r.energy_residual() / turnover
         );
     }
     assert!(touching >= 25, "the starts must touch: {touching} of 30");
+    eprintln!("random transients: largest residual {worst:e} of the turnover");
 }
 
 #[test]
@@ -404,6 +422,13 @@ fn bad_settings_and_starts_name_their_field() {
             "position_tolerance_m",
         ),
         (BodyTransientSettings { max_steps: 0, ..ok }, "max_steps"),
+        (
+            BodyTransientSettings {
+                switch_tolerance_factor: 2.0,
+                ..ok
+            },
+            "switch_tolerance_factor",
+        ),
     ] {
         assert_eq!(bad(s).as_deref(), Some(name));
     }

@@ -3,7 +3,7 @@
 //! bodies on their prescribed motion, and the quadratures the transient hands back.
 
 use crate::physics::body::{BodyFrame, BodyKind};
-use crate::physics::contact::{EvaluationOutputs, GeometryCache, TrackState};
+use crate::physics::contact::{EvaluationOutputs, GeometryCache, PointLoad, TrackState};
 use crate::physics::forces::Wrench;
 use crate::physics::system::MultibodySystem;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
@@ -65,6 +65,8 @@ pub(super) struct Evaluator<'a> {
     pub(super) last_normal: [Vector3<f64>; MAX_TRACKS],
     /// Stored energy at the last evaluation, J.
     pub(super) stored: f64,
+    /// Contact points carrying a normal force at the last evaluation.
+    pub(super) loaded_points: usize,
 }
 
 impl Evaluator<'_> {
@@ -112,6 +114,7 @@ impl Evaluator<'_> {
         self.wrenches[self.body].0 += gravity;
         let mut d = [0.0; DIM];
         let mut stored = 0.0;
+        let mut loaded = 0usize;
         for &e in &self.elements {
             let p = self.system.forces[e].accumulate_with_power(&self.frames, &mut self.wrenches);
             stored += p.potential;
@@ -156,7 +159,10 @@ impl Evaluator<'_> {
                 Some(&mut wrenches),
                 &mut sink,
                 &mut geometry,
-                EvaluationOutputs::default(),
+                EvaluationOutputs {
+                    points: Some(&mut |_: &PointLoad| loaded += 1),
+                    ..EvaluationOutputs::default()
+                },
             );
             self.geometry = geometry;
             self.wrenches = wrenches;
@@ -170,6 +176,7 @@ impl Evaluator<'_> {
         }
         d[W_GRAV] = gravity.dot(&velocity);
         self.stored = stored;
+        self.loaded_points = loaded;
         // Newton-Euler of the body, as `MultibodySystem::derivative_with` (its quaternion rate
         // from the normalised rotation).
         let (force, torque) = self.wrenches[self.body];
