@@ -20,6 +20,9 @@ pub(crate) struct BodyHybrid {
     /// This thread's CPU time over the [`TIMED_REPEATS`] evaluations, s (10 ms ticks: read
     /// as a sum over many touches).
     pub(crate) cpu_repeats_s: Option<f64>,
+    /// The body's weight times the transient's duration, N·s, and gravity's unit direction.
+    pub(crate) weight_impulse: f64,
+    pub(crate) down: Vector3<f64>,
 }
 
 /// Evaluations of each transient for its wall-clock time.
@@ -37,29 +40,25 @@ impl BodyHybrid {
 }
 
 /// The body transient of the body carrying `track`'s pieces, from the system state `y` at
-/// `t` over `horizon_s`. None when that body is not dynamic or the transient fails (printed).
+/// `t` with `settings`. None when that body is not dynamic or the transient fails (printed).
 pub(crate) fn body_hybrid_start(
     model: &BuiltModel,
     t: f64,
     y: &[f64],
     track: &TrackState,
-    horizon_s: f64,
+    settings: &BodyTransientSettings,
 ) -> Option<BodyHybrid> {
     let system = &model.system;
     let body = system.contacts[track.contact as usize].body_a;
     let BodyKind::Dynamic { offset } = system.bodies[body].kind else {
         return None;
     };
-    let settings = BodyTransientSettings {
-        horizon_s,
-        ..BodyTransientSettings::default()
-    };
     let mut walls = Vec::with_capacity(TIMED_REPEATS);
     let mut last = None;
     let cpu0 = thread_cpu_s();
     for _ in 0..TIMED_REPEATS {
         let clock = Instant::now();
-        let r = body_transient(system, body, t, y, &settings);
+        let r = body_transient(system, body, t, y, settings);
         walls.push(clock.elapsed().as_secs_f64());
         last = Some(r);
     }
@@ -78,6 +77,11 @@ pub(crate) fn body_hybrid_start(
         start: (t + transient.duration, y_end),
         wall_s: walls[TIMED_REPEATS / 2],
         cpu_repeats_s,
+        weight_impulse: system.bodies[body].mass.mass * system.gravity.norm() * transient.duration,
+        down: system
+            .gravity
+            .try_normalize(0.0)
+            .unwrap_or_else(Vector3::zeros),
         transient,
     })
 }
@@ -96,6 +100,10 @@ pub(crate) fn body_hybrid_table() -> Table {
             ("saved", "steps resolved / body hybrid"),
             ("map_slip", "map hybrid: ∫N\\|v_slip\\| dt vs resolved"),
             ("body_slip", "body hybrid: ∫N\\|v_slip\\| dt vs resolved"),
+            (
+                "body_slip_case",
+                "body hybrid: ∫N\\|v_slip\\| dt vs case tol",
+            ),
             ("map_damping", "map hybrid: damping work vs resolved"),
             ("body_damping", "body hybrid: damping work vs resolved"),
             ("transient_us", "µs per body transient (median wall)"),
@@ -113,6 +121,11 @@ pub(crate) fn body_hybrid_table() -> Table {
             (
                 "floor_share",
                 "share of the transient's ∫N\\|v_slip\\| dt off the touching track",
+            ),
+            ("floor_load", "other tracks' Σ∫N dt / (m g T)"),
+            (
+                "wall_friction",
+                "touching track's friction impulse along g / (other tracks' Σ∫N dt − m g T)",
             ),
         ],
     )
@@ -132,7 +145,7 @@ pub(crate) struct GroupResult {
 pub(crate) fn body_hybrid_row(
     case_name: &str,
     mode: &str,
-    [resolved, map, body]: [GroupResult; 3],
+    [reference, resolved, map, body]: [GroupResult; 4],
     hybrids: &[(&TrackState, BodyHybrid)],
 ) -> Vec<Cell> {
     let diff = |a: f64, b: f64| Cell::text(format!("{:+.2} %", 100.0 * (a / b - 1.0)));
@@ -153,11 +166,16 @@ pub(crate) fn body_hybrid_row(
         .map(|(_, h)| (h.transient.energy_residual() / h.transient.dissipated()).abs())
         .fold(0.0f64, f64::max);
     let (mut off_track, mut total) = (0.0, 0.0);
+    let (mut off_load, mut weight, mut wall_down) = (0.0, 0.0, 0.0);
     for (track, h) in hybrids {
+        weight += h.weight_impulse;
         for t in &h.transient.tracks {
             total += t.normal_force_slip_integral;
             if (t.contact, t.track) != (track.contact, track.track) {
                 off_track += t.normal_force_slip_integral;
+                off_load += t.normal_impulse;
+            } else {
+                wall_down += t.tangential_impulse.dot(&h.down);
             }
         }
     }
@@ -171,6 +189,7 @@ pub(crate) fn body_hybrid_row(
         Cell::Num(resolved.accepted as f64 / body.accepted.max(1) as f64),
         diff(map.normal_slip, resolved.normal_slip),
         diff(body.normal_slip, resolved.normal_slip),
+        diff(body.normal_slip, reference.normal_slip),
         diff(map.damping_j, resolved.damping_j),
         diff(body.damping_j, resolved.damping_j),
         Cell::opt(wall.map(|s| s * 1e6)),
@@ -180,5 +199,7 @@ pub(crate) fn body_hybrid_row(
         Cell::Num(steps as f64 / n),
         Cell::Num(residual),
         Cell::Num(off_track / total),
+        Cell::Num(off_load / weight),
+        Cell::Num(wall_down / (off_load - weight)),
     ]
 }

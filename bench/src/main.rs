@@ -169,6 +169,9 @@ enum Command {
         /// from the touch and the two hybrids (map, body transient) in full control.
         #[arg(long)]
         hybrid_only: bool,
+        /// The body transient's relative tolerance.
+        #[arg(long, default_value_t = 1e-8)]
+        transient_rtol: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -488,6 +491,7 @@ fn main() -> Result<()> {
             window_us,
             fast_rate,
             hybrid_only,
+            transient_rtol,
         } => impact_split::impact_split(
             &cli.configs_dir,
             &impact_split::ImpactSplitBench {
@@ -497,6 +501,7 @@ fn main() -> Result<()> {
                 approach_s: *window_us * 1e-6,
                 fast_rate_m_s: *fast_rate,
                 hybrid_only: *hybrid_only,
+                transient_rtol: *transient_rtol,
             },
         )?,
         Command::Missiles {
