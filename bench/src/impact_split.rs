@@ -11,6 +11,11 @@
 //!   either end (an impact-like normal motion inside a persistent contact too: a cube slapping
 //!   flat onto a wall it already touches with an edge stays one track).
 //!
+//! The first touches are restarted from before the touch, from the arrested state and from the
+//! touch itself, resolved and through two hybrids (the frozen-rest impulse map, and the body
+//! transient with all the body's contacts: `body_hybrid.rs`); `--hybrid-only` runs just what
+//! the hybrids' comparison needs.
+//!
 //! A track touches at the first accepted step where it is active after a step where it was
 //! not; the touch time is taken as that step's start (the integrator does not locate it).
 //! Each step's trapezoid of a track's power goes whole to the part its classification names.
