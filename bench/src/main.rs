@@ -172,6 +172,9 @@ enum Command {
         /// The body transient's relative tolerance.
         #[arg(long, default_value_t = 1e-8)]
         transient_rtol: f64,
+        /// The body transient's horizon, µs (the map's is 20 µs).
+        #[arg(long, default_value_t = 20.0)]
+        transient_horizon_us: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -492,6 +495,7 @@ fn main() -> Result<()> {
             fast_rate,
             hybrid_only,
             transient_rtol,
+            transient_horizon_us,
         } => impact_split::impact_split(
             &cli.configs_dir,
             &impact_split::ImpactSplitBench {
@@ -502,6 +506,7 @@ fn main() -> Result<()> {
                 fast_rate_m_s: *fast_rate,
                 hybrid_only: *hybrid_only,
                 transient_rtol: *transient_rtol,
+                transient_horizon_s: *transient_horizon_us * 1e-6,
             },
         )?,
         Command::Missiles {
