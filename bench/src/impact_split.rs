@@ -11,14 +11,21 @@
 //!   either end (an impact-like normal motion inside a persistent contact too: a cube slapping
 //!   flat onto a wall it already touches with an edge stays one track).
 //!
+//! The first touches are restarted from before the touch, from the arrested state and from the
+//! touch itself, resolved and through two hybrids (the frozen-rest impulse map, and the body
+//! transient with all the body's contacts: `body_hybrid.rs`); `--hybrid-only` runs just what
+//! the hybrids' comparison needs.
+//!
 //! A track touches at the first accepted step where it is active after a step where it was
 //! not; the touch time is taken as that step's start (the integrator does not locate it).
 //! Each step's trapezoid of a track's power goes whole to the part its classification names.
 
+use super::body_hybrid::{body_hybrid_row, body_hybrid_start, body_hybrid_table, GroupResult};
 use super::*;
 use nalgebra::Point3;
 use railwear::models::run::run_model_observed;
 use railwear::physics::body::{frame_from_state, BodyKind};
+use railwear::physics::body_transient::BodyTransientSettings;
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact_map::{
     effective_mass, impact_map, ContactApproach, ImpactMapSettings,
@@ -36,6 +43,13 @@ pub(crate) struct ImpactSplitBench {
     pub(crate) approach_s: f64,
     /// |ẇ| above which a step is "fast normal motion", m/s.
     pub(crate) fast_rate_m_s: f64,
+    /// Only what the hybrids need: the full run (for its touches), the resolved restarts from
+    /// the touch and the two hybrids, with full control at the case tolerance and 64x it.
+    pub(crate) hybrid_only: bool,
+    /// The body transient's relative tolerance.
+    pub(crate) transient_rtol: f64,
+    /// The body transient's horizon, s.
+    pub(crate) transient_horizon_s: f64,
 }
 
 /// Power integrals, J: N·|v_slip| (N·m), friction, damping.
@@ -664,6 +678,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("map_slip", "Σ map ∫N\\|v_slip\\| (N·m)"),
         ],
     );
+    let mut summary = body_hybrid_table();
     let mut restart_table = Table::new(
         "Impact split: the full run's touches restarted, from before the touch and from the arrested state, in each mode",
         &[
@@ -698,7 +713,12 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
     );
     for case_name in b.cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let mut measured = Vec::new();
-        for (label, mode, work_test, factor) in variants {
+        let variants = if b.hybrid_only {
+            &variants[..1]
+        } else {
+            &variants[..]
+        };
+        for &(label, mode, work_test, factor) in variants {
             eprintln!("impact-split: {case_name} {label} ...");
             let maps = (measured.is_empty()).then_some(&map_settings);
             let s = run_split(configs_dir, case_name, b, mode, work_test, factor, maps)?;
@@ -760,11 +780,25 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                     0.0,
                 ),
             ];
-            // The hybrid against the resolved run from the same touch state to the same end.
-            let hybrid: Vec<_> = restarts
+            if b.hybrid_only {
+                groups.clear();
+            }
+            // The hybrids against the resolved run from the same touch state to the same end:
+            // the frozen-rest map's and the body transient's, on the touches where both run.
+            let (hybrid, bodies): (Vec<_>, Vec<_>) = restarts
                 .iter()
-                .filter_map(|r| Some((r, hybrid_start(&model, r)?)))
-                .collect();
+                .filter_map(|r| {
+                    let map = hybrid_start(&model, r)?;
+                    let (t, y) = &r.touch;
+                    let settings = BodyTransientSettings {
+                        horizon_s: b.transient_horizon_s,
+                        relative_tolerance: b.transient_rtol,
+                        ..BodyTransientSettings::default()
+                    };
+                    let body = body_hybrid_start(&model, *t, y, &r.track, &settings)?;
+                    Some(((r, map), (&r.track, body)))
+                })
+                .unzip();
             groups.push((
                 "the touch (first active state), resolved",
                 hybrid
@@ -783,7 +817,21 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 hybrid.iter().map(|(_, h)| h.1).sum(),
                 hybrid.iter().map(|(_, h)| h.2).sum(),
             ));
+            groups.push((
+                "hybrid: body transient over 20 µs at the touch, then",
+                bodies
+                    .iter()
+                    .zip(&hybrid)
+                    .map(|((_, h), (r, _))| (h.start.0, h.start.1.clone(), horizon(r.touch.0)))
+                    .collect(),
+                bodies.iter().map(|(_, h)| h.normal_slip()).sum(),
+                bodies
+                    .iter()
+                    .map(|(_, h)| h.transient.damping_dissipation)
+                    .sum(),
+            ));
             let mut touch_full = None;
+            let mut results: HashMap<(&str, &str), GroupResult> = HashMap::new();
             for (from, starts, map_slip, map_damping) in &groups {
                 let mut full_slip = None;
                 for (label, mode, work_test, opts) in [
@@ -796,8 +844,13 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         &options,
                     ),
                 ] {
+                    if b.hybrid_only && matches!(mode, ErrorControl::Positions) {
+                        continue;
+                    }
                     eprintln!("impact-split: {case_name} restarts {from}, {label} ...");
+                    let cpu0 = thread_cpu_s();
                     let r = restarted(&model, opts, starts, mode, work_test)?;
+                    let cpu_s = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
                     let normal_slip = r.normal_slip + map_slip;
                     let base = if from.starts_with("hybrid") {
                         touch_full.unwrap_or(f64::NAN)
@@ -821,8 +874,37 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         Cell::Num(r.damping_j + map_damping),
                         Cell::Num(r.residual_j.abs() / r.dissipated_j.max(1e-30)),
                     ]);
+                    results.insert(
+                        (*from, label),
+                        GroupResult {
+                            accepted: r.accepted,
+                            normal_slip,
+                            damping_j: r.damping_j + map_damping,
+                            cpu_s,
+                        },
+                    );
                 }
             }
+            for mode in ["full", "full, tol × 64"] {
+                let group = |from: &str| results.get(&(from, mode)).copied();
+                let reference = results.get(&("the touch (first active state), resolved", "full"));
+                if let (Some(reference), Some(resolved), Some(map), Some(body)) = (
+                    reference.copied(),
+                    group("the touch (first active state), resolved"),
+                    group("hybrid: map over 20 µs at the touch, then"),
+                    group("hybrid: body transient over 20 µs at the touch, then"),
+                ) {
+                    summary.row(body_hybrid_row(
+                        case_name,
+                        mode,
+                        [reference, resolved, map, body],
+                        &bodies,
+                    ));
+                }
+            }
+        }
+        if b.hybrid_only {
+            continue;
         }
         let total_of = |s: &Split| s.per_track.values().map(|t| t.0).sum::<f64>();
         let total_diff = total_of(&measured[1]) - total_of(&measured[0]);
@@ -983,5 +1065,22 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
         h = RESTART_HORIZON_S,
         a = ARRESTED_AFTER_S * 1e6
     ));
-    Ok(vec![runs, parts, touches, tracks, restart_table])
+    summary.note(
+        "the restarted touches of the restart table; resolved = \"the touch (first active state), \
+         resolved\", map hybrid = the frozen-rest impulse map over 20 µs (the cube's \
+         translational mass), body hybrid = physics::body_transient over 20 µs (the cube's six \
+         degrees of freedom with all its tracks, the tube on its prescribed motion, gravity; \
+         Dormand-Prince 5(4), position tolerance 1e-12 m, a step across a change of the loaded \
+         points at 1e-3 of the tolerance); ∫N|v_slip| dt and damping work summed over the \
+         touches, each hybrid's including its transient's; \"vs resolved\" against the \
+         resolved run in the row's mode, \"vs case tol\" against the resolved run at the case \
+         tolerance; CPU from /proc/thread-self/stat (10 ms ticks)",
+    );
+    summary.note(format!(
+        "body transient relative tolerance {:e}, horizon {} µs (the rows' labels say 20 µs)",
+        b.transient_rtol,
+        b.transient_horizon_s * 1e6
+    ));
+    summary.note(machine_note());
+    Ok(vec![runs, parts, touches, tracks, restart_table, summary])
 }

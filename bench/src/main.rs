@@ -24,6 +24,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
+mod body_hybrid;
 mod budget;
 mod convergence;
 mod engine;
@@ -164,6 +165,16 @@ enum Command {
         /// |ẇ| above which a step counts as fast normal motion, m/s.
         #[arg(long, default_value_t = 1e-3)]
         fast_rate: f64,
+        /// Only the hybrids' comparison: the full run for its touches, the resolved restarts
+        /// from the touch and the two hybrids (map, body transient) in full control.
+        #[arg(long)]
+        hybrid_only: bool,
+        /// The body transient's relative tolerance.
+        #[arg(long, default_value_t = 1e-8)]
+        transient_rtol: f64,
+        /// The body transient's horizon, µs (the map's is 20 µs).
+        #[arg(long, default_value_t = 20.0)]
+        transient_horizon_us: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -482,6 +493,9 @@ fn main() -> Result<()> {
             window,
             window_us,
             fast_rate,
+            hybrid_only,
+            transient_rtol,
+            transient_horizon_us,
         } => impact_split::impact_split(
             &cli.configs_dir,
             &impact_split::ImpactSplitBench {
@@ -490,6 +504,9 @@ fn main() -> Result<()> {
                 window: *window,
                 approach_s: *window_us * 1e-6,
                 fast_rate_m_s: *fast_rate,
+                hybrid_only: *hybrid_only,
+                transient_rtol: *transient_rtol,
+                transient_horizon_s: *transient_horizon_us * 1e-6,
             },
         )?,
         Command::Missiles {

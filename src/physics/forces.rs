@@ -200,6 +200,17 @@ impl ForceElement {
         }
     }
 
+    /// The bodies this element acts on: its first end, and its second end or reaction (None
+    /// for a constant force without a modelled reaction).
+    pub fn bodies(&self) -> [Option<usize>; 2] {
+        match self {
+            ForceElement::SpringDamper(s) => [Some(s.a.body), Some(s.b.body)],
+            ForceElement::OneSidedSpring(s) => [Some(s.a.body), Some(s.b.body)],
+            ForceElement::ConstantForce(s) => [Some(s.a.body), s.reaction.map(|r| r.body)],
+            ForceElement::Bushing(s) => [Some(s.a.body), Some(s.b.body)],
+        }
+    }
+
     /// Adds this element's forces to `wrenches`; returns its potential energy, J.
     pub fn accumulate(&self, frames: &[BodyFrame], wrenches: &mut [Wrench]) -> f64 {
         self.accumulate_with_power(frames, wrenches).potential

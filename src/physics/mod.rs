@@ -1,6 +1,7 @@
 //! Rigid multibody dynamics: bodies, force elements, contact and friction laws, integrators.
 
 pub mod body;
+pub mod body_transient;
 pub mod contact;
 pub mod control;
 pub mod energy;

@@ -1,6 +1,7 @@
 //! The engine test binary: physics, models, the gap diagnosis, checkpoints, closed forms, energy
 //! and error control, called as a library (no HTTP, no store). One module per concern.
 
+mod body_transient;
 mod checkpoint_resume;
 mod contact_fit;
 mod energy_passivity;

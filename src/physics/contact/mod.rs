@@ -160,6 +160,9 @@ pub struct TrackState {
     pub damping_power: f64,
     /// Power dissipated by friction `Σ μ_i N_i |v_i|`, W (>= 0).
     pub friction_power: f64,
+    /// The track's total contact force on body a (normal and friction, the points' sum), N,
+    /// world (−force acts on b): its part off `normal` is the friction force.
+    pub force: Vector3<f64>,
 }
 
 impl TrackState {
@@ -492,6 +495,7 @@ impl Contact {
                     friction_force: track.friction_force,
                     damping_power: track.damping_power,
                     friction_power: track.friction_power,
+                    force: track.force,
                 });
             }
         }
