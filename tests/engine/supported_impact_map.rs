@@ -256,7 +256,7 @@ fn energy_account_closes_with_supports() {
 /// work, and the account within 1e-7 of the energy turned over.
 #[test]
 fn random_supported_transients_are_passive() {
-    let mut rng = ChaCha8Rng::seed_from_u64(28_2);
+    let mut rng = ChaCha8Rng::seed_from_u64(282);
     let mut worst = 0.0f64;
     let mut lifted = 0;
     for case in 0..200 {
