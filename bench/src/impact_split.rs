@@ -58,6 +58,8 @@ pub(crate) struct ImpactSplitBench {
     pub(crate) transient_horizon_s: f64,
     /// The supported map's supports without the frozen rotation's velocity offset.
     pub(crate) supports_translating: bool,
+    /// The supported map's relative tolerance.
+    pub(crate) supported_rtol: f64,
 }
 
 /// Power integrals, J: N·|v_slip| (N·m), friction, damping.
@@ -806,6 +808,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         &r.track,
                         ARRESTED_AFTER_S,
                         b.supports_translating,
+                        b.supported_rtol,
                     )?;
                     let map = hybrid_start(&model, r)?;
                     let (t, y) = &r.touch;
@@ -1133,8 +1136,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
          physics::supported_impact_map over 20 µs at the touch (the cube's translational mass, \
          the touching track's law; the cube's other pressed tracks with a normal off the wall's \
          as rigid supports, tracks on one normal merged, their friction on their own slip with \
-         the frozen rotation's offset; gravity, the tube's inertia and unpressed tracks frozen; \
-         relative tolerance 1e-10), its velocity change and displacement applied to the cube, \
+         the frozen rotation's offset; gravity, the tube's inertia and unpressed tracks frozen), its velocity change and displacement applied to the cube, \
          the rotation frozen, then the global integrator in the row's mode; integrals summed \
          over the touches, each hybrid's including its map's or transient's; CPU from \
          /proc/thread-self/stat (10 ms ticks; a map's CPU over 200 repeats)",
@@ -1146,6 +1148,10 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
         "supports with the frozen rotation's velocity offset (the support point's velocity \
          relative to the touching point at the touch, N-weighted over the merged tracks)"
     });
+    supported_summary.note(format!(
+        "supported map relative tolerance {:e}",
+        b.supported_rtol
+    ));
     supported_summary.note(machine_note());
     Ok(vec![
         runs,

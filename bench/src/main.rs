@@ -180,6 +180,9 @@ enum Command {
         /// cube translating: each support point moves with the touching point).
         #[arg(long)]
         supports_translating: bool,
+        /// The supported map's relative tolerance.
+        #[arg(long, default_value_t = 1e-10)]
+        supported_rtol: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -502,6 +505,7 @@ fn main() -> Result<()> {
             transient_rtol,
             transient_horizon_us,
             supports_translating,
+            supported_rtol,
         } => impact_split::impact_split(
             &cli.configs_dir,
             &impact_split::ImpactSplitBench {
@@ -514,6 +518,7 @@ fn main() -> Result<()> {
                 transient_rtol: *transient_rtol,
                 transient_horizon_s: *transient_horizon_us * 1e-6,
                 supports_translating: *supports_translating,
+                supported_rtol: *supported_rtol,
             },
         )?,
         Command::Missiles {

@@ -51,6 +51,7 @@ pub(crate) fn supported_hybrid_start(
     track: &TrackState,
     horizon_s: f64,
     translating: bool,
+    relative_tolerance: f64,
 ) -> Option<SupportedHybrid> {
     let system = &model.system;
     let c = &system.contacts[track.contact as usize];
@@ -155,6 +156,7 @@ pub(crate) fn supported_hybrid_start(
     let friction = c.friction.as_ref().unwrap_or(&no_friction);
     let settings = ImpactMapSettings {
         time_limit: horizon_s,
+        relative_tolerance,
         ..ImpactMapSettings::default()
     };
     let mut walls = Vec::with_capacity(TIMED_REPEATS);
