@@ -26,7 +26,7 @@ pub(crate) struct BodyHybrid {
 }
 
 /// Evaluations of each transient for its wall-clock time.
-const TIMED_REPEATS: usize = 5;
+pub(crate) const TIMED_REPEATS: usize = 5;
 
 impl BodyHybrid {
     /// `∫N|v_slip| dt` of all the body's tracks over the transient, N·m.

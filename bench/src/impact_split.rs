@@ -20,7 +20,13 @@
 //! not; the touch time is taken as that step's start (the integrator does not locate it).
 //! Each step's trapezoid of a track's power goes whole to the part its classification names.
 
-use super::body_hybrid::{body_hybrid_row, body_hybrid_start, body_hybrid_table, GroupResult};
+use super::body_hybrid::{
+    body_hybrid_row, body_hybrid_start, body_hybrid_table, GroupResult,
+    TIMED_REPEATS as BODY_REPEATS,
+};
+use super::supported_hybrid::{
+    supported_hybrid_row, supported_hybrid_start, supported_hybrid_table,
+};
 use super::*;
 use nalgebra::Point3;
 use railwear::models::run::run_model_observed;
@@ -50,6 +56,10 @@ pub(crate) struct ImpactSplitBench {
     pub(crate) transient_rtol: f64,
     /// The body transient's horizon, s.
     pub(crate) transient_horizon_s: f64,
+    /// The supported map's supports without the frozen rotation's velocity offset.
+    pub(crate) supports_translating: bool,
+    /// The supported map's relative tolerance.
+    pub(crate) supported_rtol: f64,
 }
 
 /// Power integrals, J: N·|v_slip| (N·m), friction, damping.
@@ -679,6 +689,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
         ],
     );
     let mut summary = body_hybrid_table();
+    let mut supported_summary = supported_hybrid_table();
     let mut restart_table = Table::new(
         "Impact split: the full run's touches restarted, from before the touch and from the arrested state, in each mode",
         &[
@@ -785,9 +796,20 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             }
             // The hybrids against the resolved run from the same touch state to the same end:
             // the frozen-rest map's and the body transient's, on the touches where both run.
+            let mut supported = Vec::new();
             let (hybrid, bodies): (Vec<_>, Vec<_>) = restarts
                 .iter()
                 .filter_map(|r| {
+                    let (t, y) = &r.touch;
+                    let s = supported_hybrid_start(
+                        &model,
+                        *t,
+                        y,
+                        &r.track,
+                        ARRESTED_AFTER_S,
+                        b.supports_translating,
+                        b.supported_rtol,
+                    )?;
                     let map = hybrid_start(&model, r)?;
                     let (t, y) = &r.touch;
                     let settings = BodyTransientSettings {
@@ -796,6 +818,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         ..BodyTransientSettings::default()
                     };
                     let body = body_hybrid_start(&model, *t, y, &r.track, &settings)?;
+                    supported.push(s);
                     Some(((r, map), (&r.track, body)))
                 })
                 .unzip();
@@ -828,6 +851,19 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 bodies
                     .iter()
                     .map(|(_, h)| h.transient.damping_dissipation)
+                    .sum(),
+            ));
+            groups.push((
+                "hybrid: supported map over 20 µs at the touch, then",
+                supported
+                    .iter()
+                    .zip(&hybrid)
+                    .map(|(h, (r, _))| (h.start.0, h.start.1.clone(), horizon(r.touch.0)))
+                    .collect(),
+                supported.iter().map(|h| h.normal_slip).sum(),
+                supported
+                    .iter()
+                    .map(|h| h.map.contact.damping_dissipation)
                     .sum(),
             ));
             let mut touch_full = None;
@@ -900,6 +936,19 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                         [reference, resolved, map, body],
                         &bodies,
                     ));
+                    if let Some(s) = group("hybrid: supported map over 20 µs at the touch, then") {
+                        let body_cpu: Option<f64> = bodies
+                            .iter()
+                            .map(|(_, h)| h.cpu_repeats_s.map(|s| s / BODY_REPEATS as f64))
+                            .sum();
+                        supported_summary.row(supported_hybrid_row(
+                            case_name,
+                            mode,
+                            [reference, resolved, map, body, s],
+                            body_cpu,
+                            &supported,
+                        ));
+                    }
                 }
             }
         }
@@ -1082,5 +1131,35 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
         b.transient_horizon_s * 1e6
     ));
     summary.note(machine_note());
-    Ok(vec![runs, parts, touches, tracks, restart_table, summary])
+    supported_summary.note(
+        "the restarted touches of the restart table; supported hybrid = \
+         physics::supported_impact_map over 20 µs at the touch (the cube's translational mass, \
+         the touching track's law; the cube's other pressed tracks with a normal off the wall's \
+         as rigid supports, tracks on one normal merged, their friction on their own slip with \
+         the frozen rotation's offset; gravity, the tube's inertia and unpressed tracks frozen), its velocity change and displacement applied to the cube, \
+         the rotation frozen, then the global integrator in the row's mode; integrals summed \
+         over the touches, each hybrid's including its map's or transient's; CPU from \
+         /proc/thread-self/stat (10 ms ticks; a map's CPU over 200 repeats)",
+    );
+    supported_summary.note(if b.supports_translating {
+        "supports translating (--supports-translating): no velocity offset, each support point \
+         moves with the touching point"
+    } else {
+        "supports with the frozen rotation's velocity offset (the support point's velocity \
+         relative to the touching point at the touch, N-weighted over the merged tracks)"
+    });
+    supported_summary.note(format!(
+        "supported map relative tolerance {:e}",
+        b.supported_rtol
+    ));
+    supported_summary.note(machine_note());
+    Ok(vec![
+        runs,
+        parts,
+        touches,
+        tracks,
+        restart_table,
+        summary,
+        supported_summary,
+    ])
 }

@@ -36,6 +36,7 @@ mod launcher;
 mod load;
 mod missiles;
 mod peers;
+mod supported_hybrid;
 mod sweep;
 mod sweep_procs;
 mod table;
@@ -175,6 +176,13 @@ enum Command {
         /// The body transient's horizon, µs (the map's is 20 µs).
         #[arg(long, default_value_t = 20.0)]
         transient_horizon_us: f64,
+        /// The supported map's supports without the frozen rotation's velocity offset (the
+        /// cube translating: each support point moves with the touching point).
+        #[arg(long)]
+        supports_translating: bool,
+        /// The supported map's relative tolerance.
+        #[arg(long, default_value_t = 1e-10)]
+        supported_rtol: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -496,6 +504,8 @@ fn main() -> Result<()> {
             hybrid_only,
             transient_rtol,
             transient_horizon_us,
+            supports_translating,
+            supported_rtol,
         } => impact_split::impact_split(
             &cli.configs_dir,
             &impact_split::ImpactSplitBench {
@@ -507,6 +517,8 @@ fn main() -> Result<()> {
                 hybrid_only: *hybrid_only,
                 transient_rtol: *transient_rtol,
                 transient_horizon_s: *transient_horizon_us * 1e-6,
+                supports_translating: *supports_translating,
+                supported_rtol: *supported_rtol,
             },
         )?,
         Command::Missiles {

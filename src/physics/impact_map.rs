@@ -251,9 +251,10 @@ impl ImpactMapSettings {
     }
 }
 
-// State components: penetration, its rate, slip velocity, then the quadratures.
-const W: usize = 0;
-const WDOT: usize = 1;
+// State components: penetration, its rate, slip velocity, then the quadratures. The first two
+// are shared with every transient [`integrate`] runs (`physics::supported_impact_map` too).
+pub(super) const W: usize = 0;
+pub(super) const WDOT: usize = 1;
 const VX: usize = 2;
 const VY: usize = 3;
 const PN: usize = 4;
@@ -270,7 +271,7 @@ type State = [f64; DIM];
 /// the clamp holds `N` at zero. Each piece's formula is used a little past its boundary, up to
 /// the event the step lands on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct Piece {
+pub(super) struct Piece {
     on_ramp: bool,
     clamped: bool,
 }
@@ -295,15 +296,13 @@ const EVENTS: [Event; 6] = [
     Event::Turning,
 ];
 
-struct LocalContact<'a> {
-    approach: &'a ContactApproach,
-    impact: &'a ImpactParams,
-    friction: &'a FrictionParams,
-    /// `dμ/dv` at zero slip: `μ(v)/v` there, the regularized law's viscous limit.
-    mu_slope_at_rest: f64,
+/// The contact's normal law on its smooth pieces (eq. 2.1-2.3 with the STEP ramp and clamp).
+#[derive(Clone, Copy)]
+pub(super) struct NormalLaw<'a> {
+    pub(super) impact: &'a ImpactParams,
 }
 
-impl LocalContact<'_> {
+impl NormalLaw<'_> {
     /// Damping coefficient of `piece` at `w`, N·s/m.
     #[inline]
     fn damping(&self, piece: Piece, w: f64) -> f64 {
@@ -321,15 +320,47 @@ impl LocalContact<'_> {
         self.impact.elastic_force(w) + self.damping(piece, w) * wdot
     }
 
-    fn derivative(&self, piece: Piece, y: &State) -> State {
-        let a = self.approach;
-        let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
+    /// The elastic force `k w^e` and the normal force `N` of `piece` at `(w, ẇ)`, N.
+    #[inline]
+    pub(super) fn forces(&self, piece: Piece, w: f64, wdot: f64) -> (f64, f64) {
         let spring = self.impact.elastic_force(w);
         let normal = if piece.clamped {
             0.0
         } else {
             spring + self.damping(piece, w) * wdot
         };
+        (spring, normal)
+    }
+
+    /// The event's function at `(w, ẇ)`: >= 0 on the piece's side, < 0 past the event.
+    /// `None` where the event cannot happen from `piece` (or, for the turning point, from a
+    /// step that starts leaving).
+    fn event_value(&self, event: Event, piece: Piece, w: f64, wdot: f64) -> Option<f64> {
+        let d = self.impact.full_damping_depth;
+        match event {
+            Event::Separation => (piece.on_ramp || d == 0.0).then_some(w),
+            Event::RampEnd => piece.on_ramp.then_some(d - w),
+            Event::RampStart => (!piece.on_ramp && d > 0.0).then_some(w - d),
+            Event::Clamp => (!piece.clamped).then(|| self.unclamped_force(piece, w, wdot)),
+            Event::Release => piece.clamped.then(|| -self.unclamped_force(piece, w, wdot)),
+            Event::Turning => Some(wdot),
+        }
+    }
+}
+
+struct LocalContact<'a> {
+    approach: &'a ContactApproach,
+    law: NormalLaw<'a>,
+    friction: &'a FrictionParams,
+    /// `dμ/dv` at zero slip: `μ(v)/v` there, the regularized law's viscous limit.
+    mu_slope_at_rest: f64,
+}
+
+impl LocalContact<'_> {
+    fn derivative(&self, piece: Piece, y: &State) -> State {
+        let a = self.approach;
+        let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
+        let (spring, normal) = self.law.forces(piece, w, wdot);
         let speed = vx.hypot(vy);
         let mu = self.friction.coefficient(speed);
         let mu_per_speed = if speed > 0.0 {
@@ -353,21 +384,6 @@ impl LocalContact<'_> {
         d[W_EXT] = a.external_normal_force * wdot + ftx * vx + fty * vy;
         d[N_SLIP] = normal * speed;
         d
-    }
-
-    /// The event's function at `(w, ẇ)`: >= 0 on the piece's side, < 0 past the event.
-    /// `None` where the event cannot happen from `piece` (or, for the turning point, from a
-    /// step that starts leaving).
-    fn event_value(&self, event: Event, piece: Piece, w: f64, wdot: f64) -> Option<f64> {
-        let d = self.impact.full_damping_depth;
-        match event {
-            Event::Separation => (piece.on_ramp || d == 0.0).then_some(w),
-            Event::RampEnd => piece.on_ramp.then_some(d - w),
-            Event::RampStart => (!piece.on_ramp && d > 0.0).then_some(w - d),
-            Event::Clamp => (!piece.clamped).then(|| self.unclamped_force(piece, w, wdot)),
-            Event::Release => piece.clamped.then(|| -self.unclamped_force(piece, w, wdot)),
-            Event::Turning => Some(wdot),
-        }
     }
 }
 
@@ -410,57 +426,76 @@ const PI_BETA: f64 = 0.04;
 const GROWTH_MAX: f64 = 10.0;
 const SHRINK_MAX: f64 = 5.0;
 
-/// The map of one transient: integrates the contact from first touch to separation or the
-/// time limit and returns its impulses, energies, wear integrals and end state.
-pub fn impact_map(
-    approach: &ContactApproach,
-    impact: &ImpactParams,
-    friction: &FrictionParams,
+/// Error-test scales of a transient from `approach`: the undamped peak penetration at the
+/// approach speed (or the static one under the pressing force), the larger of the approach
+/// and slip speeds, and the momentum and kinetic energy at that speed.
+pub(super) struct Scales {
+    pub(super) penetration: f64,
+    pub(super) speed: f64,
+    pub(super) momentum: f64,
+    pub(super) energy: f64,
+}
+
+impl Scales {
+    pub(super) fn of(approach: &ContactApproach, impact: &ImpactParams) -> Self {
+        let speed = approach
+            .approach_speed
+            .max(approach.slip_velocity[0].hypot(approach.slip_velocity[1]));
+        let mass = approach.normal_mass.max(approach.tangential_mass);
+        let e = impact.exponent;
+        let penetration = ((e + 1.0) * approach.normal_mass * approach.approach_speed.powi(2)
+            / (2.0 * impact.stiffness))
+            .powf(1.0 / (e + 1.0))
+            .max(impact.static_penetration(approach.external_normal_force.abs()));
+        Self {
+            penetration,
+            speed,
+            momentum: mass * speed,
+            energy: 0.5 * mass * speed * speed,
+        }
+    }
+
+    /// The first step's size: 1e-3 of the time to the undamped peak, and 0.1 of `m_n/c_max`.
+    pub(super) fn first_step(&self, approach: &ContactApproach, impact: &ImpactParams) -> f64 {
+        let mut h = 1e-3 * self.penetration / approach.approach_speed;
+        if impact.max_damping > 0.0 {
+            h = h.min(0.1 * approach.normal_mass / impact.max_damping);
+        }
+        h
+    }
+}
+
+/// The end of a transient [`integrate`] ran: how, when, the state, the steps.
+pub(super) struct Transient<const D: usize> {
+    pub(super) end: ContactEnd,
+    pub(super) duration: f64,
+    pub(super) y: [f64; D],
+    pub(super) max_penetration: f64,
+    pub(super) steps: usize,
+    pub(super) rejected: usize,
+}
+
+/// Integrates a transient whose components [`W`] and [`WDOT`] are the contact's penetration
+/// and its rate (the events of `law` are read on them), from `y0` (`w = 0`) with `derivative`
+/// on each piece of the law, under the relative tolerance against `scale` per component, to
+/// separation or the settings' limits.
+pub(super) fn integrate<const D: usize>(
+    law: NormalLaw<'_>,
     settings: &ImpactMapSettings,
-) -> Result<ImpactMap, ImpactMapError> {
-    approach.validate().map_err(ImpactMapError::Approach)?;
-    impact.validate().map_err(ImpactMapError::Impact)?;
-    friction.validate().map_err(ImpactMapError::Friction)?;
-    settings.validate().map_err(ImpactMapError::Settings)?;
-    let contact = LocalContact {
-        approach,
-        impact,
-        friction,
-        mu_slope_at_rest: friction.coefficient_derivative(0.0),
-    };
-
-    // Each component's scale for the error test: the undamped peak penetration at the larger of
-    // the approach and slip speeds, the momentum and kinetic energy at that speed.
-    let speed = approach
-        .approach_speed
-        .max(approach.slip_velocity[0].hypot(approach.slip_velocity[1]));
-    let mass = approach.normal_mass.max(approach.tangential_mass);
-    let e = impact.exponent;
-    let w_scale = ((e + 1.0) * approach.normal_mass * approach.approach_speed.powi(2)
-        / (2.0 * impact.stiffness))
-        .powf(1.0 / (e + 1.0))
-        .max(impact.static_penetration(approach.external_normal_force.abs()));
-    let (p_scale, e_scale) = (mass * speed, 0.5 * mass * speed * speed);
-    let mut scale = [e_scale; DIM];
-    scale[W] = w_scale;
-    scale[WDOT..=VY].fill(speed);
-    scale[PN..=PTY].fill(p_scale);
+    y0: [f64; D],
+    scale: &[f64; D],
+    first_step: f64,
+    derivative: impl Fn(Piece, &[f64; D]) -> [f64; D],
+) -> Result<Transient<D>, ImpactMapError> {
     let rtol = settings.relative_tolerance;
-
     let mut piece = Piece {
-        on_ramp: impact.full_damping_depth > 0.0,
+        on_ramp: law.impact.full_damping_depth > 0.0,
         clamped: false,
     };
-    let mut y: State = [0.0; DIM];
-    y[WDOT] = approach.approach_speed;
-    y[VX] = approach.slip_velocity[0];
-    y[VY] = approach.slip_velocity[1];
-    let mut f0 = contact.derivative(piece, &y);
+    let mut y = y0;
+    let mut f0 = derivative(piece, &y);
     let mut t = 0.0;
-    let mut h = 1e-3 * w_scale / approach.approach_speed;
-    if impact.max_damping > 0.0 {
-        h = h.min(0.1 * approach.normal_mass / impact.max_damping);
-    }
+    let mut h = first_step;
     let (mut steps, mut rejected, mut max_penetration) = (0usize, 0usize, 0.0f64);
     let mut err_old: f64 = 1e-4;
     let mut last_rejected = false;
@@ -480,10 +515,10 @@ pub fn impact_map(
         if !(h_try > 0.0) || t + h_try == t {
             return Err(ImpactMapError::StepSizeUnderflow { time: t });
         }
-        let mut rhs = |z: &State| contact.derivative(piece, z);
+        let mut rhs = |z: &[f64; D]| derivative(piece, z);
         let step = dopri5_step(&mut rhs, &y, &f0, h_try);
         let mut err = 0.0f64;
-        for i in 0..DIM {
+        for i in 0..D {
             let sc = rtol * scale[i].max(y[i].abs()).max(step.y[i].abs());
             err = err.max(step.error[i].abs() / sc);
         }
@@ -505,17 +540,17 @@ pub fn impact_map(
             if event == Event::Turning && (wd0 <= 0.0 || at_turning) {
                 continue;
             }
-            let Some(g1) = contact.event_value(event, piece, w1, wd1) else {
+            let Some(g1) = law.event_value(event, piece, w1, wd1) else {
                 continue;
             };
             if g1 >= 0.0 {
                 continue;
             }
-            let g0 = contact.event_value(event, piece, w0, wd0).unwrap_or(0.0);
+            let g0 = law.event_value(event, piece, w0, wd0).unwrap_or(0.0);
             let at = |theta: f64| {
                 let w = hermite(w0, wd0, w1, wd1, h_try, theta);
                 let wd = hermite(wd0, a0, wd1, a1, h_try, theta);
-                contact.event_value(event, piece, w, wd).unwrap_or(0.0)
+                law.event_value(event, piece, w, wd).unwrap_or(0.0)
             };
             let theta = first_crossing(at, g0, g1);
             if first.is_none_or(|(th, _)| theta < th) {
@@ -565,12 +600,57 @@ pub fn impact_map(
             Event::Release => piece.clamped = false,
             Event::Turning => {}
         }
-        f0 = contact.derivative(piece, &y);
+        f0 = derivative(piece, &y);
     }
-
-    Ok(ImpactMap {
+    Ok(Transient {
         end,
         duration: t,
+        y,
+        max_penetration,
+        steps,
+        rejected,
+    })
+}
+
+/// The map of one transient: integrates the contact from first touch to separation or the
+/// time limit and returns its impulses, energies, wear integrals and end state.
+pub fn impact_map(
+    approach: &ContactApproach,
+    impact: &ImpactParams,
+    friction: &FrictionParams,
+    settings: &ImpactMapSettings,
+) -> Result<ImpactMap, ImpactMapError> {
+    approach.validate().map_err(ImpactMapError::Approach)?;
+    impact.validate().map_err(ImpactMapError::Impact)?;
+    friction.validate().map_err(ImpactMapError::Friction)?;
+    settings.validate().map_err(ImpactMapError::Settings)?;
+    let contact = LocalContact {
+        approach,
+        law: NormalLaw { impact },
+        friction,
+        mu_slope_at_rest: friction.coefficient_derivative(0.0),
+    };
+    let sc = Scales::of(approach, impact);
+    let mut scale = [sc.energy; DIM];
+    scale[W] = sc.penetration;
+    scale[WDOT..=VY].fill(sc.speed);
+    scale[PN..=PTY].fill(sc.momentum);
+    let mut y0: State = [0.0; DIM];
+    y0[WDOT] = approach.approach_speed;
+    y0[VX] = approach.slip_velocity[0];
+    y0[VY] = approach.slip_velocity[1];
+    let run = integrate(
+        contact.law,
+        settings,
+        y0,
+        &scale,
+        sc.first_step(approach, impact),
+        |piece, y| contact.derivative(piece, y),
+    )?;
+    let y = run.y;
+    Ok(ImpactMap {
+        end: run.end,
+        duration: run.duration,
         normal_impulse: y[PN],
         tangential_impulse: [y[PTX], y[PTY]],
         damping_dissipation: y[E_DAMP],
@@ -580,8 +660,8 @@ pub fn impact_map(
         exit_normal_velocity: y[WDOT],
         exit_slip_velocity: [y[VX], y[VY]],
         end_penetration: y[W],
-        max_penetration,
-        steps,
-        rejected_steps: rejected,
+        max_penetration: run.max_penetration,
+        steps: run.steps,
+        rejected_steps: run.rejected,
     })
 }

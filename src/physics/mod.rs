@@ -15,5 +15,6 @@ pub mod newton_matrix;
 pub mod partition;
 pub mod simulate;
 pub mod step;
+pub mod supported_impact_map;
 pub mod system;
 pub mod track;

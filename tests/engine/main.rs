@@ -24,3 +24,4 @@ mod multi_missile;
 mod newton_matrix;
 mod rattle_box;
 mod step_diagnostics;
+mod supported_impact_map;
