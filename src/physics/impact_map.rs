@@ -356,20 +356,52 @@ struct LocalContact<'a> {
     mu_slope_at_rest: f64,
 }
 
+/// The touching contact's forces at `(w, ẇ)` and slip `(vx, vy)` on `piece`: the normal law's
+/// spring part and total, and the regularized friction `−N μ(|v|)/|v| v` (the rest slope at
+/// zero slip). Shared with [`super::supported_impact_map`], whose wall is this contact.
+pub(super) struct WallForces {
+    pub spring: f64,
+    pub normal: f64,
+    pub friction: [f64; 2],
+    pub mu: f64,
+    pub speed: f64,
+}
+
+impl WallForces {
+    pub fn at(law: &NormalLaw, f: &FrictionParams, slope: f64, p: Piece, y: [f64; 4]) -> Self {
+        let [w, wdot, vx, vy] = y;
+        let (spring, normal) = law.forces(p, w, wdot);
+        let speed = vx.hypot(vy);
+        let mu = f.coefficient(speed);
+        let mu_per_speed = if speed > 0.0 { mu / speed } else { slope };
+        let friction = [-normal * mu_per_speed * vx, -normal * mu_per_speed * vy];
+        Self {
+            spring,
+            normal,
+            friction,
+            mu,
+            speed,
+        }
+    }
+}
+
 impl LocalContact<'_> {
     fn derivative(&self, piece: Piece, y: &State) -> State {
         let a = self.approach;
         let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
-        let (spring, normal) = self.law.forces(piece, w, wdot);
-        let speed = vx.hypot(vy);
-        let mu = self.friction.coefficient(speed);
-        let mu_per_speed = if speed > 0.0 {
-            mu / speed
-        } else {
-            self.mu_slope_at_rest
-        };
-        let fx = -normal * mu_per_speed * vx;
-        let fy = -normal * mu_per_speed * vy;
+        let WallForces {
+            spring,
+            normal,
+            friction: [fx, fy],
+            mu,
+            speed,
+        } = WallForces::at(
+            &self.law,
+            self.friction,
+            self.mu_slope_at_rest,
+            piece,
+            [w, wdot, vx, vy],
+        );
         let [ftx, fty] = a.external_tangential_force;
         let mut d = [0.0; DIM];
         d[W] = wdot;

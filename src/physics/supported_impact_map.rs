@@ -27,7 +27,7 @@ use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use super::impact_map::{
     integrate, ContactApproach, ImpactMap, ImpactMapError, ImpactMapSettings, NormalLaw, Piece,
-    Scales, W, WDOT,
+    Scales, WallForces, W, WDOT,
 };
 use crate::field_error::FieldError;
 use std::cell::Cell;
@@ -349,16 +349,19 @@ impl SupportedContact<'_> {
     fn derivative(&self, piece: Piece, y: &State) -> State {
         let a = self.approach;
         let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
-        let (spring, normal) = self.law.forces(piece, w, wdot);
-        let speed = vx.hypot(vy);
-        let mu = self.friction.coefficient(speed);
-        let mu_per_speed = if speed > 0.0 {
-            mu / speed
-        } else {
-            self.mu_slope_at_rest
-        };
-        let fx = -normal * mu_per_speed * vx;
-        let fy = -normal * mu_per_speed * vy;
+        let WallForces {
+            spring,
+            normal,
+            friction: [fx, fy],
+            mu,
+            speed,
+        } = WallForces::at(
+            &self.law,
+            self.friction,
+            self.mu_slope_at_rest,
+            piece,
+            [w, wdot, vx, vy],
+        );
         let [ftx, fty] = a.external_tangential_force;
         let mut total = [a.external_normal_force - normal, ftx + fx, fty + fy];
         let mut d = [0.0; DIM];
