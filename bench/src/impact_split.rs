@@ -30,12 +30,10 @@ use super::supported_hybrid::{
 use super::*;
 use nalgebra::Point3;
 use railwear::models::run::run_model_observed;
-use railwear::physics::body::{frame_from_state, BodyKind};
+use railwear::physics::body::{effective_mass, frame_from_state, BodyKind};
 use railwear::physics::body_transient::BodyTransientSettings;
 use railwear::physics::friction::FrictionParams;
-use railwear::physics::impact_map::{
-    effective_mass, impact_map, ContactApproach, ImpactMapSettings,
-};
+use railwear::physics::impact_map::{impact_map, ContactApproach, ImpactMapSettings};
 use railwear::physics::integrator::ErrorControl;
 use railwear::physics::system::MultibodySystem;
 use std::collections::HashMap;

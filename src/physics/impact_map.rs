@@ -20,12 +20,10 @@
 //! side using its own smooth formula, so the method keeps its order. docs/models.md,
 //! "Contact-local impulse map", gives the assumptions and the measured error.
 
-use super::body::MassProperties;
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use super::local_dopri5::{dopri5_step, hermite};
 use crate::field_error::FieldError;
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 /// The contact at first touch: effective masses, the approach and slip velocities, and the
 /// external force frozen over the transient (`w = 0` at the start by definition).
@@ -195,34 +193,8 @@ impl ContactApproach {
     }
 }
 
-/// Effective mass of one free rigid body at a point along a direction, kg: `1 / (u·K u)` with
-/// `K = I₃/m − [r]× I_w⁻¹ [r]×` the body's inverse mass seen at the point (the velocity change
-/// there per unit impulse), `r` the lever arm from the centre of mass to the point and `I_w` the
-/// inertia in world axes (`rotation` takes body axes to world). `direction` need not be unit
-/// length. None when the inertia is singular or the direction is zero or not finite.
-///
-/// This is the mass a single touching point meets. A face that lands flat engages all its
-/// points within the damping ramp, which locks the rotation: the pressed patch then meets the
-/// body's translational mass `m` (docs/models.md, "Where position-only error control's
-/// difference comes from": on the rattle boxes the map with `m` reproduces the resolved arrests
-/// to 0.1 %, with the first point's mass it misses them by 40 %).
-pub fn effective_mass(
-    mass: &MassProperties,
-    rotation: &UnitQuaternion<f64>,
-    lever_arm: &Vector3<f64>,
-    direction: &Vector3<f64>,
-) -> Option<f64> {
-    let u = direction.try_normalize(0.0)?;
-    let r = rotation.to_rotation_matrix();
-    let inverse_inertia = r.matrix() * mass.inertia.try_inverse()? * r.matrix().transpose();
-    let skew = lever_arm.cross_matrix();
-    let k: Matrix3<f64> = Matrix3::identity() / mass.mass - skew * inverse_inertia * skew;
-    let inverse = u.dot(&(k * u));
-    (inverse.is_finite() && inverse > 0.0).then(|| 1.0 / inverse)
-}
-
 /// `x` finite and > 0, or the field's error.
-fn positive(field: &str, x: f64) -> Result<(), FieldError> {
+pub(super) fn positive(field: &str, x: f64) -> Result<(), FieldError> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
@@ -233,16 +205,22 @@ fn positive(field: &str, x: f64) -> Result<(), FieldError> {
     }
 }
 
+/// A relative tolerance `r`: finite and in (0, 1), or the field's error.
+pub(super) fn relative_tolerance(field: &str, r: f64) -> Result<(), FieldError> {
+    if r.is_finite() && r > 0.0 && r < 1.0 {
+        Ok(())
+    } else {
+        Err(FieldError::new(
+            field,
+            format!("must be a finite number in (0, 1), got {r}"),
+        ))
+    }
+}
+
 impl ImpactMapSettings {
     /// Checks the tolerance (finite, in (0, 1)), the time limit (finite, > 0) and the step count.
     pub fn validate(&self) -> Result<(), FieldError> {
-        let r = self.relative_tolerance;
-        if !(r.is_finite() && r > 0.0 && r < 1.0) {
-            return Err(FieldError::new(
-                "relative_tolerance",
-                format!("must be a finite number in (0, 1), got {r}"),
-            ));
-        }
+        relative_tolerance("relative_tolerance", self.relative_tolerance)?;
         positive("time_limit", self.time_limit)?;
         if self.max_steps == 0 {
             return Err(FieldError::new("max_steps", "must be at least 1"));
@@ -251,20 +229,22 @@ impl ImpactMapSettings {
     }
 }
 
-// State components: penetration, its rate, slip velocity, then the quadratures. The first two
-// are shared with every transient [`integrate`] runs (`physics::supported_impact_map` too).
+// State components: penetration, its rate, slip velocity, then the quadratures. They are the
+// first `WALL_DIM` components of every map's state (`physics::supported_impact_map` appends
+// its supports' to them).
 pub(super) const W: usize = 0;
 pub(super) const WDOT: usize = 1;
-const VX: usize = 2;
-const VY: usize = 3;
-const PN: usize = 4;
-const PTX: usize = 5;
-const PTY: usize = 6;
+pub(super) const VX: usize = 2;
+pub(super) const VY: usize = 3;
+pub(super) const PN: usize = 4;
+pub(super) const PTX: usize = 5;
+pub(super) const PTY: usize = 6;
 const E_DAMP: usize = 7;
 const E_FRIC: usize = 8;
 const W_EXT: usize = 9;
 const N_SLIP: usize = 10;
-const DIM: usize = 11;
+pub(super) const WALL_DIM: usize = 11;
+const DIM: usize = WALL_DIM;
 type State = [f64; DIM];
 
 /// Which smooth piece of the force law applies: the damping ramp or full damping, and whether
@@ -383,38 +363,33 @@ impl WallForces {
             speed,
         }
     }
+
+    /// Writes the touching contact's quadrature rates into `d` (impulses, damping and friction
+    /// dissipation, the external forces' work at rates `wdot` and `v`, `N|v_t|`).
+    pub fn quadratures(&self, a: &ContactApproach, wdot: f64, v: [f64; 2], d: &mut [f64]) {
+        let [ftx, fty] = a.external_tangential_force;
+        d[PN] = self.normal;
+        [d[PTX], d[PTY]] = self.friction;
+        d[E_DAMP] = (self.normal - self.spring) * wdot;
+        d[E_FRIC] = self.normal * self.mu * self.speed;
+        d[W_EXT] = a.external_normal_force * wdot + ftx * v[0] + fty * v[1];
+        d[N_SLIP] = self.normal * self.speed;
+    }
 }
 
 impl LocalContact<'_> {
     fn derivative(&self, piece: Piece, y: &State) -> State {
         let a = self.approach;
-        let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
-        let WallForces {
-            spring,
-            normal,
-            friction: [fx, fy],
-            mu,
-            speed,
-        } = WallForces::at(
-            &self.law,
-            self.friction,
-            self.mu_slope_at_rest,
-            piece,
-            [w, wdot, vx, vy],
-        );
+        let (wdot, vx, vy) = (y[WDOT], y[VX], y[VY]);
+        let (law, rest) = (&self.law, self.mu_slope_at_rest);
+        let f = WallForces::at(law, self.friction, rest, piece, [y[W], wdot, vx, vy]);
         let [ftx, fty] = a.external_tangential_force;
         let mut d = [0.0; DIM];
         d[W] = wdot;
-        d[WDOT] = (a.external_normal_force - normal) / a.normal_mass;
-        d[VX] = (ftx + fx) / a.tangential_mass;
-        d[VY] = (fty + fy) / a.tangential_mass;
-        d[PN] = normal;
-        d[PTX] = fx;
-        d[PTY] = fy;
-        d[E_DAMP] = (normal - spring) * wdot;
-        d[E_FRIC] = normal * mu * speed;
-        d[W_EXT] = a.external_normal_force * wdot + ftx * vx + fty * vy;
-        d[N_SLIP] = normal * speed;
+        d[WDOT] = (a.external_normal_force - f.normal) / a.normal_mass;
+        d[VX] = (ftx + f.friction[0]) / a.tangential_mass;
+        d[VY] = (fty + f.friction[1]) / a.tangential_mass;
+        f.quadratures(a, wdot, [vx, vy], &mut d);
         d
     }
 }
@@ -487,6 +462,16 @@ impl Scales {
         }
     }
 
+    /// Error-control scales of a map's state: the wall's components by their kind, the rest
+    /// (quadratures of energy, and whatever a longer state appends) by the energy scale.
+    pub(super) fn state<const D: usize>(&self) -> [f64; D] {
+        let mut scale = [self.energy; D];
+        scale[W] = self.penetration;
+        scale[WDOT..=VY].fill(self.speed);
+        scale[PN..=PTY].fill(self.momentum);
+        scale
+    }
+
     /// The first step's size: 1e-3 of the time to the undamped peak, and 0.1 of `m_n/c_max`.
     pub(super) fn first_step(&self, approach: &ContactApproach, impact: &ImpactParams) -> f64 {
         let mut h = 1e-3 * self.penetration / approach.approach_speed;
@@ -505,6 +490,37 @@ pub(super) struct Transient<const D: usize> {
     pub(super) max_penetration: f64,
     pub(super) steps: usize,
     pub(super) rejected: usize,
+}
+
+impl<const D: usize> Transient<D> {
+    /// The touching contact's map from the transient's end (its first [`WALL_DIM`] components).
+    pub(super) fn wall_map(&self) -> ImpactMap {
+        let y = &self.y;
+        ImpactMap {
+            end: self.end,
+            duration: self.duration,
+            normal_impulse: y[PN],
+            tangential_impulse: [y[PTX], y[PTY]],
+            damping_dissipation: y[E_DAMP],
+            friction_dissipation: y[E_FRIC],
+            external_work: y[W_EXT],
+            normal_force_slip_integral: y[N_SLIP],
+            exit_normal_velocity: y[WDOT],
+            exit_slip_velocity: [y[VX], y[VY]],
+            end_penetration: y[W],
+            max_penetration: self.max_penetration,
+            steps: self.steps,
+            rejected_steps: self.rejected,
+        }
+    }
+}
+
+/// A map's state at first touch: the approach and slip velocities, nothing integrated yet.
+pub(super) fn start_state<const D: usize>(approach: &ContactApproach) -> [f64; D] {
+    let mut y0 = [0.0; D];
+    y0[WDOT] = approach.approach_speed;
+    [y0[VX], y0[VY]] = approach.slip_velocity;
+    y0
 }
 
 /// Integrates a transient whose components [`W`] and [`WDOT`] are the contact's penetration
@@ -663,37 +679,13 @@ pub fn impact_map(
         mu_slope_at_rest: friction.coefficient_derivative(0.0),
     };
     let sc = Scales::of(approach, impact);
-    let mut scale = [sc.energy; DIM];
-    scale[W] = sc.penetration;
-    scale[WDOT..=VY].fill(sc.speed);
-    scale[PN..=PTY].fill(sc.momentum);
-    let mut y0: State = [0.0; DIM];
-    y0[WDOT] = approach.approach_speed;
-    y0[VX] = approach.slip_velocity[0];
-    y0[VY] = approach.slip_velocity[1];
     let run = integrate(
         contact.law,
         settings,
-        y0,
-        &scale,
+        start_state(approach),
+        &sc.state(),
         sc.first_step(approach, impact),
         |piece, y| contact.derivative(piece, y),
     )?;
-    let y = run.y;
-    Ok(ImpactMap {
-        end: run.end,
-        duration: run.duration,
-        normal_impulse: y[PN],
-        tangential_impulse: [y[PTX], y[PTY]],
-        damping_dissipation: y[E_DAMP],
-        friction_dissipation: y[E_FRIC],
-        external_work: y[W_EXT],
-        normal_force_slip_integral: y[N_SLIP],
-        exit_normal_velocity: y[WDOT],
-        exit_slip_velocity: [y[VX], y[VY]],
-        end_penetration: y[W],
-        max_penetration: run.max_penetration,
-        steps: run.steps,
-        rejected_steps: run.rejected,
-    })
+    Ok(run.wall_map())
 }

@@ -26,8 +26,8 @@
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use super::impact_map::{
-    integrate, ContactApproach, ImpactMap, ImpactMapError, ImpactMapSettings, NormalLaw, Piece,
-    Scales, WallForces, W, WDOT,
+    integrate, start_state, ContactApproach, ImpactMap, ImpactMapError, ImpactMapSettings,
+    NormalLaw, Piece, Scales, WallForces, VX, VY, W, WALL_DIM, WDOT,
 };
 use crate::field_error::FieldError;
 use std::cell::Cell;
@@ -200,19 +200,10 @@ impl Support {
 
 // State: the 1-D map's first components, then the supports' work, the slip-plane
 // displacement, and per support its impulses and integrals.
-const VX: usize = 2;
-const VY: usize = 3;
-const PN: usize = 4;
-const PTX: usize = 5;
-const PTY: usize = 6;
-const E_DAMP: usize = 7;
-const E_FRIC: usize = 8;
-const W_EXT: usize = 9;
-const N_SLIP: usize = 10;
-const W_SUP: usize = 11;
-const DX: usize = 12;
-const DY: usize = 13;
-const SUPPORT_BASE: usize = 14;
+const W_SUP: usize = WALL_DIM;
+const DX: usize = WALL_DIM + 1;
+const DY: usize = WALL_DIM + 2;
+const SUPPORT_BASE: usize = WALL_DIM + 3;
 // Per support: ∫N_j dt, the friction impulse (3), ∫μ N_j |s_j| dt, ∫N_j |s_j| dt.
 const S_PN: usize = 0;
 const S_PT: usize = 1;
@@ -348,22 +339,15 @@ impl SupportedContact<'_> {
     /// The state's derivative on `piece`; a support let go in it is marked in `lifted`.
     fn derivative(&self, piece: Piece, y: &State) -> State {
         let a = self.approach;
-        let (w, wdot, vx, vy) = (y[W], y[WDOT], y[VX], y[VY]);
-        let WallForces {
-            spring,
-            normal,
-            friction: [fx, fy],
-            mu,
-            speed,
-        } = WallForces::at(
-            &self.law,
-            self.friction,
-            self.mu_slope_at_rest,
-            piece,
-            [w, wdot, vx, vy],
-        );
+        let (wdot, vx, vy) = (y[WDOT], y[VX], y[VY]);
+        let (law, rest) = (&self.law, self.mu_slope_at_rest);
+        let f = WallForces::at(law, self.friction, rest, piece, [y[W], wdot, vx, vy]);
         let [ftx, fty] = a.external_tangential_force;
-        let mut total = [a.external_normal_force - normal, ftx + fx, fty + fy];
+        let mut total = [
+            a.external_normal_force - f.normal,
+            ftx + f.friction[0],
+            fty + f.friction[1],
+        ];
         let mut d = [0.0; DIM];
         if self.count > 0 {
             let v = [wdot, vx, vy];
@@ -402,13 +386,7 @@ impl SupportedContact<'_> {
         d[WDOT] = total[0] / a.normal_mass;
         d[VX] = total[1] / a.tangential_mass;
         d[VY] = total[2] / a.tangential_mass;
-        d[PN] = normal;
-        d[PTX] = fx;
-        d[PTY] = fy;
-        d[E_DAMP] = (normal - spring) * wdot;
-        d[E_FRIC] = normal * mu * speed;
-        d[W_EXT] = a.external_normal_force * wdot + ftx * vx + fty * vy;
-        d[N_SLIP] = normal * speed;
+        f.quadratures(a, wdot, [vx, vy], &mut d);
         d[DX] = vx;
         d[DY] = vy;
         d
@@ -459,23 +437,16 @@ pub fn supported_impact_map(
         lifted: Cell::new(0),
     };
     let sc = Scales::of(approach, impact);
-    let mut scale = [sc.energy; DIM];
-    scale[W] = sc.penetration;
-    scale[WDOT..=VY].fill(sc.speed);
-    scale[PN..=PTY].fill(sc.momentum);
+    let mut scale: State = sc.state();
     scale[DX..=DY].fill(sc.penetration);
     for j in 0..MAX_SUPPORTS {
         let base = SUPPORT_BASE + PER_SUPPORT * j;
         scale[base + S_PN..base + S_PT + 3].fill(sc.momentum);
     }
-    let mut y0: State = [0.0; DIM];
-    y0[WDOT] = approach.approach_speed;
-    y0[VX] = approach.slip_velocity[0];
-    y0[VY] = approach.slip_velocity[1];
     let run = integrate(
         contact.law,
         settings,
-        y0,
+        start_state(approach),
         &scale,
         sc.first_step(approach, impact),
         |piece, y| contact.derivative(piece, y),
@@ -494,22 +465,7 @@ pub fn supported_impact_map(
         };
     }
     Ok(SupportedImpactMap {
-        contact: ImpactMap {
-            end: run.end,
-            duration: run.duration,
-            normal_impulse: y[PN],
-            tangential_impulse: [y[PTX], y[PTY]],
-            damping_dissipation: y[E_DAMP],
-            friction_dissipation: y[E_FRIC],
-            external_work: y[W_EXT],
-            normal_force_slip_integral: y[N_SLIP],
-            exit_normal_velocity: y[WDOT],
-            exit_slip_velocity: [y[VX], y[VY]],
-            end_penetration: y[W],
-            max_penetration: run.max_penetration,
-            steps: run.steps,
-            rejected_steps: run.rejected,
-        },
+        contact: run.wall_map(),
         supports: shares,
         support_count: contact.count,
         support_work: y[W_SUP],

@@ -4,12 +4,11 @@
 //! form, a bound, the 1 %), never copied from the map's output.
 
 use nalgebra::{UnitQuaternion, Vector3};
-use railwear::physics::body::MassProperties;
+use railwear::physics::body::{effective_mass, MassProperties};
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::impact_map::{
-    effective_mass, impact_map, ContactApproach, ContactEnd, ImpactMap, ImpactMapError,
-    ImpactMapSettings,
+    impact_map, ContactApproach, ContactEnd, ImpactMap, ImpactMapError, ImpactMapSettings,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -28,6 +28,7 @@
 use crate::field_error::FieldError;
 use crate::physics::body::{BodyKind, BODY_STATE_LEN};
 use crate::physics::contact::{GeometryCache, GeometryMode};
+use crate::physics::impact_map::{positive, relative_tolerance};
 use crate::physics::local_dopri5::dopri5_step;
 use crate::physics::system::MultibodySystem;
 use nalgebra::Vector3;
@@ -85,24 +86,9 @@ impl Default for BodyTransientSettings {
 impl BodyTransientSettings {
     /// Checks every field: tolerances finite in (0, 1) and > 0, horizon finite > 0, steps >= 1.
     pub fn validate(&self) -> Result<(), FieldError> {
-        let r = self.relative_tolerance;
-        if !(r.is_finite() && r > 0.0 && r < 1.0) {
-            return Err(FieldError::new(
-                "relative_tolerance",
-                format!("must be a finite number in (0, 1), got {r}"),
-            ));
-        }
-        for (field, x) in [
-            ("position_tolerance_m", self.position_tolerance_m),
-            ("horizon_s", self.horizon_s),
-        ] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(FieldError::new(
-                    field,
-                    format!("must be a finite number > 0, got {x}"),
-                ));
-            }
-        }
+        relative_tolerance("relative_tolerance", self.relative_tolerance)?;
+        positive("position_tolerance_m", self.position_tolerance_m)?;
+        positive("horizon_s", self.horizon_s)?;
         if self.max_steps == 0 {
             return Err(FieldError::new("max_steps", "must be at least 1"));
         }
