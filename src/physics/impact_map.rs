@@ -22,7 +22,7 @@
 
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
-use super::local_dopri5::{dopri5_step, hermite};
+use super::local_dopri5::{dopri5_step, hermite, PiControl};
 use crate::field_error::FieldError;
 
 /// The contact at first touch: effective masses, the approach and slip velocities, and the
@@ -427,12 +427,6 @@ fn first_crossing(mut g: impl FnMut(f64) -> f64, g0: f64, g1: f64) -> f64 {
     b
 }
 
-/// Step-size controller of Hairer's DOPRI5 (PI with β = 0.04, factors in [0.2, 10]).
-const SAFETY: f64 = 0.9;
-const PI_BETA: f64 = 0.04;
-const GROWTH_MAX: f64 = 10.0;
-const SHRINK_MAX: f64 = 5.0;
-
 /// Error-test scales of a transient from `approach`: the undamped peak penetration at the
 /// approach speed (or the static one under the pressing force), the larger of the approach
 /// and slip speeds, and the momentum and kinetic energy at that speed.
@@ -545,8 +539,7 @@ pub(super) fn integrate<const D: usize>(
     let mut t = 0.0;
     let mut h = first_step;
     let (mut steps, mut rejected, mut max_penetration) = (0usize, 0usize, 0.0f64);
-    let mut err_old: f64 = 1e-4;
-    let mut last_rejected = false;
+    let mut control = PiControl::default();
     // Just landed on the turning point (ẇ there is 0 up to the location's residual, either sign).
     let mut at_turning = false;
     let mut end = ContactEnd::TimeLimit;
@@ -573,11 +566,9 @@ pub(super) fn integrate<const D: usize>(
         if !err.is_finite() {
             err = 1e10;
         }
-        let fac_pi = err.powf(0.2 - 0.75 * PI_BETA);
         if err > 1.0 {
             rejected += 1;
-            last_rejected = true;
-            h = h_try / (fac_pi / SAFETY).min(SHRINK_MAX);
+            h = control.rejected(h_try, err);
             continue;
         }
         // Accepted by the error test: does a switch of the law lie inside it?
@@ -625,14 +616,7 @@ pub(super) fn integrate<const D: usize>(
         };
         steps += 1;
         max_penetration = max_penetration.max(y[W]);
-        let fac_old = err.max(1e-4);
-        let mut fac = (fac_pi / err_old.powf(PI_BETA) / SAFETY).clamp(1.0 / GROWTH_MAX, SHRINK_MAX);
-        if last_rejected {
-            fac = fac.max(1.0);
-        }
-        err_old = fac_old;
-        last_rejected = false;
-        h = h_try / fac;
+        h = control.accepted(h_try, err);
         at_turning = landed == Some(Event::Turning);
         let Some(event) = landed else {
             continue;

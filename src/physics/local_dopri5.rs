@@ -146,3 +146,55 @@ mod tests {
         }
     }
 }
+
+/// Safety factor, PI exponent β and the step's growth and shrink limits of Hairer's DOPRI5
+/// controller (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4: PI with β = 0.04, factors in
+/// [0.2, 10]).
+const SAFETY: f64 = 0.9;
+const PI_BETA: f64 = 0.04;
+const GROWTH_MAX: f64 = 10.0;
+const SHRINK_MAX: f64 = 5.0;
+
+/// The PI step-size control of the array steps above, one per integration: the next step size
+/// from a step's error norm (`err <= 1` accepts), remembering the last accepted error and
+/// whether the last attempt was rejected (no growth right after a rejection). The impulse maps
+/// ([`super::impact_map`]) and the body transient ([`super::body_transient`]) step with it.
+#[derive(Debug, Clone, Copy)]
+pub struct PiControl {
+    err_old: f64,
+    last_rejected: bool,
+}
+
+impl Default for PiControl {
+    fn default() -> Self {
+        Self {
+            err_old: 1e-4,
+            last_rejected: false,
+        }
+    }
+}
+
+impl PiControl {
+    /// The size to retry with after a step of size `h` was rejected with error `err` (> 1).
+    pub fn rejected(&mut self, h: f64, err: f64) -> f64 {
+        self.last_rejected = true;
+        h / (pi_factor(err) / SAFETY).min(SHRINK_MAX)
+    }
+
+    /// The next step's size after a step of size `h` was accepted with error `err` (<= 1).
+    pub fn accepted(&mut self, h: f64, err: f64) -> f64 {
+        let mut fac = (pi_factor(err) / self.err_old.powf(PI_BETA) / SAFETY)
+            .clamp(1.0 / GROWTH_MAX, SHRINK_MAX);
+        if self.last_rejected {
+            fac = fac.max(1.0);
+        }
+        self.err_old = err.max(1e-4);
+        self.last_rejected = false;
+        h / fac
+    }
+}
+
+/// The error's part of the PI factor, `err^(1/5 − 0.75 β)`.
+fn pi_factor(err: f64) -> f64 {
+    err.powf(0.2 - 0.75 * PI_BETA)
+}

@@ -29,7 +29,7 @@ use crate::field_error::FieldError;
 use crate::physics::body::{BodyKind, BODY_STATE_LEN};
 use crate::physics::contact::{GeometryCache, GeometryMode};
 use crate::physics::impact_map::{positive, relative_tolerance};
-use crate::physics::local_dopri5::dopri5_step;
+use crate::physics::local_dopri5::{dopri5_step, PiControl};
 use crate::physics::system::MultibodySystem;
 use nalgebra::Vector3;
 
@@ -250,13 +250,6 @@ impl BodyTransientError {
     }
 }
 
-/// Step-size controller of Hairer's DOPRI5 (PI with β = 0.04, factors in [0.2, 10]), as in
-/// [`crate::physics::impact_map`].
-const SAFETY: f64 = 0.9;
-const PI_BETA: f64 = 0.04;
-const GROWTH_MAX: f64 = 10.0;
-const SHRINK_MAX: f64 = 5.0;
-
 /// Integrates dynamic body `body` of `system` from the system state `y` at time `t` over
 /// `settings.horizon_s`, with all its contacts and force elements, the kinematic bodies on
 /// their prescribed motion. `y` is not changed: the end state is in the result
@@ -439,8 +432,7 @@ pub fn body_transient(
     }
     let t_end = t + settings.horizon_s;
     let (mut steps, mut rejected) = (0usize, 0usize);
-    let mut err_old: f64 = 1e-4;
-    let mut last_rejected = false;
+    let mut control = PiControl::default();
     let mut end = TransientEnd::Horizon;
     let mut first_active = [f64::NAN; MAX_TRACKS];
     let mut approaching = [false; MAX_TRACKS];
@@ -494,11 +486,9 @@ pub fn body_transient(
         if !err.is_finite() {
             err = 1e10;
         }
-        let fac_pi = err.powf(0.2 - 0.75 * PI_BETA);
         if err > 1.0 {
             rejected += 1;
-            last_rejected = true;
-            h = h_try / (fac_pi / SAFETY).min(SHRINK_MAX);
+            h = control.rejected(h_try, err);
             continue;
         }
         state = step.y;
@@ -510,14 +500,7 @@ pub fn body_transient(
         steps += 1;
         // The last stage was evaluated at the accepted state (FSAL): its tracks are there.
         record(&ev, state[TIME] - t);
-        let fac_old = err.max(1e-4);
-        let mut fac = (fac_pi / err_old.powf(PI_BETA) / SAFETY).clamp(1.0 / GROWTH_MAX, SHRINK_MAX);
-        if last_rejected {
-            fac = fac.max(1.0);
-        }
-        err_old = fac_old;
-        last_rejected = false;
-        h = h_try / fac;
+        h = control.accepted(h_try, err);
     }
 
     // The end state with its quaternion normalised (the forces used the normalised rotation
