@@ -1,7 +1,7 @@
 //! Campaign format (issue 14 items 1-2): the thesis campaign loads with Table 5.3's numbers,
 //! TOML and JSON forms round-trip, and bad campaigns are refused naming the field and row.
 
-use railwear::gap::campaign::Campaign;
+use railwear::gap::campaign::{Campaign, CampaignTest};
 use railwear::gap::GapError;
 use railwear_testkit::TempDir;
 use std::path::{Path, PathBuf};
@@ -72,6 +72,42 @@ fn thesis_campaign_loads_with_table_5_3() {
         .collect();
     for (got, want) in k.iter().zip([0.25, 0.4444, 0.64, 0.7901]) {
         assert!((got - want).abs() < 1e-3, "{got} vs {want}");
+    }
+}
+
+/// The bench skeletons load and validate against the reference configs, each test's rattle
+/// space is eq. 5.1's (item area over enclosure area) for the tube it builds, and no
+/// increment carries a measurement (the rig fills them).
+#[test]
+fn bench_skeletons_load_and_validate() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("campaigns");
+    for name in ["bench-rattle-box.toml", "bench-rattle-box-25hz.toml"] {
+        let c = Campaign::load(&dir.join(name)).unwrap();
+        c.validate(&configs()).unwrap();
+        for (ti, test) in c.tests.iter().enumerate() {
+            let case = test.case(ti, &configs()).unwrap();
+            let rb = case.rattle_box.as_ref().expect("a rattle box");
+            let k = (rb.cube_side_m / rb.tube_inner_side_m).powi(2);
+            let reported = CampaignTest::rattle_space_of(&case).expect("a rattle space");
+            assert!(
+                (k - reported).abs() < 1e-12,
+                "{name} {}: {k} {reported}",
+                test.id
+            );
+            if let Some(asked) = test.rattle_space {
+                assert!((k - asked).abs() < 1e-12, "{name} {}: {k} {asked}", test.id);
+            }
+            let weighed = test
+                .specimens
+                .iter()
+                .flat_map(|s| &s.increments)
+                .any(|i| !i.mass_loss_mg.is_empty());
+            assert!(
+                !weighed,
+                "{name} {}: a skeleton carries no measurement",
+                test.id
+            );
+        }
     }
 }
 

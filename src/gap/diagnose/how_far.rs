@@ -65,8 +65,15 @@ pub(super) fn best_effect(
     for (i, &(t, m)) in c.spec.iter().enumerate() {
         let table = &problem.emulator.effects[t];
         let info = table.info;
-        let family = problem.family_of(t);
-        let interval = profile_interval(problem, &c.spec, i);
+        let started = std::time::Instant::now();
+        let profile = Profile::of(problem, &c.spec, i);
+        tracing::debug!(
+            effect = info.name,
+            points = profile.tables.iter().map(|(_, r)| r.len()).sum::<usize>(),
+            seconds = started.elapsed().as_secs_f64(),
+            "likelihood profile for the intervals"
+        );
+        let interval = profile.magnitude_interval(problem, &c.spec, i);
         for (pi, p) in info.parameters.iter().enumerate() {
             if pi == 0 {
                 parameters.push(FittedParameter {
@@ -99,7 +106,7 @@ pub(super) fn best_effect(
                 });
                 continue;
             }
-            let profiled = secondary_interval(problem, family, &c.spec, i, p.name);
+            let profiled = profile.secondary_interval(problem, value, p.name);
             parameters.push(FittedParameter {
                 effect: info.name.to_string(),
                 name: p.name.to_string(),
@@ -137,78 +144,233 @@ pub(super) fn best_effect(
     }
 }
 
-/// 95 % profile-likelihood interval of member `i`'s magnitude around the full-data optimum
-/// `spec` (the other member, for a pair, held at its fitted magnitude: a conditional interval).
-/// The member's secondary values are profiled out: each magnitude takes the best of its
-/// family's tables (the variants the diagnosis simulated), so a slip scale and a magnitude
-/// that trade off along a ridge widen the interval rather than pin it to the chosen variant.
-fn profile_interval(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> [f64; 2] {
-    let (t, best) = spec[i];
-    let tables = &problem.families[problem.family_of(t)];
-    let nll = |table: usize, m: f64| {
-        let mut s = spec.to_vec();
-        s[i] = (table, m);
-        problem.nll_of(&s, |_| true)
-    };
-    let floor = nll(t, best);
-    let mut cands: Vec<f64> = Vec::new();
-    let mut inside: Vec<f64> = Vec::new();
-    for &table in tables {
-        for m in problem.candidates(table) {
-            cands.push(m);
-            if nll(table, m) <= floor + PROFILE_95 {
-                inside.push(m);
-            }
-        }
-    }
-    inside.extend(ridge_magnitudes(problem, spec, i));
-    let lo = inside.iter().copied().fold(best, f64::min);
-    let hi = inside.iter().copied().fold(best, f64::max);
-    widen_to_grid(&cands, [lo, hi])
+/// Member `i`'s likelihood profile over its family's tables: each table's candidate
+/// magnitudes ([`FitProblem::candidates`]) with their negative log-likelihoods on all the
+/// data. For a pair, the other member is profiled out at each point: its best over the tables
+/// the pair's fit may take beside this one ([`FitProblem::pair_combinations`]), each at 0 and
+/// its grid magnitudes, then at the candidates around the best of those. So a pair member's
+/// intervals are not conditional on where the search left its partner: a drift's magnitude
+/// and a cross-axis share that trade off widen each other's intervals, as a magnitude and its
+/// own slip scale do.
+struct Profile {
+    /// `(table, [(magnitude, nll)])`, in family order.
+    tables: Vec<(usize, Vec<(f64, f64)>)>,
+    /// The negative log-likelihood at the reported fit: a magnitude's interval is drawn
+    /// around it (so a fit the search left short of the profile's lowest point keeps the
+    /// points better than it inside).
+    at_fit: f64,
+    /// The lowest negative log-likelihood in the profile: a secondary value's interval is
+    /// drawn around it.
+    floor: f64,
 }
 
-/// The magnitude each of member `i`'s family tables fits best, for the tables whose secondary
-/// values all lie within their (grid-widened) intervals: the magnitude's interval is the
-/// projection of the same region the secondary values' intervals span. A slip scale and a
-/// magnitude that trade off along a ridge otherwise give a magnitude interval conditional on
-/// the grid's tables inside the threshold, while the secondary value's interval reaches the
-/// neighbouring grid values beyond it (2035: a drift of 0.48 drawn at 7143 m, fitted 0.485
-/// at 5623 m with a slip-scale interval of 3162-7499 m and a magnitude interval of
-/// 0.4838-0.4886). Empty for a family without variants.
-fn ridge_magnitudes(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> Vec<f64> {
-    let family = problem.family_of(spec[i].0);
-    let tables = &problem.families[family];
-    let names: std::collections::BTreeSet<&String> = tables
-        .iter()
-        .flat_map(|t| problem.emulator.effects[*t].parameters.keys())
-        .collect();
-    let intervals: Vec<(&String, [f64; 2])> = names
-        .into_iter()
-        .filter_map(|n| Some((n, secondary_interval(problem, family, spec, i, n)?)))
-        .collect();
-    if intervals.is_empty() {
-        return Vec::new();
-    }
-    tables
-        .iter()
-        .filter(|t| {
-            let table = &problem.emulator.effects[**t];
-            intervals.iter().all(|(n, [lo, hi])| {
-                let v = table.parameter(n);
-                *lo <= v && v <= *hi
-            })
-        })
-        .filter_map(|&t| {
-            problem
-                .candidates(t)
+impl Profile {
+    fn of(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> Self {
+        let partners = |ti: usize| -> Vec<usize> {
+            let [(a, _), (b, _)] = spec[..] else {
+                return Vec::new();
+            };
+            let mut allowed = vec![(a, b)];
+            allowed.extend(problem.pair_combinations(a, b));
+            allowed
                 .into_iter()
-                .map(|m| {
-                    let mut s = spec.to_vec();
-                    s[i] = (t, m);
-                    (m, problem.nll_of(&s, |_| true))
+                .filter_map(|(ta, tb)| match i {
+                    0 if ta == ti => Some(tb),
+                    1 if tb == ti => Some(ta),
+                    _ => None,
                 })
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .map(|(m, _)| m)
+                .collect()
+        };
+        let nll_at = |ti: usize, m: f64, partner: Option<(usize, f64)>| {
+            let mut s = spec.to_vec();
+            s[i] = (ti, m);
+            if let Some(p) = partner {
+                s[1 - i] = p;
+            }
+            problem.nll_of(&s, |_| true)
+        };
+        let coarse = |tj: usize| {
+            std::iter::once(0.0)
+                .chain(problem.emulator.effects[tj].magnitudes.iter().copied())
+                .collect()
+        };
+        let near = |tj: usize, y: f64| problem.candidates_near(tj, y);
+        let space = PartnerSpace {
+            tables: &partners,
+            coarse: &coarse,
+            near: &near,
+        };
+        let family = &problem.families[problem.family_of(spec[i].0)];
+        let tables = profile_rows(
+            family,
+            &|t| problem.candidates(t),
+            (spec.len() == 2).then_some(&space),
+            &nll_at,
+        );
+        let at_fit = problem.nll_of(spec, |_| true);
+        let floor = tables
+            .iter()
+            .flat_map(|(_, row)| row.iter().map(|v| v.1))
+            .fold(f64::INFINITY, f64::min);
+        Profile {
+            tables,
+            at_fit,
+            floor,
+        }
+    }
+
+    /// A table's best `(magnitude, nll)` over its row.
+    fn best_of(row: &[(f64, f64)]) -> Option<(f64, f64)> {
+        row.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// 95 % profile-likelihood interval of member `i`'s magnitude: every magnitude of any of
+    /// its family's tables within [`PROFILE_95`] of the fit (the secondary values and a
+    /// pair's partner profiled out), and the magnitude each table fits best where the table's
+    /// secondary values all lie within their (grid-widened) intervals, so the magnitude's
+    /// interval is the projection of the same region the secondary values' intervals span. A
+    /// slip scale and a magnitude that trade off along a ridge otherwise give a magnitude
+    /// interval conditional on the grid's tables inside the threshold, while the secondary
+    /// value's interval reaches the neighbouring grid values beyond it (2035: a drift of 0.48
+    /// drawn at 7143 m, fitted 0.485 at 5623 m with a slip-scale interval of 3162-7499 m and a
+    /// magnitude interval of 0.4838-0.4886). Widened to the neighbouring candidates.
+    fn magnitude_interval(
+        &self,
+        problem: &FitProblem,
+        spec: &[(usize, f64)],
+        i: usize,
+    ) -> [f64; 2] {
+        let best = spec[i].1;
+        let cands: Vec<f64> = self
+            .tables
+            .iter()
+            .flat_map(|(_, row)| row.iter().map(|v| v.0))
+            .collect();
+        let mut inside: Vec<f64> = self
+            .tables
+            .iter()
+            .flat_map(|(_, row)| row.iter())
+            .filter(|v| v.1 <= self.at_fit + PROFILE_95)
+            .map(|v| v.0)
+            .collect();
+        let names: std::collections::BTreeSet<&String> = self
+            .tables
+            .iter()
+            .flat_map(|(t, _)| problem.emulator.effects[*t].parameters.keys())
+            .collect();
+        let intervals: Vec<(&String, [f64; 2])> = names
+            .into_iter()
+            .filter_map(|n| {
+                let chosen = problem.emulator.effects[spec[i].0].parameter(n);
+                Some((n, self.secondary_interval(problem, chosen, n)?))
+            })
+            .collect();
+        if !intervals.is_empty() {
+            inside.extend(
+                self.tables
+                    .iter()
+                    .filter(|(t, _)| {
+                        let table = &problem.emulator.effects[*t];
+                        intervals.iter().all(|(n, [lo, hi])| {
+                            let v = table.parameter(n);
+                            *lo <= v && v <= *hi
+                        })
+                    })
+                    .filter_map(|(_, row)| Self::best_of(row).map(|b| b.0)),
+            );
+        }
+        let lo = inside.iter().copied().fold(best, f64::min);
+        let hi = inside.iter().copied().fold(best, f64::max);
+        widen_to_grid(&cands, [lo, hi])
+    }
+
+    /// 95 % profile-likelihood interval of secondary parameter `name` over the values the
+    /// family's tables hold (each value at its best magnitude, a pair's partner profiled out),
+    /// the values within [`PROFILE_95`] of the floor spanned, with `chosen` (the fit's value)
+    /// always inside. None when the family holds no variant in that parameter (it was not
+    /// fitted). Its resolution is the profile's grid.
+    fn secondary_interval(
+        &self,
+        problem: &FitProblem,
+        chosen: f64,
+        name: &str,
+    ) -> Option<[f64; 2]> {
+        let effects = &problem.emulator.effects;
+        if !self
+            .tables
+            .iter()
+            .any(|(t, _)| effects[*t].parameters.contains_key(name))
+        {
+            return None;
+        }
+        let by_value: Vec<(f64, f64)> = self
+            .tables
+            .iter()
+            .map(|(t, row)| {
+                let nll = Self::best_of(row).map_or(f64::INFINITY, |b| b.1);
+                (effects[*t].parameter(name), nll)
+            })
+            .collect();
+        let inside = by_value
+            .iter()
+            .filter(|(_, n)| *n <= self.floor + PROFILE_95)
+            .map(|(v, _)| *v);
+        let lo = inside.clone().fold(chosen, f64::min);
+        let hi = inside.fold(chosen, f64::max);
+        let grid: Vec<f64> = by_value.iter().map(|v| v.0).collect();
+        Some(widen_to_grid(&grid, [lo, hi]))
+    }
+}
+
+/// Where a pair member's partner is profiled out: the partner's tables the pair's fit may take
+/// beside a table of the member, each table's coarse magnitudes (0, the member alone, and its
+/// grid), and the candidates around a coarse best.
+struct PartnerSpace<'a> {
+    tables: &'a dyn Fn(usize) -> Vec<usize>,
+    coarse: &'a dyn Fn(usize) -> Vec<f64>,
+    near: &'a dyn Fn(usize, f64) -> Vec<f64>,
+}
+
+/// A profile's rows: for each table of `family`, each of its `candidates` with `nll(table,
+/// magnitude, partner)`, the partner (with `partner`) at its best over its tables beside this
+/// one, coarse then refined around each table's coarse best; without a partner table beside
+/// it (or without `partner`), the fit's own partner (`None`).
+fn profile_rows(
+    family: &[usize],
+    candidates: &dyn Fn(usize) -> Vec<f64>,
+    partner: Option<&PartnerSpace>,
+    nll: &dyn Fn(usize, f64, Option<(usize, f64)>) -> f64,
+) -> Vec<(usize, Vec<(f64, f64)>)> {
+    let profiled = |ti: usize, m: f64, beside: &[usize], space: &PartnerSpace| {
+        let mut best = f64::INFINITY;
+        for &tj in beside {
+            let coarse = (space.coarse)(tj)
+                .into_iter()
+                .map(|y| (y, nll(ti, m, Some((tj, y)))))
+                .min_by(|x, y| x.1.total_cmp(&y.1));
+            let Some((y0, n0)) = coarse else { continue };
+            let fine = (space.near)(tj, y0)
+                .into_iter()
+                .map(|y| nll(ti, m, Some((tj, y))))
+                .fold(n0, f64::min);
+            best = best.min(fine);
+        }
+        best
+    };
+    family
+        .iter()
+        .map(|&ti| {
+            let beside = partner.map(|p| ((p.tables)(ti), p));
+            let row = candidates(ti)
+                .into_iter()
+                .map(|m| match &beside {
+                    Some((tables, space)) if !tables.is_empty() => {
+                        (m, profiled(ti, m, tables, space))
+                    }
+                    _ => (m, nll(ti, m, None)),
+                })
+                .collect();
+            (ti, row)
         })
         .collect()
 }
@@ -230,46 +392,6 @@ fn widen_to_grid(grid: &[f64], [lo, hi]: [f64; 2]) -> [f64; 2] {
         if below.is_nan() { lo } else { below },
         if above.is_nan() { hi } else { above },
     ]
-}
-
-/// 95 % profile-likelihood interval of secondary parameter `name` of member `i`, over the
-/// values its family's tables hold (each value at its best magnitude, the other member held):
-/// the values within [`PROFILE_95`] of the best, spanned. None when the family holds no
-/// variant in that parameter (it was not fitted). Its resolution is the profile's grid.
-fn secondary_interval(
-    problem: &FitProblem,
-    family: usize,
-    spec: &[(usize, f64)],
-    i: usize,
-    name: &str,
-) -> Option<[f64; 2]> {
-    let tables = &problem.families[family];
-    if !tables
-        .iter()
-        .any(|t| problem.emulator.effects[*t].parameters.contains_key(name))
-    {
-        return None;
-    }
-    let chosen = problem.emulator.effects[spec[i].0].parameter(name);
-    let mut by_value: Vec<(f64, f64)> = Vec::new();
-    for &t in tables {
-        let mut best = f64::INFINITY;
-        for m in problem.candidates(t) {
-            let mut s = spec.to_vec();
-            s[i] = (t, m);
-            best = best.min(problem.nll_of(&s, |_| true));
-        }
-        by_value.push((problem.emulator.effects[t].parameter(name), best));
-    }
-    let floor = by_value.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
-    let inside = by_value
-        .iter()
-        .filter(|(_, n)| *n <= floor + PROFILE_95)
-        .map(|(v, _)| *v);
-    let lo = inside.clone().fold(chosen, f64::min);
-    let hi = inside.fold(chosen, f64::max);
-    let grid: Vec<f64> = by_value.iter().map(|v| v.0).collect();
-    Some(widen_to_grid(&grid, [lo, hi]))
 }
 
 /// Why a chosen candidate only partly explains the gap: a magnitude fitted at its physical
@@ -321,4 +443,98 @@ pub(super) fn partly_explained(
         cannot_predict: worst.group.clone(),
         cannot_predict_error: [worst.before, worst.after],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Magnitudes `0, step, ..., 1`.
+    fn steps(step: f64) -> Vec<f64> {
+        (0..=(1.0 / step).round() as usize)
+            .map(|k| k as f64 * step)
+            .collect()
+    }
+
+    /// The 95 % interval of a profile's rows: the magnitudes within [`PROFILE_95`] of the
+    /// lowest.
+    fn interval(rows: &[(usize, Vec<(f64, f64)>)]) -> [f64; 2] {
+        let all: Vec<(f64, f64)> = rows.iter().flat_map(|(_, r)| r.iter().copied()).collect();
+        let floor = all.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
+        let inside = all
+            .iter()
+            .filter(|v| v.1 <= floor + PROFILE_95)
+            .map(|v| v.0);
+        [
+            inside.clone().fold(f64::INFINITY, f64::min),
+            inside.fold(f64::NEG_INFINITY, f64::max),
+        ]
+    }
+
+    /// Two Gaussian constraints on a pair's magnitudes `a` and `b`: a sharp one on `a + b`
+    /// (sd `s1`) and a loose one on `a - b` (sd `s2`), both centred on `a = b = 0.3`. With `b`
+    /// held at 0.3 the 95 % interval of `a` is `0.3 ± sqrt(2 PROFILE_95 / (1/s1² + 1/s2²))`;
+    /// with `b` profiled out, the profile is `(2a - 0.6)² / (2 (s1² + s2²))`, so the interval
+    /// is `0.3 ± sqrt(2 PROFILE_95 (s1² + s2²)) / 2`: ten times wider here. The rows must give
+    /// both to within the candidates' spacing.
+    #[test]
+    fn a_pair_members_profile_takes_its_partner_out_as_the_closed_form_says() {
+        let (s1, s2) = (0.02, 0.2);
+        let nll = |_: usize, a: f64, partner: Option<(usize, f64)>| {
+            let b = partner.map_or(0.3, |p| p.1);
+            let (u, v) = ((a + b - 0.6) / s1, (a - b) / s2);
+            0.5 * (u * u + v * v)
+        };
+        let fine = steps(0.002);
+        let candidates = |_: usize| fine.clone();
+        let held = profile_rows(&[0], &candidates, None, &nll);
+        let half = (2.0 * PROFILE_95 / (1.0 / (s1 * s1) + 1.0 / (s2 * s2))).sqrt();
+        let [lo, hi] = interval(&held);
+        assert!((lo - (0.3 - half)).abs() <= 0.002, "{lo} {half}");
+        assert!((hi - (0.3 + half)).abs() <= 0.002, "{hi} {half}");
+
+        let partners = |_: usize| vec![1];
+        let coarse = |_: usize| steps(0.1);
+        let near = |_: usize, y: f64| {
+            steps(0.002)
+                .into_iter()
+                .filter(|c| (c - y).abs() <= 0.1 + 1e-12)
+                .collect()
+        };
+        let space = PartnerSpace {
+            tables: &partners,
+            coarse: &coarse,
+            near: &near,
+        };
+        let profiled = profile_rows(&[0], &candidates, Some(&space), &nll);
+        let half = (2.0 * PROFILE_95 * (s1 * s1 + s2 * s2)).sqrt() / 2.0;
+        let [lo, hi] = interval(&profiled);
+        assert!((lo - (0.3 - half)).abs() <= 0.004, "{lo} {half}");
+        assert!((hi - (0.3 + half)).abs() <= 0.004, "{hi} {half}");
+        // Profiling never raises a point's negative log-likelihood (the partner's held value
+        // is among those it tries).
+        for ((_, p), (_, h)) in profiled.iter().zip(&held) {
+            for (x, y) in p.iter().zip(h) {
+                assert!(x.1 <= y.1 + 1e-12, "{x:?} {y:?}");
+            }
+        }
+    }
+
+    /// A member table without a partner table beside it keeps the fit's own partner.
+    #[test]
+    fn a_table_without_a_partner_beside_it_keeps_the_fits_partner() {
+        let nll = |t: usize, a: f64, partner: Option<(usize, f64)>| {
+            a + t as f64 + partner.map_or(100.0, |p| p.1)
+        };
+        let partners = |t: usize| if t == 0 { vec![7] } else { Vec::new() };
+        let coarse = |_: usize| vec![0.0, 1.0];
+        let near = |_: usize, y: f64| vec![y];
+        let space = PartnerSpace {
+            tables: &partners,
+            coarse: &coarse,
+            near: &near,
+        };
+        let rows = profile_rows(&[0, 1], &|_| vec![0.5], Some(&space), &nll);
+        assert_eq!(rows, vec![(0, vec![(0.5, 0.5)]), (1, vec![(0.5, 101.5)])]);
+    }
 }
