@@ -1000,9 +1000,18 @@ fn interval_hits(o: &Outcome) -> Vec<(bool, bool)> {
             let info = crate::gap::effects::info(effect)?;
             let value = *drawn.parameters.get(parameter)?;
             let magnitude = info.parameters.first().is_some_and(|p| p.name == parameter);
-            Some((magnitude, lo <= value && value <= hi))
+            Some((magnitude, holds([lo, hi], value)))
         })
         .collect()
+}
+
+/// Whether `[lo, hi]` holds `value`, to round-off: the diagnosis' candidate magnitudes are
+/// computed between grid points (0.01875 + 3/5 of 0.00375 = 0.020999999999999998) and the
+/// rig draws the value as written (0.021), so an endpoint within 1e-9 of the value,
+/// relative, holds it.
+fn holds([lo, hi]: [f64; 2], value: f64) -> bool {
+    let tol = 1e-9 * lo.abs().max(hi.abs()).max(value.abs());
+    lo - tol <= value && value <= hi + tol
 }
 
 /// Two or more tests carry the effect, so held-out tests can confirm it.
@@ -1528,6 +1537,13 @@ mod tests {
         assert_eq!(s.interval_coverage, 0.75);
         assert_eq!(s.magnitude_intervals_checked, 2);
         assert_eq!(s.magnitude_interval_coverage, 0.5);
+        // An endpoint one rounding step from the drawn value holds it; a real miss does not.
+        let step = 0.01875 + (0.0225 - 0.01875) * 3.0 / 5.0;
+        assert!(step < 0.021);
+        assert!(holds([0.020574, step], 0.021));
+        assert!(holds([0.021 + (0.021 - step), 0.0216], 0.021));
+        assert!(!holds([0.02061, 0.020724], 0.021));
+        assert!(!holds([0.0201, 0.0209999], 0.021));
     }
 
     /// A single effect one test alone carries counts apart: in the top-1 over every detectable

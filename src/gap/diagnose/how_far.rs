@@ -276,7 +276,11 @@ impl Profile {
                             *lo <= v && v <= *hi
                         })
                     })
-                    .filter_map(|(_, row)| Self::best_of(row).map(|b| b.0)),
+                    .filter_map(|(t, row)| {
+                        let m = ridge_point(Self::best_of(row)?.0, best)?;
+                        tracing::debug!(table = t, magnitude = m, "ridge point");
+                        Some(m)
+                    }),
             );
         }
         let lo = inside.iter().copied().fold(best, f64::min);
@@ -320,6 +324,17 @@ impl Profile {
         let grid: Vec<f64> = by_value.iter().map(|v| v.0).collect();
         Some(widen_to_grid(&grid, [lo, hi]))
     }
+}
+
+/// A table's best magnitude `m` as a point of the ridge a fitted magnitude `fit` trades off
+/// along: only where the effect is on, on the fit's side of 0. A table of the grid-widened
+/// secondary interval that fits best with the effect off (a poor neighbour, where the data
+/// would rather have none of it) is not a point of the ridge: taking its 0 would put "no
+/// effect" inside the magnitude's interval, against the likelihood-ratio test that chose the
+/// effect (1039: a drift interval reaching 0 beside a pair that beats the cross-axis drive
+/// alone by 63 units of log-likelihood).
+fn ridge_point(m: f64, fit: f64) -> Option<f64> {
+    (m != 0.0 && m.signum() == fit.signum()).then_some(m)
 }
 
 /// Where a pair member's partner is profiled out: the partner's tables the pair's fit may take
@@ -518,6 +533,14 @@ mod tests {
                 assert!(x.1 <= y.1 + 1e-12, "{x:?} {y:?}");
             }
         }
+    }
+
+    #[test]
+    fn the_effect_off_is_not_a_ridge_point() {
+        assert_eq!(ridge_point(0.0, 0.18), None);
+        assert_eq!(ridge_point(-0.01, 0.18), None);
+        assert_eq!(ridge_point(0.6, 0.18), Some(0.6));
+        assert_eq!(ridge_point(-0.05, -0.02), Some(-0.05));
     }
 
     /// A member table without a partner table beside it keeps the fit's own partner.
