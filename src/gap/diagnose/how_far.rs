@@ -73,7 +73,7 @@ pub(super) fn best_effect(
             seconds = started.elapsed().as_secs_f64(),
             "likelihood profile for the intervals"
         );
-        let interval = profile.magnitude_interval(problem, &c.spec, i);
+        let interval = profile.magnitude_interval(problem);
         for (pi, p) in info.parameters.iter().enumerate() {
             if pi == 0 {
                 parameters.push(FittedParameter {
@@ -153,6 +153,8 @@ pub(super) fn best_effect(
 /// and a cross-axis share that trade off widen each other's intervals, as a magnitude and its
 /// own slip scale do.
 struct Profile {
+    /// The member's fitted `(table, magnitude)`.
+    fit: (usize, f64),
     /// `(table, [(magnitude, nll)])`, in family order.
     tables: Vec<(usize, Vec<(f64, f64)>)>,
     /// The negative log-likelihood at the reported fit: a magnitude's interval is drawn
@@ -166,15 +168,17 @@ struct Profile {
 
 impl Profile {
     fn of(problem: &FitProblem, spec: &[(usize, f64)], i: usize) -> Self {
+        // The table combinations the pair's fit may take (none for a single).
+        let allowed: Vec<(usize, usize)> = match spec {
+            [(a, _), (b, _)] => std::iter::once((*a, *b))
+                .chain(problem.pair_combinations(*a, *b))
+                .collect(),
+            _ => Vec::new(),
+        };
         let partners = |ti: usize| -> Vec<usize> {
-            let [(a, _), (b, _)] = spec[..] else {
-                return Vec::new();
-            };
-            let mut allowed = vec![(a, b)];
-            allowed.extend(problem.pair_combinations(a, b));
             allowed
-                .into_iter()
-                .filter_map(|(ta, tb)| match i {
+                .iter()
+                .filter_map(|&(ta, tb)| match i {
                     0 if ta == ti => Some(tb),
                     1 if tb == ti => Some(ta),
                     _ => None,
@@ -213,6 +217,7 @@ impl Profile {
             .flat_map(|(_, row)| row.iter().map(|v| v.1))
             .fold(f64::INFINITY, f64::min);
         Profile {
+            fit: spec[i],
             tables,
             at_fit,
             floor,
@@ -224,7 +229,7 @@ impl Profile {
         row.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
-    /// 95 % profile-likelihood interval of member `i`'s magnitude: every magnitude of any of
+    /// 95 % profile-likelihood interval of the member's magnitude: every magnitude of any of
     /// its family's tables within [`PROFILE_95`] of the fit (the secondary values and a
     /// pair's partner profiled out), and the magnitude each table fits best where the table's
     /// secondary values all lie within their (grid-widened) intervals, so the magnitude's
@@ -234,13 +239,8 @@ impl Profile {
     /// value's interval reaches the neighbouring grid values beyond it (2035: a drift of 0.48
     /// drawn at 7143 m, fitted 0.485 at 5623 m with a slip-scale interval of 3162-7499 m and a
     /// magnitude interval of 0.4838-0.4886). Widened to the neighbouring candidates.
-    fn magnitude_interval(
-        &self,
-        problem: &FitProblem,
-        spec: &[(usize, f64)],
-        i: usize,
-    ) -> [f64; 2] {
-        let best = spec[i].1;
+    fn magnitude_interval(&self, problem: &FitProblem) -> [f64; 2] {
+        let (fitted_table, best) = self.fit;
         let cands: Vec<f64> = self
             .tables
             .iter()
@@ -261,7 +261,7 @@ impl Profile {
         let intervals: Vec<(&String, [f64; 2])> = names
             .into_iter()
             .filter_map(|n| {
-                let chosen = problem.emulator.effects[spec[i].0].parameter(n);
+                let chosen = problem.emulator.effects[fitted_table].parameter(n);
                 Some((n, self.secondary_interval(problem, chosen, n)?))
             })
             .collect();
