@@ -25,6 +25,24 @@ impl FieldError {
         }
     }
 
+    /// `value` must be a finite number > 0; the error names `field` and that rule.
+    pub fn positive(field: &str, value: f64) -> Result<(), Self> {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(Self::new(field, "must be a finite number > 0"))
+        }
+    }
+
+    /// `value` must be a finite number >= 0; the error names `field` and that rule.
+    pub fn non_negative(field: &str, value: f64) -> Result<(), Self> {
+        if value.is_finite() && value >= 0.0 {
+            Ok(())
+        } else {
+            Err(Self::new(field, "must be a finite number >= 0"))
+        }
+    }
+
     /// The same error with its field placed under `prefix` (`prefix.field`; unchanged when
     /// `prefix` is empty), for a nested value reported at its path.
     pub fn at(mut self, prefix: &str) -> Self {
@@ -38,6 +56,24 @@ impl FieldError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn positive_and_non_negative_name_the_field_and_the_rule() {
+        assert_eq!(FieldError::positive("k", 1e-12), Ok(()));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                FieldError::positive("k", bad),
+                Err(FieldError::new("k", "must be a finite number > 0"))
+            );
+        }
+        assert_eq!(FieldError::non_negative("c", 0.0), Ok(()));
+        for bad in [-1e-300, f64::NAN, f64::NEG_INFINITY] {
+            assert_eq!(
+                FieldError::non_negative("c", bad),
+                Err(FieldError::new("c", "must be a finite number >= 0"))
+            );
+        }
+    }
 
     #[test]
     fn names_the_field_and_nests_under_a_prefix() {

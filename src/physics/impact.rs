@@ -49,24 +49,12 @@ impl ImpactParams {
 
     /// Checks the rules on each field; the first violation as a [`FieldError`].
     pub fn validate(&self) -> Result<(), FieldError> {
-        if !(self.stiffness.is_finite() && self.stiffness > 0.0) {
-            return Err(FieldError::new("stiffness", "must be a finite number > 0"));
-        }
+        FieldError::positive("stiffness", self.stiffness)?;
         if !(self.exponent.is_finite() && self.exponent >= 1.0) {
             return Err(FieldError::new("exponent", "must be a finite number >= 1"));
         }
-        if !(self.max_damping.is_finite() && self.max_damping >= 0.0) {
-            return Err(FieldError::new(
-                "max_damping",
-                "must be a finite number >= 0",
-            ));
-        }
-        if !(self.full_damping_depth.is_finite() && self.full_damping_depth >= 0.0) {
-            return Err(FieldError::new(
-                "full_damping_depth",
-                "must be a finite number >= 0",
-            ));
-        }
+        FieldError::non_negative("max_damping", self.max_damping)?;
+        FieldError::non_negative("full_damping_depth", self.full_damping_depth)?;
         Ok(())
     }
 

@@ -213,9 +213,7 @@ impl WearAccumulator {
         if !law.gives_k_of_sigma() {
             return Err(FieldError::new("mechanism", super::law::TERMS_NEED_K_OF_SIGMA).into());
         }
-        if !(yield_strength_pa.is_finite() && yield_strength_pa > 0.0) {
-            return Err(FieldError::new("yield_strength_pa", "must be a finite number > 0").into());
-        }
+        FieldError::positive("yield_strength_pa", yield_strength_pa)?;
         let mut acc = Self::new(law)?;
         acc.mechanism = Some(MechanismState {
             mechanism,
@@ -258,24 +256,16 @@ impl WearAccumulator {
             damping_power_w,
             penetration_rate_m_s,
         } = *track;
-        if !(damping_power_w.is_finite() && damping_power_w >= 0.0) {
-            return Err(FieldError::new("damping_power_w", "must be a finite number >= 0").into());
-        }
+        FieldError::non_negative("damping_power_w", damping_power_w)?;
         if !penetration_rate_m_s.is_finite() {
             return Err(FieldError::new("penetration_rate_m_s", "must be finite").into());
         }
         if !time_s.is_finite() {
             return Err(FieldError::new("time_s", "must be finite").into());
         }
-        if !(normal_force_n.is_finite() && normal_force_n >= 0.0) {
-            return Err(FieldError::new("normal_force_n", "must be a finite number >= 0").into());
-        }
-        if !(slip_speed_m_s.is_finite() && slip_speed_m_s >= 0.0) {
-            return Err(FieldError::new("slip_speed_m_s", "must be a finite number >= 0").into());
-        }
-        if !(area_m2.is_finite() && area_m2 >= 0.0) {
-            return Err(FieldError::new("area_m2", "must be a finite number >= 0").into());
-        }
+        FieldError::non_negative("normal_force_n", normal_force_n)?;
+        FieldError::non_negative("slip_speed_m_s", slip_speed_m_s)?;
+        FieldError::non_negative("area_m2", area_m2)?;
         let in_contact = normal_force_n > 0.0;
         let pressure_pa = if !in_contact {
             0.0

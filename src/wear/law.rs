@@ -97,13 +97,7 @@ impl WearLaw {
             Self::Archard {
                 coefficient_m2_per_n,
             } => {
-                if !(finite(coefficient_m2_per_n) && coefficient_m2_per_n >= 0.0) {
-                    return Err(FieldError::new(
-                        "coefficient_m2_per_n",
-                        "must be a finite number >= 0",
-                    )
-                    .into());
-                }
+                FieldError::non_negative("coefficient_m2_per_n", coefficient_m2_per_n)?;
             }
             Self::Modified {
                 c1,
@@ -114,9 +108,7 @@ impl WearLaw {
                 if !finite(c1) {
                     return Err(FieldError::new("c1", "must be a finite number").into());
                 }
-                if !(finite(c2) && c2 > 0.0) {
-                    return Err(FieldError::new("c2", "must be a finite number > 0").into());
-                }
+                FieldError::positive("c2", c2)?;
                 if !finite(c3) {
                     return Err(FieldError::new("c3", "must be a finite number").into());
                 }
@@ -134,16 +126,8 @@ impl WearLaw {
                 if !(finite(c1) && finite(c2) && finite(c3)) {
                     return Err(FieldError::new("c1/c2/c3", "must be finite numbers").into());
                 }
-                if !(finite(speed_unit_m_s) && speed_unit_m_s > 0.0) {
-                    return Err(
-                        FieldError::new("speed_unit_m_s", "must be a finite number > 0").into(),
-                    );
-                }
-                if !(finite(output_unit_m3) && output_unit_m3 > 0.0) {
-                    return Err(
-                        FieldError::new("output_unit_m3", "must be a finite number > 0").into(),
-                    );
-                }
+                FieldError::positive("speed_unit_m_s", speed_unit_m_s)?;
+                FieldError::positive("output_unit_m3", output_unit_m3)?;
             }
         }
         Ok(())

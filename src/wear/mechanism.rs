@@ -301,9 +301,7 @@ impl WearMechanism {
             ],
         };
         for (name, value) in fields {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(FieldError::new(name, "must be a finite number >= 0").into());
-            }
+            FieldError::non_negative(name, value)?;
         }
         if let Self::LocalPressure(t) = self {
             if t.share > 1.0 {

@@ -41,9 +41,7 @@ impl PressureHistogram {
         max_pressure_pa: f64,
         bins_per_decade: u32,
     ) -> Result<Self, WearError> {
-        if !(min_pressure_pa.is_finite() && min_pressure_pa > 0.0) {
-            return Err(FieldError::new("min_pressure_pa", "must be a finite number > 0").into());
-        }
+        FieldError::positive("min_pressure_pa", min_pressure_pa)?;
         if !(max_pressure_pa.is_finite() && max_pressure_pa > min_pressure_pa) {
             return Err(
                 FieldError::new("max_pressure_pa", "must be finite and > min_pressure_pa").into(),

@@ -345,20 +345,17 @@ fn a_pattern_no_effect_makes_is_not_explained() {
     assert!(test_groups.iter().all(|g| g.mean_residual < 0.0));
 }
 
-#[test]
-fn an_effect_seen_in_one_test_only_is_named_as_unconfirmable() {
-    // A wear-law effect that acts on test T0 alone (a coating worn through only where the
-    // slip is longest): the campaign is drawn from it. Leave-one-test-out has nothing to fit
-    // it on when T0 is held out, so no held-out gain can confirm it, and the verdict stays
-    // not_explained; the summary must say which test carries it and that more such tests
-    // could confirm it.
+/// The emulator with a coating breakthrough that acts on test T0 alone, from the increment
+/// `from` on (a coating worn through only where the slip is longest, by then): T0's mass x
+/// (1 + 3 f) at the share f of its bound.
+fn with_coating_on_t0(from: usize) -> (Emulator, f64, impl Fn(usize, usize, f64) -> Prediction) {
     let mut em = emulator();
     let info = effects::info("coating_breakthrough").unwrap();
     let max = info.parameters[0].max;
     let magnitudes: Vec<f64> = (0..41).map(|i| max * i as f64 / 40.0).collect();
-    let only_t0 = |t: usize, k: usize, f: f64| {
+    let only_t0 = move |t: usize, k: usize, f: f64| {
         let mut p = truth(t, k, 0.0, 0.0, 0.0);
-        if t == 0 {
+        if t == 0 && k >= from {
             for v in p.mass_mg.values_mut() {
                 *v *= 1.0 + 3.0 * f;
             }
@@ -380,9 +377,59 @@ fn an_effect_seen_in_one_test_only_is_named_as_unconfirmable() {
         simulated: false,
         parameters: BTreeMap::new(),
     });
+    (em, max, only_t0)
+}
+
+#[test]
+fn an_effect_seen_in_one_test_only_is_confirmed_by_increment_and_named_partly() {
+    // A wear-law effect that acts on test T0 alone: the campaign is drawn from it.
+    // Leave-one-test-out has nothing to fit it on when T0 is held out, so no held-out gain can
+    // confirm it. T0's increments can: fitted on the other increments, the effect must predict
+    // the one left out. That holds within one test only, so the verdict names the effect as
+    // the leading candidate (partly_explained, saying which test carries it), with the drawn
+    // magnitude inside its interval, and never `explained`.
+    let (em, max, only_t0) = with_coating_on_t0(0);
+    let c = campaign(|t, k| only_t0(t, k, 0.5), 11);
+    let r = diagnose_with(&c, &em, &options()).unwrap();
+    assert_eq!(r.verdict, Verdict::PartlyExplained, "{}", r.summary);
+    assert!(
+        r.held_out
+            .starts_with("leave-one-increment-out, as T0 carries"),
+        "{}",
+        r.held_out
+    );
+    assert!(
+        r.summary
+            .contains("partly explained by coating_breakthrough")
+            && r.summary
+                .contains("confirmed by increment within one test only"),
+        "{}",
+        r.summary
+    );
+    let b = r.best_effect.unwrap();
+    assert_eq!(b.name, "coating_breakthrough");
+    let [lo, hi] = b.parameters[0].interval.unwrap();
+    assert!(
+        lo <= 0.5 * max && 0.5 * max <= hi,
+        "{} not in [{lo}, {hi}]",
+        0.5 * max
+    );
+    // Held out by increment, the effect predicts what the nominal cannot.
+    assert!(b.shrink > 0.5, "shrink {}", b.shrink);
+}
+
+#[test]
+fn an_effect_seen_in_one_increment_of_one_test_stays_unconfirmable() {
+    // The same coating reached only in T0's last increment: held out by test, T0 carries it;
+    // held out by increment, the last increment does, and the other increments hold nothing
+    // to fit it on either. No split of the data can confirm it, so the verdict stays
+    // not_explained, and the summary says which test carries it and that more such tests
+    // could confirm it.
+    let (em, _, only_t0) = with_coating_on_t0(INCREMENTS - 1);
     let c = campaign(|t, k| only_t0(t, k, 0.5), 11);
     let r = diagnose_with(&c, &em, &options()).unwrap();
     assert_eq!(r.verdict, Verdict::NotExplained, "{}", r.summary);
+    assert_eq!(r.held_out, "leave-one-test-out");
     assert!(
         r.summary
             .contains("coating_breakthrough fits every observation")

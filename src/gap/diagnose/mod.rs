@@ -28,7 +28,10 @@
 //!    held-out log-likelihood gain over the nominal exceeds [`MIN_HELD_OUT_GAIN`], it removes
 //!    at least [`MIN_EXPLAINED_SHARE`] of the nominal's excess chi-square, and the residuals
 //!    left after it pass the lack-of-fit test at `alpha`: the diagnosis never names the least
-//!    bad effect. Pairs are tried when no single effect explains.
+//!    bad effect. Pairs are tried when no single effect explains. When one test carries what
+//!    the leading single explains, leave-one-test-out has nothing to fit it on; the campaign
+//!    is then judged again leave-one-increment-out, and an effect that passes there is named
+//!    `partly_explained` (confirmed within that test only).
 //! 5. **How far**: held-out RMS standardized error before and after, the shrink and its
 //!    bootstrap interval, and the fitted magnitude with its profile-likelihood interval.
 
@@ -203,9 +206,18 @@ enum Model {
 
 impl<'a> FitProblem<'a> {
     fn new(campaign: &Campaign, emulator: &'a Emulator, options: &DiagnoseOptions) -> Self {
+        Self::with_folds(campaign, emulator, options, campaign.tests.len() >= 3)
+    }
+
+    /// The problem held out by test (`by_test`) or by increment.
+    fn with_folds(
+        campaign: &Campaign,
+        emulator: &'a Emulator,
+        options: &DiagnoseOptions,
+        by_test: bool,
+    ) -> Self {
         let mut obs = noise::observations(campaign);
         let noise = NoiseModel::estimate(campaign, &mut obs, emulator, options);
-        let by_test = campaign.tests.len() >= 3;
         let (group, groups, group_labels, held_out) = if by_test {
             (
                 obs.iter().map(|o| o.test).collect(),
@@ -219,7 +231,11 @@ impl<'a> FitProblem<'a> {
                 obs.iter().map(|o| o.increment).collect(),
                 n,
                 (1..=n).map(|k| format!("increment {k}")).collect(),
-                "leave-one-increment-out (fewer than 3 tests)".to_string(),
+                if campaign.tests.len() >= 3 {
+                    "leave-one-increment-out".to_string()
+                } else {
+                    "leave-one-increment-out (fewer than 3 tests)".to_string()
+                },
             )
         };
         // A variant (the effect at other secondary values, a few magnitudes) carries its
@@ -699,10 +715,7 @@ fn seen_in_one_group(
     nominal: &Candidate,
     alpha: f64,
 ) -> Option<String> {
-    let c = singles
-        .iter()
-        .filter(|c| c.residual_p >= alpha && !c.explains(nominal))
-        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))?;
+    let c = one_group_single(problem, singles, nominal, alpha)?;
     let (g, share) = carried_by_one_group(problem, c)?;
     Some(format!(
         "{} fits every observation within the noise (lack-of-fit p = {:.2}), but {} carries {:.0} % of what it explains, so held out it has nothing to be fitted on: this campaign cannot confirm it; more tests like {} could",
@@ -712,6 +725,21 @@ fn seen_in_one_group(
         100.0 * share,
         problem.group_labels[g],
     ))
+}
+
+/// The best single (by full-data chi-square) that fits every observation within the noise
+/// (lack-of-fit p >= `alpha`) but does not explain held out, if one group carries it.
+fn one_group_single<'c>(
+    problem: &FitProblem,
+    singles: &'c [Candidate],
+    nominal: &Candidate,
+    alpha: f64,
+) -> Option<&'c Candidate> {
+    singles
+        .iter()
+        .filter(|c| c.residual_p >= alpha && !c.explains(nominal))
+        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+        .filter(|c| carried_by_one_group(problem, c).is_some())
 }
 
 /// The held-out group that carries at least [`ONE_GROUP_SHARE`] of candidate `c`'s full-data
@@ -742,12 +770,53 @@ pub fn diagnose_with(
     if problem.obs.is_empty() {
         return Err(no_measurement());
     }
+    let (report, carried) = judge(campaign, emulator, options, &problem, None);
+    let increments = problem
+        .obs
+        .iter()
+        .map(|o| o.increment + 1)
+        .max()
+        .unwrap_or(1);
+    let Some(carried) = carried.filter(|_| problem.held_out == "leave-one-test-out") else {
+        return Ok(report);
+    };
+    if increments < 2 {
+        return Ok(report);
+    }
+    // Held out by test, an effect one test carries has nothing to be fitted on when that test
+    // is left out. Its increments can still judge it (as in a campaign of fewer than three
+    // tests): fitted on the other increments of every test, it must predict the one left out.
+    // What that confirms holds within the one test only, so it names a leading candidate
+    // (`partly_explained`), never more.
+    let scope = format!(
+        "confirmed by increment within one test only: held out by test, {carried} and leaves nothing to fit it on"
+    );
+    let by_increment = FitProblem::with_folds(campaign, emulator, options, false);
+    let (mut within, _) = judge(campaign, emulator, options, &by_increment, Some(&scope));
+    tracing::debug!(verdict = ?within.verdict, summary = %within.summary, "judged again by increment");
+    if within.verdict != Verdict::PartlyExplained {
+        return Ok(report);
+    }
+    within.held_out = format!("leave-one-increment-out, as {carried}");
+    Ok(within)
+}
+
+/// The verdict on one way of holding data out, and, when one held-out group carries what the
+/// leading single explains (so the held-out fits cannot confirm it), which group and how much.
+/// `scope`, when given, is a reason every named candidate explains only partly.
+fn judge(
+    campaign: &Campaign,
+    emulator: &Emulator,
+    options: &DiagnoseOptions,
+    problem: &FitProblem,
+    scope: Option<&str>,
+) -> (Report, Option<String>) {
     let alpha = options.alpha;
     let nominal = problem.evaluate(Model::Nominal, alpha);
     let nominal_score = problem.totals(&[], &|_| true);
     let (chi2, dof) = (nominal_score.r2, nominal_score.w);
     let nominal_p = stats::lack_of_fit_p(chi2, dof, 0.0);
-    let location = location::locate(campaign, &problem);
+    let location = location::locate(campaign, problem);
     let any_flag = location.any_flagged();
 
     let singles: Vec<Candidate> = (0..problem.families.len())
@@ -823,7 +892,7 @@ pub fn diagnose_with(
     let ranking: Vec<RankEntry> = order.iter().map(|&i| entry(&singles[i], 1 + i)).collect();
     let held_out_predictions = order
         .first()
-        .map(|&i| held_out_predictions(campaign, &problem, &singles[i]))
+        .map(|&i| held_out_predictions(campaign, problem, &singles[i]))
         .unwrap_or_default();
     let pair_entries: Vec<RankEntry> = pairs
         .iter()
@@ -850,7 +919,7 @@ pub fn diagnose_with(
         // full-data AICc instead (docs/diagnosis.md, "Seen in one test").
         let c = &singles[first];
         let best =
-            if c.only_partly(&nominal, emulator) && carried_by_one_group(&problem, c).is_some() {
+            if c.only_partly(&nominal, emulator) && carried_by_one_group(problem, c).is_some() {
                 explaining_singles
                     .iter()
                     .copied()
@@ -909,11 +978,18 @@ pub fn diagnose_with(
     let chosen_candidate: Option<&Candidate> = chosen.as_ref().map(|(c, _)| *c);
     let best_effect = chosen
         .as_ref()
-        .map(|(c, _)| best_effect(&problem, c, &nominal, &resamples));
+        .map(|(c, _)| best_effect(problem, c, &nominal, &resamples));
     let partly = chosen
         .as_ref()
         .zip(best_effect.as_ref())
-        .and_then(|((c, _), b)| partly_explained(&problem, c, b, unidentified));
+        .and_then(|((c, _), b)| {
+            let also: Vec<&str> = unidentified
+                .iter()
+                .map(String::as_str)
+                .chain(scope)
+                .collect();
+            partly_explained(problem, c, b, (!also.is_empty()).then(|| also.join("; ")))
+        });
     let verdict = if no_gap {
         Verdict::NoGap
     } else if partly.is_some() {
@@ -922,6 +998,23 @@ pub fn diagnose_with(
         Verdict::Explained
     } else {
         Verdict::NotExplained
+    };
+    let carried_by = |c: &Candidate| {
+        carried_by_one_group(problem, c).map(|(g, share)| {
+            format!(
+                "{} carries {:.0} % of what {} explains",
+                problem.group_labels[g],
+                100.0 * share,
+                problem.name_of(&c.families)
+            )
+        })
+    };
+    let carried = match verdict {
+        Verdict::PartlyExplained => chosen_candidate.and_then(carried_by),
+        Verdict::NotExplained => {
+            one_group_single(problem, &singles, &nominal, alpha).and_then(carried_by)
+        }
+        _ => None,
     };
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
@@ -942,7 +1035,7 @@ pub fn diagnose_with(
             let mut text = partly
                 .as_ref()
                 .map_or_else(String::new, PartlyExplained::sentence);
-            let carried = chosen_candidate.and_then(|c| carried_by_one_group(&problem, c));
+            let carried = chosen_candidate.and_then(|c| carried_by_one_group(problem, c));
             if let Some((g, share)) = carried {
                 text.push_str(&format!(
                     "; {} carries {:.0} % of what it explains, so held out it has nothing to be fitted on: more tests like {} could confirm it",
@@ -957,14 +1050,14 @@ pub fn diagnose_with(
             let mut text = format!(
                 "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
             );
-            if let Some(seen) = seen_in_one_group(&problem, &singles, &nominal, alpha) {
+            if let Some(seen) = seen_in_one_group(problem, &singles, &nominal, alpha) {
                 text.push_str("; ");
                 text.push_str(&seen);
             }
             text
         }
     };
-    Ok(Report {
+    let report = Report {
         campaign: campaign.name.clone(),
         verdict,
         summary,
@@ -1000,7 +1093,8 @@ pub fn diagnose_with(
         held_out_predictions,
         partly_explained: partly,
         code_version: crate::models::case::code_version().to_string(),
-    })
+    };
+    (report, carried)
 }
 
 /// The nominal model and every single effect evaluated, when the nominal model shows a gap
