@@ -1009,8 +1009,10 @@ fn judge(
             )
         })
     };
+    // A pair member named because its partner is not identified was confirmed by the pairs
+    // held out as they are; only a single's one-group share asks for another way to hold out.
     let carried = match verdict {
-        Verdict::PartlyExplained => chosen_candidate.and_then(carried_by),
+        Verdict::PartlyExplained if unidentified.is_none() => chosen_candidate.and_then(carried_by),
         Verdict::NotExplained => {
             one_group_single(problem, &singles, &nominal, alpha).and_then(carried_by)
         }
