@@ -206,7 +206,7 @@ enum Model {
 
 impl<'a> FitProblem<'a> {
     fn new(campaign: &Campaign, emulator: &'a Emulator, options: &DiagnoseOptions) -> Self {
-        Self::with_folds(campaign, emulator, options, campaign.tests.len() >= 3)
+        Self::with_folds(campaign, emulator, options, held_out_by_test(campaign))
     }
 
     /// The problem held out by test (`by_test`) or by increment.
@@ -231,7 +231,7 @@ impl<'a> FitProblem<'a> {
                 obs.iter().map(|o| o.increment).collect(),
                 n,
                 (1..=n).map(|k| format!("increment {k}")).collect(),
-                if campaign.tests.len() >= 3 {
+                if held_out_by_test(campaign) {
                     "leave-one-increment-out".to_string()
                 } else {
                     "leave-one-increment-out (fewer than 3 tests)".to_string()
@@ -699,47 +699,47 @@ fn no_measurement() -> GapError {
     )
 }
 
+/// Whether the campaign's default held-out groups are its tests (three or more of them) rather
+/// than its increments.
+fn held_out_by_test(campaign: &Campaign) -> bool {
+    campaign.tests.len() >= 3
+}
+
 /// Share of a candidate's full-data chi-square reduction that one group must carry for the
 /// effect to count as seen in that group alone.
 const ONE_GROUP_SHARE: f64 = 0.9;
 
-/// For a `not_explained` verdict: the best single effect (by full-data chi-square) that fits
-/// every observation within the noise (lack-of-fit p >= `alpha`) but is not confirmed held
-/// out, when one held-out group carries at least [`ONE_GROUP_SHARE`] of its chi-square
-/// reduction. Such an effect is seen in that group alone, so leaving the group out leaves
-/// nothing to fit it on: the campaign cannot confirm it, and more tests like that group could.
-/// None otherwise.
-fn seen_in_one_group(
-    problem: &FitProblem,
-    singles: &[Candidate],
-    nominal: &Candidate,
-    alpha: f64,
-) -> Option<String> {
-    let c = one_group_single(problem, singles, nominal, alpha)?;
-    let (g, share) = carried_by_one_group(problem, c)?;
-    Some(format!(
+/// For a `not_explained` verdict, the sentence on [`one_group_single`]'s effect: it is seen in
+/// one group alone, so leaving the group out leaves nothing to fit it on; the campaign cannot
+/// confirm it, and more tests like that group could.
+fn seen_in_one_group(problem: &FitProblem, (c, g, share): OneGroup) -> String {
+    format!(
         "{} fits every observation within the noise (lack-of-fit p = {:.2}), but {} carries {:.0} % of what it explains, so held out it has nothing to be fitted on: this campaign cannot confirm it; more tests like {} could",
         problem.name_of(&c.families),
         c.residual_p,
         problem.group_labels[g],
         100.0 * share,
         problem.group_labels[g],
-    ))
+    )
 }
 
+/// A candidate, the held-out group that carries what it explains, and that group's share.
+type OneGroup<'c> = (&'c Candidate, usize, f64);
+
 /// The best single (by full-data chi-square) that fits every observation within the noise
-/// (lack-of-fit p >= `alpha`) but does not explain held out, if one group carries it.
+/// (lack-of-fit p >= `alpha`) but does not explain held out, if one held-out group carries at
+/// least [`ONE_GROUP_SHARE`] of its chi-square reduction.
 fn one_group_single<'c>(
     problem: &FitProblem,
     singles: &'c [Candidate],
     nominal: &Candidate,
     alpha: f64,
-) -> Option<&'c Candidate> {
-    singles
+) -> Option<OneGroup<'c>> {
+    let c = singles
         .iter()
         .filter(|c| c.residual_p >= alpha && !c.explains(nominal))
-        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
-        .filter(|c| carried_by_one_group(problem, c).is_some())
+        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))?;
+    carried_by_one_group(problem, c).map(|(g, share)| (c, g, share))
 }
 
 /// The held-out group that carries at least [`ONE_GROUP_SHARE`] of candidate `c`'s full-data
@@ -771,18 +771,9 @@ pub fn diagnose_with(
         return Err(no_measurement());
     }
     let (report, carried) = judge(campaign, emulator, options, &problem, None);
-    let increments = problem
-        .obs
-        .iter()
-        .map(|o| o.increment + 1)
-        .max()
-        .unwrap_or(1);
-    let Some(carried) = carried.filter(|_| problem.held_out == "leave-one-test-out") else {
+    let Some(carried) = carried.filter(|_| held_out_by_test(campaign)) else {
         return Ok(report);
     };
-    if increments < 2 {
-        return Ok(report);
-    }
     // Held out by test, an effect one test carries has nothing to be fitted on when that test
     // is left out. Its increments can still judge it (as in a campaign of fewer than three
     // tests): fitted on the other increments of every test, it must predict the one left out.
@@ -792,6 +783,9 @@ pub fn diagnose_with(
         "confirmed by increment within one test only: held out by test, {carried} and leaves nothing to fit it on"
     );
     let by_increment = FitProblem::with_folds(campaign, emulator, options, false);
+    if by_increment.groups < 2 {
+        return Ok(report);
+    }
     let (mut within, _) = judge(campaign, emulator, options, &by_increment, Some(&scope));
     tracing::debug!(verdict = ?within.verdict, summary = %within.summary, "judged again by increment");
     if within.verdict != Verdict::PartlyExplained {
@@ -999,25 +993,26 @@ fn judge(
     } else {
         Verdict::NotExplained
     };
-    let carried_by = |c: &Candidate| {
-        carried_by_one_group(problem, c).map(|(g, share)| {
+    // The candidate the summary reports as carried by one group: the chosen one when it
+    // explains only partly, the best single that fits within the noise when none explains.
+    let one_group: Option<OneGroup> = match verdict {
+        Verdict::PartlyExplained => chosen_candidate
+            .and_then(|c| carried_by_one_group(problem, c).map(|(g, share)| (c, g, share))),
+        Verdict::NotExplained => one_group_single(problem, &singles, &nominal, alpha),
+        _ => None,
+    };
+    // A pair member named because its partner is not identified was confirmed by the pairs
+    // held out as they are; only a single's one-group share asks for another way to hold out.
+    let carried = one_group
+        .filter(|_| verdict == Verdict::NotExplained || unidentified.is_none())
+        .map(|(c, g, share)| {
             format!(
                 "{} carries {:.0} % of what {} explains",
                 problem.group_labels[g],
                 100.0 * share,
                 problem.name_of(&c.families)
             )
-        })
-    };
-    // A pair member named because its partner is not identified was confirmed by the pairs
-    // held out as they are; only a single's one-group share asks for another way to hold out.
-    let carried = match verdict {
-        Verdict::PartlyExplained if unidentified.is_none() => chosen_candidate.and_then(carried_by),
-        Verdict::NotExplained => {
-            one_group_single(problem, &singles, &nominal, alpha).and_then(carried_by)
-        }
-        _ => None,
-    };
+        });
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
         Verdict::NoGap => format!(
@@ -1037,8 +1032,7 @@ fn judge(
             let mut text = partly
                 .as_ref()
                 .map_or_else(String::new, PartlyExplained::sentence);
-            let carried = chosen_candidate.and_then(|c| carried_by_one_group(problem, c));
-            if let Some((g, share)) = carried {
+            if let Some((_, g, share)) = one_group {
                 text.push_str(&format!(
                     "; {} carries {:.0} % of what it explains, so held out it has nothing to be fitted on: more tests like {} could confirm it",
                     problem.group_labels[g],
@@ -1052,9 +1046,9 @@ fn judge(
             let mut text = format!(
                 "not explained: a gap (p = {nominal_p:.2e}) that no effect of the library (nor pair) fits on held-out data with residuals consistent with noise"
             );
-            if let Some(seen) = seen_in_one_group(problem, &singles, &nominal, alpha) {
+            if let Some(seen) = one_group {
                 text.push_str("; ");
-                text.push_str(&seen);
+                text.push_str(&seen_in_one_group(problem, seen));
             }
             text
         }
