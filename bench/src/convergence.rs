@@ -104,7 +104,7 @@ pub(crate) fn run_variant(
         case.simulation.contact_points_per_edge = n;
     }
     if let Some(f) = v.face_contact {
-        case.simulation.face_contact = f;
+        case.simulation.face_contact = Some(f);
     }
     let mut model = build(&case, configs_dir)?;
     model.initial_state[0] += v.nudge_m;

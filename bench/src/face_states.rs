@@ -58,9 +58,9 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
                 // The case's validation caps the points at 33: finer lattices are set on the
                 // built contacts.
                 case.simulation.contact_points_per_edge = n.min(33);
-                case.simulation.face_contact = FaceContact::Lattice;
+                case.simulation.face_contact = Some(FaceContact::Lattice);
             }
-            None => case.simulation.face_contact = FaceContact::Exact,
+            None => case.simulation.face_contact = Some(FaceContact::Exact),
         }
         let mut model = build(&case, configs_dir)?;
         if let Some(n) = n.filter(|&n| n > 33) {

@@ -383,3 +383,42 @@ fn a_run_with_a_non_finite_base_motion_fails_with_a_diagnostic() {
         ),
     }
 }
+
+#[test]
+fn face_contact_defaults_per_model_and_a_case_that_names_it_keeps_it() {
+    use crate::physics::contact::FaceContact;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let faces = |name: &str, set: Option<FaceContact>| -> Vec<FaceContact> {
+        let mut case = super::case::load_case(&dir.join(format!("{name}.toml"))).expect("case");
+        case.simulation.face_contact = set;
+        let model = super::case::build(&case, &dir).expect("model");
+        model
+            .system
+            .contacts
+            .iter()
+            .map(|c| c.face_contact)
+            .collect()
+    };
+    // Absent: the launcher integrates its faces exactly (its lattice is not converged), the
+    // rattle box keeps the lattice (converged at 3 points per edge).
+    let launcher = faces("launcher-design", None);
+    assert_eq!(launcher.len(), 5);
+    assert!(
+        launcher.iter().all(|f| *f == FaceContact::Exact),
+        "{launcher:?}"
+    );
+    let rattle = faces("rattle-box-c", None);
+    assert!(!rattle.is_empty());
+    assert!(
+        rattle.iter().all(|f| *f == FaceContact::Lattice),
+        "{rattle:?}"
+    );
+    // Named: kept, either way round.
+    let named = faces("launcher-design", Some(FaceContact::Lattice));
+    assert!(
+        named.iter().all(|f| *f == FaceContact::Lattice),
+        "{named:?}"
+    );
+    let named = faces("rattle-box-c", Some(FaceContact::Exact));
+    assert!(named.iter().all(|f| *f == FaceContact::Exact), "{named:?}");
+}

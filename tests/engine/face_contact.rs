@@ -373,7 +373,7 @@ fn a_head_sliding_off_a_lip_unloads_continuously_and_its_work_is_the_energy_drop
 pub(crate) fn pressed_cube(moving: bool) -> (MultibodySystem, Vec<f64>) {
     let mut case =
         railwear::models::case::load_case(&configs().join("rattle-box-c.toml")).expect("case");
-    case.simulation.face_contact = FaceContact::Exact;
+    case.simulation.face_contact = Some(FaceContact::Exact);
     let model = railwear::models::case::build(&case, configs()).expect("model");
     let mut y = model.initial_state.clone();
     y[1] -= 3e-5;
@@ -496,7 +496,7 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     let model_at = |n: usize, face: FaceContact| {
         let mut case = case.clone();
         case.simulation.contact_points_per_edge = n;
-        case.simulation.face_contact = face;
+        case.simulation.face_contact = Some(face);
         railwear::models::case::build(&case, configs()).expect("model")
     };
     let fine = model_at(33, FaceContact::Lattice);
@@ -546,7 +546,7 @@ fn random_missile_states_never_gain_energy_with_the_exact_face_contact() {
     let mut case =
         railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
     case.excitation = serde_json::json!({ "kind": "none" });
-    case.simulation.face_contact = FaceContact::Exact;
+    case.simulation.face_contact = Some(FaceContact::Exact);
     let model = railwear::models::case::build(&case, configs()).expect("model");
     let settings = railwear::models::case::integrator_settings(&case).expect("settings");
     let sys = &model.system;
@@ -757,7 +757,7 @@ fn lattice_force_gaps(
 
 #[test]
 fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_first_order() {
-    // launcher-loose run with the default lattice; 20 states of its excitation window (shoe
+    // launcher-loose run with the 5-point lattice; 20 states of its excitation window (shoe
     // heads rattling across the lips' edges, tilted, hitting the walls and the roof). At each,
     // the shoe-rail contacts' forces with the lattice at 33, 65 and 129 points per edge
     // against the exact face contact. The lattice is a trapezoid rule of the same continuum
@@ -780,15 +780,16 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
     let mut case = load_case(&configs().join("launcher-loose.toml")).expect("case");
     case.simulation.settle_s = 1.0;
     case.simulation.duration_s = 0.5;
+    case.simulation.face_contact = Some(FaceContact::Lattice);
     let recorder = build(&case, configs()).expect("model");
     let options = run_options(&case).expect("options");
     let states = record_states(&recorder, &options, &RunControl::silent(), 0.025).expect("runs");
     assert!(states.len() >= 19, "{} states", states.len());
-    case.simulation.face_contact = FaceContact::Exact;
+    case.simulation.face_contact = Some(FaceContact::Exact);
     let exact = build(&case, configs()).expect("exact");
     let lattice_at = |n: usize| {
         let mut case = case.clone();
-        case.simulation.face_contact = FaceContact::Lattice;
+        case.simulation.face_contact = Some(FaceContact::Lattice);
         let mut model = build(&case, configs()).expect("lattice");
         for c in &mut model.system.contacts {
             *c = c.clone().with_points_per_edge(n);

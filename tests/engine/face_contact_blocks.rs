@@ -86,7 +86,7 @@ fn the_exact_face_jacobian_per_track_is_the_sum_over_its_nodes() {
     )
     .expect("settles")
     .state;
-    case.simulation.face_contact = FaceContact::Exact;
+    case.simulation.face_contact = Some(FaceContact::Exact);
     let exact = railwear::models::case::build(&case, configs()).expect("model");
     let n = exact.system.state_len();
     let mut rng = ChaCha8Rng::seed_from_u64(2727);

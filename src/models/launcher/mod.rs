@@ -37,7 +37,7 @@ use crate::field_error::FieldError;
 use crate::geometry::{ConvexShape, FaceExtent, HalfSpace};
 use crate::models::motion::TranslatingBase;
 use crate::physics::body::{write_state, BodyKind, MassProperties, RigidBody};
-use crate::physics::contact::Contact;
+use crate::physics::contact::{Contact, FaceContact};
 use crate::physics::forces::{
     Attachment, Bushing, ConstantForce, ForceElement, OneSidedSpring, SpringDamper,
 };
@@ -68,6 +68,13 @@ pub const CONTACT_NAMES: [&str; 5] = [
     "mid_shoe-latch",
     "rear_shoe-rail",
 ];
+
+/// How the launcher's faces are resolved when a case does not say (`simulation.face_contact`):
+/// exactly. The contact-point lattice is not converged on the launcher (friction power and
+/// shoe wear move by per cents from 5 to 17 points per edge, and a shoe head over a lip's edge
+/// gets a staircase of the face law); the exact contact is its continuum limit
+/// (docs/performance.md, eleventh and eighteenth passes).
+pub const FACE_CONTACT: FaceContact = FaceContact::Exact;
 
 /// Index of the rear leaf spring in `system.forces`.
 pub const LEAF_SPRING_FORCE: usize = 1;
@@ -549,7 +556,7 @@ pub fn build(
         .into_iter()
         .map(|c| {
             c.with_points_per_edge(case.simulation.contact_points_per_edge)
-                .with_face_contact(case.simulation.face_contact)
+                .with_face_contact(case.simulation.face_contact.unwrap_or(FACE_CONTACT))
         })
         .collect();
     // Stations: the first is the rail above (bodies 0-2, the thesis' names); each further one

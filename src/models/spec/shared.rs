@@ -195,11 +195,14 @@ pub struct SimulationSpec {
     #[serde(default = "default_contact_points_per_edge")]
     pub contact_points_per_edge: usize,
     /// How rounded boxes' faces are resolved (docs/models.md "Exact face contact"): `lattice`
-    /// (default; `contact_points_per_edge` points per edge) or `exact` (each face integrated
-    /// over its pressed polygon, exact for the IMPACT force, torque and stored energy at an
-    /// integer exponent; `contact_points_per_edge` then unused by boxes).
-    #[serde(default)]
-    pub face_contact: crate::physics::contact::FaceContact,
+    /// (`contact_points_per_edge` points per edge) or `exact` (each face integrated over its
+    /// pressed polygon, exact for the IMPACT force, torque and stored energy at an integer
+    /// exponent; `contact_points_per_edge` then unused by boxes). Absent: the model's own
+    /// default, `exact` for launchers (the lattice is not converged there) and `lattice` for
+    /// rattle boxes (converged at 3 points per edge, about a third of the exact contact's
+    /// cost); docs/performance.md, eighteenth pass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub face_contact: Option<crate::physics::contact::FaceContact>,
 }
 
 fn default_contact_points_per_edge() -> usize {
