@@ -4,9 +4,13 @@
 //! iterates of one step (the penetration and the normal force stay exact) moves the application
 //! point by far less than the tolerance-level error. So the launcher's rail wear over the same
 //! window must agree to well within 1 % (the launcher's 2 s window is not chaotic: successive
-//! engine versions give it to 0.2 %).
+//! engine versions give it to 0.2 %). On the 5-point lattice: the finite-difference matrix
+//! takes a force evaluation per state entry, and the exact face contact (the launcher's default)
+//! makes each of those about 6x dearer; the exact contact's own Jacobian is checked against
+//! central differences in face_contact.rs.
 
 use railwear::models::case::load_case;
+use railwear::physics::contact::FaceContact;
 use railwear::physics::integrator::{ContactPatches, NewtonJacobian};
 use railwear::pipeline::{run_case, RunControl};
 use std::path::Path;
@@ -19,6 +23,7 @@ fn rail_rate(newton: NewtonJacobian, patches: ContactPatches) -> f64 {
     case.simulation.record_interval_s = 2.0;
     case.simulation.newton_jacobian = newton;
     case.simulation.contact_patches = patches;
+    case.simulation.face_contact = Some(FaceContact::Lattice);
     let (report, _) = run_case(&case, configs, &RunControl::silent()).expect("runs");
     report
         .bodies
