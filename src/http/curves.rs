@@ -51,7 +51,9 @@ pub struct CurveView {
     /// Swept rattle-space range [min, max].
     pub rattle_space_range: Option<[f64; 2]>,
     /// Config, vehicle_profile, environment, wear_law, points, duration_per_point_s, seeds,
-    /// range, offsets, base dimensions, code_version, created_by.
+    /// range, offsets, base dimensions, face_contact (with the lattice its
+    /// contact_points_per_edge; absent on curves swept before it was recorded), code_version,
+    /// created_by.
     #[schema(value_type = Object)]
     pub provenance: serde_json::Value,
     /// Token name of who submitted the sweep.

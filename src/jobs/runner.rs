@@ -593,28 +593,36 @@ pub fn sweep_output(
         Some(serde_json::Value::String(name)) => serde_json::Value::from(name.as_str()),
         Some(_) => serde_json::Value::from("inline"),
     };
+    // Which face contact the runs used (`face_contact`, with the lattice its points per edge):
+    // the launcher's default changed from the lattice to the exact contact, and a curve must
+    // say which one its rates come from.
+    let contact = crate::models::case::face_contact_record(&plan.base)?;
+    let mut provenance = serde_json::json!({
+        "config": config,
+        "overrides": params.get("overrides").cloned().unwrap_or(serde_json::Value::Null),
+        "vehicle_profile": plan.vehicle_profile,
+        "environment": plan.environment,
+        "wear_law": plan.wear_law,
+        "diagnosed_wear_law": plan.diagnosed,
+        "points": plan.len(),
+        "duration_per_point_s": plan.duration_per_point_s(),
+        "settle_s": plan.base.simulation.settle_s,
+        "seeds": plan.seeds,
+        "rattle_space_range": {"min": k_min, "max": k_max},
+        "offsets_mm": plan.offsets_mm,
+        "base_dimensions_mm": plan.range.base,
+        "design_base": plan.range.design_base,
+    });
+    if let (Some(map), serde_json::Value::Object(contact)) = (provenance.as_object_mut(), contact) {
+        map.extend(contact);
+    }
     let curve_info = CurveInfo {
         fidelity: crate::store::CurveFidelity {
             points: plan.len() as i64,
             duration_per_point_s: Some(plan.duration_per_point_s()),
             seeds: plan.seeds.len() as i64,
         },
-        provenance: serde_json::json!({
-            "config": config,
-            "overrides": params.get("overrides").cloned().unwrap_or(serde_json::Value::Null),
-            "vehicle_profile": plan.vehicle_profile,
-            "environment": plan.environment,
-            "wear_law": plan.wear_law,
-            "diagnosed_wear_law": plan.diagnosed,
-            "points": plan.len(),
-            "duration_per_point_s": plan.duration_per_point_s(),
-            "settle_s": plan.base.simulation.settle_s,
-            "seeds": plan.seeds,
-            "rattle_space_range": {"min": k_min, "max": k_max},
-            "offsets_mm": plan.offsets_mm,
-            "base_dimensions_mm": plan.range.base,
-            "design_base": plan.range.design_base,
-        }),
+        provenance,
     };
     let plot = crate::report::curve_plot(&curve);
     let summary = serde_json::to_value(sweep).map_err(|e| RunError::InvalidConfig {
@@ -628,4 +636,46 @@ pub fn sweep_output(
         penalization: Some(curve),
         curve_info: Some(curve_info),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::penalization::SweepPoint;
+
+    /// A sweep's curve names the face contact its runs used: the launcher's default (exact)
+    /// when the sweep says nothing, and the lattice with its points per edge when an override
+    /// names it.
+    #[test]
+    fn a_sweeps_curve_records_the_face_contact_its_runs_used() {
+        let configs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+        let provenance = |params: serde_json::Value| {
+            let plan = SweepPlan::from_params(&params, &configs).expect("plan");
+            // Three points of any wear rates: only the provenance is read here.
+            let points = (0..3)
+                .map(|i| SweepPoint {
+                    offset_mm: None,
+                    rattle_space: 0.2 + 0.1 * i as f64,
+                    rail_wear_rate_mg_per_h: 1.0 + i as f64,
+                })
+                .collect();
+            let outcome = SweepOutcome {
+                design_rattle_space: 0.3,
+                points,
+                seeds: Vec::new(),
+                rate_by_seed_mg_per_h: Vec::new(),
+            };
+            let output = sweep_output(&plan, &params, &outcome).expect("output");
+            output.curve_info.expect("curve info").provenance
+        };
+        let exact = provenance(serde_json::json!({"config": "launcher-design"}));
+        assert_eq!(exact["face_contact"], "exact", "{exact}");
+        assert!(exact.get("contact_points_per_edge").is_none(), "{exact}");
+        let lattice = provenance(serde_json::json!({
+            "config": "launcher-design",
+            "overrides": {"simulation": {"face_contact": "lattice", "contact_points_per_edge": 9}},
+        }));
+        assert_eq!(lattice["face_contact"], "lattice", "{lattice}");
+        assert_eq!(lattice["contact_points_per_edge"], 9, "{lattice}");
+    }
 }

@@ -9,6 +9,7 @@ use super::{launcher, persistent_contact, rattle_box};
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
 use crate::field_error::FieldError;
+use crate::physics::contact::FaceContact;
 use crate::physics::integrator::{IntegratorKind, IntegratorSettings, Tolerances};
 use crate::physics::simulate::{DivergenceLimits, SimError};
 use serde_json::{json, Value};
@@ -161,6 +162,32 @@ pub(crate) fn build_validated(case: &CaseSpec, configs_dir: &Path) -> Result<Bui
         ModelSpecRef::Launcher(spec) => launcher::build(case, spec, motion),
         ModelSpecRef::PersistentContact(spec) => persistent_contact::build(spec),
     }
+}
+
+/// How a case's model resolves the faces of its rounded boxes: what `simulation.face_contact`
+/// names, else the model's own default ([`launcher::FACE_CONTACT`],
+/// [`rattle_box::FACE_CONTACT`]); `None` for a model without boxes (the persistent-contact
+/// block). The builders take it from here, and a sweep's curve records it in its provenance.
+pub fn face_contact(case: &CaseSpec) -> Result<Option<FaceContact>, RunError> {
+    let default = match case.model_spec()? {
+        ModelSpecRef::RattleBox(_) => rattle_box::FACE_CONTACT,
+        ModelSpecRef::Launcher(_) => launcher::FACE_CONTACT,
+        ModelSpecRef::PersistentContact(_) => return Ok(None),
+    };
+    Ok(Some(case.simulation.face_contact.unwrap_or(default)))
+}
+
+/// [`face_contact`] as a provenance record: `{"face_contact": "exact"}`, or with the lattice
+/// its `contact_points_per_edge`; `null` for a model without boxes.
+pub fn face_contact_record(case: &CaseSpec) -> Result<Value, RunError> {
+    Ok(match face_contact(case)? {
+        None => Value::Null,
+        Some(FaceContact::Exact) => json!({"face_contact": FaceContact::Exact}),
+        Some(FaceContact::Lattice) => json!({
+            "face_contact": FaceContact::Lattice,
+            "contact_points_per_edge": case.simulation.contact_points_per_edge,
+        }),
+    })
 }
 
 /// Run options of a case.

@@ -392,12 +392,19 @@ fn face_contact_defaults_per_model_and_a_case_that_names_it_keeps_it() {
         let mut case = super::case::load_case(&dir.join(format!("{name}.toml"))).expect("case");
         case.simulation.face_contact = set;
         let model = super::case::build(&case, &dir).expect("model");
-        model
+        let built: Vec<FaceContact> = model
             .system
             .contacts
             .iter()
             .map(|c| c.face_contact)
-            .collect()
+            .collect();
+        // What a curve's provenance records is what the builder used.
+        let resolved = super::case::face_contact(&case).expect("resolved");
+        assert!(
+            built.iter().all(|f| Some(*f) == resolved),
+            "{name}: built {built:?}, resolved {resolved:?}"
+        );
+        built
     };
     // Absent: the launcher integrates its faces exactly (its lattice is not converged), the
     // rattle box keeps the lattice (converged at 3 points per edge).
