@@ -1,7 +1,8 @@
 //! `/v1/curves`: penalization curve versions with provenance and fidelity. A successful sweep
 //! stores a new version of its key (`vehicle_profile/environment/wear_law`); reports use the
 //! version an engineer published (`POST /v1/curves/{id}/publish`). Publishing a version with
-//! fewer points, a shorter duration per point or fewer seeds than the published one needs
+//! fewer points, a shorter duration per point or fewer seeds than the published one, or swept
+//! on the contact-point lattice over one swept with the exact face contact, needs
 //! `{"force": true}`, else 409.
 
 use super::auth::{Area, Caller};
@@ -131,7 +132,8 @@ pub struct CurveQuery {
 #[serde(deny_unknown_fields)]
 pub struct PublishRequest {
     /// Publish even when this version has a lower fidelity (fewer points, shorter duration per
-    /// point, fewer seeds) than the published one. Default false.
+    /// point, fewer seeds, or the contact-point lattice against the exact face contact) than
+    /// the published one. Default false.
     #[serde(default)]
     pub force: bool,
 }
