@@ -1,14 +1,16 @@
 //! `face-states`: issue 27's per-state face study. One case (launcher-loose by default) runs
 //! with the lattice at `record_points` points per edge; states along its excitation window are
 //! recorded, and at each the contacts are evaluated with the exact face contact and with the
-//! lattice at several points per edge (same state, same time, so the same rail motion): each
+//! lattice at several points per edge (same state, same time, so the same rail motion), and
+//! with the exact contact's friction taken per part at its load centre
+//! (`FrictionRule::PerPart`, issue 27's cheaper friction) against the per-node law: each
 //! contact's normal force, force and torque on its body a, and friction power, and each
 //! track's normal force. The question is whether the lattice converges to the exact contact
 //! at the states the dynamics visits, and which track makes a difference.
 
 use super::*;
 use railwear::models::run::record_states;
-use railwear::physics::contact::{FaceContact, TrackState};
+use railwear::physics::contact::{FaceContact, FrictionRule, TrackState};
 use railwear::physics::system::MultibodySystem;
 
 /// What `face-states` runs.
@@ -76,6 +78,12 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
         .map_err(|e| anyhow!("{}: {e}", b.case))?;
     eprintln!("face-states: {} states recorded", states.len());
     let exact = model_at(None)?;
+    // The exact contact with friction per part at its load centre (issue 27's cheaper friction,
+    // measured against the per-node law at the same states).
+    let mut per_part = model_at(None)?;
+    for c in &mut per_part.system.contacts {
+        *c = c.clone().with_friction_rule(FrictionRule::PerPart);
+    }
     let lattices: Vec<(usize, BuiltModel)> = b
         .ladder
         .iter()
@@ -92,6 +100,9 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
     let nc = names.len();
     let mut ex = vec![(0.0, 0.0, 0.0, 0.0); nc];
     let mut lat = vec![vec![(0.0, 0.0, 0.0, 0.0); nc]; lattices.len()];
+    // Friction per part: (N, friction power, Σ|ΔF|, Σ|Δτ|) against exact, and Σ|ΔP_friction|.
+    let mut part = vec![(0.0, 0.0, 0.0, 0.0); nc];
+    let mut part_power_gap = vec![0.0; nc];
     // Per (contact, track): Σ N exact and per lattice.
     let mut per_track: Vec<((u32, u32), f64, Vec<f64>)> = Vec::new();
     for (si, (t, y)) in states.iter().enumerate() {
@@ -118,6 +129,14 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
         };
         for tr in &e.tracks {
             add_track(tr, None);
+        }
+        let pp = evaluate_all(&per_part.system, *t, y);
+        for (ci, c) in pp.contacts.iter().enumerate() {
+            part[ci].0 += c.0;
+            part[ci].1 += c.3;
+            part[ci].2 += (c.1 - e.contacts[ci].1).norm();
+            part[ci].3 += (c.2 - e.contacts[ci].2).norm();
+            part_power_gap[ci] += (c.3 - e.contacts[ci].3).abs();
         }
         let mut line = format!("t {t:.4} exact N");
         for c in &e.contacts {
@@ -174,6 +193,22 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
             Cell::text("-"),
             Cell::text("-"),
         ]);
+        let p = part[ci];
+        table.row(vec![
+            Cell::text(&names[ci]),
+            Cell::text("exact, friction per part"),
+            Cell::Num(p.0 / count),
+            pct(p.0, ex[ci].0),
+            Cell::Num(p.1 / count),
+            pct(p.1, ex[ci].1),
+            Cell::Num(p.2 / ex[ci].2.max(1e-300)),
+            Cell::Num(p.3 / ex[ci].3.max(1e-300)),
+        ]);
+        table.note(format!(
+            "{}: friction per part, Σ|ΔP_friction| / ΣP_friction over the states = {:.3e}",
+            names[ci],
+            part_power_gap[ci] / ex[ci].1.abs().max(1e-300)
+        ));
         for (li, (n, _)) in lattices.iter().enumerate() {
             let l = lat[li][ci];
             table.row(vec![

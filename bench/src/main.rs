@@ -228,8 +228,10 @@ enum Command {
         faces: Option<String>,
     },
     /// Issue 27's per-state face study: a case run with the lattice, its states recorded, and
-    /// at each the contacts evaluated with the exact face contact and the lattice at several
-    /// points per edge (normal force, force, torque, friction power, per contact and track).
+    /// at each the contacts evaluated with the exact face contact, the exact contact with
+    /// friction per part at its load centre (`FrictionRule::PerPart`), and the lattice at
+    /// several points per edge (normal force, force, torque, friction power, per contact and
+    /// track).
     FaceStates {
         /// Case (config name).
         #[arg(long, default_value = "launcher-loose")]

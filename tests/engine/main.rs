@@ -11,6 +11,7 @@ mod face_contact;
 mod face_contact_blocks;
 mod face_contact_closed_form;
 mod face_contact_rules;
+mod face_friction_rule;
 mod gap_campaign;
 mod gap_diagnose;
 mod gap_diagnose_simulated;

@@ -14,7 +14,7 @@
 //! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
 //! unloads continuously.
 
-use super::point::PointOutputs;
+use super::point::{Lump, PointOutputs};
 use super::Contact;
 use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
@@ -34,6 +34,25 @@ pub enum FaceContact {
     /// bounded face's sides with a 5 × 5 rule: the lattice's limit of infinitely many points
     /// (docs/models.md "Exact face contact").
     Exact,
+}
+
+/// Where the exact face contact evaluates friction. Cases always use [`FrictionRule::PerNode`];
+/// the other rule is a measurement of the cheaper friction that issue 27's cost target would
+/// need (`railwear-bench face-states`, docs/performance.md twentieth pass). Its own Jacobian
+/// is not built: linearized, its nodes still hand the per-node law's friction derivatives to
+/// the Newton matrix, an approximation of its own (the converged stages do not depend on it,
+/// the Newton iterations may).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FrictionRule {
+    /// Every quadrature node is a point of the per-material-point law, friction included.
+    #[default]
+    PerNode,
+    /// Each part of a pressed polygon, and each strip beyond a bounded face's side, takes one
+    /// friction force `−μ(|s_c|) N ŝ_c` at its nodes' load centre `p_c = Σ f_n p / N`, with `N =
+    /// Σ f_n` and `s_c` the slip there in the plane of the load-weighted normal: passive
+    /// (its power is `−μ N |s_c| <= 0`), exact where the slip is uniform over the part, and
+    /// off by the slip's variation over the part (`ω × r`) elsewhere.
+    PerPart,
 }
 
 /// Slices per strip beyond a bounded face's side (each with the 5 × 5 rule): the strip's
@@ -293,6 +312,7 @@ impl Contact {
         face: &PlacedFace,
         out: &mut PointOutputs<'_, '_>,
     ) {
+        let lumped = self.begin_lump(out);
         let mut visit = |x: Point3<f64>, share: f64| {
             // A ball that does not reach the solid adds nothing (`evaluate_point` returns at
             // `w <= 0` before using anything): its normal is not taken.
@@ -311,6 +331,48 @@ impl Contact {
             let order = QuadratureOrder::SIDE_EDGE;
             strip.for_each_node_sliced(order, 1, &mut |x, share| visit(x, (1.0 - fine) * share));
         }
+        if lumped {
+            self.end_lump(fa, fb, out);
+        }
+    }
+
+    /// Starts summing a part's normal loads for its friction at their load centre, when the
+    /// contact's [`FrictionRule`] says so: true when it did.
+    fn begin_lump(&self, out: &mut PointOutputs<'_, '_>) -> bool {
+        let lumped = self.friction_rule == FrictionRule::PerPart && self.friction.is_some();
+        if lumped {
+            out.lump = Some(Lump::default());
+        }
+        lumped
+    }
+
+    /// The part's friction at its nodes' load centre ([`FrictionRule::PerPart`]), added to
+    /// the track's sums as one more point.
+    fn end_lump(&self, fa: &BodyFrame, fb: &BodyFrame, out: &mut PointOutputs<'_, '_>) {
+        let (Some(lump), Some(fr)) = (out.lump.take(), &self.friction) else {
+            return;
+        };
+        let n = lump.normal_force;
+        let Some(normal) = lump.normal.try_normalize(0.0) else {
+            return;
+        };
+        if n <= 0.0 {
+            return;
+        }
+        let p = Point3::from(lump.moment / n);
+        let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
+        let slip = v_rel - normal * v_rel.dot(&normal);
+        let speed = slip.norm();
+        if speed <= 0.0 {
+            return;
+        }
+        let ft = fr.coefficient(speed) * n;
+        let force = slip * (-ft / speed);
+        out.sum.force += force;
+        out.sum.torque_a += (p.coords - fa.position).cross(&force);
+        out.sum.torque_b += (p.coords - fb.position).cross(&force);
+        out.sum.friction_force += ft;
+        out.sum.friction_power += ft * speed;
     }
 
     /// Integrates `part` of a pressed polygon of `face` with `rule` at the nodes, each node's
@@ -329,6 +391,7 @@ impl Contact {
     ) {
         let normal = face.plane.normal.into_inner();
         let offset = face.plane.offset;
+        let lumped = self.begin_lump(out);
         let mut visit = |x: Point3<f64>, share: f64| {
             let distance = normal.dot(&x.coords) - offset;
             self.evaluate_point(fa, fb, &x, radius, scale * share, distance, &normal, out);
@@ -355,6 +418,9 @@ impl Contact {
                 };
                 part.for_each_node_clamped(rule, sign, &mut visit);
             }
+        }
+        if lumped {
+            self.end_lump(fa, fb, out);
         }
     }
 

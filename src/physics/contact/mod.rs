@@ -39,7 +39,7 @@ mod geometry_cache;
 mod moments;
 mod point;
 
-pub use face::FaceContact;
+pub use face::{FaceContact, FrictionRule};
 pub use geometry_cache::{GeometryCache, GeometryMode, PATCH_REUSE};
 pub(crate) use moments::Matrix6x12;
 pub use moments::TrackMoments;
@@ -66,6 +66,9 @@ pub struct Contact {
     pub friction: Option<FrictionParams>,
     /// How the rounded boxes' faces are resolved (contact points or exact integration).
     pub face_contact: FaceContact,
+    /// Where the exact face contact evaluates friction: at every node (the per-point law,
+    /// always in a case) or per part (a measurement, `railwear-bench face-states`).
+    pub friction_rule: FrictionRule,
     /// Contact points of each piece, in the piece's frame.
     points: Vec<Vec<ContactPoint>>,
 }
@@ -92,6 +95,7 @@ impl Contact {
             impact,
             friction,
             face_contact: FaceContact::default(),
+            friction_rule: FrictionRule::default(),
             points: Vec::new(),
         };
         c.set_points_per_edge(DEFAULT_POINTS_PER_EDGE);
@@ -113,6 +117,12 @@ impl Contact {
     /// How the rounded boxes' faces are resolved (see [`FaceContact`]).
     pub fn with_face_contact(mut self, face_contact: FaceContact) -> Self {
         self.face_contact = face_contact;
+        self
+    }
+
+    /// Where the exact face contact evaluates friction ([`FrictionRule`]).
+    pub fn with_friction_rule(mut self, rule: FrictionRule) -> Self {
+        self.friction_rule = rule;
         self
     }
 
@@ -416,6 +426,7 @@ impl Contact {
                     energy: &mut energy,
                     sum: TrackSum::default(),
                     tangent: PointOutputs::NO_TANGENT,
+                    lump: None,
                 };
                 match (self.face_contact, shape) {
                     (

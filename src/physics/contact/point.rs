@@ -28,6 +28,18 @@ pub(super) struct PointOutputs<'s, 'p> {
     /// The tangent projector `I − n nᵀ` of the last normal `n` the friction's derivatives
     /// used ([`PointOutputs::tangent`]).
     pub(super) tangent: (Vector3<f64>, Matrix3<f64>),
+    /// While set, the points take no friction of their own and sum their normal loads here
+    /// instead ([`super::FrictionRule::PerPart`]).
+    pub(super) lump: Option<Lump>,
+}
+
+/// The normal loads of a part's points, for its friction at their load centre
+/// ([`super::FrictionRule::PerPart`]): `Σ f_n`, `Σ f_n p` and `Σ f_n n`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Lump {
+    pub(super) normal_force: f64,
+    pub(super) moment: Vector3<f64>,
+    pub(super) normal: Vector3<f64>,
 }
 
 impl PointOutputs<'_, '_> {
@@ -93,7 +105,13 @@ impl super::Contact {
         let mut ft = 0.0;
         let mut mu = None;
         let mut force = normal * fn_mag;
-        if let Some(fr) = &self.friction {
+        if let Some(lump) = out.lump.as_mut() {
+            if fn_mag > 0.0 {
+                lump.normal_force += fn_mag;
+                lump.moment += p.coords * fn_mag;
+                lump.normal += normal * fn_mag;
+            }
+        } else if let Some(fr) = &self.friction {
             if speed > 0.0 && fn_mag > 0.0 {
                 let m = if linearizing {
                     let both = fr.coefficient_with_derivative(speed);
