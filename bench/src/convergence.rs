@@ -8,7 +8,7 @@
 
 use super::*;
 use railwear::analysis::spectra::welch_psd;
-use railwear::physics::contact::FaceContact;
+use railwear::physics::contact::{FaceContact, FrictionRule};
 use railwear::physics::integrator::ErrorControl;
 
 /// One run of the convergence study.
@@ -27,6 +27,8 @@ pub(crate) struct Variant {
     pub(crate) points_per_edge: Option<usize>,
     /// Face resolution (None: the case's).
     pub(crate) face_contact: Option<FaceContact>,
+    /// Where the exact face contact takes friction (a measurement; cases are per node).
+    pub(crate) friction_rule: FrictionRule,
 }
 
 impl Variant {
@@ -40,6 +42,7 @@ impl Variant {
             nudge_m: 0.0,
             points_per_edge: None,
             face_contact: None,
+            friction_rule: FrictionRule::PerNode,
         }
     }
 }
@@ -108,6 +111,9 @@ pub(crate) fn run_variant(
     }
     let mut model = build(&case, configs_dir)?;
     model.initial_state[0] += v.nudge_m;
+    for c in &mut model.system.contacts {
+        c.friction_rule = v.friction_rule;
+    }
     let mut options = run_options(&case)?;
     // Output is not engine work: no track samples (the wear integral sees every step anyway).
     options.record_interval_s = -1.0;
@@ -193,6 +199,8 @@ pub(crate) struct ConvergenceBench {
     /// Face study: lattice points per edge whose runs are extrapolated to the reference
     /// (empty: no face study).
     pub(crate) faces: Vec<usize>,
+    /// Face study: also the exact contact with friction per part (`FrictionRule::PerPart`).
+    pub(crate) friction_per_part: bool,
     pub(crate) cases: String,
     pub(crate) settle_box: f64,
     pub(crate) settle_launcher: f64,
@@ -276,6 +284,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             nudge_m: 0.0,
             points_per_edge: None,
             face_contact: None,
+            friction_rule: FrictionRule::PerNode,
         },
         Variant {
             label: "full, tol, start moved 1 nm".into(),
@@ -285,6 +294,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             nudge_m: 1e-9,
             points_per_edge: None,
             face_contact: None,
+            friction_rule: FrictionRule::PerNode,
         },
     ];
     for m in &modes {
@@ -297,6 +307,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 nudge_m: 0.0,
                 points_per_edge: None,
                 face_contact: None,
+                friction_rule: FrictionRule::PerNode,
             });
         }
     }
@@ -517,6 +528,7 @@ pub(crate) fn ladder(
         nudge_m: 0.0,
         points_per_edge,
         face_contact: None,
+        friction_rule: FrictionRule::PerNode,
     };
     let points = b.points_per_edge;
     for case_name in b.case_names() {

@@ -1,11 +1,12 @@
 //! `convergence --faces`: issue 27's face study. For each case, the contact-point lattice at
-//! several points per edge and the exact face contact, each at the case tolerance: friction
-//! power and every contact's wear rate, the lattice's last three runs extrapolated to zero
-//! spacing as the reference, and the CPU cost per accepted step.
+//! several points per edge and the exact face contact (with `--friction-per-part` also with
+//! friction per part, `FrictionRule::PerPart`), each at the case tolerance: friction power
+//! and every contact's wear rate, the lattice's last three runs extrapolated to zero spacing
+//! as the reference, and the CPU cost per accepted step.
 
 use super::convergence::{run_variant, Measured, QuantityKind, Variant};
 use super::*;
-use railwear::physics::contact::FaceContact;
+use railwear::physics::contact::{FaceContact, FrictionRule};
 
 /// `Q(h) = Q∞ + C h^p` through three (spacing, value) pairs with `h1 > h2 > h3`: `(Q∞, p)`,
 /// `p` found by bisection in [0.25, 6]; None when the three are not monotone in `h` (then no
@@ -68,6 +69,7 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
             ("exact_vs_ref", "Δ exact vs reference"),
             ("first_vs_ref", "Δ first lattice vs reference"),
             ("exact_vs_9", "Δ exact vs 9 points"),
+            ("per_part_vs_exact", "Δ exact with friction per part vs exact"),
         ],
     );
     for case_name in b.case_names() {
@@ -90,6 +92,15 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
             "exact".into(),
             run_variant(configs_dir, case_name, settle, b.window, &v)?,
         ));
+        if b.friction_per_part {
+            v.label = "exact, friction per part".into();
+            v.friction_rule = FrictionRule::PerPart;
+            eprintln!("faces: {case_name} {} ...", v.label);
+            measured.push((
+                v.label.clone(),
+                run_variant(configs_dir, case_name, settle, b.window, &v)?,
+            ));
+        }
         for (label, m) in &measured {
             runs.row(vec![
                 Cell::text(case_name),
@@ -102,6 +113,7 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
             ]);
         }
         let (lattice, exact) = measured.split_at(ladder.len());
+        let per_part = exact.get(1).map(|m| &m.1);
         let exact = &exact[0].1;
         let spacing = |n: usize| 1.0 / (n as f64 - 1.0);
         for (i, (name, _, kind)) in exact.quantities.iter().enumerate() {
@@ -141,6 +153,7 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
                 pct(reference.map(|r| rel(val(exact), r))),
                 pct(reference.map(|r| rel(val(&lattice[0].1), r))),
                 pct(at9.map(|r| rel(val(exact), r))),
+                pct(per_part.map(|m| rel(val(m), val(exact)))),
             ]);
         }
     }

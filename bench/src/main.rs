@@ -226,6 +226,10 @@ enum Command {
         /// the exact face contact, each at the case tolerance.
         #[arg(long)]
         faces: Option<String>,
+        /// Face study: also the exact face contact with friction per part at each part's load
+        /// centre (`FrictionRule::PerPart`, a measurement of issue 27's cheaper friction).
+        #[arg(long)]
+        friction_per_part: bool,
     },
     /// Issue 27's per-state face study: a case run with the lattice, its states recorded, and
     /// at each the contacts evaluated with the exact face contact, the exact contact with
@@ -448,6 +452,7 @@ fn main() -> Result<()> {
             points_per_edge,
             reference_points_per_edge,
             faces,
+            friction_per_part,
         } => {
             let bench = ConvergenceBench {
                 faces: match faces {
@@ -457,6 +462,7 @@ fn main() -> Result<()> {
                         .collect(),
                     None => Vec::new(),
                 },
+                friction_per_part: *friction_per_part,
                 cases: cases.clone(),
                 settle_box: *settle_box,
                 settle_launcher: *settle_launcher,

@@ -406,7 +406,7 @@ fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64
 }
 
 /// The analytic contact Jacobian and the contact part of the central-difference one.
-fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let n = sys.state_len();
     let mut ws = sys.workspace();
     ws.linearize = true;
@@ -421,7 +421,7 @@ fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
     (analytic, contact)
 }
 
-fn assert_columns_agree(
+pub(crate) fn assert_columns_agree(
     analytic: &[f64],
     fd: &[f64],
     n: usize,

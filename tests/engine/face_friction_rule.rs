@@ -95,3 +95,46 @@ fn friction_per_part_only_dissipates() {
     }
     assert!(loaded >= 100, "{loaded} loaded states");
 }
+
+#[test]
+fn the_per_part_frictions_jacobian_equals_central_differences() {
+    // The per-part rule's own Jacobian (`Contact::end_lump`): each node's ∂F/∂f_n takes the
+    // part's −μ ŝ_c at its own lever, one more record at the load centre takes ∂F/∂s_c.
+    // Left out: the load centre's own motion in the slip, [ω_rel]× δp_c, as the load shifts
+    // within a part (δp_c = Σ δf_n (p − p_c) / N; the damping moves it with the normal
+    // velocity). It vanishes at rest, so the pose columns at rest keep the per-node law's
+    // bound (face_contact.rs, 1e-5). On the velocity columns of the cube spinning at
+    // |ω| = 2.3 rad/s and sliding at |s| = 0.32 m/s, relative to the friction's own share μ of
+    // the normal entries, it is about |ω| L / |s| = 0.09 (L = 12.7 mm, the cube's half
+    // edge): within μ_d · 0.09 ≈ 1.5e-2 of the largest entry; bound 2e-2. The tangential
+    // velocity columns (v_x, v_z), where the friction's slip derivative is the whole entry
+    // and the normal loads do not move, must agree within 1e-5 of their own largest entry.
+    let per_part = |moving: bool| {
+        let (mut sys, y) = super::face_contact::pressed_cube(moving);
+        for c in &mut sys.contacts {
+            *c = c.clone().with_friction_rule(FrictionRule::PerPart);
+        }
+        (sys, y)
+    };
+    let (sys, y) = per_part(true);
+    let n = sys.state_len();
+    let (analytic, fd) = super::face_contact::jacobians(&sys, &y);
+    super::face_contact::assert_columns_agree(&analytic, &fd, n, 7..13, 2e-2);
+    for j in [7, 9] {
+        let scale = (7..13).map(|i| fd[j * n + i].abs()).fold(0.0_f64, f64::max);
+        assert!(scale > 0.0, "column {j} must feel the friction");
+        for i in 7..13 {
+            let err = (fd[j * n + i] - analytic[j * n + i]).abs();
+            assert!(
+                err <= 1e-5 * scale,
+                "d f[{i}] / d y[{j}]: central {:e}, analytic {:e}",
+                fd[j * n + i],
+                analytic[j * n + i]
+            );
+        }
+    }
+    let (sys, y) = per_part(false);
+    let (analytic, fd) = super::face_contact::jacobians(&sys, &y);
+    super::face_contact::assert_columns_agree(&analytic, &fd, n, 0..3, 1e-5);
+    super::face_contact::assert_columns_agree(&analytic, &fd, n, 3..7, 1e-5);
+}

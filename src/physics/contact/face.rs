@@ -14,12 +14,13 @@
 //! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
 //! unloads continuously.
 
-use super::point::{Lump, PointOutputs};
+use super::point::{friction_derivatives, Lump, PointOutputs};
 use super::Contact;
+use super::TrackLinearization;
 use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use crate::physics::step::StepKind;
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
 /// How a contact resolves the faces of its rounded boxes (spheres are one point either way).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -38,10 +39,8 @@ pub enum FaceContact {
 
 /// Where the exact face contact evaluates friction. Cases always use [`FrictionRule::PerNode`];
 /// the other rule is a measurement of the cheaper friction that issue 27's cost target would
-/// need (`railwear-bench face-states`, docs/performance.md twentieth pass). Its own Jacobian
-/// is not built: linearized, its nodes still hand the per-node law's friction derivatives to
-/// the Newton matrix, an approximation of its own (the converged stages do not depend on it,
-/// the Newton iterations may).
+/// need (`railwear-bench face-states` and `convergence --faces .. --friction-per-part`,
+/// docs/performance.md twentieth pass), with its own Jacobian (`Contact::end_lump`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FrictionRule {
     /// Every quadrature node is a point of the per-material-point law, friction included.
@@ -342,37 +341,92 @@ impl Contact {
         let lumped = self.friction_rule == FrictionRule::PerPart && self.friction.is_some();
         if lumped {
             out.lump = Some(Lump::default());
+            out.lump_nodes.clear();
         }
         lumped
     }
 
     /// The part's friction at its nodes' load centre ([`FrictionRule::PerPart`]), added to
-    /// the track's sums as one more point.
+    /// the track's sums as one more point; with derivatives, the part's nodes' records get the
+    /// friction's share of `∂F/∂f_n` and go to the track's moments, with one more record at the
+    /// load centre carrying the friction's slip derivative.
+    ///
+    /// Why this is the part's Jacobian but for the load centre's own motion in the slip,
+    /// `[ω_rel]× δp_c` (tests/engine/face_friction_rule.rs bounds what that leaves): the
+    /// friction `F = −μ(|s_c|) N ŝ_c` changes with each node's `f_n` by `−μ ŝ_c`, and its
+    /// torque `p_c × F` by `p × (−μ ŝ_c)` at that node's own lever `p` (`N p_c = Σ f_n p`),
+    /// which is what a node with `∂F/∂f_n = n − μ ŝ_c` at its own point contributes; the slip
+    /// derivative `∂F/∂s_c` acts at `p_c`.
     fn end_lump(&self, fa: &BodyFrame, fb: &BodyFrame, out: &mut PointOutputs<'_, '_>) {
         let (Some(lump), Some(fr)) = (out.lump.take(), &self.friction) else {
             return;
         };
         let n = lump.normal_force;
-        let Some(normal) = lump.normal.try_normalize(0.0) else {
+        let normal = lump.normal.try_normalize(0.0);
+        let (Some(normal), true) = (normal, n > 0.0) else {
+            // No load: the records carry no friction share (their `f_n` and derivatives are 0).
+            self.flush_lump_nodes(Vector3::zeros(), out);
             return;
         };
-        if n <= 0.0 {
-            return;
-        }
         let p = Point3::from(lump.moment / n);
         let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
         let slip = v_rel - normal * v_rel.dot(&normal);
         let speed = slip.norm();
-        if speed <= 0.0 {
-            return;
+        let linearizing = out.moments.is_some() || out.linearizations.is_some();
+        let mut share = Vector3::zeros();
+        let mut mu_both = None;
+        if speed > 0.0 {
+            let both = fr.coefficient_with_derivative(speed);
+            mu_both = Some(both);
+            let ft = both.0 * n;
+            share = slip * (-both.0 / speed);
+            let force = share * n;
+            out.sum.force += force;
+            out.sum.torque_a += (p.coords - fa.position).cross(&force);
+            out.sum.torque_b += (p.coords - fb.position).cross(&force);
+            out.sum.friction_force += ft;
+            out.sum.friction_power += ft * speed;
         }
-        let ft = fr.coefficient(speed) * n;
-        let force = slip * (-ft / speed);
-        out.sum.force += force;
-        out.sum.torque_a += (p.coords - fa.position).cross(&force);
-        out.sum.torque_b += (p.coords - fb.position).cross(&force);
-        out.sum.friction_force += ft;
-        out.sum.friction_power += ft * speed;
+        if linearizing {
+            let tangent = Matrix3::identity() - normal * normal.transpose();
+            let (_, dforce_dslip) =
+                friction_derivatives(self.friction.as_ref(), &normal, &tangent, &slip, n, mu_both);
+            self.flush_lump_nodes(share, out);
+            let lin = TrackLinearization {
+                body_a: self.body_a,
+                body_b: self.body_b,
+                deepest_point: p,
+                point: p,
+                centre: Point3::from(lump.centre / n),
+                // The force itself is in the nodes' records, at their levers.
+                force: Vector3::zeros(),
+                normal,
+                dfn_dw: 0.0,
+                dfn_dwdot: 0.0,
+                dforce_dfn: Vector3::zeros(),
+                dforce_dslip,
+            };
+            if let Some(sum) = out.moments.as_deref_mut() {
+                sum.add(&lin);
+            } else if let Some(all) = out.linearizations.as_deref_mut() {
+                all.push(lin);
+            }
+        }
+    }
+
+    /// Hands the part's node records to the track's moments (or list) with the friction's
+    /// share `share = −μ_c ŝ_c` of `∂F/∂f_n` and of each node's force.
+    fn flush_lump_nodes(&self, share: Vector3<f64>, out: &mut PointOutputs<'_, '_>) {
+        for mut lin in out.lump_nodes.drain(..) {
+            let fn_mag = lin.force.dot(&lin.normal);
+            lin.dforce_dfn += share;
+            lin.force += share * fn_mag;
+            if let Some(sum) = out.moments.as_deref_mut() {
+                sum.add(&lin);
+            } else if let Some(all) = out.linearizations.as_deref_mut() {
+                all.push(lin);
+            }
+        }
     }
 
     /// Integrates `part` of a pressed polygon of `face` with `rule` at the nodes, each node's

@@ -375,6 +375,9 @@ impl Contact {
         let recording = matches!(geometry.mode, GeometryMode::Record | GeometryMode::Refresh);
         let refreshing = geometry.mode == GeometryMode::Refresh;
         let frozen = geometry.mode == GeometryMode::Frozen;
+        // The per-part friction's node records ([`FrictionRule::PerPart`], linearized only):
+        // one buffer for the whole evaluation, cleared per part.
+        let mut lump_nodes = Vec::new();
         for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
             let pose = iso_a * piece_pose;
             for (jf, face) in self.faces_b.iter().enumerate() {
@@ -427,6 +430,7 @@ impl Contact {
                     sum: TrackSum::default(),
                     tangent: PointOutputs::NO_TANGENT,
                     lump: None,
+                    lump_nodes: &mut lump_nodes,
                 };
                 match (self.face_contact, shape) {
                     (

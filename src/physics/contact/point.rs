@@ -31,15 +31,20 @@ pub(super) struct PointOutputs<'s, 'p> {
     /// While set, the points take no friction of their own and sum their normal loads here
     /// instead ([`super::FrictionRule::PerPart`]).
     pub(super) lump: Option<Lump>,
+    /// While [`PointOutputs::lump`] is set and derivatives are taken, each point's
+    /// derivatives wait here for the part's friction direction ([`super::Contact::end_lump`]).
+    pub(super) lump_nodes: &'s mut Vec<TrackLinearization>,
 }
 
 /// The normal loads of a part's points, for its friction at their load centre
-/// ([`super::FrictionRule::PerPart`]): `Σ f_n`, `Σ f_n p` and `Σ f_n n`.
+/// ([`super::FrictionRule::PerPart`]): `Σ f_n`, `Σ f_n p`, `Σ f_n n` and `Σ f_n c` (the balls'
+/// centres).
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Lump {
     pub(super) normal_force: f64,
     pub(super) moment: Vector3<f64>,
     pub(super) normal: Vector3<f64>,
+    pub(super) centre: Vector3<f64>,
 }
 
 impl PointOutputs<'_, '_> {
@@ -105,13 +110,19 @@ impl super::Contact {
         let mut ft = 0.0;
         let mut mu = None;
         let mut force = normal * fn_mag;
-        if let Some(lump) = out.lump.as_mut() {
+        let lumped = if let Some(lump) = out.lump.as_mut() {
             if fn_mag > 0.0 {
                 lump.normal_force += fn_mag;
                 lump.moment += p.coords * fn_mag;
                 lump.normal += normal * fn_mag;
+                lump.centre += centre.coords * fn_mag;
             }
-        } else if let Some(fr) = &self.friction {
+            true
+        } else {
+            false
+        };
+        // Lumped, the part's friction comes at its end (`Contact::end_lump`).
+        if let (false, Some(fr)) = (lumped, &self.friction) {
             if speed > 0.0 && fn_mag > 0.0 {
                 let m = if linearizing {
                     let both = fr.coefficient_with_derivative(speed);
@@ -128,12 +139,16 @@ impl super::Contact {
             let (dfn_dw, dfn_dwdot) =
                 self.impact
                     .unclamped_gradient_with_slope(w, wdot, damping, damping_slope);
-            let tangent = match self.friction {
-                Some(_) => out.tangent(&normal),
-                None => Matrix3::zeros(),
+            let (dforce_dfn, dforce_dslip) = if lumped {
+                // The part's `−μ_c ŝ_c` joins `∂F/∂f_n` when the part ends.
+                (normal, Matrix3::zeros())
+            } else {
+                let tangent = match self.friction {
+                    Some(_) => out.tangent(&normal),
+                    None => Matrix3::zeros(),
+                };
+                friction_derivatives(self.friction.as_ref(), &normal, &tangent, &slip, fn_mag, mu)
             };
-            let (dforce_dfn, dforce_dslip) =
-                friction_derivatives(self.friction.as_ref(), &normal, &tangent, &slip, fn_mag, mu);
             let lin = TrackLinearization {
                 body_a: self.body_a,
                 body_b: self.body_b,
@@ -147,7 +162,9 @@ impl super::Contact {
                 dforce_dfn,
                 dforce_dslip,
             };
-            if let Some(sum) = out.moments.as_deref_mut() {
+            if lumped {
+                out.lump_nodes.push(lin);
+            } else if let Some(sum) = out.moments.as_deref_mut() {
                 sum.add(&lin);
             } else if let Some(all) = out.linearizations.as_deref_mut() {
                 all.push(lin);
