@@ -49,6 +49,17 @@ fn evaluate_all(sys: &MultibodySystem, t: f64, y: &[f64]) -> Evaluation {
     Evaluation { contacts, tracks }
 }
 
+/// Adds, per contact, `eval`'s normal force and friction power and its force and torque gaps
+/// `|ΔF|`, `|Δτ|` against `exact` at the same state to `sums`.
+fn add_gaps(sums: &mut [(f64, f64, f64, f64)], eval: &Evaluation, exact: &Evaluation) {
+    for ((sum, c), e) in sums.iter_mut().zip(&eval.contacts).zip(&exact.contacts) {
+        sum.0 += c.0;
+        sum.1 += c.3;
+        sum.2 += (c.1 - e.1).norm();
+        sum.3 += (c.2 - e.2).norm();
+    }
+}
+
 pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec<Table>> {
     let mut case = load_case(&configs_dir.join(format!("{}.toml", b.case)))?;
     case.simulation.settle_s = b.settle;
@@ -131,11 +142,8 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
             add_track(tr, None);
         }
         let pp = evaluate_all(&per_part.system, *t, y);
+        add_gaps(&mut part, &pp, &e);
         for (ci, c) in pp.contacts.iter().enumerate() {
-            part[ci].0 += c.0;
-            part[ci].1 += c.3;
-            part[ci].2 += (c.1 - e.contacts[ci].1).norm();
-            part[ci].3 += (c.2 - e.contacts[ci].2).norm();
             part_power_gap[ci] += (c.3 - e.contacts[ci].3).abs();
         }
         let mut line = format!("t {t:.4} exact N");
@@ -145,11 +153,8 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
         for (li, (n, m)) in lattices.iter().enumerate() {
             let l = evaluate_all(&m.system, *t, y);
             line += &format!(" | {n}:");
-            for (ci, c) in l.contacts.iter().enumerate() {
-                lat[li][ci].0 += c.0;
-                lat[li][ci].1 += c.3;
-                lat[li][ci].2 += (c.1 - e.contacts[ci].1).norm();
-                lat[li][ci].3 += (c.2 - e.contacts[ci].2).norm();
+            add_gaps(&mut lat[li], &l, &e);
+            for c in &l.contacts {
                 line += &format!(" {:.2}", c.0);
             }
             for tr in &l.tracks {
@@ -182,6 +187,19 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
     let count = states.len().max(1) as f64;
     let pct =
         |a: f64, r: f64| Cell::text(format!("{:+.3} %", 100.0 * (a - r) / r.abs().max(1e-300)));
+    // One variant's row of contact `ci` from its sums against exact ([`add_gaps`]).
+    let gap_row = |ci: usize, label: String, g: (f64, f64, f64, f64)| {
+        vec![
+            Cell::text(&names[ci]),
+            Cell::text(label),
+            Cell::Num(g.0 / count),
+            pct(g.0, ex[ci].0),
+            Cell::Num(g.1 / count),
+            pct(g.1, ex[ci].1),
+            Cell::Num(g.2 / ex[ci].2.max(1e-300)),
+            Cell::Num(g.3 / ex[ci].3.max(1e-300)),
+        ]
+    };
     for ci in 0..nc {
         table.row(vec![
             Cell::text(&names[ci]),
@@ -193,34 +211,14 @@ pub(crate) fn face_states(configs_dir: &Path, b: &FaceStatesBench) -> Result<Vec
             Cell::text("-"),
             Cell::text("-"),
         ]);
-        let p = part[ci];
-        table.row(vec![
-            Cell::text(&names[ci]),
-            Cell::text("exact, friction per part"),
-            Cell::Num(p.0 / count),
-            pct(p.0, ex[ci].0),
-            Cell::Num(p.1 / count),
-            pct(p.1, ex[ci].1),
-            Cell::Num(p.2 / ex[ci].2.max(1e-300)),
-            Cell::Num(p.3 / ex[ci].3.max(1e-300)),
-        ]);
+        table.row(gap_row(ci, "exact, friction per part".into(), part[ci]));
         table.note(format!(
             "{}: friction per part, Σ|ΔP_friction| / ΣP_friction over the states = {:.3e}",
             names[ci],
             part_power_gap[ci] / ex[ci].1.abs().max(1e-300)
         ));
         for (li, (n, _)) in lattices.iter().enumerate() {
-            let l = lat[li][ci];
-            table.row(vec![
-                Cell::text(&names[ci]),
-                Cell::text(format!("lattice {n}")),
-                Cell::Num(l.0 / count),
-                pct(l.0, ex[ci].0),
-                Cell::Num(l.1 / count),
-                pct(l.1, ex[ci].1),
-                Cell::Num(l.2 / ex[ci].2.max(1e-300)),
-                Cell::Num(l.3 / ex[ci].3.max(1e-300)),
-            ]);
+            table.row(gap_row(ci, format!("lattice {n}"), lat[li][ci]));
         }
     }
     let mut tracks = Table::new(

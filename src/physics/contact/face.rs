@@ -311,7 +311,7 @@ impl Contact {
         face: &PlacedFace,
         out: &mut PointOutputs<'_, '_>,
     ) {
-        let lumped = self.begin_lump(out);
+        self.begin_lump(out);
         let mut visit = |x: Point3<f64>, share: f64| {
             // A ball that does not reach the solid adds nothing (`evaluate_point` returns at
             // `w <= 0` before using anything): its normal is not taken.
@@ -330,23 +330,20 @@ impl Contact {
             let order = QuadratureOrder::SIDE_EDGE;
             strip.for_each_node_sliced(order, 1, &mut |x, share| visit(x, (1.0 - fine) * share));
         }
-        if lumped {
-            self.end_lump(fa, fb, out);
-        }
+        self.end_lump(fa, fb, out);
     }
 
     /// Starts summing a part's normal loads for its friction at their load centre, when the
-    /// contact's [`FrictionRule`] says so: true when it did.
-    fn begin_lump(&self, out: &mut PointOutputs<'_, '_>) -> bool {
-        let lumped = self.friction_rule == FrictionRule::PerPart && self.friction.is_some();
-        if lumped {
+    /// contact's [`FrictionRule`] says so ([`Contact::end_lump`] ends it; nothing otherwise).
+    fn begin_lump(&self, out: &mut PointOutputs<'_, '_>) {
+        if self.friction_rule == FrictionRule::PerPart && self.friction.is_some() {
             out.lump = Some(Lump::default());
             out.lump_nodes.clear();
         }
-        lumped
     }
 
-    /// The part's friction at its nodes' load centre ([`FrictionRule::PerPart`]), added to
+    /// The part's friction at its nodes' load centre ([`FrictionRule::PerPart`]; nothing
+    /// unless [`Contact::begin_lump`] started a part), added to
     /// the track's sums as one more point; with derivatives, the part's nodes' records get the
     /// friction's share of `∂F/∂f_n` and go to the track's moments, with one more record at the
     /// load centre carrying the friction's slip derivative.
@@ -372,7 +369,7 @@ impl Contact {
         let v_rel = fa.point_velocity(&p) - fb.point_velocity(&p);
         let slip = v_rel - normal * v_rel.dot(&normal);
         let speed = slip.norm();
-        let linearizing = out.moments.is_some() || out.linearizations.is_some();
+        let linearizing = out.linearizing();
         let mut share = Vector3::zeros();
         let mut mu_both = None;
         if speed > 0.0 {
@@ -406,27 +403,22 @@ impl Contact {
                 dforce_dfn: Vector3::zeros(),
                 dforce_dslip,
             };
-            if let Some(sum) = out.moments.as_deref_mut() {
-                sum.add(&lin);
-            } else if let Some(all) = out.linearizations.as_deref_mut() {
-                all.push(lin);
-            }
+            out.push_linearization(&lin);
         }
     }
 
     /// Hands the part's node records to the track's moments (or list) with the friction's
     /// share `share = −μ_c ŝ_c` of `∂F/∂f_n` and of each node's force.
     fn flush_lump_nodes(&self, share: Vector3<f64>, out: &mut PointOutputs<'_, '_>) {
-        for mut lin in out.lump_nodes.drain(..) {
+        // Taken out while `out` receives them; put back empty, its capacity kept.
+        let mut nodes = std::mem::take(&mut *out.lump_nodes);
+        for mut lin in nodes.drain(..) {
             let fn_mag = lin.force.dot(&lin.normal);
             lin.dforce_dfn += share;
             lin.force += share * fn_mag;
-            if let Some(sum) = out.moments.as_deref_mut() {
-                sum.add(&lin);
-            } else if let Some(all) = out.linearizations.as_deref_mut() {
-                all.push(lin);
-            }
+            out.push_linearization(&lin);
         }
+        *out.lump_nodes = nodes;
     }
 
     /// Integrates `part` of a pressed polygon of `face` with `rule` at the nodes, each node's
@@ -445,7 +437,7 @@ impl Contact {
     ) {
         let normal = face.plane.normal.into_inner();
         let offset = face.plane.offset;
-        let lumped = self.begin_lump(out);
+        self.begin_lump(out);
         let mut visit = |x: Point3<f64>, share: f64| {
             let distance = normal.dot(&x.coords) - offset;
             self.evaluate_point(fa, fb, &x, radius, scale * share, distance, &normal, out);
@@ -473,9 +465,7 @@ impl Contact {
                 part.for_each_node_clamped(rule, sign, &mut visit);
             }
         }
-        if lumped {
-            self.end_lump(fa, fb, out);
-        }
+        self.end_lump(fa, fb, out);
     }
 
     /// The closed form of a part where the clamp holds at every point (no force, no

@@ -54,6 +54,23 @@ impl PointOutputs<'_, '_> {
         Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     );
 
+    /// True when the points' derivatives are taken (into moments or a list).
+    #[inline]
+    pub(super) fn linearizing(&self) -> bool {
+        self.linearizations.is_some() || self.moments.is_some()
+    }
+
+    /// Hands one point's derivatives to the track's moments when they are summed, else to
+    /// the list of linearizations.
+    #[inline]
+    pub(super) fn push_linearization(&mut self, lin: &TrackLinearization) {
+        if let Some(sum) = self.moments.as_deref_mut() {
+            sum.add(lin);
+        } else if let Some(all) = self.linearizations.as_deref_mut() {
+            all.push(*lin);
+        }
+    }
+
     /// `I − n nᵀ` for the normal `n`, computed again only when `n` differs from the last
     /// one's (the points of a face's polygon share the plane's normal). Equal normals give the
     /// same matrix bit for bit: an entry `δ_ij − n_i n_j` does not depend on the sign of a
@@ -96,7 +113,7 @@ impl super::Contact {
         // The force's parts once (each STEP evaluated once per point): the same numbers as
         // `ImpactParams::force`, `elastic_force` and `force_gradient`. When the derivatives
         // are taken, each STEP's value and slope come from one `sincos`.
-        let linearizing = out.linearizations.is_some() || out.moments.is_some();
+        let linearizing = out.linearizing();
         let (spring, damping, damping_slope) = if linearizing {
             self.impact.force_parts_with_slope(w)
         } else {
@@ -164,10 +181,8 @@ impl super::Contact {
             };
             if lumped {
                 out.lump_nodes.push(lin);
-            } else if let Some(sum) = out.moments.as_deref_mut() {
-                sum.add(&lin);
-            } else if let Some(all) = out.linearizations.as_deref_mut() {
-                all.push(lin);
+            } else {
+                out.push_linearization(&lin);
             }
         }
         *out.energy += beta * self.impact.potential(w);
