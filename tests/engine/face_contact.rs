@@ -769,11 +769,18 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
     // faces' slivers, w high on a side of inner height H = 9 mm, carry up to w/H of the law
     // each (the damping does not taper with depth); the lattice resolves them once its rows
     // H/(n − 1) are closer than w, so an unresolved sliver has w < H/(n − 1) and misses at
-    // most 4/(n − 1) for four sides. At 129 points (rows 0.07 mm; the impacts press 0.05-0.5
-    // mm) the summed force gap is therefore at most 8/(n − 1) = 6.25 % of the summed force;
-    // and from 33 to 65 to 129 points it must fall. A 33-point
-    // lattice is therefore not within 0.5 % of the exact contact here (issue 27, item 3):
-    // that needs n ≈ 800.
+    // most 4/(n − 1) for four sides. That sum, 8/(n − 1), is not a bound, though: a head
+    // tilted into an impact presses its face along one edge over a band narrower than the
+    // rows along its 80 mm length (0.63 mm at 129 points), which the lattice resolves only
+    // once its spacing is below the band's width. At such states (2-4 of the 20 here) the gap
+    // stays at 35-60 % of the force from 33 to 65 points and falls only at 129 (measured:
+    // 153 of 605 N and 149 of 644 N at 129 points), so the summed gap is pre-asymptotic: at
+    // 129 points it measured 7.4 % and 4.4 % on one sample of states, and at most 6.25 % on
+    // the sample of an earlier step sequence.
+    // What the test holds is the convergence: the summed gap falls at each refinement, and
+    // over the fourfold one from 33 to 129 points to at most half (first order: a quarter;
+    // measured 0.31-0.33). A 33-point lattice is therefore not within 0.5 % of the exact
+    // contact here (issue 27, item 3).
     use railwear::models::case::{build, load_case, run_options};
     use railwear::models::run::record_states;
     use railwear::pipeline::RunControl;
@@ -821,6 +828,9 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
         .collect();
     for (k, ((&g33, &g65), &g129)) in gaps[0].iter().zip(&gaps[1]).zip(&gaps[2]).enumerate() {
         assert!(g65 < g33 && g129 < g65, "shoe {k}: {g33} {g65} {g129}");
-        assert!(g129 <= 8.0 / 128.0, "shoe {k}: {g129} above 8/(n − 1)");
+        assert!(
+            g129 <= 0.5 * g33,
+            "shoe {k}: {g129} at 129 points is more than half of {g33} at 33"
+        );
     }
 }

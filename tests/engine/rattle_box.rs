@@ -96,3 +96,32 @@ fn resting_cube_carries_its_weight_and_does_not_wear() {
         r.mean_friction_power_w
     );
 }
+
+#[test]
+fn the_work_tests_allowances_hold_the_driven_account_to_twice_their_share() {
+    // Each step's work quadrature may err by `energy_rel` × (its own work + the work of a step
+    // as long at the run's mean power so far), so a run's errors add up to at most
+    // 2 `energy_rel` of its throughput: the balance of the account, with the 15 g drive on.
+    let case = load_case(&configs().join("rattle-box-c.toml")).expect("case C loads");
+    let energy_rel = case
+        .simulation
+        .energy_rel_tolerance
+        .unwrap_or(10.0 * case.simulation.rel_tolerance);
+    let report = run_c(0.2, 1.0, 1.0, None);
+    let e = report.energy.as_ref().expect("the run keeps an account");
+    eprintln!(
+        "driven case C, 1.2 s: residual {:.3e} J, {:.3e} of the throughput (bound {:.1e}), dissipated {:.4} J, drive {:.4} J",
+        e.residual_j,
+        e.residual_relative,
+        2.0 * energy_rel,
+        e.dissipated_j,
+        e.drive_work_j
+    );
+    assert!(e.dissipated_j > 0.0 && e.drive_work_j.abs() > 0.0);
+    assert!(
+        e.residual_relative <= 2.0 * energy_rel,
+        "residual {:.3e} of the throughput, allowances sum to {:.1e}",
+        e.residual_relative,
+        2.0 * energy_rel
+    );
+}

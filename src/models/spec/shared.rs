@@ -176,10 +176,11 @@ pub struct SimulationSpec {
     #[serde(default = "default_record_interval_s")]
     pub record_interval_s: f64,
     /// Relative tolerance on each step's dissipated and drive work, dimensionless (the energy
-    /// account's quadrature, docs/models.md "Energy account"). Default 10 × `rel_tolerance`
-    /// (1e-3): the account closes within 0.5 % of the dissipated work; on the rattle box it
-    /// costs 2.2x the steps of no work control (docs/performance.md). 0 switches the check
-    /// off (the account is still kept, by the same quadrature, and may not close).
+    /// account's quadrature, docs/models.md "Energy account"): each step's quadrature error
+    /// within this share of its work plus a step's work at the run's mean power. Default 10 ×
+    /// `rel_tolerance` (1e-3): the account closes within 0.5 % of the throughput
+    /// (docs/performance.md, twenty-first pass). 0 switches the check off (the account is
+    /// still kept, by the same quadrature, and may not close).
     #[serde(default)]
     pub energy_rel_tolerance: Option<f64>,
     /// Which state entries the implicit integrators' local error test weighs: `full` (default;

@@ -36,6 +36,9 @@ pub struct IntegratorState {
     hold_steps: u32,
     stage: Option<InteriorStage>,
     power_start: super::super::system::PowerBalance,
+    /// Absent in checkpoints written before the work test's per-time floor: no history.
+    #[serde(default)]
+    work_throughput: WorkThroughput,
     stats: IntegratorStats,
 }
 
@@ -76,6 +79,7 @@ impl Integrator {
             hold_steps: self.hold_steps,
             stage: self.stage.clone(),
             power_start: self.power_start,
+            work_throughput: self.work_throughput,
             stats: self.stats,
         }
     }
@@ -117,6 +121,7 @@ impl Integrator {
         self.hold_steps = state.hold_steps;
         self.stage = state.stage;
         self.power_start = state.power_start;
+        self.work_throughput = state.work_throughput;
         self.stats = state.stats;
         Ok(())
     }

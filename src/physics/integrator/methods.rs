@@ -7,10 +7,17 @@ use crate::physics::local_dopri5::{DOPRI5_A, DOPRI5_E};
 impl Integrator {
     /// The energy account's quadrature error on this attempt over its tolerance
     /// ([`Tolerances::energy_rel`]): the embedded estimate `h Σ (w_i − b_i) P_i` of the
-    /// dissipated and the drive power against the step's work. `ws.power` holds the attempt's
+    /// dissipated and the drive power against the step's work plus `h` times the run's mean
+    /// power so far ([`WorkThroughput`]). `ws.power` holds the attempt's
     /// last evaluation (its end).
-    pub(super) fn energy_error_norm(&self, ws: &Workspace, h: f64, err_weights: [f64; 3]) -> f64 {
+    pub(super) fn energy_error_norm(
+        &mut self,
+        ws: &Workspace,
+        h: f64,
+        err_weights: [f64; 3],
+    ) -> f64 {
         let rel = self.settings.tolerances.energy_rel;
+        self.attempt_work_j = 0.0;
         let Some(stage) = self.stage.as_ref().filter(|_| rel > 0.0) else {
             return 0.0;
         };
@@ -27,7 +34,9 @@ impl Integrator {
                 (h * (err_weights[0] * v[0] + err_weights[1] * v[1] + err_weights[2] * v[2])).abs();
             work += h * (w0 * v[0].abs() + w1 * v[1].abs() + w2 * v[2].abs());
         }
-        err / (rel * work + ENERGY_ABS_TOLERANCE_J)
+        self.attempt_work_j = work;
+        let scale = work + h * self.work_throughput.mean_power_w();
+        err / (rel * scale + ENERGY_ABS_TOLERANCE_J)
     }
 
     /// Keeps the power terms of the stage just solved (the workspace holds its last Newton

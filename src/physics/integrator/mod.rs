@@ -145,6 +145,43 @@ pub struct Integrator {
     stage: Option<InteriorStage>,
     /// Power terms at the start of the current step (the accepted state).
     power_start: super::system::PowerBalance,
+    /// The energy account's throughput over the accepted steps (the work test's floor).
+    work_throughput: WorkThroughput,
+    /// The last attempt's work quadrature, J (added to `work_throughput` if it is accepted).
+    attempt_work_j: f64,
+}
+
+/// The energy account's throughput over the accepted steps so far: the work test's per-time
+/// floor ([`Tolerances::energy_rel`]).
+///
+/// The account is judged against the run's throughput (docs/models.md "Energy account"), so
+/// a step's allowance is `energy_rel` of its own work plus that of a step of the same size at
+/// the run's mean power: the allowances sum to at most `2 energy_rel` of the throughput, and a
+/// step that does little work (a light slide, a cube in flight) is no longer held to a
+/// relative accuracy on it that the account cannot see.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WorkThroughput {
+    /// `Σ h Σ_i w_i |P_i|` over the accepted steps (dissipated and drive power), J.
+    pub work_j: f64,
+    /// `Σ h` over the same steps, s.
+    pub time_s: f64,
+}
+
+impl WorkThroughput {
+    /// Adds one accepted step of size `h` (s) and work quadrature `work_j` (J).
+    pub fn add(&mut self, work_j: f64, h: f64) {
+        self.work_j += work_j;
+        self.time_s += h;
+    }
+
+    /// The throughput's mean power, W (0 before the first step).
+    pub fn mean_power_w(&self) -> f64 {
+        if self.time_s > 0.0 {
+            self.work_j / self.time_s
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The power terms at a step's interior stage and the method's quadrature weights: the
@@ -237,6 +274,8 @@ impl Integrator {
             prev_h: 0.0,
             stage: None,
             power_start: Default::default(),
+            work_throughput: WorkThroughput::default(),
+            attempt_work_j: 0.0,
         }
     }
 
@@ -360,6 +399,7 @@ impl Integrator {
                 y.copy_from_slice(&self.ynew);
                 sys.normalize(y);
                 self.stats.accepted += 1;
+                self.work_throughput.add(self.attempt_work_j, h);
                 // Explicit FSAL reuses the last stage. The implicit methods need f itself at
                 // the new point, not the stage derivative (z - rhs)/(h d), which carries the
                 // Newton error divided by h d and would poison the next step after a tiny

@@ -48,9 +48,10 @@ pub struct Tolerances {
     /// the energy account's works are quadratures of the power terms like the state's own
     /// (the integrator's weights at the step's start, stage and end), and a step is accepted
     /// only if the embedded estimate of that quadrature's error is within this share of the
-    /// step's work (+ [`ENERGY_ABS_TOLERANCE_J`]). Default 1e-3 (cases: 10 × `rel_tolerance`),
-    /// so the account closes to well within 0.5 % of the dissipated work; 0 switches the check
-    /// off.
+    /// step's work plus the work of a step as long at the run's mean power so far
+    /// ([`WorkThroughput`](super::WorkThroughput); + [`ENERGY_ABS_TOLERANCE_J`]). Default 1e-3
+    /// (cases: 10 × `rel_tolerance`), so the account closes to well within 0.5 % of the
+    /// throughput; 0 switches the check off.
     #[serde(default = "default_energy_rel")]
     pub energy_rel: f64,
     /// Which state entries the implicit methods' local error test weighs (the energy account's
