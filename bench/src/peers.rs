@@ -214,8 +214,8 @@ pub(crate) fn peers(
                 .map_or("-".into(), |(a, b)| format!("{:.2}", a / b.max(1e-9)));
             table.note(format!(
                 "railwear (case tolerance x {factor}, {points} points per edge) / MuJoCo at its converged 5e-5 s step, real-time factor: \
-                 {:.2} wall, {cpu_ratio} CPU (issue 16 target >= 3 at a converged tolerance; \
-                 `convergence --ladder` says which are)",
+                 {:.2} wall, {cpu_ratio} CPU (issue 27 target >= 1 at the case's settings; \
+                 `convergence --ladder` says which settings are converged)",
                 wall / m
             ));
         }

@@ -413,13 +413,10 @@ impl Contact {
                     self.face_extents.get(jf).and_then(Option::as_ref),
                     &iso_b,
                 );
-                // The exact face contact's nodes sum their derivatives into one block per
-                // track when the moments are taken.
-                let exact_faces = self.face_contact == FaceContact::Exact
-                    && matches!(shape, ConvexShape::RoundedBox { .. });
-                let mut track_moments =
-                    (exact_faces && linearizations.is_some() && moments.is_some())
-                        .then(|| TrackMoments::new(self.body_a, self.body_b, fa, fb));
+                // The nodes (exact face contact) or points (lattice) sum their derivatives into
+                // one block per track when the moments are taken.
+                let mut track_moments = (linearizations.is_some() && moments.is_some())
+                    .then(|| TrackMoments::new(self.body_a, self.body_b, fa, fb));
                 let mut out = PointOutputs {
                     index,
                     track: (ip * nfaces + jf) as u32,
