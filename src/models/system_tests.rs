@@ -236,7 +236,8 @@ fn analytic_contact_jacobian(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, usi
     sys.derivative(0.0, y, &mut f, &mut ws);
     let mut jac = vec![0.0; n * n];
     sys.contact_jacobian(y, &ws, &mut jac);
-    (jac, ws.linearizations.len())
+    // Points' records (list) and tracks' summed records (moments).
+    (jac, ws.linearizations.len() + ws.linearization_moments.len())
 }
 
 #[test]
