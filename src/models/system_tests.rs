@@ -237,7 +237,10 @@ fn analytic_contact_jacobian(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, usi
     let mut jac = vec![0.0; n * n];
     sys.contact_jacobian(y, &ws, &mut jac);
     // Points' records (list) and tracks' summed records (moments).
-    (jac, ws.linearizations.len() + ws.linearization_moments.len())
+    (
+        jac,
+        ws.linearizations.len() + ws.linearization_moments.len(),
+    )
 }
 
 #[test]
