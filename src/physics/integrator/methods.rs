@@ -8,8 +8,8 @@ impl Integrator {
     /// The energy account's quadrature error on this attempt over its tolerance
     /// ([`Tolerances::energy_rel`]): the embedded estimate `h Σ (w_i − b_i) P_i` of the
     /// dissipated and the drive power against the step's work plus `h` times the run's mean
-    /// power so far ([`WorkThroughput`]). `ws.power` holds the attempt's
-    /// last evaluation (its end).
+    /// power so far ([`WorkThroughput`]). `ws.power` holds the attempt's last evaluation (its
+    /// end).
     pub(super) fn energy_error_norm(
         &mut self,
         ws: &Workspace,
