@@ -38,11 +38,13 @@ pub struct Workspace {
     pub geometry: GeometryCache,
     /// Record each active track's force derivatives during a derivative evaluation.
     pub linearize: bool,
-    /// The tracks' force derivatives of the last evaluation (when `linearize`), per contact
-    /// point.
+    /// Force derivatives per contact point or node: filled only by an evaluation asked for
+    /// them without moments (the per-point reference tests/engine/face_contact_blocks.rs
+    /// compares the moments with); [`MultibodySystem::derivative`] asks for both, so the
+    /// contacts sum into [`Self::linearization_moments`] and this stays empty there.
     pub linearizations: Vec<TrackLinearization>,
-    /// The exact face contact's force derivatives of the last evaluation (when `linearize`),
-    /// one sum per track.
+    /// The contacts' force derivatives of the last evaluation (when `linearize`), one sum per
+    /// track: the lattice's points and the exact face contact's nodes alike.
     pub linearization_moments: Vec<TrackMoments>,
     /// Leave the contacts out of the derivative (the contact-free part of the Jacobian).
     pub skip_contacts: bool,
@@ -300,8 +302,9 @@ impl MultibodySystem {
         let n = self.state_len;
         let nb = self.bodies.len();
         // Per (source body k, target body m): the force and the torque about m's centre of
-        // mass on m, differentiated by k's [δx, δθ, δv, δω_world]. The points' blocks are summed
-        // here (in the points' order: mirror pairs cancel exactly) and mapped to the state once.
+        // mass on m, differentiated by k's [δx, δθ, δv, δω_world]. The tracks' moments and any
+        // per-point records (in the points' order) are summed into these blocks, which are mapped
+        // to the state once.
         let mut blocks: Vec<Option<Matrix6x12>> = vec![None; nb * nb];
         let dynamic = |k: usize| matches!(self.bodies[k].kind, BodyKind::Dynamic { .. });
         for sum in &ws.linearization_moments {

@@ -207,9 +207,10 @@ pub struct PointLoad {
 /// track's force derivatives, and every touching point's load.
 #[derive(Default)]
 pub struct EvaluationOutputs<'a> {
-    /// Receives each active track's force derivatives (per contact point).
+    /// Receives each active track's force derivatives per contact point or node, when
+    /// `moments` is not given.
     pub linearizations: Option<&'a mut Vec<TrackLinearization>>,
-    /// Receives the exact face contact's force derivatives, one sum per track (its nodes'
+    /// Receives the force derivatives one sum per track instead (the points' or nodes'
     /// derivatives as moments; taken only together with `linearizations`).
     pub moments: Option<&'a mut Vec<TrackMoments>>,
     /// Receives each touching contact point's load.
