@@ -179,12 +179,25 @@ pub fn independent_parts(sys: &MultibodySystem) -> Vec<Part> {
                 f
             })
             .collect();
-        let system = MultibodySystem::new(
+        let mut system = MultibodySystem::new(
             bodies.iter().map(|&b| sys.bodies[b].clone()).collect(),
             sys.gravity,
             part_forces,
             part_contacts,
         );
+        // The whole system's carrier where the part holds it; else, if the whole system has
+        // one, the part's own first kinematic body (a launcher station's rail, driven by the
+        // same motion as the first station's).
+        if let Some(carrier) = sys.carrier() {
+            let local = map[carrier].or_else(|| {
+                bodies
+                    .iter()
+                    .position(|&b| matches!(sys.bodies[b].kind, BodyKind::Kinematic(_)))
+            });
+            if let Some(local) = local {
+                system = system.with_carrier(local);
+            }
+        }
         parts.push(Part {
             system,
             bodies,

@@ -23,6 +23,9 @@ pub struct MultibodySystem {
     pub contacts: Vec<Contact>,
     inverse_inertia: Vec<Matrix3<f64>>,
     state_len: usize,
+    /// The kinematic body that carries the excitation (rail, shaker fixture), if the model
+    /// names one: [`Self::carrier_entries`].
+    carrier: Option<usize>,
 }
 
 /// Scratch buffers so a derivative evaluation does not allocate.
@@ -127,6 +130,66 @@ impl MultibodySystem {
             contacts,
             inverse_inertia,
             state_len: offset,
+            carrier: None,
+        }
+    }
+
+    /// Names `body` the carrier: the kinematic body whose rigid motion the integrators take
+    /// out of every dynamic body's position and velocity before they apply the relative
+    /// tolerance ([`Self::carrier_entries`]). A body that is not kinematic leaves the system
+    /// without a carrier (the tolerance then applies to the world-frame state).
+    pub fn with_carrier(mut self, body: usize) -> Self {
+        let kinematic = self
+            .bodies
+            .get(body)
+            .is_some_and(|b| matches!(b.kind, BodyKind::Kinematic(_)));
+        debug_assert!(kinematic, "the carrier must be a kinematic body");
+        self.carrier = kinematic.then_some(body);
+        self
+    }
+
+    /// The carrier's index, if the model names one ([`Self::with_carrier`]).
+    pub fn carrier(&self) -> Option<usize> {
+        self.carrier
+    }
+
+    /// The carrier's rigid motion at `t`, as a state vector: for each dynamic body of `y`, the
+    /// position of the carrier's origin, the velocity of the carrier's point under the body's
+    /// centre of mass (`v_c + ω_c × (x − x_c)`) and the carrier's angular velocity in the
+    /// body's frame (`Rᵀ ω_c`); zero for the quaternions. `y` minus this is each body's motion
+    /// relative to the carrier, which a relative tolerance should scale with: a rail or
+    /// fixture shaking at 0.1 m/s would otherwise loosen the tolerance on every velocity
+    /// riding on it by `rel × 0.1 m/s`, although only the motion relative to it slips, wears
+    /// and dissipates. Zeros without a carrier.
+    ///
+    /// The carrier's frame comes from `ws` when its last evaluation was at `t` (the step's
+    /// start and the last stage's end are), else from its prescribed motion.
+    pub fn carrier_entries(&self, t: f64, y: &[f64], ws: &Workspace, out: &mut [f64]) {
+        out.fill(0.0);
+        let Some(c) = self.carrier else {
+            return;
+        };
+        let (origin, v, w) = match (&self.bodies[c].kind, ws.frames.get(c)) {
+            (_, Some(f)) if ws.kinematic_time == Some(t) => {
+                (f.position, f.velocity, f.angular_velocity)
+            }
+            (BodyKind::Kinematic(motion), _) => {
+                let (v, w) = motion.velocity(t);
+                (motion.pose(t).translation.vector, v, w)
+            }
+            (BodyKind::Dynamic { .. }, _) => return,
+        };
+        for b in &self.bodies {
+            let BodyKind::Dynamic { offset } = b.kind else {
+                continue;
+            };
+            let frame = frame_from_state(y, offset);
+            let velocity = v + w.cross(&(frame.position - origin));
+            let spin = frame.rotation.inverse_transform_vector(&w);
+            let s = &mut out[offset..offset + BODY_STATE_LEN];
+            s[0..3].copy_from_slice(origin.as_slice());
+            s[7..10].copy_from_slice(velocity.as_slice());
+            s[10..13].copy_from_slice(spin.as_slice());
         }
     }
 

@@ -2,6 +2,7 @@
 //! and error control, called as a library (no HTTP, no store). One module per concern.
 
 mod body_transient;
+mod carrier_frame;
 mod checkpoint_resume;
 mod contact_fit;
 mod energy_passivity;

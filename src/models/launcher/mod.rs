@@ -600,12 +600,14 @@ pub fn build(
         }
     }
     let stations = spec.stations.len();
+    // The first station's rail carries the excitation (every station's rail moves with it).
     let system = MultibodySystem::new(
         bodies,
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
         all_forces,
         all_contacts,
-    );
+    )
+    .with_carrier(RAIL);
     let est = static_estimate(spec);
     let mut y = vec![0.0; system.state_len()];
     for (s, offset) in spec.stations.iter().enumerate() {

@@ -116,12 +116,14 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
     .with_face_extents(extents)
     .with_points_per_edge(case.simulation.contact_points_per_edge)
     .with_face_contact(case.simulation.face_contact.unwrap_or(FACE_CONTACT));
+    // The tube carries the shaker's motion.
     let system = MultibodySystem::new(
         vec![cube, tube],
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
         vec![],
         vec![contact],
-    );
+    )
+    .with_carrier(1);
     let w_static = impact.static_penetration(mass * STANDARD_GRAVITY);
     let mut y = vec![0.0; system.state_len()];
     write_state(

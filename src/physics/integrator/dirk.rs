@@ -136,6 +136,7 @@ impl Integrator {
         }
         let mut e = std::mem::take(&mut self.err);
         self.solve_in_place(&mut e);
+        self.carrier_at_end(sys, ws, t + h);
         let norm = self.error_norm(&e, y, h);
         self.err = e;
         let err_norm = if tab.energy_account {

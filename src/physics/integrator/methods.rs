@@ -92,7 +92,8 @@ impl Integrator {
             }
             self.err[i] = h * e;
         }
-        let norm = self.weighted_norm(&self.err, y, &self.ynew);
+        self.carrier_at_end(sys, ws, t + h);
+        let norm = self.explicit_error_norm(&self.err, y);
         Attempt {
             err_norm: norm,
             newton_failed: false,

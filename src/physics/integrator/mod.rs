@@ -83,6 +83,11 @@ pub struct Integrator {
     settings: IntegratorSettings,
     n: usize,
     abs_tol: Vec<f64>,
+    /// The carrier's rigid motion as a state at the step's start and at the attempt's end
+    /// ([`MultibodySystem::carrier_entries`]), taken out of the state before the local error
+    /// test applies the relative tolerance; empty when the system has no carrier.
+    carrier_start: Vec<f64>,
+    carrier_end: Vec<f64>,
     /// Body owning each state entry.
     column_body: Vec<usize>,
     /// Entries the implicit methods' local error test weighs (all, or the poses only:
@@ -233,10 +238,13 @@ impl Integrator {
             })
             .collect();
         let v = || vec![0.0; n];
+        let carrier_len = if system.carrier().is_some() { n } else { 0 };
         Self {
             settings,
             n,
             abs_tol,
+            carrier_start: vec![0.0; carrier_len],
+            carrier_end: vec![0.0; carrier_len],
             column_body,
             error_entries,
             h: settings.initial_step_s,
@@ -342,6 +350,9 @@ impl Integrator {
             if let Some(i) = self.k[0].iter().position(|v| !v.is_finite()) {
                 return Err(IntegratorError::NonFinite { t, index: i });
             }
+        }
+        if !self.carrier_start.is_empty() {
+            sys.carrier_entries(t, y, ws, &mut self.carrier_start);
         }
         let (order_exp, facmax) = step_exponent_and_growth(self.settings.kind);
         let classify = self.diagnose && ws.keep_tracks;

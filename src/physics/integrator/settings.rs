@@ -31,7 +31,12 @@ impl IntegratorKind {
 }
 
 /// Error-control settings. The local error of each component is weighted by
-/// `abs + rel * |y|` with the absolute part chosen by the component's physical kind.
+/// `abs + rel * |y|` with the absolute part chosen by the component's physical kind. When the
+/// system names a carrier (the kinematic body carrying the excitation:
+/// [`MultibodySystem::with_carrier`](crate::physics::system::MultibodySystem::with_carrier)),
+/// `y` in the relative part is each body's position and velocity relative to the carrier's
+/// rigid motion, so a shaking rail does not loosen the tolerance on what slides on it; Newton's
+/// convergence test keeps the world-frame weights.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Tolerances {
     /// Relative tolerance (dimensionless). Default 1e-4.

@@ -3,6 +3,7 @@
 
 use super::diagnostics::STEP_DECADES;
 use super::{Integrator, IntegratorKind};
+use crate::physics::system::{MultibodySystem, Workspace};
 
 /// Contact-aware Newton: a failed Newton iteration halves the step, and the next
 /// `HOLD_STEPS_AFTER_NEWTON_FAILURE` accepted steps grow by at most `HELD_GROWTH` each, so the
@@ -40,6 +41,37 @@ impl Integrator {
         e[i] / (self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs()))
     }
 
+    /// Entry `i` of an attempt's local error `e` from `y0` (to `ynew`) in units of its
+    /// tolerance, the relative part scaled by the motion relative to the carrier (the
+    /// world-frame state without one: [`MultibodySystem::carrier_entries`]).
+    #[inline]
+    fn local_error_entry(&self, i: usize, e: &[f64], y0: &[f64]) -> f64 {
+        if self.carrier_start.is_empty() {
+            return self.weighted_entry(i, e, y0, &self.ynew);
+        }
+        let rel = self.settings.tolerances.rel;
+        let start = (y0[i] - self.carrier_start[i]).abs();
+        let end = (self.ynew[i] - self.carrier_end[i]).abs();
+        e[i] / (self.abs_tol[i] + rel * start.max(end))
+    }
+
+    /// The carrier's motion at the attempt's end `t` (no-op without a carrier).
+    pub(super) fn carrier_at_end(&mut self, sys: &MultibodySystem, ws: &Workspace, t: f64) {
+        if !self.carrier_end.is_empty() {
+            sys.carrier_entries(t, &self.ynew, ws, &mut self.carrier_end);
+        }
+    }
+
+    /// The explicit method's error norm: every entry, as [`Self::local_error_entry`] weighs it.
+    pub(super) fn explicit_error_norm(&self, e: &[f64], y0: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for i in 0..self.n {
+            let r = self.local_error_entry(i, e, y0);
+            s += r * r;
+        }
+        (s / self.n.max(1) as f64).sqrt()
+    }
+
     pub(super) fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
         let mut s = 0.0;
         for i in 0..self.n {
@@ -55,7 +87,7 @@ impl Integrator {
     pub(super) fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
         let mut s = 0.0;
         for &i in &self.error_entries {
-            let r = self.weighted_entry(i, e, y0, &self.ynew);
+            let r = self.local_error_entry(i, e, y0);
             s += r * r;
         }
         let norm = (s / self.error_entries.len().max(1) as f64).sqrt();
@@ -65,7 +97,7 @@ impl Integrator {
         // The first entry of largest weighted size.
         let mut worst = (0.0, 0);
         for &i in &self.error_entries {
-            let r = self.weighted_entry(i, e, y0, &self.ynew).abs();
+            let r = self.local_error_entry(i, e, y0).abs();
             if r > worst.0 {
                 worst = (r, i);
             }
