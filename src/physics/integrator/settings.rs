@@ -36,7 +36,8 @@ impl IntegratorKind {
 /// [`MultibodySystem::with_carrier`](crate::physics::system::MultibodySystem::with_carrier)),
 /// `y` in the relative part is each body's position and velocity relative to the carrier's
 /// rigid motion, so a shaking rail does not loosen the tolerance on what slides on it; Newton's
-/// convergence test keeps the world-frame weights.
+/// convergence test keeps the world-frame weights. The local error norm is the largest over the
+/// dynamic bodies of each body's root mean square, so every body is resolved on its own.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Tolerances {
     /// Relative tolerance (dimensionless). Default 1e-4.

@@ -62,14 +62,34 @@ impl Integrator {
         }
     }
 
-    /// The explicit method's error norm: every entry, as [`Self::local_error_entry`] weighs it.
-    pub(super) fn explicit_error_norm(&self, e: &[f64], y0: &[f64]) -> f64 {
-        let mut s = 0.0;
-        for i in 0..self.n {
+    /// The largest over the bodies of the root mean square of `entries` (ascending state
+    /// indices) of one body, each as [`Self::local_error_entry`] weighs it: every body is
+    /// resolved to the tolerance on its own, so a heavy body's small errors do not dilute a
+    /// light one's (the launcher's latch beside its missile), and adding a body leaves the
+    /// others' test as it was. One body: the root mean square of its entries.
+    fn per_body_norm(&self, entries: impl Iterator<Item = usize>, e: &[f64], y0: &[f64]) -> f64 {
+        let mut norm = 0.0f64;
+        let (mut sum, mut count, mut body) = (0.0, 0usize, usize::MAX);
+        for i in entries {
+            let b = self.column_body[i];
+            if b != body && count > 0 {
+                norm = norm.max((sum / count as f64).sqrt());
+                (sum, count) = (0.0, 0);
+            }
+            body = b;
             let r = self.local_error_entry(i, e, y0);
-            s += r * r;
+            sum += r * r;
+            count += 1;
         }
-        (s / self.n.max(1) as f64).sqrt()
+        if count > 0 {
+            norm = norm.max((sum / count as f64).sqrt());
+        }
+        norm
+    }
+
+    /// The explicit method's error norm: every entry ([`Self::per_body_norm`]).
+    pub(super) fn explicit_error_norm(&self, e: &[f64], y0: &[f64]) -> f64 {
+        self.per_body_norm(0..self.n, e, y0)
     }
 
     pub(super) fn weighted_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
@@ -82,15 +102,10 @@ impl Integrator {
     }
 
     /// The error norm of an implicit attempt of size `h` over the entries
-    /// [`ErrorControl`] selects; with `diagnose`, counted by the kind of the entry that limits
-    /// it.
+    /// [`ErrorControl`] selects, body by body ([`Self::per_body_norm`]); with `diagnose`,
+    /// counted by the kind of the entry that limits it.
     pub(super) fn error_norm(&mut self, e: &[f64], y0: &[f64], h: f64) -> f64 {
-        let mut s = 0.0;
-        for &i in &self.error_entries {
-            let r = self.local_error_entry(i, e, y0);
-            s += r * r;
-        }
-        let norm = (s / self.error_entries.len().max(1) as f64).sqrt();
+        let norm = self.per_body_norm(self.error_entries.iter().copied(), e, y0);
         if !self.diagnose {
             return norm;
         }
