@@ -340,16 +340,20 @@ pub fn torque_free_anchor() -> Anchor {
     )
 }
 
-/// A 0.5 kg sled on four 2 mm spheres resting on a plane tilted by `angle` (rad) about z,
-/// Table 5.2 contact and friction, run for `t_end` s from rest. Returns the downhill speed at
-/// the end (m/s) and the mean downhill acceleration over the second half (m/s²), or None if
-/// the run fails.
-pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
-    let r = 0.002;
+/// Radius of the sled's four spheres, m ([`sled_on_base`]).
+pub const SLED_SPHERE_RADIUS_M: f64 = 0.002;
+/// Mass of the sled, kg ([`sled_on_base`]).
+pub const SLED_MASS_KG: f64 = 0.5;
+
+/// The incline anchors' sled (body 0): 0.5 kg on four 2 mm spheres 10 mm below its centre,
+/// Table 5.2 contact and friction against the plane y = 0 of `base` (body 1, in its frame),
+/// then `others` (further bodies, touching nothing). The sled rests on the plane when its
+/// centre is `SLED_SPHERE_RADIUS_M + 0.01` m minus the static penetration above it.
+pub fn sled_on_base(base: RigidBody, others: Vec<RigidBody>) -> MultibodySystem {
     let sled = RigidBody {
         name: "sled".into(),
         mass: MassProperties {
-            mass: 0.5,
+            mass: SLED_MASS_KG,
             inertia: Matrix3::from_diagonal_element(1e-3),
         },
         kind: BodyKind::Dynamic { offset: 0 },
@@ -359,11 +363,12 @@ pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
         .map(|&(x, z)| {
             (
                 Isometry3::translation(x, -0.01, z),
-                ConvexShape::Sphere { radius: r },
+                ConvexShape::Sphere {
+                    radius: SLED_SPHERE_RADIUS_M,
+                },
             )
         })
         .collect();
-    let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
     let contact = Contact::new(
         "sled-incline",
         0,
@@ -373,17 +378,29 @@ pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
         ImpactParams::thesis_table_5_2(),
         Some(FrictionParams::thesis_table_5_2()),
     );
-    let sys = MultibodySystem::new(
-        vec![
-            sled,
-            ground(Isometry3::from_parts(
-                nalgebra::Translation3::identity(),
-                rot,
-            )),
-        ],
+    let mut bodies = vec![sled, base];
+    bodies.extend(others);
+    MultibodySystem::new(
+        bodies,
         Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
         vec![],
         vec![contact],
+    )
+}
+
+/// A 0.5 kg sled on four 2 mm spheres resting on a plane tilted by `angle` (rad) about z,
+/// Table 5.2 contact and friction, run for `t_end` s from rest. Returns the downhill speed at
+/// the end (m/s) and the mean downhill acceleration over the second half (m/s²), or None if
+/// the run fails.
+pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
+    let r = SLED_SPHERE_RADIUS_M;
+    let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
+    let sys = sled_on_base(
+        ground(Isometry3::from_parts(
+            nalgebra::Translation3::identity(),
+            rot,
+        )),
+        Vec::new(),
     );
     let mut y = vec![0.0; sys.state_len()];
     let w0 = ImpactParams::thesis_table_5_2()

@@ -1,5 +1,5 @@
 //! The local error test measures each body's motion relative to the model's carrier (the
-//! kinematic body that carries the excitation: [`MultibodySystem::with_carrier`]). Galilean
+//! kinematic body that carries the excitation: `MultibodySystem::with_carrier`). Galilean
 //! relativity fixes what that must give: a scene that drifts as a whole at a constant velocity
 //! slides, creeps and wears exactly as the same scene at rest, so a drift must not loosen the
 //! tolerance on the motion that slips.
@@ -12,16 +12,14 @@
 //! body added beside the sled leaves the sled's steps as they were.
 
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
-use railwear::geometry::{ConvexShape, HalfSpace};
 use railwear::physics::body::{write_state, BodyKind, KinematicMotion, MassProperties, RigidBody};
-use railwear::physics::contact::Contact;
 use railwear::physics::friction::FrictionParams;
 use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{IntegratorSettings, Tolerances};
 use railwear::physics::simulate::{simulate, DivergenceLimits, StepView};
-use railwear::physics::system::MultibodySystem;
 use railwear::pipeline::RunControl;
 use railwear::units::STANDARD_GRAVITY;
+use railwear::validation::{sled_on_base, SLED_MASS_KG, SLED_SPHERE_RADIUS_M};
 use std::sync::Arc;
 
 /// Incline angle: 0.8 of the friction angle, so the sled creeps (`μ(v) = tan a` at a speed
@@ -70,8 +68,7 @@ fn creep(
     t_end: f64,
     bystander: bool,
 ) -> (f64, u64, f64) {
-    let r = 0.002;
-    let mass = 0.5;
+    let (r, mass) = (SLED_SPHERE_RADIUS_M, SLED_MASS_KG);
     let tilt = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle());
     // 15 m/s² peak along the slope at 40 Hz: the inertial push swings the creep in and out of
     // the stiction transition, as the rail's shaking does the latch's.
@@ -82,14 +79,6 @@ fn creep(
         amplitude: 15.0 / (omega * omega),
         omega,
     });
-    let sled = RigidBody {
-        name: "sled".into(),
-        mass: MassProperties {
-            mass,
-            inertia: Matrix3::from_diagonal_element(1e-3),
-        },
-        kind: BodyKind::Dynamic { offset: 0 },
-    };
     let ground = RigidBody {
         name: "base".into(),
         mass: MassProperties {
@@ -98,30 +87,9 @@ fn creep(
         },
         kind: BodyKind::Kinematic(base.clone()),
     };
-    let pieces = [(-0.02, -0.02), (-0.02, 0.02), (0.02, -0.02), (0.02, 0.02)]
-        .iter()
-        .map(|&(x, z)| {
-            (
-                Isometry3::translation(x, -0.01, z),
-                ConvexShape::Sphere { radius: r },
-            )
-        })
-        .collect();
-    let contact = Contact::new(
-        "sled-base",
-        0,
-        pieces,
-        1,
-        vec![HalfSpace {
-            normal: nalgebra::Unit::new_normalize(Vector3::y()),
-            offset: 0.0,
-        }],
-        ImpactParams::thesis_table_5_2(),
-        Some(FrictionParams::thesis_table_5_2()),
-    );
-    let mut bodies = vec![sled, ground];
+    let mut others = Vec::new();
     if bystander {
-        bodies.push(RigidBody {
+        others.push(RigidBody {
             name: "bystander".into(),
             mass: MassProperties {
                 mass: 2.0,
@@ -130,12 +98,7 @@ fn creep(
             kind: BodyKind::Dynamic { offset: 13 },
         });
     }
-    let mut sys = MultibodySystem::new(
-        bodies,
-        Vector3::new(0.0, -STANDARD_GRAVITY, 0.0),
-        vec![],
-        vec![contact],
-    );
+    let mut sys = sled_on_base(ground, others);
     if carrier {
         sys = sys.with_carrier(1);
     }
