@@ -143,7 +143,6 @@ impl MultibodySystem {
             .bodies
             .get(body)
             .is_some_and(|b| matches!(b.kind, BodyKind::Kinematic(_)));
-        debug_assert!(kinematic, "the carrier must be a kinematic body");
         self.carrier = kinematic.then_some(body);
         self
     }
@@ -668,5 +667,107 @@ mod tests {
                 "column {k}: {theta:?} vs {predicted:?}"
             );
         }
+    }
+
+    /// A carrier spinning about z at `omega` while translating at `v`, its origin at `v t`.
+    struct Spinning {
+        v: Vector3<f64>,
+        omega: f64,
+    }
+
+    impl crate::physics::body::KinematicMotion for Spinning {
+        fn pose(&self, t: f64) -> nalgebra::Isometry3<f64> {
+            nalgebra::Isometry3::new(self.v * t, Vector3::z() * (self.omega * t))
+        }
+        fn velocity(&self, _t: f64) -> (Vector3<f64>, Vector3<f64>) {
+            (self.v, Vector3::z() * self.omega)
+        }
+        fn acceleration(&self, _t: f64) -> Vector3<f64> {
+            Vector3::zeros()
+        }
+    }
+
+    fn body(kind: BodyKind) -> RigidBody {
+        RigidBody {
+            name: "b".into(),
+            mass: super::super::body::MassProperties {
+                mass: 1.0,
+                inertia: Matrix3::identity(),
+            },
+            kind,
+        }
+    }
+
+    #[test]
+    fn a_body_riding_rigidly_on_the_carrier_has_no_motion_relative_to_it() {
+        // Rigid-body kinematics: a point fixed to a frame moving at (v, ω) moves at
+        // v + ω × (x − x_c) and turns at ω; in its own axes the turn is Rᵀ ω.
+        let carrier = Spinning {
+            v: Vector3::new(0.3, -0.1, 0.05),
+            omega: 7.0,
+        };
+        let t = 0.4;
+        let origin = carrier.v * t;
+        let sys = MultibodySystem::new(
+            vec![
+                body(BodyKind::Dynamic { offset: 0 }),
+                body(BodyKind::Kinematic(std::sync::Arc::new(carrier))),
+            ],
+            Vector3::zeros(),
+            vec![],
+            vec![],
+        )
+        .with_carrier(1);
+        assert_eq!(sys.carrier(), Some(1));
+        let x = origin + Vector3::new(0.02, -0.01, 0.3);
+        let rotation = nalgebra::UnitQuaternion::from_euler_angles(0.2, -0.4, 0.9);
+        let omega = Vector3::z() * 7.0;
+        let mut y = vec![0.0; sys.state_len()];
+        crate::physics::body::write_state(
+            &mut y,
+            0,
+            &nalgebra::Isometry3::from_parts(x.into(), rotation),
+            Vector3::new(0.3, -0.1, 0.05) + omega.cross(&(x - origin)),
+            omega,
+        );
+        let mut out = vec![f64::NAN; sys.state_len()];
+        // No evaluation yet: the carrier's frame comes from its motion.
+        sys.carrier_entries(t, &y, &sys.workspace(), &mut out);
+        for i in 7..13 {
+            assert!(
+                (y[i] - out[i]).abs() < 1e-14,
+                "entry {i}: {} vs {}",
+                y[i],
+                out[i]
+            );
+        }
+        let relative = Vector3::new(y[0] - out[0], y[1] - out[1], y[2] - out[2]);
+        assert!((relative - (x - origin)).norm() < 1e-15);
+        assert!(
+            out[3..7].iter().all(|&q| q == 0.0),
+            "quaternions are not shifted"
+        );
+        // From the workspace after an evaluation at t: the same entries.
+        let mut ws = sys.workspace();
+        sys.frames(t, &y, &mut ws);
+        let mut again = vec![f64::NAN; sys.state_len()];
+        sys.carrier_entries(t, &y, &ws, &mut again);
+        assert_eq!(out, again);
+    }
+
+    #[test]
+    fn a_dynamic_body_is_no_carrier() {
+        let sys = MultibodySystem::new(
+            vec![body(BodyKind::Dynamic { offset: 0 })],
+            Vector3::zeros(),
+            vec![],
+            vec![],
+        )
+        .with_carrier(0)
+        .with_carrier(5);
+        assert_eq!(sys.carrier(), None);
+        let mut out = vec![1.0; sys.state_len()];
+        sys.carrier_entries(0.0, &vec![0.0; 13], &sys.workspace(), &mut out);
+        assert!(out.iter().all(|&v| v == 0.0));
     }
 }
