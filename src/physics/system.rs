@@ -767,7 +767,7 @@ mod tests {
         .with_carrier(5);
         assert_eq!(sys.carrier(), None);
         let mut out = vec![1.0; sys.state_len()];
-        sys.carrier_entries(0.0, &vec![0.0; 13], &sys.workspace(), &mut out);
+        sys.carrier_entries(0.0, &[0.0; 13], &sys.workspace(), &mut out);
         assert!(out.iter().all(|&v| v == 0.0));
     }
 }
