@@ -341,9 +341,9 @@ pub fn torque_free_anchor() -> Anchor {
 }
 
 /// Radius of the sled's four spheres, m ([`sled_on_base`]).
-pub const SLED_SPHERE_RADIUS_M: f64 = 0.002;
+const SLED_SPHERE_RADIUS_M: f64 = 0.002;
 /// Mass of the sled, kg ([`sled_on_base`]).
-pub const SLED_MASS_KG: f64 = 0.5;
+const SLED_MASS_KG: f64 = 0.5;
 
 /// The incline anchors' sled (body 0): 0.5 kg on four 2 mm spheres 10 mm below its centre,
 /// Table 5.2 contact and friction against the plane y = 0 of `base` (body 1, in its frame),
@@ -388,13 +388,24 @@ pub fn sled_on_base(base: RigidBody, others: Vec<RigidBody>) -> MultibodySystem 
     )
 }
 
+/// Where [`sled_on_base`]'s sled rests on a base at the origin tilted by `angle` (rad) about
+/// z: its centre `SLED_SPHERE_RADIUS_M + 0.01` m above the plane, less the static penetration
+/// of its four spheres under the normal share of its weight.
+pub fn sled_rest_pose(angle: f64) -> Isometry3<f64> {
+    let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
+    let w0 = ImpactParams::thesis_table_5_2()
+        .static_penetration(SLED_MASS_KG * STANDARD_GRAVITY * angle.cos() / 4.0);
+    let p = rot * Vector3::new(0.0, 0.01 + SLED_SPHERE_RADIUS_M - w0, 0.0);
+    Isometry3::from_parts(p.into(), rot)
+}
+
 /// A 0.5 kg sled on four 2 mm spheres resting on a plane tilted by `angle` (rad) about z,
 /// Table 5.2 contact and friction, run for `t_end` s from rest. Returns the downhill speed at
 /// the end (m/s) and the mean downhill acceleration over the second half (m/s²), or None if
 /// the run fails.
 pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
-    let r = SLED_SPHERE_RADIUS_M;
-    let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
+    let rest = sled_rest_pose(angle);
+    let rot = rest.rotation;
     let sys = sled_on_base(
         ground(Isometry3::from_parts(
             nalgebra::Translation3::identity(),
@@ -403,16 +414,7 @@ pub fn sled_on_incline(angle: f64, t_end: f64) -> Option<(f64, f64)> {
         Vec::new(),
     );
     let mut y = vec![0.0; sys.state_len()];
-    let w0 = ImpactParams::thesis_table_5_2()
-        .static_penetration(0.5 * STANDARD_GRAVITY * angle.cos() / 4.0);
-    let p = rot * Vector3::new(0.0, 0.01 + r - w0, 0.0);
-    write_state(
-        &mut y,
-        0,
-        &Isometry3::from_parts(p.into(), rot),
-        Vector3::zeros(),
-        Vector3::zeros(),
-    );
+    write_state(&mut y, 0, &rest, Vector3::zeros(), Vector3::zeros());
     let downhill = rot * -Vector3::x();
     let mut samples: Vec<(f64, f64)> = Vec::new();
     let ok = simulate(

@@ -14,12 +14,10 @@
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 use railwear::physics::body::{write_state, BodyKind, KinematicMotion, MassProperties, RigidBody};
 use railwear::physics::friction::FrictionParams;
-use railwear::physics::impact::ImpactParams;
 use railwear::physics::integrator::{IntegratorSettings, Tolerances};
 use railwear::physics::simulate::{simulate, DivergenceLimits, StepView};
 use railwear::pipeline::RunControl;
-use railwear::units::STANDARD_GRAVITY;
-use railwear::validation::{sled_on_base, SLED_MASS_KG, SLED_SPHERE_RADIUS_M};
+use railwear::validation::{sled_on_base, sled_rest_pose};
 use std::sync::Arc;
 
 /// Incline angle: 0.8 of the friction angle, so the sled creeps (`μ(v) = tan a` at a speed
@@ -68,7 +66,6 @@ fn creep(
     t_end: f64,
     bystander: bool,
 ) -> (f64, u64, f64) {
-    let (r, mass) = (SLED_SPHERE_RADIUS_M, SLED_MASS_KG);
     let tilt = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle());
     // 15 m/s² peak along the slope at 40 Hz: the inertial push swings the creep in and out of
     // the stiction transition, as the rail's shaking does the latch's.
@@ -102,18 +99,11 @@ fn creep(
     if carrier {
         sys = sys.with_carrier(1);
     }
-    let w0 = ImpactParams::thesis_table_5_2()
-        .static_penetration(mass * STANDARD_GRAVITY * angle().cos() / 4.0);
+    // At t = 0 the base sits at the origin: the sled rests on it, moving with it.
     let mut y = vec![0.0; sys.state_len()];
-    let p = tilt * Vector3::new(0.0, 0.01 + r - w0, 0.0);
     let (v0, _) = base.velocity(0.0);
-    write_state(
-        &mut y,
-        0,
-        &Isometry3::from_parts(p.into(), tilt),
-        v0,
-        Vector3::zeros(),
-    );
+    let rest = sled_rest_pose(angle());
+    write_state(&mut y, 0, &rest, v0, Vector3::zeros());
     // The state's local error test alone: the energy account's work test (`energy_rel`)
     // integrates the drive's power, which a drift changes by nature (kinetic energy and the
     // base's work on the sled depend on the inertial frame), so it would see the drift.
@@ -158,7 +148,9 @@ fn creep(
     )
     .expect("the sled runs");
     let downhill = -base.slope();
-    let relative = Vector3::new(y[0], y[1], y[2]) - base.pose(t_end).translation.vector - p;
+    let relative = Vector3::new(y[0], y[1], y[2])
+        - base.pose(t_end).translation.vector
+        - rest.translation.vector;
     (
         relative.dot(&downhill),
         stats.integrator.accepted,

@@ -37,8 +37,13 @@ impl Integrator {
     /// Entry `i` of `e` in units of its tolerance between states `y0` and `y1`.
     #[inline]
     pub(super) fn weighted_entry(&self, i: usize, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
-        let rel = self.settings.tolerances.rel;
-        e[i] / (self.abs_tol[i] + rel * y0[i].abs().max(y1[i].abs()))
+        self.over_tolerance(i, e[i], y0[i].abs().max(y1[i].abs()))
+    }
+
+    /// An error `e_i` of entry `i` in units of its tolerance `abs_i + rel × size`.
+    #[inline]
+    fn over_tolerance(&self, i: usize, e_i: f64, size: f64) -> f64 {
+        e_i / (self.abs_tol[i] + self.settings.tolerances.rel * size)
     }
 
     /// Entry `i` of an attempt's local error `e` from `y0` (to `ynew`) in units of its
@@ -49,10 +54,9 @@ impl Integrator {
         if self.carrier_start.is_empty() {
             return self.weighted_entry(i, e, y0, &self.ynew);
         }
-        let rel = self.settings.tolerances.rel;
         let start = (y0[i] - self.carrier_start[i]).abs();
         let end = (self.ynew[i] - self.carrier_end[i]).abs();
-        e[i] / (self.abs_tol[i] + rel * start.max(end))
+        self.over_tolerance(i, e[i], start.max(end))
     }
 
     /// The carrier's motion at the attempt's end `t` (no-op without a carrier).
