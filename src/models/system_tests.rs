@@ -303,10 +303,13 @@ fn contact_jacobian_pose_columns_equal_finite_differences() {
 }
 
 #[test]
-fn integrator_leaves_the_tracks_of_the_accepted_state() {
-    // simulate() records each step's tracks from the integrator's last derivative
-    // evaluation instead of recomputing the overlaps: that evaluation must be at the
-    // accepted state, for every method and Newton matrix.
+fn integrator_leaves_the_tracks_of_its_last_evaluation() {
+    // simulate() records each step's tracks from the integrator's last derivative evaluation
+    // instead of recomputing them. For the finite-difference Newton and Dopri5 that evaluation
+    // is at the accepted state. The contact-aware Newton takes the next step's start from its
+    // last iterate `z − Δz` (Δz its last update): the tracks are that iterate's, with the
+    // area (thesis 2.5) of the accepted state, refreshed as the next step's patches are.
+    use crate::physics::contact::PATCH_REUSE;
     use crate::physics::integrator::{Integrator, IntegratorKind, NewtonJacobian};
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
     let case = super::case::load_case(&dir.join("rattle-box-c.toml")).expect("case");
@@ -327,23 +330,41 @@ fn integrator_leaves_the_tracks_of_the_accepted_state() {
         ws.keep_tracks = true;
         let mut check = sys.workspace();
         let mut y = y0.clone();
-        let (mut t, mut steps_in_contact) = (0.0, 0);
+        let (mut t, mut steps_in_contact, mut from_iterate) = (0.0, 0, 0);
         while t < 2e-4 {
             t = integ
                 .advance(&sys, &mut ws, t, &mut y, 2e-4)
                 .expect("advances");
+            let mut at = y.clone();
+            if let Some(dz) = integ.last_newton_update() {
+                at.iter_mut().zip(dz).for_each(|(v, d)| *v -= d);
+                from_iterate += 1;
+            }
             let mut fresh = Vec::new();
-            sys.tracks(t, &y, &mut check, &mut |tr| fresh.push(*tr));
+            sys.tracks(t, &at, &mut check, &mut |tr| fresh.push(*tr));
+            let mut accepted = Vec::new();
+            sys.tracks(t, &y, &mut check, &mut |tr| accepted.push(*tr));
             assert_eq!(fresh.len(), ws.tracks.len(), "{kind:?} {newton:?} t = {t}");
-            for (a, b) in fresh.iter().zip(&ws.tracks) {
+            for ((a, b), c) in fresh.iter().zip(&ws.tracks).zip(&accepted) {
                 assert_eq!((a.contact, a.track), (b.contact, b.track));
                 let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
                 assert!(close(a.penetration, b.penetration), "{kind:?} t = {t}");
                 assert!(close(a.normal_force, b.normal_force), "{kind:?} t = {t}");
+                // The area is the accepted state's, computed again or kept while its plane
+                // moved by less than PATCH_REUSE of the penetration (7 PATCH_REUSE of it).
+                assert!(
+                    (b.area - c.area).abs() <= 7.0 * PATCH_REUSE * c.area,
+                    "{kind:?} {newton:?} t = {t}: area {} vs {}",
+                    b.area,
+                    c.area
+                );
             }
             steps_in_contact += usize::from(!fresh.is_empty());
         }
         assert!(steps_in_contact > 10, "the cube must touch the floor");
+        let contact_aware =
+            newton == NewtonJacobian::ContactAware && kind != IntegratorKind::Dopri5;
+        assert_eq!(contact_aware, from_iterate > 0, "{kind:?} {newton:?}");
     }
 }
 

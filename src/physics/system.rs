@@ -3,8 +3,8 @@
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
 use super::contact::{
-    Contact, EvaluationOutputs, GeometryCache, Matrix6x12, PointLoad, TrackLinearization,
-    TrackMoments, TrackState,
+    Contact, EvaluationOutputs, GeometryCache, GeometryMode, Matrix6x12, PointLoad,
+    TrackLinearization, TrackMoments, TrackState,
 };
 use super::forces::{ForceElement, Wrench};
 use nalgebra::{Matrix3, Matrix3x4, Quaternion, Vector3};
@@ -450,6 +450,21 @@ impl MultibodySystem {
                 }
             }
         }
+    }
+
+    /// After an implicit step accepted at `(t, y)` with the tracks of its last Newton iterate
+    /// in `ws.tracks`: refreshes every contact's overlaps at `y` ([`GeometryMode::Refresh`],
+    /// the patches the next step's iterates hold) and gives those tracks the thesis 2.5 area
+    /// at `y` ([`Contact::refresh_areas`]). No force is evaluated.
+    pub fn refresh_patches(&self, t: f64, y: &[f64], ws: &mut Workspace) {
+        self.frames(t, y, ws);
+        ws.geometry.set_mode(GeometryMode::Refresh);
+        let mut tracks = std::mem::take(&mut ws.tracks);
+        for (ci, c) in self.contacts.iter().enumerate() {
+            c.refresh_areas(ci as u32, &ws.frames, &mut ws.geometry, &mut tracks);
+        }
+        ws.tracks = tracks;
+        ws.geometry.set_mode(GeometryMode::Compute);
     }
 
     /// dy/dt without track output.

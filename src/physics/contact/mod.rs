@@ -30,7 +30,7 @@ use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use crate::geometry::{
     contact_points, shape_halfspace_overlap, ContactPoint, ConvexShape, FaceExtent, HalfSpace,
-    PlacedFace, DEFAULT_POINTS_PER_EDGE,
+    PlacedFace, PlaneOverlap, DEFAULT_POINTS_PER_EDGE,
 };
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
@@ -373,39 +373,17 @@ impl Contact {
             self.body_a,
             self.body_b,
         );
-        let recording = matches!(geometry.mode, GeometryMode::Record | GeometryMode::Refresh);
-        let refreshing = geometry.mode == GeometryMode::Refresh;
-        let frozen = geometry.mode == GeometryMode::Frozen;
         // The per-part friction's node records ([`FrictionRule::PerPart`], linearized only):
         // one buffer for the whole evaluation, cleared per part.
         let mut lump_nodes = Vec::new();
         for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
             let pose = iso_a * piece_pose;
             for (jf, face) in self.faces_b.iter().enumerate() {
-                let n_world = fb.rotation * face.normal.into_inner();
-                let offset_world = face.offset + n_world.dot(&fb.position);
-                let hs = HalfSpace {
-                    normal: Unit::new_unchecked(n_world),
-                    offset: offset_world,
-                };
+                let hs = face_in_world(face, fb);
                 // The piece's overlap with the face's plane: the gate (no point of a piece
                 // clear of the plane can touch the face's solid) and the thesis 2.5 area.
-                let ov = match replay_from {
-                    Some(start) if frozen => {
-                        geometry.frozen(start + ip * nfaces + jf, shape, &pose, &hs)
-                    }
-                    Some(start) if refreshing => {
-                        geometry.refresh(start + ip * nfaces + jf, shape, &pose, &hs)
-                    }
-                    Some(start) => geometry.entries[start + ip * nfaces + jf],
-                    None => {
-                        let ov = shape_halfspace_overlap(shape, &pose, &hs);
-                        if recording {
-                            geometry.push(ov, &pose, &hs);
-                        }
-                        ov
-                    }
-                };
+                let pair = replay_from.map(|start| start + ip * nfaces + jf);
+                let ov = pair_overlap(geometry, pair, shape, &pose, &hs);
                 let Some(ov) = ov else {
                     continue;
                 };
@@ -513,6 +491,89 @@ impl Contact {
             }
         }
         energy
+    }
+}
+
+impl Contact {
+    /// At an implicit step's accepted state, whose tracks came from its last Newton iterate:
+    /// each (piece, face) pair's overlap as `geometry.mode` says (the caller sets
+    /// [`GeometryMode::Refresh`]: the patches the next step's iterates hold), and each of this
+    /// contact's `tracks` given the thesis 2.5 area at these poses. A track whose pair is clear
+    /// of its plane here (it separated within Newton's last update) keeps its area.
+    pub fn refresh_areas(
+        &self,
+        index: u32,
+        frames: &[BodyFrame],
+        geometry: &mut GeometryCache,
+        tracks: &mut [TrackState],
+    ) {
+        let fa = &frames[self.body_a];
+        let fb = &frames[self.body_b];
+        let (iso_a, iso_b) = (fa.isometry(), fb.isometry());
+        let nfaces = self.faces_b.len();
+        let replay_from = geometry.begin(
+            index as usize,
+            self.pieces_a.len() * nfaces,
+            self.body_a,
+            self.body_b,
+        );
+        for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
+            let pose = iso_a * piece_pose;
+            for (jf, face) in self.faces_b.iter().enumerate() {
+                let hs = face_in_world(face, fb);
+                let pair = replay_from.map(|start| start + ip * nfaces + jf);
+                let Some(ov) = pair_overlap(geometry, pair, shape, &pose, &hs) else {
+                    continue;
+                };
+                let id = (ip * nfaces + jf) as u32;
+                if let Some(track) = tracks
+                    .iter_mut()
+                    .find(|t| t.contact == index && t.track == id)
+                {
+                    let placed = PlacedFace::new(
+                        hs,
+                        self.face_extents.get(jf).and_then(Option::as_ref),
+                        &iso_b,
+                    );
+                    track.area = ov.area * placed.coverage(shape, &pose);
+                }
+            }
+        }
+    }
+}
+
+/// A face of body b placed by its frame: the world half-space.
+#[inline]
+fn face_in_world(face: &HalfSpace, fb: &BodyFrame) -> HalfSpace {
+    let n_world = fb.rotation * face.normal.into_inner();
+    HalfSpace {
+        normal: Unit::new_unchecked(n_world),
+        offset: face.offset + n_world.dot(&fb.position),
+    }
+}
+
+/// The overlap of a piece placed by `pose` with the half-space `hs`, as `geometry.mode` says:
+/// from the cache's entry `pair` (replayed, frozen or refreshed), or computed (and recorded
+/// when the mode records) when the contact reads no entries (`pair` is `None`).
+#[inline]
+fn pair_overlap(
+    geometry: &mut GeometryCache,
+    pair: Option<usize>,
+    shape: &ConvexShape,
+    pose: &Isometry3<f64>,
+    hs: &HalfSpace,
+) -> Option<PlaneOverlap> {
+    match (pair, geometry.mode) {
+        (Some(k), GeometryMode::Frozen) => geometry.frozen(k, shape, pose, hs),
+        (Some(k), GeometryMode::Refresh) => geometry.refresh(k, shape, pose, hs),
+        (Some(k), _) => geometry.entries[k],
+        (None, mode) => {
+            let ov = shape_halfspace_overlap(shape, pose, hs);
+            if matches!(mode, GeometryMode::Record | GeometryMode::Refresh) {
+                geometry.push(ov, pose, hs);
+            }
+            ov
+        }
     }
 }
 

@@ -114,6 +114,11 @@ pub struct Integrator {
     newton_eta: f64,
     /// The last Newton solve stopped after an update: `fz` is not f at the accepted point.
     newton_z_is_new: bool,
+    /// That update (`z` minus the iterate `fz` was evaluated at), when `newton_z_is_new`.
+    last_dz: Vec<f64>,
+    /// Contact-aware Newton: `newton_jac` is the Jacobian at the last evaluated iterate (false:
+    /// no contact was active there, and `jac` is).
+    newton_jac_at_iterate: bool,
     jac_fresh: bool,
     jac_age: u32,
     /// Perturbed state and derivative for the finite differences (no allocation per call).
@@ -262,6 +267,8 @@ impl Integrator {
             lu_jac: vec![0.0; n * n],
             newton_eta: 1.0,
             newton_z_is_new: false,
+            last_dz: v(),
+            newton_jac_at_iterate: false,
             jac_fresh: false,
             jac_age: u32::MAX,
             jac_y: v(),
@@ -291,6 +298,13 @@ impl Integrator {
     /// works the account integrates by the trapezoid rule).
     pub fn interior_stage(&self) -> Option<&InteriorStage> {
         self.stage.as_ref()
+    }
+
+    /// Newton's last update `Δz` of the last accepted step when the step's tracks and power
+    /// terms are those of the iterate before it, `z − Δz` ([`Integrator::start_from_last_iterate`]),
+    /// and `None` when they are at the accepted state.
+    pub fn last_newton_update(&self) -> Option<&[f64]> {
+        (self.contact_aware() && self.newton_z_is_new).then_some(self.last_dz.as_slice())
     }
 
     /// Step size the next attempt will use, s.
@@ -327,6 +341,44 @@ impl Integrator {
 
     fn frozen_patches(&self) -> bool {
         self.contact_aware() && self.settings.patches == ContactPatches::PerStep
+    }
+
+    /// The next step's start from the contact-aware Newton's last iterate `z_p` (the accepted
+    /// `z = z_p + Δz`, or `z_p` itself when Newton stopped on its residual): `f(z) = f(z_p) +
+    /// J(z_p) Δz + O(|Δz|²)` with the Jacobian that Newton assembled at `z_p`, the power terms
+    /// (energy account) and the tracks (wear) of `z_p`, and with frozen patches the overlaps
+    /// refreshed at `z` ([`MultibodySystem::refresh_patches`]). `Δz` is Newton's last update,
+    /// so the tracks and powers lie within it of the accepted state; the derivative, which the
+    /// next step's stages integrate, is off by its square. This replaces an evaluation of every
+    /// contact at the accepted state (docs/performance.md, twenty-third pass).
+    fn start_from_last_iterate(
+        &mut self,
+        sys: &MultibodySystem,
+        ws: &mut Workspace,
+        t_new: f64,
+        y: &[f64],
+    ) {
+        let n = self.n;
+        self.k[0].copy_from_slice(&self.fz);
+        if self.newton_z_is_new {
+            let jac = if self.newton_jac_at_iterate {
+                &self.newton_jac
+            } else {
+                &self.jac
+            };
+            for (column, &d) in jac.chunks_exact(n).zip(&self.last_dz) {
+                if d != 0.0 {
+                    for (k, &j) in self.k[0].iter_mut().zip(column) {
+                        *k += j * d;
+                    }
+                }
+            }
+        }
+        sys.rescale_quaternion_rates(&self.ynew, &mut self.k[0]);
+        self.power_start = ws.power;
+        if self.frozen_patches() {
+            sys.refresh_patches(t_new, y, ws);
+        }
     }
 
     fn contact_aware(&self) -> bool {
@@ -414,17 +466,17 @@ impl Integrator {
                 // Explicit FSAL reuses the last stage. The implicit methods need f itself at
                 // the new point, not the stage derivative (z - rhs)/(h d), which carries the
                 // Newton error divided by h d and would poison the next step after a tiny
-                // step. The last Newton iteration evaluated f exactly there (the accepted z is
-                // the iterate whose residual passed); renormalising the quaternions changes no
-                // force (frames are built from normalised quaternions) and scales q' = q ⊗ ω/2
-                // by 1/|q|, applied here.
+                // step. The contact-aware Newton has it from its last iterate
+                // ([`Integrator::start_from_last_iterate`]); the finite-difference Newton
+                // evaluates it when the accepted z moved after its last evaluation.
+                // Renormalising the quaternions changes no force (frames are built from
+                // normalised quaternions) and scales q' = q ⊗ ω/2 by 1/|q|, applied here.
                 std::mem::swap(&mut self.k_prev, &mut self.k[0]);
                 self.prev_h = h;
                 match self.settings.kind {
                     IntegratorKind::Dopri5 => self.k.swap(0, 6),
-                    _ if self.newton_z_is_new || self.frozen_patches() => {
-                        self.step_start_rhs(sys, ws, t_new, y)
-                    }
+                    _ if self.contact_aware() => self.start_from_last_iterate(sys, ws, t_new, y),
+                    _ if self.newton_z_is_new => self.step_start_rhs(sys, ws, t_new, y),
                     _ => {
                         self.k[0].copy_from_slice(&self.fz);
                         sys.rescale_quaternion_rates(&self.ynew, &mut self.k[0]);

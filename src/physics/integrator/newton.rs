@@ -88,6 +88,7 @@ impl Integrator {
                     for i in 0..self.n {
                         self.k[out_k][i] = (self.z[i] - self.rhs[i]) / hd;
                     }
+                    self.last_dz.copy_from_slice(&self.tmp);
                     self.newton_z_is_new = true;
                     return true;
                 }
