@@ -367,12 +367,7 @@ impl Contact {
         let iso_b = fb.isometry();
         let mut energy = 0.0;
         let nfaces = self.faces_b.len();
-        let replay_from = geometry.begin(
-            index as usize,
-            self.pieces_a.len() * nfaces,
-            self.body_a,
-            self.body_b,
-        );
+        let replay_from = self.begin_pairs(index, geometry);
         // The per-part friction's node records ([`FrictionRule::PerPart`], linearized only):
         // one buffer for the whole evaluation, cleared per part.
         let mut lump_nodes = Vec::new();
@@ -387,11 +382,7 @@ impl Contact {
                 let Some(ov) = ov else {
                     continue;
                 };
-                let placed = PlacedFace::new(
-                    hs,
-                    self.face_extents.get(jf).and_then(Option::as_ref),
-                    &iso_b,
-                );
+                let placed = self.placed_face(jf, hs, &iso_b);
                 // The nodes (exact face contact) or points (lattice) sum their derivatives into
                 // one block per track when the moments are taken.
                 let mut track_moments = (linearizations.is_some() && moments.is_some())
@@ -495,6 +486,26 @@ impl Contact {
 }
 
 impl Contact {
+    /// Where this contact's (piece, face) pairs read their overlaps from in `geometry`
+    /// ([`GeometryCache::begin`]): `Some(first entry)` to replay, freeze or refresh.
+    fn begin_pairs(&self, index: u32, geometry: &mut GeometryCache) -> Option<usize> {
+        geometry.begin(
+            index as usize,
+            self.pieces_a.len() * self.faces_b.len(),
+            self.body_a,
+            self.body_b,
+        )
+    }
+
+    /// Face `jf` of body b (placed as `iso_b`, its world half-space `hs`) with its extent.
+    fn placed_face(&self, jf: usize, hs: HalfSpace, iso_b: &Isometry3<f64>) -> PlacedFace {
+        PlacedFace::new(
+            hs,
+            self.face_extents.get(jf).and_then(Option::as_ref),
+            iso_b,
+        )
+    }
+
     /// At an implicit step's accepted state, whose tracks came from its last Newton iterate:
     /// each (piece, face) pair's overlap as `geometry.mode` says (the caller sets
     /// [`GeometryMode::Refresh`]: the patches the next step's iterates hold), and each of this
@@ -511,12 +522,7 @@ impl Contact {
         let fb = &frames[self.body_b];
         let (iso_a, iso_b) = (fa.isometry(), fb.isometry());
         let nfaces = self.faces_b.len();
-        let replay_from = geometry.begin(
-            index as usize,
-            self.pieces_a.len() * nfaces,
-            self.body_a,
-            self.body_b,
-        );
+        let replay_from = self.begin_pairs(index, geometry);
         for (ip, (piece_pose, shape)) in self.pieces_a.iter().enumerate() {
             let pose = iso_a * piece_pose;
             for (jf, face) in self.faces_b.iter().enumerate() {
@@ -530,11 +536,7 @@ impl Contact {
                     .iter_mut()
                     .find(|t| t.contact == index && t.track == id)
                 {
-                    let placed = PlacedFace::new(
-                        hs,
-                        self.face_extents.get(jf).and_then(Option::as_ref),
-                        &iso_b,
-                    );
+                    let placed = self.placed_face(jf, hs, &iso_b);
                     track.area = ov.area * placed.coverage(shape, &pose);
                 }
             }
