@@ -307,6 +307,12 @@ impl Integrator {
         (self.contact_aware() && self.newton_z_is_new).then_some(self.last_dz.as_slice())
     }
 
+    /// `f` at the next step's start and at the last evaluated Newton iterate (tests).
+    #[cfg(test)]
+    pub(crate) fn start_and_iterate_derivatives(&self) -> (&[f64], &[f64]) {
+        (&self.k[0], &self.fz)
+    }
+
     /// Step size the next attempt will use, s.
     pub fn step_size(&self) -> f64 {
         self.h
