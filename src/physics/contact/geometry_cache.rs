@@ -116,6 +116,31 @@ impl GeometryCache {
         .then_some(start)
     }
 
+    /// The overlap of a piece placed by `pose` with the half-space `hs`, as the mode says: from
+    /// entry `pair` (replayed, frozen or refreshed), or computed, and recorded when the mode
+    /// records, when the contact reads no entries (`pair` is `None`, [`Self::begin`]).
+    #[inline]
+    pub(super) fn overlap(
+        &mut self,
+        pair: Option<usize>,
+        shape: &ConvexShape,
+        pose: &Isometry3<f64>,
+        hs: &HalfSpace,
+    ) -> Option<PlaneOverlap> {
+        match (pair, self.mode) {
+            (Some(k), GeometryMode::Frozen) => self.frozen(k, shape, pose, hs),
+            (Some(k), GeometryMode::Refresh) => self.refresh(k, shape, pose, hs),
+            (Some(k), _) => self.entries[k],
+            (None, mode) => {
+                let ov = shape_halfspace_overlap(shape, pose, hs);
+                if matches!(mode, GeometryMode::Record | GeometryMode::Refresh) {
+                    self.push(ov, pose, hs);
+                }
+                ov
+            }
+        }
+    }
+
     /// Contact `index`'s entries start at the end of the list (recording).
     pub(super) fn register(&mut self, index: usize) {
         if self.contact_start.len() <= index {

@@ -29,8 +29,8 @@ use super::forces::Wrench;
 use super::friction::FrictionParams;
 use super::impact::ImpactParams;
 use crate::geometry::{
-    contact_points, shape_halfspace_overlap, ContactPoint, ConvexShape, FaceExtent, HalfSpace,
-    PlacedFace, PlaneOverlap, DEFAULT_POINTS_PER_EDGE,
+    contact_points, ContactPoint, ConvexShape, FaceExtent, HalfSpace, PlacedFace,
+    DEFAULT_POINTS_PER_EDGE,
 };
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 
@@ -378,7 +378,7 @@ impl Contact {
                 // The piece's overlap with the face's plane: the gate (no point of a piece
                 // clear of the plane can touch the face's solid) and the thesis 2.5 area.
                 let pair = replay_from.map(|start| start + ip * nfaces + jf);
-                let ov = pair_overlap(geometry, pair, shape, &pose, &hs);
+                let ov = geometry.overlap(pair, shape, &pose, &hs);
                 let Some(ov) = ov else {
                     continue;
                 };
@@ -528,7 +528,7 @@ impl Contact {
             for (jf, face) in self.faces_b.iter().enumerate() {
                 let hs = face_in_world(face, fb);
                 let pair = replay_from.map(|start| start + ip * nfaces + jf);
-                let Some(ov) = pair_overlap(geometry, pair, shape, &pose, &hs) else {
+                let Some(ov) = geometry.overlap(pair, shape, &pose, &hs) else {
                     continue;
                 };
                 let id = (ip * nfaces + jf) as u32;
@@ -551,31 +551,6 @@ fn face_in_world(face: &HalfSpace, fb: &BodyFrame) -> HalfSpace {
     HalfSpace {
         normal: Unit::new_unchecked(n_world),
         offset: face.offset + n_world.dot(&fb.position),
-    }
-}
-
-/// The overlap of a piece placed by `pose` with the half-space `hs`, as `geometry.mode` says:
-/// from the cache's entry `pair` (replayed, frozen or refreshed), or computed (and recorded
-/// when the mode records) when the contact reads no entries (`pair` is `None`).
-#[inline]
-fn pair_overlap(
-    geometry: &mut GeometryCache,
-    pair: Option<usize>,
-    shape: &ConvexShape,
-    pose: &Isometry3<f64>,
-    hs: &HalfSpace,
-) -> Option<PlaneOverlap> {
-    match (pair, geometry.mode) {
-        (Some(k), GeometryMode::Frozen) => geometry.frozen(k, shape, pose, hs),
-        (Some(k), GeometryMode::Refresh) => geometry.refresh(k, shape, pose, hs),
-        (Some(k), _) => geometry.entries[k],
-        (None, mode) => {
-            let ov = shape_halfspace_overlap(shape, pose, hs);
-            if matches!(mode, GeometryMode::Record | GeometryMode::Refresh) {
-                geometry.push(ov, pose, hs);
-            }
-            ov
-        }
     }
 }
 

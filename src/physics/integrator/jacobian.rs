@@ -121,7 +121,6 @@ impl Integrator {
         hd: f64,
         t: f64,
     ) -> bool {
-        self.newton_jac_at_iterate = false;
         if ws.linearizations.is_empty() && ws.linearization_moments.is_empty() {
             if self.lu_valid && self.lu_contact_free && self.lu_h == hd {
                 return true;
@@ -134,7 +133,6 @@ impl Integrator {
         }
         self.newton_jac.copy_from_slice(&self.jac);
         sys.contact_jacobian(&self.z, ws, &mut self.newton_jac);
-        self.newton_jac_at_iterate = true;
         if self.lu_valid && !self.lu_contact_free && self.lu_h == hd {
             // Keep the factorisation while no entry of I - h d J moved by more than
             // LU_REUSE_CHANGE of its size (persistent contact; Newton still contracts).

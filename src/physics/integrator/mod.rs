@@ -106,7 +106,9 @@ pub struct Integrator {
     jac: Vec<f64>,
     /// Contact-aware Newton: `jac` plus the contacts' Jacobian at the current iterate.
     newton_jac: Vec<f64>,
-    /// Contact-aware Newton: the LU holds `I - h d jac` (no contact term).
+    /// Contact-aware Newton: the LU holds `I - h d jac` (no contact term). After each
+    /// iterate's factorisation this is true exactly when no contact was active at the iterate;
+    /// otherwise `newton_jac` is the Jacobian there.
     lu_contact_free: bool,
     /// Contact-aware Newton: the `J` the LU was made from.
     lu_jac: Vec<f64>,
@@ -116,9 +118,6 @@ pub struct Integrator {
     newton_z_is_new: bool,
     /// That update (`z` minus the iterate `fz` was evaluated at), when `newton_z_is_new`.
     last_dz: Vec<f64>,
-    /// Contact-aware Newton: `newton_jac` is the Jacobian at the last evaluated iterate (false:
-    /// no contact was active there, and `jac` is).
-    newton_jac_at_iterate: bool,
     jac_fresh: bool,
     jac_age: u32,
     /// Perturbed state and derivative for the finite differences (no allocation per call).
@@ -268,7 +267,6 @@ impl Integrator {
             newton_eta: 1.0,
             newton_z_is_new: false,
             last_dz: v(),
-            newton_jac_at_iterate: false,
             jac_fresh: false,
             jac_age: u32::MAX,
             jac_y: v(),
@@ -349,8 +347,8 @@ impl Integrator {
         self.contact_aware() && self.settings.patches == ContactPatches::PerStep
     }
 
-    /// The next step's start from the contact-aware Newton's last iterate `z_p` (the accepted
-    /// `z = z_p + Δz`, or `z_p` itself when Newton stopped on its residual): `f(z) = f(z_p) +
+    /// The next step's start from Newton's last iterate `z_p` (the accepted `z = z_p + Δz` of
+    /// the contact-aware Newton, or `z_p` itself when Newton stopped on its residual): `f(z) = f(z_p) +
     /// J(z_p) Δz + O(|Δz|²)` with the Jacobian that Newton assembled at `z_p`, the power terms
     /// (energy account) and the tracks (wear) of `z_p`, and with frozen patches the overlaps
     /// refreshed at `z` ([`MultibodySystem::refresh_patches`]). `Δz` is Newton's last update,
@@ -367,10 +365,12 @@ impl Integrator {
         let n = self.n;
         self.k[0].copy_from_slice(&self.fz);
         if self.newton_z_is_new {
-            let jac = if self.newton_jac_at_iterate {
-                &self.newton_jac
-            } else {
+            // The LU of the last iterate is contact-free exactly when no contact was active
+            // there (`factorize_at_iterate`); otherwise `newton_jac` was assembled there.
+            let jac = if self.lu_contact_free {
                 &self.jac
+            } else {
+                &self.newton_jac
             };
             for (column, &d) in jac.chunks_exact(n).zip(&self.last_dz) {
                 if d != 0.0 {
@@ -481,14 +481,10 @@ impl Integrator {
                 self.prev_h = h;
                 match self.settings.kind {
                     IntegratorKind::Dopri5 => self.k.swap(0, 6),
-                    _ if self.contact_aware() => self.start_from_last_iterate(sys, ws, t_new, y),
-                    _ if self.newton_z_is_new => self.step_start_rhs(sys, ws, t_new, y),
-                    _ => {
-                        self.k[0].copy_from_slice(&self.fz);
-                        sys.rescale_quaternion_rates(&self.ynew, &mut self.k[0]);
-                        // The last Newton evaluation was at the accepted state.
-                        self.power_start = ws.power;
+                    _ if self.newton_z_is_new && !self.contact_aware() => {
+                        self.step_start_rhs(sys, ws, t_new, y)
                     }
+                    _ => self.start_from_last_iterate(sys, ws, t_new, y),
                 }
                 self.jac_fresh = false;
                 self.jac_age = self.jac_age.saturating_add(1);
