@@ -446,9 +446,21 @@ fn exit_now() -> ! {
     std::process::exit(0)
 }
 
+/// A failed command prints its error and the chain of causes on one line (`error: a: b`) and
+/// exits with status 1; never a stack backtrace, whatever `RUST_BACKTRACE` says (the errors
+/// name the field and the rule; a backtrace is for a panic).
 #[tokio::main]
-async fn main() -> Result<()> {
-    let cli = Cli::parse();
+async fn main() -> std::process::ExitCode {
+    match run(Cli::parse()).await {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+async fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Serve {
             listen,

@@ -81,7 +81,12 @@ pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<Excitat
         let text = std::fs::read_to_string(&path).map_err(|e| {
             FieldError::new(
                 "excitation.profile",
-                format!("cannot read {}: {e}", path.display()),
+                format!(
+                    "cannot read {} (profiles are looked up in the configs directory's \
+                     profiles/, here {}; the CLI's --configs-dir sets it): {e}",
+                    path.display(),
+                    configs_dir.display()
+                ),
             )
         })?;
         let file = ProfileFile::from_toml_str(&text)

@@ -4,6 +4,7 @@
 mod body_transient;
 mod carrier_frame;
 mod checkpoint_resume;
+mod cli_errors;
 mod contact_fit;
 mod energy_passivity;
 mod engine_closed_forms;

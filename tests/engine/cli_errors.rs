@@ -1,0 +1,58 @@
+//! A failed CLI command prints one line, `error: ` and the chain of causes naming the field and
+//! the rule, and exits with status 1: never a stack backtrace, even with `RUST_BACKTRACE=1`
+//! set (as it is on the development machines).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn railwear(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_railwear"))
+        .args(args)
+        .env("RUST_BACKTRACE", "1")
+        .env("RUST_LIB_BACKTRACE", "1")
+        .output()
+        .expect("railwear runs")
+}
+
+fn assert_one_line_error(out: &Output, names: &[&str]) {
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.starts_with("error: "), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!err.to_lowercase().contains("backtrace"), "{err}");
+    for name in names {
+        assert!(err.contains(name), "{name} missing from: {err}");
+    }
+}
+
+#[test]
+fn a_missing_case_file_is_one_line_naming_the_field() {
+    let out = railwear(&[
+        "run",
+        "/nonexistent/railwear-case.toml",
+        "--duration",
+        "0.1",
+    ]);
+    assert_one_line_error(&out, &["`config`", "/nonexistent/railwear-case.toml"]);
+}
+
+#[test]
+fn a_profile_missing_from_the_configs_directory_names_the_field_and_the_flag() {
+    // A configs directory holding the launcher's case but not its profiles/.
+    let dir: PathBuf =
+        std::env::temp_dir().join(format!("railwear-cli-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("launcher-design.toml");
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(manifest.join("configs/launcher-design.toml"), &case).unwrap();
+    let out = railwear(&[
+        "run",
+        case.to_str().unwrap(),
+        "--configs-dir",
+        dir.to_str().unwrap(),
+        "--duration",
+        "0.1",
+    ]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_one_line_error(&out, &["`excitation.profile`", "--configs-dir", "profiles"]);
+}
