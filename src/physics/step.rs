@@ -8,6 +8,10 @@
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
+/// `1 / (2π)`: the cycloid's sine term as a product (a division was one of a contact node's
+/// dozen).
+const FRAC_1_TAU: f64 = 0.5 / PI;
+
 /// Which smooth step to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -28,7 +32,7 @@ impl StepKind {
         if span == 0.0 {
             return if x < x1 { h1 } else { h2 };
         }
-        let u = ((x - x1) / span).clamp(0.0, 1.0);
+        let u = ((x - x1) * (1.0 / span)).clamp(0.0, 1.0);
         h1 + (h2 - h1) * self.unit(u)
     }
 
@@ -39,11 +43,12 @@ impl StepKind {
         if span == 0.0 {
             return 0.0;
         }
-        let u = (x - x1) / span;
+        let inv_span = 1.0 / span;
+        let u = (x - x1) * inv_span;
         if !(0.0..=1.0).contains(&u) {
             return 0.0;
         }
-        (h2 - h1) * self.unit_derivative(u) / span
+        (h2 - h1) * self.unit_derivative(u) * inv_span
     }
 
     /// [`StepKind::eval`] and [`StepKind::derivative`] at once, bit for bit: for the
@@ -56,7 +61,9 @@ impl StepKind {
         if span == 0.0 {
             return (if x < x1 { h1 } else { h2 }, 0.0);
         }
-        let u = (x - x1) / span;
+        // One division: the argument and the slope share `1 / span`.
+        let inv_span = 1.0 / span;
+        let u = (x - x1) * inv_span;
         if !(0.0..=1.0).contains(&u) {
             return (self.eval(x, x1, h1, x2, h2), 0.0);
         }
@@ -64,13 +71,13 @@ impl StepKind {
             StepKind::Cycloidal => {
                 let (sin, cos) = sin_cos_turns(u);
                 (
-                    h1 + (h2 - h1) * (u - sin / (2.0 * PI)),
-                    (h2 - h1) * (1.0 - cos) / span,
+                    h1 + (h2 - h1) * (u - sin * FRAC_1_TAU),
+                    (h2 - h1) * (1.0 - cos) * inv_span,
                 )
             }
             StepKind::Cubic => (
                 h1 + (h2 - h1) * self.unit(u),
-                (h2 - h1) * self.unit_derivative(u) / span,
+                (h2 - h1) * self.unit_derivative(u) * inv_span,
             ),
         }
     }
@@ -79,7 +86,7 @@ impl StepKind {
     #[inline]
     pub fn unit(self, u: f64) -> f64 {
         match self {
-            StepKind::Cycloidal => u - sin_cos_turns(u).0 / (2.0 * PI),
+            StepKind::Cycloidal => u - sin_cos_turns(u).0 * FRAC_1_TAU,
             StepKind::Cubic => u * u * (3.0 - 2.0 * u),
         }
     }

@@ -299,12 +299,14 @@ pub(super) fn friction_derivatives(
     };
     let speed = slip.norm();
     if speed > 0.0 {
-        let dir = slip / speed;
+        // One division for the direction and `μ/|s|`.
+        let inv_speed = 1.0 / speed;
+        let dir = slip * inv_speed;
         let along = dir * dir.transpose();
         let (mu, dmu) = mu.unwrap_or_else(|| fr.coefficient_with_derivative(speed));
         (
             normal - dir * mu,
-            -(along * dmu + (tangent - along) * (mu / speed)) * fn_mag,
+            -(along * dmu + (tangent - along) * (mu * inv_speed)) * fn_mag,
         )
     } else {
         (
