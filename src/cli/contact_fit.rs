@@ -1,5 +1,5 @@
 //! `railwear contact-fit`: the IMPACT stiffness k and exponent e of a sphere on a flat, fitted
-//! to a quasistatic model of thesis 2.3.1 ([`crate::contact_models::impact_fit`]), printed with
+//! to a quasistatic model of thesis 2.3.1 ([`crate::contact_models::impact_fit()`]), printed with
 //! the fitted range and the weighting.
 
 use crate::contact_models::{impact_fit, ContactModelError, FitSpace, ImpactFit, ImpactFitSpec};

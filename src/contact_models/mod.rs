@@ -1,7 +1,7 @@
 //! Quasistatic sphere-on-flat contact models of thesis 2.3.1 (Hertz, fully plastic,
 //! Jackson-Green, Kogut-Etsion) and their least-squares fits to the IMPACT spring `k w^e`.
 //!
-//! They choose IMPACT stiffness and exponent from material data ([`impact_fit`], the
+//! They choose IMPACT stiffness and exponent from material data ([`impact_fit()`], the
 //! `railwear contact-fit` command, and the Table 2.1/2.2 anchors of `railwear validate`); they
 //! are not used inside the time integration itself.
 

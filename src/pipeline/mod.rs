@@ -3,10 +3,10 @@
 //! A job hands a case configuration (JSON, the same schema as the TOML files in `configs/`)
 //! and a [`RunControl`]; it gets back a [`CaseOutcome`] or a [`RunError`].
 //!
-//! [`run_case`] runs a case to its packaged outcome ([`run`]). One file per job kind's
-//! parameters: [`case`] (simulate jobs: params to a validated case),
-//! [`sweep_range`] (the rattle-space range a sweep covers), [`sweep`] (the planned sweep, its
-//! points, labels and assembly), [`calibrate`] (calibration data sets), [`diagnose`] (a
+//! [`run_case`] runs a case to its packaged outcome (`run`). One file per job kind's
+//! parameters: `case` (simulate jobs: params to a validated case),
+//! `sweep_range` (the rattle-space range a sweep covers), `sweep` (the planned sweep, its
+//! points, labels and assembly), [`calibrate`] (calibration data sets), `diagnose` (a
 //! diagnosis' options). The bounds every parser applies are in [`limits`], the physical range
 //! of every case field in [`bounds`]. Each kind's params are parsed once, at submission, into
 //! its typed plan, stored as canonical JSON ([`plan_to_json`]) and run by the worker from there

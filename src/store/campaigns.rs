@@ -54,7 +54,7 @@ pub struct CampaignRecord {
     pub content: String,
 }
 
-/// What [`Store::insert_campaign`] did.
+/// What [`Store::insert_campaign`](super::Store::insert_campaign) did.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CampaignInsert {
     /// A new record.

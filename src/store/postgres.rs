@@ -4,11 +4,11 @@
 //! `FOR UPDATE SKIP LOCKED` inside one transaction (concurrent claimers skip each other's row
 //! instead of waiting or taking it twice), every worker write is fenced by the job's attempt, and
 //! expired leases go back to the queue until `max_attempts`. The operations both engines share
-//! are in [`super::portable`]; this file holds the connection, the dialect ([`Dialect`]), and
+//! are in `store::portable`; this file holds the connection, the dialect (`Dialect`), and
 //! how claims and the lease sweeps pick and lock their rows.
 //!
 //! Lock order, to keep concurrent writers free of deadlocks: a transaction that touches a child
-//! job and its parent locks the parent row first ([`Dialect::LOCK_PARENT`]), then the child.
+//! job and its parent locks the parent row first (`Dialect::LOCK_PARENT`), then the child.
 
 use super::delegate::portable_store_methods;
 use super::dialect::Dialect;

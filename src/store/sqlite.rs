@@ -1,8 +1,8 @@
 //! SQLite implementation of [`Store`]: WAL journal (readers never block the writer), a busy
 //! timeout, `BEGIN IMMEDIATE` for multi-statement writes (takes the write lock up front, so two
 //! writers queue instead of deadlocking on a lock upgrade), single-statement job claims. The
-//! operations both engines share are in [`super::portable`]; this file holds the connection,
-//! the dialect ([`Dialect`]), and how claims and the lease sweeps pick and lock their rows.
+//! operations both engines share are in `store::portable`; this file holds the connection,
+//! the dialect (`Dialect`), and how claims and the lease sweeps pick and lock their rows.
 
 use super::delegate::portable_store_methods;
 use super::dialect::Dialect;

@@ -315,7 +315,7 @@ pub struct Scores {
     /// and secondary values the diagnosis fitted (measured ones included).
     #[serde(default)]
     pub intervals_checked: usize,
-    /// Of those, the share whose interval holds the drawn value ([`interval_hits`]).
+    /// Of those, the share whose interval holds the drawn value (`interval_hits`).
     #[serde(default)]
     pub interval_coverage: f64,
     /// The magnitudes alone: checked and the share held.

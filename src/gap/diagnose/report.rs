@@ -106,7 +106,7 @@ pub struct RankEntry {
     /// Share of the nominal model's excess chi-square (chi2 - dof) the full-data fit removes.
     pub explained_share: f64,
     /// Explains the gap: gain > MIN_HELD_OUT_GAIN, residual p-value >= alpha and at least
-    /// [`MIN_EXPLAINED_SHARE`] of the excess removed.
+    /// [`MIN_EXPLAINED_SHARE`](super::MIN_EXPLAINED_SHARE) of the excess removed.
     pub explains: bool,
 }
 

@@ -1,7 +1,7 @@
 //! `/v1/rails`: the rail registry by serial number, measured dimensions -> rattle space at once
 //! (eq. 6.1-6.3) and measurement history; the service-life report (K_SL and the penalized life
 //! with 0.9/0.8 bands, eq. 6.4, Figure 6.68, or a clear answer saying which sweep to run) is
-//! [`report`].
+//! `report`.
 
 mod report;
 

@@ -299,7 +299,7 @@ impl Integrator {
     }
 
     /// Newton's last update `Δz` of the last accepted step when the step's tracks and power
-    /// terms are those of the iterate before it, `z − Δz` ([`Integrator::start_from_last_iterate`]),
+    /// terms are those of the iterate before it, `z − Δz` (`Integrator::start_from_last_iterate`),
     /// and `None` when they are at the accepted state.
     pub fn last_newton_update(&self) -> Option<&[f64]> {
         (self.contact_aware() && self.newton_z_is_new).then_some(self.last_dz.as_slice())
