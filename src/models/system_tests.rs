@@ -235,7 +235,7 @@ fn analytic_contact_jacobian(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, usi
     let mut f = vec![0.0; n];
     sys.derivative(0.0, y, &mut f, &mut ws);
     let mut jac = vec![0.0; n * n];
-    sys.contact_jacobian(y, &ws, &mut jac);
+    sys.contact_jacobian(y, &mut ws, &mut jac);
     // Points' records (list) and tracks' summed records (moments).
     (
         jac,

@@ -56,12 +56,18 @@ pub struct Workspace {
     /// Keep the active tracks of each derivative evaluation in `tracks`.
     pub keep_tracks: bool,
     /// Stored energy and power terms of the last derivative evaluation with contacts (like
-    /// `tracks`, those of the accepted state after a step).
+    /// `tracks`, those of the step's last evaluation after a step).
     pub power: PowerBalance,
     /// Active tracks of the last derivative evaluation with contacts (when `keep_tracks`).
     /// After [`Integrator::advance`](super::integrator::Integrator::advance) these are the
-    /// tracks at the accepted state: its last evaluation is there.
+    /// tracks of the step's last evaluation: the accepted state's, or with the contact-aware
+    /// Newton its last iterate's (first order in Newton's last update off the accepted state),
+    /// with the accepted state's areas.
     pub tracks: Vec<TrackState>,
+    /// Scratch of [`MultibodySystem::contact_jacobian`]: one block per (source, target) body.
+    jacobian_blocks: Vec<Option<Matrix6x12>>,
+    /// Scratch of [`MultibodySystem::energy`]: the force elements' wrenches it discards.
+    energy_wrenches: Vec<Wrench>,
 }
 
 /// The stored elastic energy and the power terms of one derivative evaluation, for the energy
@@ -160,6 +166,8 @@ impl MultibodySystem {
             keep_tracks: false,
             power: PowerBalance::default(),
             tracks: Vec::new(),
+            jacobian_blocks: vec![None; self.bodies.len() * self.bodies.len()],
+            energy_wrenches: vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()],
         }
     }
 
@@ -304,14 +312,16 @@ impl MultibodySystem {
     /// torque's lever, and the turn of the body-frame torque `Rᵀ τ` with the body. Left out:
     /// the turn of a face's normal with body b (the gyroscopic term is in the contact-free
     /// part). Checked against finite differences on every column (`physics::system` tests).
-    pub fn contact_jacobian(&self, y: &[f64], ws: &Workspace, jac: &mut [f64]) {
+    pub fn contact_jacobian(&self, y: &[f64], ws: &mut Workspace, jac: &mut [f64]) {
         let n = self.state_len;
         let nb = self.bodies.len();
         // Per (source body k, target body m): the force and the torque about m's centre of
         // mass on m, differentiated by k's [δx, δθ, δv, δω_world]. The tracks' moments and any
         // per-point records (in the points' order) are summed into these blocks, which are mapped
         // to the state once.
-        let mut blocks: Vec<Option<Matrix6x12>> = vec![None; nb * nb];
+        let mut blocks = std::mem::take(&mut ws.jacobian_blocks);
+        blocks.clear();
+        blocks.resize(nb * nb, None);
         let dynamic = |k: usize| matches!(self.bodies[k].kind, BodyKind::Dynamic { .. });
         for sum in &ws.linearization_moments {
             sum.add_blocks(&ws.frames, dynamic, &mut blocks);
@@ -450,6 +460,7 @@ impl MultibodySystem {
                 }
             }
         }
+        ws.jacobian_blocks = blocks;
     }
 
     /// After an implicit step accepted at `(t, y)` with the tracks of its last Newton iterate
@@ -499,10 +510,13 @@ impl MultibodySystem {
     /// Mechanical energy of the state (kinematic bodies excluded from kinetic energy).
     pub fn energy(&self, t: f64, y: &[f64], ws: &mut Workspace) -> Energy {
         let mut e = self.motion_energy(t, y, ws);
-        let mut wr = vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()];
+        let mut wr = std::mem::take(&mut ws.energy_wrenches);
+        wr.clear();
+        wr.resize(self.bodies.len(), (Vector3::zeros(), Vector3::zeros()));
         for f in &self.forces {
             e.elastic += f.accumulate(&ws.frames, &mut wr);
         }
+        ws.energy_wrenches = wr;
         for (ci, c) in self.contacts.iter().enumerate() {
             e.elastic += c.evaluate(ci as u32, &ws.frames, None, &mut |_| {});
         }

@@ -414,7 +414,7 @@ pub(crate) fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>
     sys.derivative(0.0, y, &mut f, &mut ws);
     assert!(!ws.linearization_moments.is_empty());
     let mut analytic = vec![0.0; n * n];
-    sys.contact_jacobian(y, &ws, &mut analytic);
+    sys.contact_jacobian(y, &mut ws, &mut analytic);
     let full = fd_jacobian(sys, y, true);
     let free = fd_jacobian(sys, y, false);
     let contact = full.iter().zip(&free).map(|(a, b)| a - b).collect();

@@ -25,7 +25,7 @@ fn both_jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>, usiz
     assert!(ws.linearizations.is_empty(), "exact faces sum per track");
     let tracks = ws.linearization_moments.len();
     let mut by_track = vec![0.0; n * n];
-    sys.contact_jacobian(y, &ws, &mut by_track);
+    sys.contact_jacobian(y, &mut ws, &mut by_track);
     let mut per_node = Vec::new();
     for (ci, c) in sys.contacts.iter().enumerate() {
         c.evaluate_with(
@@ -45,7 +45,7 @@ fn both_jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>, usiz
     nodes_ws.linearizations = per_node;
     nodes_ws.linearization_moments.clear();
     let mut by_node = vec![0.0; n * n];
-    sys.contact_jacobian(y, &nodes_ws, &mut by_node);
+    sys.contact_jacobian(y, &mut nodes_ws, &mut by_node);
     (by_track, by_node, tracks)
 }
 

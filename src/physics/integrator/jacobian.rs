@@ -117,7 +117,7 @@ impl Integrator {
     pub(super) fn factorize_at_iterate(
         &mut self,
         sys: &MultibodySystem,
-        ws: &Workspace,
+        ws: &mut Workspace,
         hd: f64,
         t: f64,
     ) -> bool {
