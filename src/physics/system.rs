@@ -64,9 +64,11 @@ pub struct Workspace {
     /// Newton its last iterate's (first order in Newton's last update off the accepted state),
     /// with the accepted state's areas.
     pub tracks: Vec<TrackState>,
-    /// Scratch of [`MultibodySystem::contact_jacobian`]: one block per (source, target) body.
+    /// Scratch of [`MultibodySystem::contact_jacobian`]: one block per (source, target) body
+    /// (sized there, where it is filled).
     jacobian_blocks: Vec<Option<Matrix6x12>>,
-    /// Scratch of [`MultibodySystem::energy`]: the force elements' wrenches it discards.
+    /// Scratch of [`MultibodySystem::energy`]: the force elements' wrenches it discards (sized
+    /// there).
     energy_wrenches: Vec<Wrench>,
 }
 
@@ -166,8 +168,8 @@ impl MultibodySystem {
             keep_tracks: false,
             power: PowerBalance::default(),
             tracks: Vec::new(),
-            jacobian_blocks: vec![None; self.bodies.len() * self.bodies.len()],
-            energy_wrenches: vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()],
+            jacobian_blocks: Vec::new(),
+            energy_wrenches: Vec::new(),
         }
     }
 
