@@ -115,6 +115,9 @@ enum Command {
         /// factor 1 runs at it too).
         #[arg(long)]
         points_per_edge: Option<usize>,
+        /// Timed runs of each engine row (railwear's and the peers'); the fastest is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
     },
     /// Launcher reference run (launcher-design, AH-64 transverse): real-time factor and the
     /// peak memory of a long run with all contact tracks stored.
@@ -406,6 +409,7 @@ fn main() -> Result<()> {
             peer_args,
             tolerance_factors,
             points_per_edge,
+            repeats,
         } => peers(
             &cli.configs_dir,
             *with_peers,
@@ -416,6 +420,7 @@ fn main() -> Result<()> {
             &ExtraRuns {
                 tolerance_factors: parse_list(tolerance_factors, "--tolerance-factors")?,
                 points_per_edge: *points_per_edge,
+                repeats: *repeats,
             },
         )?,
         Command::Launcher {
