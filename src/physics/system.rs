@@ -3,7 +3,7 @@
 
 use super::body::{frame_from_state, BodyFrame, BodyKind, RigidBody, BODY_STATE_LEN};
 use super::contact::{
-    Contact, EvaluationOutputs, GeometryCache, GeometryMode, Matrix6x12, PointLoad,
+    Contact, EvaluationOutputs, GeometryCache, GeometryMode, JacobianScope, Matrix6x12, PointLoad,
     TrackLinearization, TrackMoments, TrackState,
 };
 use super::forces::{ForceElement, Wrench};
@@ -43,6 +43,9 @@ pub struct Workspace {
     pub geometry: GeometryCache,
     /// Record each active track's force derivatives during a derivative evaluation.
     pub linearize: bool,
+    /// Which nodes' derivatives `linearize` takes: every node's (the exact Jacobian, the
+    /// default) or a Newton matrix's ([`JacobianScope`]).
+    pub jacobian_scope: JacobianScope,
     /// Force derivatives per contact point or node: filled only by an evaluation asked for
     /// them without moments (the per-point reference tests/engine/face_contact_blocks.rs
     /// compares the moments with); [`MultibodySystem::derivative`] asks for both, so the
@@ -162,6 +165,7 @@ impl MultibodySystem {
             wrenches: vec![(Vector3::zeros(), Vector3::zeros()); self.bodies.len()],
             geometry: GeometryCache::default(),
             linearize: false,
+            jacobian_scope: JacobianScope::Exact,
             linearizations: Vec::new(),
             linearization_moments: Vec::new(),
             skip_contacts: false,
@@ -252,6 +256,7 @@ impl MultibodySystem {
                         linearizations: ws.linearize.then_some(&mut ws.linearizations),
                         moments: ws.linearize.then_some(&mut ws.linearization_moments),
                         points: None,
+                        scope: ws.jacobian_scope,
                     },
                 );
             }

@@ -385,7 +385,7 @@ pub(crate) fn pressed_cube(moving: bool) -> (MultibodySystem, Vec<f64>) {
     (model.system, y)
 }
 
-fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64> {
+pub(crate) fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64> {
     let n = sys.state_len();
     let mut ws = sys.workspace();
     ws.skip_contacts = !with_contacts;

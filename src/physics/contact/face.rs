@@ -16,7 +16,7 @@
 
 use super::point::{friction_derivatives, Lump, PointOutputs};
 use super::Contact;
-use super::TrackLinearization;
+use super::{JacobianScope, TrackLinearization};
 use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use crate::physics::step::StepKind;
@@ -72,6 +72,15 @@ const ROUNDED_EDGE_SLICES: usize = 2;
 /// `(U_fine − U_side) ∇λ`: zero on the ramps, whose side rule is exact for the stored
 /// energy too, and a strip's quadrature difference on the strips.
 const FACING: (f64, f64) = (0.3, 0.5);
+
+/// A Newton matrix ([`JacobianScope::NewtonMatrix`]) leaves out the side faces' nodes (beyond
+/// [`FACING`]'s 72.5°) of a piece pressed `w` deep when `w P <= SIDE_SHARE_MAX A`, with `A`
+/// and `P` the area and perimeter of its inner face that most faces the plane. The side faces
+/// are then pressed in slivers at most `w` high along at most `P`, so their share of the
+/// track's stiffness, damping and friction derivatives is at most about `w P / A`
+/// (docs/models.md "The Newton matrix leaves out the side faces"); beyond it (a degenerate
+/// or narrow face, a deep press) every node is linearized.
+const SIDE_SHARE_MAX: f64 = 0.02;
 
 /// The ramp rule of the faces that do not face the plane ([`FACING`]): 3 nodes across the
 /// ramp instead of 5, for both its closing part ([`CLOSING_RAMP_RULE`]) and its separating
@@ -143,6 +152,22 @@ impl PartRule {
             _ => None,
         }
     }
+}
+
+/// Whether the side faces of an inner box of half extents `inner` placed by `pose`, pressed
+/// `depth` deep against a plane of unit normal `normal`, are slivers a Newton matrix may leave
+/// out ([`SIDE_SHARE_MAX`]): `depth P <= SIDE_SHARE_MAX A` for the inner face that most faces
+/// the plane.
+fn side_faces_are_slivers(
+    inner: &Vector3<f64>,
+    pose: &Isometry3<f64>,
+    normal: &Vector3<f64>,
+    depth: f64,
+) -> bool {
+    let local = pose.rotation.inverse_transform_vector(normal);
+    let k = local.iamax();
+    let (a, b) = (inner[(k + 1) % 3], inner[(k + 2) % 3]);
+    depth * 4.0 * (a + b) <= SIDE_SHARE_MAX * 4.0 * a * b
 }
 
 /// The share of the facing rules at `|n_F · n| = facing` ([`FACING`]): 1 within 60° of facing
@@ -241,14 +266,22 @@ impl Contact {
         pose: &Isometry3<f64>,
         inner: &Vector3<f64>,
         radius: f64,
+        depth: f64,
         face: &PlacedFace,
         out: &mut PointOutputs<'_, '_>,
     ) {
         let normal = face.plane.normal.into_inner();
         let mut deepest: Option<(f64, Point3<f64>)> = None;
+        let side_faces_unlinearized = out.scope == JacobianScope::NewtonMatrix
+            && out.linearizing()
+            && side_faces_are_slivers(inner, pose, &normal, depth);
         for (centre, axis_u, axis_v) in inner_box_faces(inner, pose) {
             // The share of the facing rules on this face ([`FACING`]).
             let fine = facing_share(axis_u.cross(&axis_v).normalize().dot(&normal).abs());
+            // A Newton matrix leaves a side face's nodes out ([`JacobianScope::NewtonMatrix`]):
+            // their derivatives are not taken, their forces are.
+            let unlinearized = (fine == 0.0 && side_faces_unlinearized)
+                .then(|| (out.linearizations.take(), out.moments.take()));
             let mut each = |part: &FacePatch, beyond_side: bool| {
                 if beyond_side {
                     self.integrate_strip(part, fine, fa, fb, radius, face, out);
@@ -283,6 +316,10 @@ impl Contact {
             };
             // The strips beyond a side come only from a bounded face.
             FacePatch::for_each_part(centre, axis_u, axis_v, radius, face, &mut each);
+            if let Some((linearizations, moments)) = unlinearized {
+                out.linearizations = linearizations;
+                out.moments = moments;
+            }
         }
         // The track's penetration is the patch's deepest vertex (the exact maximum of the
         // linear `w`), not the deepest node.

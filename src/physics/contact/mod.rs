@@ -203,6 +203,20 @@ pub struct PointLoad {
     pub slip_speed: f64,
 }
 
+/// Which nodes' force derivatives a linearizing evaluation takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JacobianScope {
+    /// Every point's and node's: the exact contact Jacobian.
+    #[default]
+    Exact,
+    /// All but the exact face contact's side faces, the inner faces turned more than 72.5°
+    /// from the plane (the face contact's `FACING`): a Newton matrix. Those faces are pressed in
+    /// slivers at most `w` high, whose share of a track's stiffness and damping is of the order
+    /// of `w` over the pressed face's width (docs/models.md "The Newton matrix leaves out the
+    /// side faces"); their forces are all still evaluated.
+    NewtonMatrix,
+}
+
 /// What an evaluation hands out besides forces and tracks (each when given): every active
 /// track's force derivatives, and every touching point's load.
 #[derive(Default)]
@@ -215,6 +229,8 @@ pub struct EvaluationOutputs<'a> {
     pub moments: Option<&'a mut Vec<TrackMoments>>,
     /// Receives each touching contact point's load.
     pub points: Option<&'a mut dyn FnMut(&PointLoad)>,
+    /// Which nodes' derivatives are taken (when they are).
+    pub scope: JacobianScope,
 }
 
 /// Local derivatives of one contact point's force at one instant, for the contact-aware Newton
@@ -360,6 +376,7 @@ impl Contact {
             mut linearizations,
             mut moments,
             mut points,
+            scope,
         } = outputs;
         let fa = &frames[self.body_a];
         let fb = &frames[self.body_b];
@@ -398,6 +415,7 @@ impl Contact {
                     tangent: PointOutputs::NO_TANGENT,
                     lump: None,
                     lump_nodes: &mut lump_nodes,
+                    scope,
                 };
                 match (self.face_contact, shape) {
                     (
@@ -408,7 +426,9 @@ impl Contact {
                         },
                     ) => {
                         let inner = half_extents.map(|h| (h - roundover).max(0.0));
-                        self.evaluate_faces(fa, fb, &pose, &inner, *roundover, &placed, &mut out);
+                        self.evaluate_faces(
+                            fa, fb, &pose, &inner, *roundover, ov.depth, &placed, &mut out,
+                        );
                     }
                     _ => {
                         // Narrow-phase cull: a point whose ball centre lies farther above the

@@ -34,6 +34,8 @@ pub(super) struct PointOutputs<'s, 'p> {
     /// While [`PointOutputs::lump`] is set and derivatives are taken, each point's
     /// derivatives wait here for the part's friction direction ([`super::Contact::end_lump`]).
     pub(super) lump_nodes: &'s mut Vec<TrackLinearization>,
+    /// Which nodes' derivatives are taken ([`super::JacobianScope`]).
+    pub(super) scope: super::JacobianScope,
 }
 
 /// The normal loads of a part's points, for its friction at their load centre

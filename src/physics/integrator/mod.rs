@@ -56,7 +56,7 @@ pub use settings::{
 };
 
 use super::body::{BodyKind, BODY_STATE_LEN};
-use super::contact::GeometryMode;
+use super::contact::{GeometryMode, JacobianScope};
 use super::newton_matrix::NewtonLu;
 use super::system::{MultibodySystem, Workspace};
 use diagnostics::{contact_change, contact_set_into};

@@ -22,12 +22,14 @@ impl Integrator {
         for iter in 0..10 {
             let mut fz = std::mem::take(&mut self.fz);
             ws.linearize = contact_aware;
+            ws.jacobian_scope = JacobianScope::NewtonMatrix;
             if frozen {
                 ws.geometry.set_mode(GeometryMode::Frozen);
             }
             sys.derivative(ts, &self.z, &mut fz, ws);
             ws.geometry.set_mode(GeometryMode::Compute);
             ws.linearize = false;
+            ws.jacobian_scope = JacobianScope::Exact;
             self.stats.rhs_evals += 1;
             for i in 0..self.n {
                 self.tmp[i] = -(self.z[i] - hd * fz[i] - self.rhs[i]);
