@@ -535,6 +535,32 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     eprintln!("exact: F {f_e:?} τ {t_e:?}");
 }
 
+/// launcher-design without excitation in the exact face contact, its integrator settings, and
+/// its state after `settle_s` at rest.
+pub(crate) fn settled_exact_launcher(
+    settle_s: f64,
+) -> (
+    railwear::models::run::BuiltModel,
+    railwear::physics::integrator::IntegratorSettings,
+    Vec<f64>,
+) {
+    let mut case =
+        railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
+    case.excitation = serde_json::json!({ "kind": "none" });
+    case.simulation.face_contact = Some(FaceContact::Exact);
+    let model = railwear::models::case::build(&case, configs()).expect("model");
+    let settings = railwear::models::case::integrator_settings(&case).expect("settings");
+    let rest = railwear::validation::energy::energy_run(
+        &model.system,
+        &model.initial_state,
+        settings,
+        settle_s,
+    )
+    .expect("settles")
+    .state;
+    (model, settings, rest)
+}
+
 #[test]
 fn random_missile_states_never_gain_energy_with_the_exact_face_contact() {
     // As the lattice's test in `energy_passivity`: launcher-design without excitation, in the
@@ -543,16 +569,8 @@ fn random_missile_states_never_gain_energy_with_the_exact_face_contact() {
     // running minimum by more than PASSIVITY_TOLERANCE of what was available, and the energy
     // account closes within BALANCE_TOLERANCE of the dissipated work (SPEC §2).
     use railwear::validation::energy::{energy_run, BALANCE_TOLERANCE, PASSIVITY_TOLERANCE};
-    let mut case =
-        railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
-    case.excitation = serde_json::json!({ "kind": "none" });
-    case.simulation.face_contact = Some(FaceContact::Exact);
-    let model = railwear::models::case::build(&case, configs()).expect("model");
-    let settings = railwear::models::case::integrator_settings(&case).expect("settings");
+    let (model, settings, rest) = settled_exact_launcher(1.0);
     let sys = &model.system;
-    let rest = energy_run(sys, &model.initial_state, settings, 1.0)
-        .expect("settles")
-        .state;
     let mut ws = sys.workspace();
     let rest_energy = sys.energy(0.0, &rest, &mut ws).total();
     let mut rng = ChaCha8Rng::seed_from_u64(127);

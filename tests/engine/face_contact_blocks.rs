@@ -140,23 +140,10 @@ fn newton_contraction(free: &[f64], newton: &[f64], exact: &[f64], n: usize, hd:
 #[test]
 fn the_newton_matrix_leaves_out_only_derivatives_that_newton_does_not_need() {
     // Launcher-design at rest, then the missile shifted, turned and moving at random: the
-    // shoes on the rail lips and the latch pressed at their settled depths, where the
-    // side faces of the latch's and the small shoe heads' pieces are slivers
-    // (`SIDE_SHARE_MAX`); the large pieces are pressed too deep for it and keep every node.
-    let mut case =
-        railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
-    case.excitation = serde_json::json!({ "kind": "none" });
-    case.simulation.face_contact = Some(FaceContact::Exact);
-    let model = railwear::models::case::build(&case, configs()).expect("model");
-    let settings = railwear::models::case::integrator_settings(&case).expect("settings");
-    let rest = railwear::validation::energy::energy_run(
-        &model.system,
-        &model.initial_state,
-        settings,
-        0.3,
-    )
-    .expect("settles")
-    .state;
+    // shoes on the rail lips and the latch pressed at their settled depths. The side faces of
+    // the latch's tooth and of the mid shoe's protrusion are slivers there (`SIDE_SHARE_MAX`);
+    // the shoe heads, pressed about 0.47 mm, keep every node.
+    let (model, _, rest) = super::face_contact::settled_exact_launcher(0.3);
     let sys = &model.system;
     let n = sys.state_len();
     let mut rng = ChaCha8Rng::seed_from_u64(2728);
