@@ -385,7 +385,13 @@ pub(crate) fn pressed_cube(moving: bool) -> (MultibodySystem, Vec<f64>) {
     (model.system, y)
 }
 
-pub(crate) fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool) -> Vec<f64> {
+/// Central differences of the derivative at `(t, y)`, with or without the contacts.
+pub(crate) fn fd_jacobian(
+    sys: &MultibodySystem,
+    t: f64,
+    y: &[f64],
+    with_contacts: bool,
+) -> Vec<f64> {
     let n = sys.state_len();
     let mut ws = sys.workspace();
     ws.skip_contacts = !with_contacts;
@@ -395,9 +401,9 @@ pub(crate) fn fd_jacobian(sys: &MultibodySystem, y: &[f64], with_contacts: bool)
         let delta = 1e-7 * y[j].abs().max(1e-3);
         let mut yp = y.to_vec();
         yp[j] += delta;
-        sys.derivative(0.0, &yp, &mut f1, &mut ws);
+        sys.derivative(t, &yp, &mut f1, &mut ws);
         yp[j] = y[j] - delta;
-        sys.derivative(0.0, &yp, &mut f0, &mut ws);
+        sys.derivative(t, &yp, &mut f0, &mut ws);
         for i in 0..n {
             jac[j * n + i] = (f1[i] - f0[i]) / (2.0 * delta);
         }
@@ -415,8 +421,8 @@ pub(crate) fn jacobians(sys: &MultibodySystem, y: &[f64]) -> (Vec<f64>, Vec<f64>
     assert!(!ws.linearization_moments.is_empty());
     let mut analytic = vec![0.0; n * n];
     sys.contact_jacobian(y, &mut ws, &mut analytic);
-    let full = fd_jacobian(sys, y, true);
-    let free = fd_jacobian(sys, y, false);
+    let full = fd_jacobian(sys, 0.0, y, true);
+    let free = fd_jacobian(sys, 0.0, y, false);
     let contact = full.iter().zip(&free).map(|(a, b)| a - b).collect();
     (analytic, contact)
 }

@@ -102,14 +102,19 @@ fn the_exact_face_jacobian_per_track_is_the_sum_over_its_nodes() {
     assert_round_off(&by_track, &by_node, system.state_len(), 1e-11);
 }
 
-/// The contact Jacobian at `y` taken in `scope`, and the derivative evaluated with it.
-fn jacobian_in(sys: &MultibodySystem, y: &[f64], scope: JacobianScope) -> (Vec<f64>, Vec<f64>) {
+/// The contact Jacobian at `(t, y)` taken in `scope`, and the derivative evaluated with it.
+fn jacobian_in(
+    sys: &MultibodySystem,
+    t: f64,
+    y: &[f64],
+    scope: JacobianScope,
+) -> (Vec<f64>, Vec<f64>) {
     let n = sys.state_len();
     let mut ws = sys.workspace();
     ws.linearize = true;
     ws.jacobian_scope = scope;
     let mut f = vec![0.0; n];
-    sys.derivative(0.0, y, &mut f, &mut ws);
+    sys.derivative(t, y, &mut f, &mut ws);
     let mut jac = vec![0.0; n * n];
     sys.contact_jacobian(y, &mut ws, &mut jac);
     (jac, f)
@@ -137,6 +142,9 @@ fn newton_contraction(free: &[f64], newton: &[f64], exact: &[f64], n: usize, hd:
         .fold(0.0, f64::max)
 }
 
+/// The largest contraction the Newton matrix may cost an iteration (see the test).
+const CONTRACTION_BOUND: f64 = 0.15;
+
 #[test]
 fn the_newton_matrix_leaves_out_only_derivatives_that_newton_does_not_need() {
     // Launcher-design at rest, then the missile shifted, turned and moving at random: the
@@ -151,8 +159,8 @@ fn the_newton_matrix_leaves_out_only_derivatives_that_newton_does_not_need() {
     let mut worst: f64 = 0.0;
     for _ in 0..8 {
         let y = random_missile_state(&rest, &mut rng);
-        let (exact, f_exact) = jacobian_in(sys, &y, JacobianScope::Exact);
-        let (newton, f_newton) = jacobian_in(sys, &y, JacobianScope::NewtonMatrix);
+        let (exact, f_exact) = jacobian_in(sys, 0.0, &y, JacobianScope::Exact);
+        let (newton, f_newton) = jacobian_in(sys, 0.0, &y, JacobianScope::NewtonMatrix);
         // The scope changes which derivatives are taken, never a force.
         assert_eq!(f_exact, f_newton, "the derivative is the same bit for bit");
         if exact != newton {
@@ -160,21 +168,52 @@ fn the_newton_matrix_leaves_out_only_derivatives_that_newton_does_not_need() {
         }
         // Steps of 1e-5 to 1e-3 s (TR-BDF2's h d = 0.29 h). Newton with the exact matrix
         // converges at once where the contacts are linear; with the Newton matrix the error
-        // shrinks by this factor per iteration. The contact-aware Newton's stopping test
-        // (θ/(1 − θ) times the update) and its LU reuse (entries within 5 %) are built for
-        // contraction rates well below 0.1.
-        let free = super::face_contact::fd_jacobian(sys, &y, false);
+        // shrinks by this factor per iteration. The contact-aware Newton stops once
+        // θ/(1 − θ) times its update is below 0.03 tolerance units (NEWTON_KAPPA) and gives up
+        // at θ >= 0.99: at a contraction of 0.15 an update of a tolerance unit is one
+        // iteration from the stopping test (0.18 × 0.15 < 0.03).
+        let free = super::face_contact::fd_jacobian(sys, 0.0, &y, false);
         for hd in [3e-6, 3e-5, 3e-4] {
             let rho = newton_contraction(&free, &newton, &exact, n, hd);
             worst = worst.max(rho);
-            assert!(rho <= 0.1, "h d {hd:e}: contraction {rho:.4}");
+            assert!(rho <= CONTRACTION_BOUND, "h d {hd:e}: contraction {rho:.4}");
         }
     }
-    // Measured 0.036-0.045 over these states: the latch's side faces carry about 2 % of its
+    // Measured 0.038-0.047 over these states: the latch's side faces carry about 2 % of its
     // load, and their lever arms at the piece's ends weigh its rotation.
     assert!(
         left_out >= 4,
         "the side faces must be left out: {left_out} of 8 states"
     );
     assert!(worst > 0.0);
+
+    // launcher-loose in its excitation window: shoe heads rattling across the lips' edges,
+    // tilted, hitting the walls and the roof, their strips beyond the lips' edges loaded
+    // (their derivatives on 9 nodes, the force on 50). Measured 0.030-0.049 at h d up to 3e-5
+    // and up to 0.099 at 3e-4, where the stiff limit `J_N⁻¹ (J − J_N)` is approached.
+    use railwear::models::case::{build, load_case, run_options};
+    use railwear::models::run::record_states;
+    use railwear::pipeline::RunControl;
+    let mut case = load_case(&configs().join("launcher-loose.toml")).expect("case");
+    case.simulation.settle_s = 1.0;
+    case.simulation.duration_s = 0.5;
+    let loose = build(&case, configs()).expect("model");
+    let options = run_options(&case).expect("options");
+    let states = record_states(&loose, &options, &RunControl::silent(), 0.025).expect("runs");
+    assert!(states.len() >= 19, "{} states", states.len());
+    let sys = &loose.system;
+    let n = sys.state_len();
+    for (t, y) in &states {
+        let (exact, f_exact) = jacobian_in(sys, *t, y, JacobianScope::Exact);
+        let (newton, f_newton) = jacobian_in(sys, *t, y, JacobianScope::NewtonMatrix);
+        assert_eq!(f_exact, f_newton, "the derivative is the same bit for bit");
+        let free = super::face_contact::fd_jacobian(sys, *t, y, false);
+        for hd in [3e-6, 3e-5, 3e-4] {
+            let rho = newton_contraction(&free, &newton, &exact, n, hd);
+            assert!(
+                rho <= CONTRACTION_BOUND,
+                "launcher-loose, h d {hd:e}: contraction {rho:.4}"
+            );
+        }
+    }
 }

@@ -14,7 +14,7 @@
 //! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
 //! unloads continuously.
 
-use super::point::{friction_derivatives, Lump, PointOutputs};
+use super::point::{friction_derivatives, Lump, PointOutputs, TrackSum};
 use super::Contact;
 use super::{JacobianScope, TrackLinearization};
 use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
@@ -81,6 +81,12 @@ const FACING: (f64, f64) = (0.3, 0.5);
 /// (docs/models.md "The Newton matrix leaves out the side faces"); beyond it (a degenerate
 /// or narrow face, a deep press) every node is linearized.
 const SIDE_SHARE_MAX: f64 = 0.02;
+
+/// The rule a Newton matrix takes a facing face's strip beyond a bounded face's side on
+/// ([`JacobianScope::NewtonMatrix`]): one slice of 3 × 3 nodes (the side faces' strips' rule)
+/// for the derivatives, where the force takes [`QuadratureOrder::ROUNDED_EDGE`] on
+/// [`ROUNDED_EDGE_SLICES`] slices (50 nodes).
+const STRIP_JACOBIAN_RULE: QuadratureOrder = QuadratureOrder::SIDE_EDGE;
 
 /// The ramp rule of the faces that do not face the plane ([`FACING`]): 3 nodes across the
 /// ramp instead of 5, for both its closing part ([`CLOSING_RAMP_RULE`]) and its separating
@@ -349,7 +355,7 @@ impl Contact {
         out: &mut PointOutputs<'_, '_>,
     ) {
         self.begin_lump(out);
-        let mut visit = |x: Point3<f64>, share: f64| {
+        let visit = |x: Point3<f64>, share: f64, out: &mut PointOutputs<'_, '_>| {
             // A ball that does not reach the solid adds nothing (`evaluate_point` returns at
             // `w <= 0` before using anything): its normal is not taken.
             if let Some((distance, normal)) = face.signed_distance_within(&x, radius) {
@@ -357,17 +363,77 @@ impl Contact {
             }
         };
         if fine > 0.0 {
-            // `fine` is exactly 1 on a facing face: its nodes' shares unchanged.
+            // `fine` is exactly 1 on a facing face: its nodes' shares unchanged. A Newton
+            // matrix takes the strip's derivatives on the side rule's nodes instead
+            // ([`STRIP_JACOBIAN_RULE`]); the force stays the fine rule's.
             let order = QuadratureOrder::ROUNDED_EDGE;
+            let coarse = out.scope == JacobianScope::NewtonMatrix
+                && out.linearizing()
+                && self.friction_rule == FrictionRule::PerNode;
+            let kept = coarse.then(|| (out.linearizations.take(), out.moments.take()));
             strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
-                visit(x, fine * share)
+                visit(x, fine * share, out)
             });
+            if let Some((linearizations, moments)) = kept {
+                out.linearizations = linearizations;
+                out.moments = moments;
+                self.strip_derivatives(strip, fine, fa, fb, radius, face, out);
+            }
         }
         if fine < 1.0 {
             let order = QuadratureOrder::SIDE_EDGE;
-            strip.for_each_node_sliced(order, 1, &mut |x, share| visit(x, (1.0 - fine) * share));
+            strip.for_each_node_sliced(order, 1, &mut |x, share| {
+                visit(x, (1.0 - fine) * share, out)
+            });
         }
         self.end_lump(fa, fb, out);
+    }
+
+    /// The derivatives of `strip` (share `fine`) at [`STRIP_JACOBIAN_RULE`]'s nodes into `out`'s
+    /// linearizations or moments, and nothing else: its force, energy, powers and track sums
+    /// are the fine rule's, taken by the caller without derivatives. Per-node friction only
+    /// (no lump).
+    #[allow(clippy::too_many_arguments)]
+    fn strip_derivatives(
+        &self,
+        strip: &FacePatch,
+        fine: f64,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        radius: f64,
+        face: &PlacedFace,
+        out: &mut PointOutputs<'_, '_>,
+    ) {
+        let mut energy = 0.0;
+        let mut lump_nodes = Vec::new();
+        let mut derivatives = PointOutputs {
+            index: out.index,
+            track: out.track,
+            linearizations: out.linearizations.as_deref_mut(),
+            moments: out.moments.as_deref_mut(),
+            points: None,
+            energy: &mut energy,
+            sum: TrackSum::default(),
+            tangent: out.tangent,
+            lump: None,
+            lump_nodes: &mut lump_nodes,
+            scope: out.scope,
+        };
+        strip.for_each_node_sliced(STRIP_JACOBIAN_RULE, 1, &mut |x, share| {
+            if let Some((distance, normal)) = face.signed_distance_within(&x, radius) {
+                self.evaluate_point(
+                    fa,
+                    fb,
+                    &x,
+                    radius,
+                    fine * share,
+                    distance,
+                    &normal,
+                    &mut derivatives,
+                );
+            }
+        });
+        out.tangent = derivatives.tangent;
     }
 
     /// Starts summing a part's normal loads for its friction at their load centre, when the
