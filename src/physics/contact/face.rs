@@ -75,11 +75,13 @@ const FACING: (f64, f64) = (0.3, 0.5);
 
 /// A Newton matrix ([`JacobianScope::NewtonMatrix`]) leaves out the side faces' nodes (beyond
 /// [`FACING`]'s 72.5°) of a piece pressed `w` deep when `w P <= SIDE_SHARE_MAX A`, with `A`
-/// and `P` the area and perimeter of its inner face that most faces the plane. The side faces
-/// are then pressed in slivers at most `w` high along at most `P`, so their share of the
-/// track's stiffness, damping and friction derivatives is at most about `w P / A`
-/// (docs/models.md "The Newton matrix leaves out the side faces"); beyond it (a degenerate
-/// or narrow face, a deep press) every node is linearized.
+/// and `P` the area and perimeter of its inner face that most faces the plane (`w` is the
+/// piece's depth below the face's unbounded plane, at least the pressed depth). The side
+/// faces are then pressed in slivers at most `w` high along at most `P`: of a facing face
+/// pressed whole they carry about `w P / ((e + 1) A)` of the load. A face pressed in part
+/// (tilted, or over a lip's edge) gives them more, so what the matrix loses is measured as
+/// Newton's contraction (docs/models.md "The Newton matrix leaves out the side faces"); beyond
+/// the gate (a degenerate or narrow face, a deep press) every node is linearized.
 const SIDE_SHARE_MAX: f64 = 0.02;
 
 /// The rule a Newton matrix takes a facing face's strip beyond a bounded face's side on

@@ -209,11 +209,12 @@ pub enum JacobianScope {
     /// Every point's and node's: the exact contact Jacobian.
     #[default]
     Exact,
-    /// All but the exact face contact's side faces, the inner faces turned more than 72.5°
-    /// from the plane (the face contact's `FACING`): a Newton matrix. Those faces are pressed in
-    /// slivers at most `w` high, whose share of a track's stiffness and damping is of the order
-    /// of `w` over the pressed face's width (docs/models.md "The Newton matrix leaves out the
-    /// side faces"); their forces are all still evaluated.
+    /// A Newton matrix: the exact face contact leaves out the nodes of a piece's side faces
+    /// (turned more than 72.5° from the plane) while they are pressed in slivers, and takes a
+    /// facing face's strips beyond a bounded face's side on 9 nodes instead of 50 (per-node
+    /// friction). Every force is still evaluated at every node; only derivatives are left out.
+    /// What that costs Newton is its contraction, measured and bounded in docs/models.md "The
+    /// Newton matrix leaves out the side faces".
     NewtonMatrix,
 }
 
