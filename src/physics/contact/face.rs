@@ -14,7 +14,7 @@
 //! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
 //! unloads continuously.
 
-use super::point::{friction_derivatives, Lump, PointOutputs, TrackSum};
+use super::point::{friction_derivatives, Lump, PointOutputs};
 use super::Contact;
 use super::{JacobianScope, TrackLinearization};
 use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
@@ -175,7 +175,8 @@ fn side_faces_are_slivers(
     let local = pose.rotation.inverse_transform_vector(normal);
     let k = local.iamax();
     let (a, b) = (inner[(k + 1) % 3], inner[(k + 2) % 3]);
-    depth * 4.0 * (a + b) <= SIDE_SHARE_MAX * 4.0 * a * b
+    // P = 4 (a + b) and A = 4 a b: the common factor 4 cancels.
+    depth * (a + b) <= SIDE_SHARE_MAX * a * b
 }
 
 /// The share of the facing rules at `|n_F · n| = facing` ([`FACING`]): 1 within 60° of facing
@@ -379,7 +380,13 @@ impl Contact {
             if let Some((linearizations, moments)) = kept {
                 out.linearizations = linearizations;
                 out.moments = moments;
-                self.strip_derivatives(strip, fine, fa, fb, radius, face, out);
+                // The derivatives alone (per-node friction: no lump), at the coarse nodes.
+                let (mut energy, mut lump_nodes) = (0.0, Vec::new());
+                let mut derivatives = out.derivatives_only(&mut energy, &mut lump_nodes);
+                strip.for_each_node_sliced(STRIP_JACOBIAN_RULE, 1, &mut |x, share| {
+                    visit(x, fine * share, &mut derivatives)
+                });
+                out.tangent = derivatives.tangent;
             }
         }
         if fine < 1.0 {
@@ -389,53 +396,6 @@ impl Contact {
             });
         }
         self.end_lump(fa, fb, out);
-    }
-
-    /// The derivatives of `strip` (share `fine`) at [`STRIP_JACOBIAN_RULE`]'s nodes into `out`'s
-    /// linearizations or moments, and nothing else: its force, energy, powers and track sums
-    /// are the fine rule's, taken by the caller without derivatives. Per-node friction only
-    /// (no lump).
-    #[allow(clippy::too_many_arguments)]
-    fn strip_derivatives(
-        &self,
-        strip: &FacePatch,
-        fine: f64,
-        fa: &BodyFrame,
-        fb: &BodyFrame,
-        radius: f64,
-        face: &PlacedFace,
-        out: &mut PointOutputs<'_, '_>,
-    ) {
-        let mut energy = 0.0;
-        let mut lump_nodes = Vec::new();
-        let mut derivatives = PointOutputs {
-            index: out.index,
-            track: out.track,
-            linearizations: out.linearizations.as_deref_mut(),
-            moments: out.moments.as_deref_mut(),
-            points: None,
-            energy: &mut energy,
-            sum: TrackSum::default(),
-            tangent: out.tangent,
-            lump: None,
-            lump_nodes: &mut lump_nodes,
-            scope: out.scope,
-        };
-        strip.for_each_node_sliced(STRIP_JACOBIAN_RULE, 1, &mut |x, share| {
-            if let Some((distance, normal)) = face.signed_distance_within(&x, radius) {
-                self.evaluate_point(
-                    fa,
-                    fb,
-                    &x,
-                    radius,
-                    fine * share,
-                    distance,
-                    &normal,
-                    &mut derivatives,
-                );
-            }
-        });
-        out.tangent = derivatives.tangent;
     }
 
     /// Starts summing a part's normal loads for its friction at their load centre, when the

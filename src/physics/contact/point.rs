@@ -62,6 +62,30 @@ impl PointOutputs<'_, '_> {
         self.linearizations.is_some() || self.moments.is_some()
     }
 
+    /// Outputs that take only the points' derivatives, into this track's linearizations or
+    /// moments: their force, energy, powers and sums go to `energy` and a discarded sum, and
+    /// they take no lump (per-node friction). For a Newton matrix taken on other nodes than
+    /// the force ([`super::JacobianScope::NewtonMatrix`]).
+    pub(super) fn derivatives_only<'a>(
+        &'a mut self,
+        energy: &'a mut f64,
+        lump_nodes: &'a mut Vec<TrackLinearization>,
+    ) -> PointOutputs<'a, 'a> {
+        PointOutputs {
+            index: self.index,
+            track: self.track,
+            linearizations: self.linearizations.as_deref_mut(),
+            moments: self.moments.as_deref_mut(),
+            points: None,
+            energy,
+            sum: TrackSum::default(),
+            tangent: self.tangent,
+            lump: None,
+            lump_nodes,
+            scope: self.scope,
+        }
+    }
+
     /// Hands one point's derivatives to the track's moments when they are summed, else to
     /// the list of linearizations.
     #[inline]
