@@ -38,7 +38,7 @@ fn main() {
             );
             println!(
                 "mean N {:.4} N, mean N*v {:.5} W",
-                r.mean_normal_force_n, r.mean_friction_power_w
+                r.mean_normal_force_n, r.mean_normal_slip_power_w
             );
             for c in &r.contacts {
                 println!(

@@ -123,7 +123,7 @@ pub(crate) fn run_variant(
     let cpu = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
     let mut quantities = vec![(
         "friction power Σ N·|v_slip| (W)".to_string(),
-        report.mean_friction_power_w,
+        report.mean_normal_slip_power_w,
         QuantityKind::Relative,
     )];
     for c in &report.contacts {

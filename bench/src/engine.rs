@@ -8,7 +8,7 @@ pub(crate) struct SphereRun {
     pub(crate) accepted: u64,
     pub(crate) rejected: u64,
     pub(crate) mean_normal_force_n: f64,
-    pub(crate) mean_friction_power_w: f64,
+    pub(crate) mean_normal_slip_power_w: f64,
     pub(crate) vdv_y: Option<f64>,
 }
 
@@ -128,7 +128,7 @@ pub(crate) fn sphere_bounce(
                 accepted: stats.integrator.accepted,
                 rejected: stats.integrator.rejected,
                 mean_normal_force_n: means.normal_int / duration,
-                mean_friction_power_w: means.power_int / duration,
+                mean_normal_slip_power_w: means.power_int / duration,
                 vdv_y: vibration_dose_value_uniform(&acc, means.dt_resp).ok(),
             })
         }
@@ -148,7 +148,7 @@ pub(crate) const ENGINE_COLUMNS: &[(&str, &str)] = &[
     ("accepted", "accepted"),
     ("rejected", "rejected"),
     ("mean_normal_force_n", "mean normal force N"),
-    ("mean_friction_power_w", "mean N·\\|v_slip\\| W"),
+    ("mean_normal_slip_power_w", "mean N·\\|v_slip\\| W"),
     ("vdv_ratio", "VDV/VDV_trbdf2"),
 ];
 
@@ -203,7 +203,7 @@ pub(crate) fn engine(
                         Cell::Int(r.integrator.accepted),
                         Cell::Int(r.integrator.rejected),
                         Cell::Num(r.mean_normal_force_n),
-                        Cell::Num(r.mean_friction_power_w),
+                        Cell::Num(r.mean_normal_slip_power_w),
                     ],
                     vdv,
                 ));
@@ -245,7 +245,7 @@ pub(crate) fn engine(
                         Cell::Int(s.accepted),
                         Cell::Int(s.rejected),
                         Cell::Num(s.mean_normal_force_n),
-                        Cell::Num(s.mean_friction_power_w),
+                        Cell::Num(s.mean_normal_slip_power_w),
                     ],
                     s.vdv_y,
                 ));

@@ -203,7 +203,7 @@ struct Split {
     touches: u64,
     accepted: u64,
     cpu_s: Option<f64>,
-    mean_friction_power_w: f64,
+    mean_normal_slip_power_w: f64,
     touch_maps: Vec<TouchMap>,
     /// Per separated episode: (duration from touch to the last active state, s, exit speed /
     /// approach speed).
@@ -406,7 +406,7 @@ fn run_split(
     .map_err(|e| anyhow!("{case_name} {}: {e}", mode.name()))?;
     split.cpu_s = thread_cpu_s().zip(cpu0).map(|(b, a)| b - a);
     split.accepted = report.integrator.accepted;
-    split.mean_friction_power_w = report.mean_friction_power_w;
+    split.mean_normal_slip_power_w = report.mean_normal_slip_power_w;
     Ok(split)
 }
 
@@ -628,7 +628,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             ("window_steps", "steps within the window after touch"),
             ("creep_steps", "other steps within 1 ms after a touch"),
             ("touches_per_s", "touches per s"),
-            ("mean_friction_power_w", "mean N·\\|v_slip\\| W (report)"),
+            ("mean_normal_slip_power_w", "mean N·\\|v_slip\\| W (report)"),
             ("episodes", "separations"),
             ("short", "separations within 10 ms of the touch"),
             ("duration", "median contact duration s"),
@@ -740,7 +740,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
                 Cell::Int(s.window_steps),
                 Cell::Int(s.creep_steps),
                 Cell::Num(s.touches as f64 / b.window),
-                Cell::Num(s.mean_friction_power_w),
+                Cell::Num(s.mean_normal_slip_power_w),
                 Cell::Int(s.episodes.len() as u64),
                 Cell::Int(s.episodes.iter().filter(|e| e.0 < 0.01).count() as u64),
                 Cell::opt(quantile(s.episodes.iter().map(|e| e.0).collect(), 0.5)),

@@ -152,7 +152,7 @@ pub(crate) fn peers(
             ("real_time_factor_cpu", "real-time factor (CPU time)"),
             ("steps_per_s", "steps/s"),
             ("mean_normal_force_n", "mean normal force N"),
-            ("mean_friction_power_w", "mean N·\\|v_slip\\| W"),
+            ("mean_normal_slip_power_w", "mean N·\\|v_slip\\| W"),
             ("ratio_vs_mujoco", "railwear RTF / this RTF"),
         ],
     );
@@ -171,7 +171,7 @@ pub(crate) fn peers(
             Cell::opt(cpu.map(|c| end_time_s / c.max(1e-9))),
             Cell::Num(run.integrator.accepted as f64 / run.wall_s.max(1e-9)),
             Cell::Num(run.mean_normal_force_n),
-            Cell::Num(run.mean_friction_power_w),
+            Cell::Num(run.mean_normal_slip_power_w),
             Cell::Num(rw_rtf / rtf),
         ]);
     }
@@ -231,7 +231,7 @@ pub(crate) fn peers(
             Cell::opt(f("real_time_factor_cpu")),
             Cell::opt(f("steps_per_s")),
             Cell::opt(f("mean_normal_force_n")),
-            Cell::opt(f("mean_friction_power_w")),
+            Cell::opt(f("mean_normal_slip_power_w")),
             Cell::opt(rtf.filter(|r| *r > 0.0).map(|r| rw_rtf / r)),
         ]);
     }

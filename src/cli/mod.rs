@@ -71,12 +71,12 @@ pub fn run(
         end / report.wall_s.max(1e-9)
     );
     println!(
-        "mean normal force {:.4} N, mean friction power {:.5} W",
-        report.mean_normal_force_n, report.mean_friction_power_w
+        "mean normal force {:.4} N, mean friction power {:.5} W (dissipated), mean N·|v_slip| {:.5} W (what the wear law integrates)",
+        report.mean_normal_force_n, report.mean_friction_power_w, report.mean_normal_slip_power_w
     );
     println!(
         "{:<18} {:>12} {:>12} {:>12} {:>12} {:>10}",
-        "contact", "wear mg/h", "a mg/h", "b mg/h", "N·v W", ">cutoff"
+        "contact", "wear mg/h", "a mg/h", "b mg/h", "N·|v| W", ">cutoff"
     );
     for c in &report.contacts {
         println!(
@@ -85,7 +85,7 @@ pub fn run(
             c.mass_rate_mg_per_h,
             c.mass_rate_a_mg_per_h,
             c.mass_rate_b_mg_per_h,
-            c.mean_friction_power_w,
+            c.mean_normal_slip_power_w,
             100.0 * c.work_share_above_cutoff
         );
     }
@@ -217,7 +217,7 @@ pub fn compare_rattle_box(
     for ((letter, measured, repeats), adams, k_rs, c, wall, _sim, residual) in &rows {
         let density = crate::wear::material::Material::aluminium_7075_t73().density_kg_per_m3;
         let vol_rate_m3_s = adams * 1e-6 / density / 3600.0;
-        let k_needed = vol_rate_m3_s / c.mean_friction_power_w.max(1e-30);
+        let k_needed = vol_rate_m3_s / c.mean_normal_slip_power_w.max(1e-30);
         let meas = if repeats.is_empty() {
             format!("{measured}")
         } else {
@@ -229,14 +229,14 @@ pub fn compare_rattle_box(
             c.mass_rate_a_mg_per_h,
             c.mass_rate_mg_per_h / adams,
             100.0 * c.work_share_above_cutoff,
-            c.mean_friction_power_w,
+            c.mean_normal_slip_power_w,
             c.mean_normal_force_n,
             c.peak_normal_force_n,
             k_needed,
         ));
     }
     md.push_str(&format!(
-        "\n## Why railwear is below ADAMS\n\nThe largest wear coefficient Table 4.3 allows in SI is K(2 Sy) = {k_max:.3e} m²/N. The column \"K needed for ADAMS\" is the coefficient that ADAMS' Table 5.4 rate would need at the friction power railwear computes for the same case: wherever it exceeds {k_max:.3e} m²/N, no contact pressure history can reproduce Table 5.4 with Table 4.3 read in SI and eq. 3.11 as written. The appendix post-processor (docs/errata.md §6) feeds |N| into K instead of sigma and scales C3 by 1e-3; ADAMS' friction power also includes impact force spikes that railwear's work-above-cutoff column shows are outside the law's validity range. The contact and wear parameters were not tuned to force agreement (SPEC 8). The measured rates (Table 5.3) of cases A and B are one to two orders above both models: those cases tumble and impact, the regime where eq. 3.11's cutoff discards the work.\n"
+        "\n## Why railwear is below ADAMS\n\nThe largest wear coefficient Table 4.3 allows in SI is K(2 Sy) = {k_max:.3e} m²/N. The column \"K needed for ADAMS\" is the coefficient that ADAMS' Table 5.4 rate would need at the N·|v_slip| power railwear computes for the same case: wherever it exceeds {k_max:.3e} m²/N, no contact pressure history can reproduce Table 5.4 with Table 4.3 read in SI and eq. 3.11 as written. The appendix post-processor (docs/errata.md §6) feeds |N| into K instead of sigma and scales C3 by 1e-3; ADAMS' N·|v_slip| power also includes impact force spikes that railwear's work-above-cutoff column shows are outside the law's validity range. The contact and wear parameters were not tuned to force agreement (SPEC 8). The measured rates (Table 5.3) of cases A and B are one to two orders above both models: those cases tumble and impact, the regime where eq. 3.11's cutoff discards the work.\n"
     ));
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;

@@ -77,6 +77,16 @@ pub struct ServiceConfig {
     /// Largest accepted campaign upload (`POST /v1/campaigns`, accelerometer samples inline),
     /// bytes.
     pub campaign_body_limit_bytes: usize,
+    /// Time a client gets to send a request's head (request line and headers), s; past it the
+    /// connection is closed. Also bounds how long an idle keep-alive connection is held.
+    pub header_read_timeout_s: f64,
+    /// Time a client gets to send a request's whole body once its head has arrived, s; past it
+    /// the request is answered 408 and the connection closed.
+    pub body_read_timeout_s: f64,
+    /// Open connections held at once; one more is answered 503 and closed.
+    pub max_connections: usize,
+    /// Open connections held at once from one peer address; one more is answered 429 and closed.
+    pub max_connections_per_peer: usize,
     /// Log format: `text` or `json`.
     pub log_format: String,
     /// Samples per stored contact-track block (each block is compressed on its own).
@@ -101,6 +111,10 @@ impl Default for ServiceConfig {
             shutdown_grace_s: 5.0,
             body_limit_bytes: 8 * 1024 * 1024,
             campaign_body_limit_bytes: DEFAULT_CAMPAIGN_BODY_LIMIT_BYTES,
+            header_read_timeout_s: 10.0,
+            body_read_timeout_s: 60.0,
+            max_connections: 1024,
+            max_connections_per_peer: 256,
             log_format: "text".into(),
             track_block_samples: 16_384,
             report: ReportSettings::default(),
@@ -199,6 +213,18 @@ impl ServiceConfig {
         if let Some(v) = env("RAILWEAR_CAMPAIGN_BODY_LIMIT_BYTES") {
             self.campaign_body_limit_bytes = num("RAILWEAR_CAMPAIGN_BODY_LIMIT_BYTES", &v)?;
         }
+        if let Some(v) = env("RAILWEAR_HEADER_READ_TIMEOUT_S") {
+            self.header_read_timeout_s = num("RAILWEAR_HEADER_READ_TIMEOUT_S", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_BODY_READ_TIMEOUT_S") {
+            self.body_read_timeout_s = num("RAILWEAR_BODY_READ_TIMEOUT_S", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_MAX_CONNECTIONS") {
+            self.max_connections = num("RAILWEAR_MAX_CONNECTIONS", &v)?;
+        }
+        if let Some(v) = env("RAILWEAR_MAX_CONNECTIONS_PER_PEER") {
+            self.max_connections_per_peer = num("RAILWEAR_MAX_CONNECTIONS_PER_PEER", &v)?;
+        }
         if let Some(v) = env("RAILWEAR_LOG_FORMAT") {
             self.log_format = v;
         }
@@ -261,6 +287,28 @@ impl ServiceConfig {
             return Err(
                 FieldError::new("campaign_body_limit_bytes", "must be at least 1024").into(),
             );
+        }
+        for (field, seconds) in [
+            ("header_read_timeout_s", self.header_read_timeout_s),
+            ("body_read_timeout_s", self.body_read_timeout_s),
+        ] {
+            if !(seconds.is_finite() && (0.1..=3600.0).contains(&seconds)) {
+                return Err(
+                    FieldError::new(field, "must be a number of seconds in [0.1, 3600]").into(),
+                );
+            }
+        }
+        if self.max_connections == 0 {
+            return Err(FieldError::new("max_connections", "must be at least 1").into());
+        }
+        if self.max_connections_per_peer == 0
+            || self.max_connections_per_peer > self.max_connections
+        {
+            return Err(FieldError::new(
+                "max_connections_per_peer",
+                "must be at least 1 and at most max_connections",
+            )
+            .into());
         }
         if self.track_block_samples == 0 {
             return Err(FieldError::new("track_block_samples", "must be at least 1").into());

@@ -4,9 +4,10 @@
 //! hyper refuses a request whose head it cannot parse (a header value with a control
 //! character, a malformed method, target or version; headers or a target too long) before
 //! any router sees it, with a bodiless `400`, `431` or `414`, and closes the connection.
-//! hyper offers no hook for that answer, so the listener wraps each connection and rewrites
-//! it on its way out: a `4xx` head with `content-length: 0` and no content type is one of
-//! these (every answer of the service itself carries a problem body, [`super::problem`]).
+//! hyper offers no hook for that answer, so the accept loop ([`super::server`]) wraps each
+//! connection and rewrites it on its way out: a `4xx` head with `content-length: 0` and no
+//! content type is one of these (every answer of the service itself carries a problem body,
+//! [`super::problem`]).
 //! Everything else passes through untouched.
 
 use super::problem::Problem;
@@ -15,24 +16,6 @@ use std::io;
 use std::pin::Pin;
 use std::task::{Context, Poll};
 use tokio::io::{AsyncRead, AsyncWrite, ReadBuf};
-use tokio::net::{TcpListener, TcpStream};
-
-/// The service's listener: TCP connections wrapped in [`ProblemIo`].
-pub struct ProblemListener(pub TcpListener);
-
-impl axum::serve::Listener for ProblemListener {
-    type Io = ProblemIo<TcpStream>;
-    type Addr = std::net::SocketAddr;
-
-    async fn accept(&mut self) -> (Self::Io, Self::Addr) {
-        let (io, addr) = axum::serve::Listener::accept(&mut self.0).await;
-        (ProblemIo::new(io), addr)
-    }
-
-    fn local_addr(&self) -> io::Result<Self::Addr> {
-        self.0.local_addr()
-    }
-}
 
 /// A connection whose bare `4xx` answers (hyper's own) go out as problem+json.
 pub struct ProblemIo<T> {

@@ -3,7 +3,8 @@
 //! version an engineer published (`POST /v1/curves/{id}/publish`). Publishing a version with
 //! fewer points, a shorter duration per point or fewer seeds than the published one, or swept
 //! on the contact-point lattice over one swept with the exact face contact, needs
-//! `{"force": true}`, else 409.
+//! `{"force": true}`, else 409; so does publishing a version whose points ran shorter than the
+//! excited window (`simulation.duration_s`) of the reference config it swept.
 
 use super::auth::{Area, Caller};
 use super::pagination::{PageQuery, PageView};
@@ -196,6 +197,26 @@ pub async fn get_curve(
 }
 
 /// Make this version the one reports use for its key (engineer). Body optional:
+/// Why `curve`'s points ran shorter than the excited window of the reference config it swept
+/// (its provenance's `config`), if they did. A curve whose config or duration is not recorded,
+/// or whose config is not a reference one, is not judged here.
+fn shorter_than_reference(
+    curve: &crate::store::CurveRecord,
+    configs_dir: &std::path::Path,
+) -> Option<String> {
+    let duration = curve.fidelity.duration_per_point_s?;
+    let config = curve.provenance.get("config")?.as_str()?;
+    let path = crate::models::reference::reference_config_path(configs_dir, config).ok()?;
+    let reference = crate::models::case::load_case(&path).ok()?;
+    let window = reference.simulation.duration_s;
+    (duration < window).then(|| {
+        format!(
+            "its points ran {duration} s each, shorter than the {window} s excited window of \
+             the reference config `{config}`"
+        )
+    })
+}
+
 /// `{"force": true}` to publish a lower-fidelity version over the published one.
 #[utoipa::path(
     post, path = "/v1/curves/{id}/publish", tag = "curves",
@@ -205,7 +226,7 @@ pub async fn get_curve(
         (status = 200, description = "Published (also when it already was)", body = CurveView),
         (status = 403, body = Problem, content_type = "application/problem+json"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
-        (status = 409, description = "Lower fidelity than the published version and `force` not set; `field` is `force`", body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Lower fidelity than the published version, or points shorter than the reference config's excited window, and `force` not set; `field` is `force`", body = Problem, content_type = "application/problem+json"),
     ),
     security(("bearer" = []))
 )]
@@ -230,6 +251,25 @@ pub async fn publish_curve(
             .await?
             .unwrap_or_default()
     };
+    if !request.force {
+        if let Some(curve) = state.store.get_curve(id).await? {
+            if let Some(reason) = shorter_than_reference(&curve, &state.config.configs_dir) {
+                let mut p = Problem::new(
+                    StatusCode::CONFLICT,
+                    "short-sweep",
+                    "Sweep points shorter than the reference window",
+                    format!(
+                        "`force` must be true to publish curve {id}: {reason}. Short windows \
+                         scatter (a 0.5 s-per-point sweep's slope can have the opposite sign of a \
+                         10 s sweep's); sweep at the reference duration, or publish with force \
+                         (the curve's fidelity says how it was swept)"
+                    ),
+                );
+                p.field = Some("force".into());
+                return Err(p);
+            }
+        }
+    }
     match state
         .store
         .publish_curve(id, &caller.name, request.force, clock::now_ms())

@@ -295,6 +295,12 @@ async fn load_job(state: &AppState, id: &str) -> Result<JobRecord, Problem> {
 }
 
 pub(super) fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, Problem> {
+    if headers.get_all("idempotency-key").iter().nth(1).is_some() {
+        return Err(Problem::bad_parameter(
+            "Idempotency-Key",
+            "must be given once (two headers name two different retries)",
+        ));
+    }
     match headers.get("idempotency-key") {
         None => Ok(None),
         Some(value) => {
@@ -588,8 +594,16 @@ pub async fn get_tracks(
     query: Result<Query<TrackQuery>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Response, Problem> {
     caller.require(Area::Jobs, &Method::GET)?;
-    let Query(query) =
-        query.map_err(|_| Problem::bad_parameter("every", "must be a positive integer"))?;
+    // A repeated or unknown key is named by serde_urlencoded's message; a bad value is `every`'s
+    // (`format` is a string, checked below).
+    let Query(query) = query.map_err(|rejection| {
+        let text = rejection.body_text();
+        if text.contains("duplicate field") || text.contains("unknown field") {
+            crate::http::problem::bare_error_problem(StatusCode::BAD_REQUEST, &text)
+        } else {
+            Problem::bad_parameter("every", "must be a positive integer")
+        }
+    })?;
     let every = query.every.unwrap_or(1);
     if every == 0 {
         return Err(Problem::bad_parameter(

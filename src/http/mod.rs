@@ -12,6 +12,7 @@ pub mod pagination;
 pub mod problem;
 pub mod query;
 pub mod rails;
+pub mod server;
 pub mod tokens;
 
 use crate::config::{Role, ServiceConfig};
@@ -206,14 +207,16 @@ pub async fn start(
         config_tokens,
     }));
     let router = app(state.clone());
+    let limits = server::Limits {
+        header_read_timeout: std::time::Duration::from_secs_f64(state.config.header_read_timeout_s),
+        body_read_timeout: std::time::Duration::from_secs_f64(state.config.body_read_timeout_s),
+        max_connections: state.config.max_connections,
+        max_connections_per_peer: state.config.max_connections_per_peer,
+    };
     let (shutdown, on_shutdown) = tokio::sync::oneshot::channel::<()>();
-    let server = tokio::spawn(async move {
-        axum::serve(connection::ProblemListener(listener), router)
-            .with_graceful_shutdown(async move {
-                let _ = on_shutdown.await;
-            })
-            .await
-    });
+    let server = tokio::spawn(server::serve(listener, router, limits, async move {
+        let _ = on_shutdown.await;
+    }));
     Ok(RunningService {
         addr,
         state,

@@ -288,14 +288,7 @@ pub async fn json_body_bytes(req: Request) -> Result<Bytes, Problem> {
     }
     let mut bytes = Vec::new();
     while let Some(frame) = body.frame().await {
-        let frame = frame.map_err(|e| {
-            Problem::new(
-                StatusCode::BAD_REQUEST,
-                "bad-body",
-                "Unreadable body",
-                format!("the request body could not be read: {e}"),
-            )
-        })?;
+        let frame = frame.map_err(|e| unreadable_body(&e))?;
         if let Some(data) = frame.data_ref() {
             if bytes.len() + data.len() > limit {
                 discard_refused_body(body).await;
@@ -305,6 +298,39 @@ pub async fn json_body_bytes(req: Request) -> Result<Bytes, Problem> {
         }
     }
     Ok(Bytes::from(bytes))
+}
+
+/// The error a request body yields once its deadline has passed (`super::server`'s body
+/// deadline, `body_read_timeout_s` from the head's arrival).
+#[derive(Debug, thiserror::Error)]
+#[error("the request body did not arrive within body_read_timeout_s ({0:?})")]
+pub struct BodyDeadlinePassed(pub std::time::Duration);
+
+/// The problem for a body that broke off: 408 when its deadline passed ([`BodyDeadlinePassed`]:
+/// the client sent less than it announced, or too slowly), 400 otherwise.
+pub fn unreadable_body(e: &axum::Error) -> Problem {
+    use std::error::Error as _;
+    let mut source: Option<&(dyn std::error::Error + 'static)> = e.source();
+    while let Some(cause) = source {
+        if let Some(passed) = cause.downcast_ref::<BodyDeadlinePassed>() {
+            return Problem::new(
+                StatusCode::REQUEST_TIMEOUT,
+                "body-timeout",
+                "Request body timed out",
+                format!(
+                    "the request body did not arrive within {} s (body_read_timeout_s): send                      the whole body, and exactly the Content-Length announced",
+                    passed.0.as_secs_f64()
+                ),
+            );
+        }
+        source = cause.source();
+    }
+    Problem::new(
+        StatusCode::BAD_REQUEST,
+        "bad-body",
+        "Unreadable body",
+        format!("the request body could not be read: {e}"),
+    )
 }
 
 /// The body limit of a route that did not set one: axum's default.

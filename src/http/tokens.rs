@@ -138,6 +138,12 @@ pub async fn create_token(
             "must be 1 to 100 characters",
         ));
     }
+    if name.chars().any(char::is_control) {
+        return Err(Problem::invalid_field(
+            "name",
+            "must not contain control characters",
+        ));
+    }
     let token = generate_token();
     let record = state
         .store

@@ -393,7 +393,7 @@ impl Jobs {
         let idempotency = idempotency_key.map(|key| {
             // serde_json maps are sorted, so this text is canonical for equal bodies.
             let sha = Sha256::digest(canonical.as_bytes());
-            (key, hex(&sha))
+            (scoped_idempotency_key(submitted_by, kind, &key), hex(&sha))
         });
         let submitted = self
             .store
@@ -442,6 +442,19 @@ pub fn draw_seed() -> u64 {
     // gives 64 uniformly random bits.
     let v = Uuid::new_v4().as_u128();
     ((v >> 64) as u64 ^ v as u64) & crate::pipeline::limits::MAX_SEED
+}
+
+/// The key an `Idempotency-Key` is stored under: scoped to the caller and the route, so two
+/// tokens that pick the same key make two resources and never see each other's job. The unit
+/// separator (0x1f) cannot occur in a key (visible ASCII and inner spaces) nor in a token name.
+/// migrations/*/0009_scoped_idempotency.sql scopes the keys stored before this way.
+pub(crate) fn scoped_idempotency_key(submitted_by: &str, kind: JobKind, key: &str) -> String {
+    let route = if kind == JobKind::Diagnose {
+        "diagnoses"
+    } else {
+        "jobs"
+    };
+    format!("{submitted_by}\u{1f}{route}\u{1f}{key}")
 }
 
 /// Lower-case hex of bytes.

@@ -228,6 +228,13 @@ impl EnergyMeter {
         });
     }
 
+    /// Work dissipated by friction per contact from the run's start to the last recorded
+    /// state, J (the account's own quadrature): the difference of two readings is the friction
+    /// work over a window, as the run's report gives it.
+    pub fn friction_work_j(&self) -> &[f64] {
+        &self.friction
+    }
+
     /// The account so far.
     pub fn audit(&self) -> EnergyAudit {
         let contacts: Vec<ContactDissipation> = self

@@ -48,6 +48,8 @@ pub struct StepView<'a> {
     pub tracks: &'a [TrackState],
     /// Stored energy and power terms at `t` (the drive's power among them).
     pub power: PowerBalance,
+    /// The energy account's friction work per contact from the start of the run to `t`, J.
+    pub friction_work_j: &'a [f64],
     /// The system.
     pub system: &'a MultibodySystem,
 }
@@ -203,6 +205,7 @@ pub fn simulate_from(
             state: y,
             tracks: &tracks,
             power: ws.power,
+            friction_work_j: meter.friction_work_j(),
             system,
         });
     }
@@ -283,6 +286,7 @@ pub fn simulate_from(
             state: y,
             tracks: &tracks,
             power: ws.power,
+            friction_work_j: meter.friction_work_j(),
             system,
         });
         last_good.copy_from_slice(y);

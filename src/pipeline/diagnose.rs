@@ -176,6 +176,12 @@ fn parse_effects(value: &serde_json::Value, library: &[&str]) -> Result<Vec<Stri
         return Err(FieldError::new("effects", "must name at least one effect"));
     }
     for (i, name) in names.iter().enumerate() {
+        if let Some(first) = names[..i].iter().position(|n| n == name) {
+            return Err(FieldError::new(
+                format!("effects[{i}]"),
+                format!("`{name}` is already effects[{first}]: name each effect once"),
+            ));
+        }
         if !library.contains(&name.as_str()) {
             return Err(FieldError::new(
                 format!("effects[{i}]"),
@@ -222,6 +228,10 @@ mod tests {
             (json!({"grid_points": 2.5}), "grid_points"),
             (json!({"effects": []}), "effects"),
             (json!({"effects": ["third_body", "gremlins"]}), "effects[1]"),
+            (
+                json!({"effects": ["third_body", "third_body"]}),
+                "effects[1]",
+            ),
             (json!({"colour": "red"}), "colour"),
         ] {
             let Err(RunError::InvalidConfig { field: got, .. }) =

@@ -16,9 +16,13 @@ use serde::{Deserialize, Serialize};
 pub struct WearTotals {
     /// Wear volume W, m³ (eq. 3.15).
     pub volume_m3: f64,
-    /// Friction work ∫ N |v_slip| dt, J (the "work" K multiplies in eq. 3.13).
-    pub friction_work_j: f64,
-    /// Part of `friction_work_j` done at sigma above the law's cutoff, J (thesis 5.5: a large
+    /// Normal-load-times-slip work ∫ N |v_slip| dt, J (the "work" K multiplies in eq. 3.13;
+    /// friction dissipates μ times it where the contact slides: the run report's
+    /// `friction_work_j` is the energy account's). Read as `friction_work_j` from JSON written
+    /// before the name said what it is.
+    #[serde(alias = "friction_work_j")]
+    pub normal_slip_work_j: f64,
+    /// Part of `normal_slip_work_j` done at sigma above the law's cutoff, J (thesis 5.5: a large
     /// share means the law is outside its validity range; that wear is not counted).
     pub work_above_cutoff_j: f64,
     /// Time with N > 0, s (trapezoid on the contact indicator).
@@ -35,7 +39,7 @@ pub struct WearTotals {
     pub peak_pressure_pa: f64,
     /// Cutoff pressure of the law used, Pa (`null` in JSON when the law has none).
     pub cutoff_pressure_pa: Option<f64>,
-    /// Contact time and friction work per pressure bin (Figure 6.65).
+    /// Contact time and normal-load-times-slip work per pressure bin (Figure 6.65).
     pub pressure_histogram: PressureHistogram,
     /// Part of `volume_m3` the case's wear mechanism added to (or, negative, took from) the
     /// law's own wear, m³ (0 without a mechanism; see [`super::mechanism`]).
@@ -52,7 +56,7 @@ impl WearTotals {
         let cutoff = law.cutoff_pressure_pa();
         Self {
             volume_m3: 0.0,
-            friction_work_j: 0.0,
+            normal_slip_work_j: 0.0,
             work_above_cutoff_j: 0.0,
             contact_time_s: 0.0,
             start_time_s: f64::NAN,
@@ -67,10 +71,11 @@ impl WearTotals {
         }
     }
 
-    /// Share of the friction work done above the cutoff (0 when there was no work).
+    /// Share of the normal-load-times-slip work done above the cutoff (0 when there was no
+    /// work).
     pub fn work_share_above_cutoff(&self) -> f64 {
-        if self.friction_work_j > 0.0 {
-            self.work_above_cutoff_j / self.friction_work_j
+        if self.normal_slip_work_j > 0.0 {
+            self.work_above_cutoff_j / self.normal_slip_work_j
         } else {
             0.0
         }
@@ -99,7 +104,7 @@ impl WearTotals {
         self.volume_m3 += other.volume_m3;
         self.mechanism_volume_m3 += other.mechanism_volume_m3;
         self.damping_work_j += other.damping_work_j;
-        self.friction_work_j += other.friction_work_j;
+        self.normal_slip_work_j += other.normal_slip_work_j;
         self.work_above_cutoff_j += other.work_above_cutoff_j;
         self.contact_time_s += other.contact_time_s;
         self.start_time_s = self.start_time_s.min(other.start_time_s);
@@ -336,7 +341,7 @@ impl WearAccumulator {
                     Quadrature::Trapezoid => 0.5 * (p.rate_m3_s + point.rate_m3_s) * dt,
                     Quadrature::RightEndpointFromZero => point.rate_m3_s * dt,
                 };
-                t.friction_work_j += 0.5 * (p.power_w + point.power_w) * dt;
+                t.normal_slip_work_j += 0.5 * (p.power_w + point.power_w) * dt;
                 t.damping_work_j += 0.5 * (p.damping_power_w + point.damping_power_w) * dt;
                 t.mechanism_volume_m3 += match self.quadrature {
                     Quadrature::Trapezoid => {
@@ -400,7 +405,7 @@ mod tests {
         let t = acc.finish();
         let expected = k_by_hand(1.0e7) * 100.0 * 0.1 * 10.0;
         assert!((t.volume_m3 - expected).abs() / expected < 1e-12);
-        assert!((t.friction_work_j - 100.0).abs() < 1e-9);
+        assert!((t.normal_slip_work_j - 100.0).abs() < 1e-9);
         assert!((t.contact_time_s - 10.0).abs() < 1e-9);
         assert_eq!(t.work_above_cutoff_j, 0.0);
         assert_eq!(t.peak_pressure_pa, 1.0e7);
@@ -421,7 +426,7 @@ mod tests {
             acc.push(t, 100.0, 0.1, a).unwrap();
         }
         let t = acc.finish();
-        assert!((t.friction_work_j - 30.0).abs() < 1e-12);
+        assert!((t.normal_slip_work_j - 30.0).abs() < 1e-12);
         assert!((t.work_above_cutoff_j - 15.0).abs() < 1e-12);
         assert!((t.work_share_above_cutoff() - 0.5).abs() < 1e-12);
         let expected = k_by_hand(1.0e8) * 10.0 * 1.5;
@@ -444,7 +449,7 @@ mod tests {
         let mut contact = a.finish();
         contact.merge(&b.finish()).unwrap();
         assert!((contact.volume_m3 - 2.0e-14 * 15.0).abs() < 1e-27);
-        assert!((contact.friction_work_j - 15.0).abs() < 1e-12);
+        assert!((contact.normal_slip_work_j - 15.0).abs() < 1e-12);
         assert!((contact.contact_time_s - 2.0).abs() < 1e-12);
         assert_eq!(contact.samples, 22);
         assert!((contact.pressure_histogram.total_work_j() - 15.0).abs() < 1e-12);

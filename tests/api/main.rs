@@ -14,6 +14,7 @@ mod service_campaigns;
 mod service_dashboard;
 mod service_diagnose;
 mod service_fanout;
+mod service_hostile;
 mod service_jobs;
 mod service_metrics;
 mod service_openapi;

@@ -199,6 +199,11 @@ fn check_text(field: &str, value: &str) -> Result<String, Problem> {
     let value = value.trim();
     if value.is_empty() || value.chars().count() > 200 {
         Err(Problem::invalid_field(field, "must be 1 to 200 characters"))
+    } else if value.chars().any(char::is_control) {
+        Err(Problem::invalid_field(
+            field,
+            "must not contain control characters (tab, newline, escape, ...)",
+        ))
     } else {
         Ok(value.to_string())
     }

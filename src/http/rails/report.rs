@@ -17,6 +17,9 @@ use serde::{Deserialize, Serialize};
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
+/// Largest design life a report accepts, h (114 years of flight).
+const MAX_DESIGN_LIFE_H: f64 = 1e6;
+
 /// One point of the sweep behind a report.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct CurvePointView {
@@ -268,9 +271,13 @@ pub async fn get_report(
             .trim()
             .parse::<f64>()
             .ok()
-            .filter(|h| h.is_finite() && *h > 0.0)
+            .filter(|h| h.is_finite() && *h > 0.0 && *h <= MAX_DESIGN_LIFE_H)
             .ok_or_else(|| {
-                Problem::bad_parameter("design_life_h", "must be a positive number of hours")
+                Problem::bad_parameter(
+                    "design_life_h",
+                    "must be a positive number of hours, at most 1e6 (114 years of flight: \
+                     more is a unit mistake)",
+                )
             })?,
     };
     let compare_id = match &query.compare {

@@ -5,8 +5,7 @@
 use crate::physics::body::BodyKind;
 use crate::physics::contact::TrackState;
 use crate::physics::control::RunControl;
-use crate::physics::energy::EnergyAudit;
-use crate::physics::integrator::{IntegratorSettings, IntegratorStats};
+use crate::physics::integrator::IntegratorSettings;
 use crate::physics::partition::independent_parts;
 use crate::physics::simulate::{
     simulate_from, DivergenceLimits, EngineCheckpoint, SimError, StepView,
@@ -23,7 +22,10 @@ use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod report;
 mod soundness;
+
+pub use report::{BodyReport, ContactReport, RunReport};
 
 use parts::run_parts;
 
@@ -63,84 +65,6 @@ pub struct RunOptions {
     pub record_interval_s: f64,
     /// Sample rate of the response acceleration record, Hz.
     pub response_rate_hz: f64,
-}
-
-/// Wear and loading of one contact over the excitation window.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ContactReport {
-    /// Contact name.
-    pub name: String,
-    /// Body carrying the convex pieces.
-    pub body_a: String,
-    /// Body carrying the faces.
-    pub body_b: String,
-    /// Wear totals (volume, work, work above the cutoff, pressure histogram).
-    pub wear: WearTotals,
-    /// Share of the friction work done above the wear law's cutoff (thesis 5.5), 0..1.
-    pub work_share_above_cutoff: f64,
-    /// Wear mass charged to body a, mg.
-    pub mass_a_mg: f64,
-    /// Wear mass charged to body b, mg.
-    pub mass_b_mg: f64,
-    /// Total wear-mass rate of the contact, mg/h.
-    pub mass_rate_mg_per_h: f64,
-    /// Wear-mass rate charged to body a, mg/h.
-    pub mass_rate_a_mg_per_h: f64,
-    /// Wear-mass rate charged to body b, mg/h.
-    pub mass_rate_b_mg_per_h: f64,
-    /// Time-averaged normal force, N.
-    pub mean_normal_force_n: f64,
-    /// Time-averaged friction power Σ N |v_slip|, W.
-    pub mean_friction_power_w: f64,
-    /// Largest normal force seen, N.
-    pub peak_normal_force_n: f64,
-}
-
-/// Wear charged to one body, summed over its contacts.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct BodyReport {
-    /// Body name.
-    pub name: String,
-    /// Wear mass, mg.
-    pub mass_mg: f64,
-    /// Wear-mass rate over the excitation window, mg/h.
-    pub mass_rate_mg_per_h: f64,
-}
-
-/// Everything a run produces (serializable: a partitioned run's checkpoint keeps the reports
-/// of its finished parts).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RunReport {
-    /// Per contact.
-    pub contacts: Vec<ContactReport>,
-    /// Per body.
-    pub bodies: Vec<BodyReport>,
-    /// Length of the averaging (excitation) window, s.
-    pub window_s: f64,
-    /// Time-averaged total normal force over the window, N.
-    pub mean_normal_force_n: f64,
-    /// Time-averaged total friction power over the window, W.
-    pub mean_friction_power_w: f64,
-    /// Integrator counters.
-    pub integrator: IntegratorStats,
-    /// Wall-clock time, s.
-    pub wall_s: f64,
-    /// Recorded track samples.
-    pub tracks: Vec<TrackSample>,
-    /// Response-body acceleration, world frame, sampled uniformly over the window, m/s².
-    pub response_acceleration: Vec<[f64; 3]>,
-    /// Sample rate of `response_acceleration`, Hz.
-    pub response_rate_hz: f64,
-    /// Base (drive) acceleration at the same instants, m/s².
-    pub base_acceleration: Vec<[f64; 3]>,
-    /// Cumulative wear volume per contact versus time: (time s, volume m³ per contact).
-    pub wear_history: Vec<(f64, Vec<f64>)>,
-    /// The run's energy account (settle and excitation).
-    pub energy: Option<EnergyAudit>,
-    /// Simulated time of the checkpoint the run resumed from, s (None: it ran from t = 0).
-    /// Set by `models::case_run::run_case_model`; not part of the results.
-    #[serde(default)]
-    pub resumed_from_s: Option<f64>,
 }
 
 /// Why a run failed.
@@ -209,6 +133,10 @@ struct Observed {
     power_int: Vec<f64>,
     peak: Vec<f64>,
     prev_sums: Option<(f64, Vec<f64>, Vec<f64>)>,
+    /// The energy account's friction work per contact at the window's first accepted state
+    /// and at the last one, J.
+    friction_at_window_start: Option<Vec<f64>>,
+    friction_now: Vec<f64>,
     tracks_out: Vec<TrackSample>,
     next_record: f64,
     next_resp: f64,
@@ -235,6 +163,8 @@ impl Observed {
             power_int: vec![0.0; ncontacts],
             peak: vec![0.0; ncontacts],
             prev_sums: None,
+            friction_at_window_start: None,
+            friction_now: vec![0.0; ncontacts],
             tracks_out: Vec::new(),
             next_record: t0,
             next_resp: t0,
@@ -256,6 +186,7 @@ impl Observed {
                 .all(|(a, c)| a.len() == c.pieces_a.len() * c.faces_b.len())
             && self.normal_int.len() == n
             && self.power_int.len() == n
+            && self.friction_now.len() == n
             && self.peak.len() == n
     }
 }
@@ -438,7 +369,15 @@ fn run_whole(
             return;
         }
         extra(v);
-        // Friction power and normal force, trapezoid between step ends.
+        // Friction work over the window: read off the energy account, so the report's friction
+        // power is the account's.
+        if st.friction_at_window_start.is_none() {
+            st.friction_at_window_start = Some(v.friction_work_j.to_vec());
+        }
+        if v.friction_work_j.len() == st.friction_now.len() {
+            st.friction_now.copy_from_slice(v.friction_work_j);
+        }
+        // Normal-load-times-slip power and normal force, trapezoid between step ends.
         let mut n_sum = vec![0.0; ncontacts];
         let mut p_sum = vec![0.0; ncontacts];
         for tr in v.tracks {
@@ -553,11 +492,21 @@ fn run_whole(
         normal_int,
         power_int,
         peak,
+        friction_at_window_start,
+        friction_now,
         tracks_out,
         resp_vel,
         wear_history,
         ..
     } = st;
+    let friction_window: Vec<f64> = match &friction_at_window_start {
+        Some(start) => friction_now
+            .iter()
+            .zip(start)
+            .map(|(now, start)| now - start)
+            .collect(),
+        None => vec![0.0; ncontacts],
+    };
     // A broken run fails here rather than report zeros (`soundness`).
     let energy_controlled = options.integrator.tolerances.energy_rel > 0.0;
     watch.verdict(
@@ -607,7 +556,9 @@ fn run_whole(
             mass_rate_a_mg_per_h: wa.mass_kg * MG_PER_KG * per_h,
             mass_rate_b_mg_per_h: wb.mass_kg * MG_PER_KG * per_h,
             mean_normal_force_n: normal_int[ci] / window,
-            mean_friction_power_w: power_int[ci] / window,
+            mean_normal_slip_power_w: power_int[ci] / window,
+            mean_friction_power_w: friction_window[ci] / window,
+            friction_work_j: friction_window[ci],
             peak_normal_force_n: peak[ci],
             wear: total,
         });
@@ -637,7 +588,8 @@ fn run_whole(
     }
     Ok(RunReport {
         mean_normal_force_n: normal_int.iter().sum::<f64>() / window,
-        mean_friction_power_w: power_int.iter().sum::<f64>() / window,
+        mean_normal_slip_power_w: power_int.iter().sum::<f64>() / window,
+        mean_friction_power_w: friction_window.iter().sum::<f64>() / window,
         contacts,
         bodies,
         window_s: window,

@@ -89,7 +89,7 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
     let mut body_mass_mg = vec![0.0; sys.bodies.len()];
     let mut body_rate = vec![0.0; sys.bodies.len()];
     let mut integrator = IntegratorStats::default();
-    let (mut wall_s, mut mean_n, mut mean_p) = (0.0, 0.0, 0.0);
+    let (mut wall_s, mut mean_n, mut mean_p, mut mean_friction) = (0.0, 0.0, 0.0, 0.0);
     let mut tracks = Vec::new();
     let mut response = None;
     let mut histories = Vec::new();
@@ -114,7 +114,8 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
         integrator.contact_free_rhs_evals += s.contact_free_rhs_evals;
         wall_s += r.wall_s;
         mean_n += r.mean_normal_force_n;
-        mean_p += r.mean_friction_power_w;
+        mean_p += r.mean_normal_slip_power_w;
+        mean_friction += r.mean_friction_power_w;
         tracks.extend(r.tracks.into_iter().map(|mut t| {
             t.contact = part.contacts[t.contact as usize] as u32;
             t
@@ -177,7 +178,8 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
             .collect(),
         window_s,
         mean_normal_force_n: mean_n,
-        mean_friction_power_w: mean_p,
+        mean_normal_slip_power_w: mean_p,
+        mean_friction_power_w: mean_friction,
         integrator,
         wall_s,
         tracks,
