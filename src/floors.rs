@@ -499,7 +499,10 @@ mod tests {
             new.is_empty(),
             "files over {LONG_FILE_LINES} lines without \"{LONG_FILE_REASON}\" and a reason \
              in their first 40 lines:\n{}",
-            new.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n")
+            new.iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join("\n")
         );
         let fixed: Vec<&&str> = KNOWN_LONG_FILES
             .iter()
@@ -518,7 +521,10 @@ mod tests {
         let long_body = "fn f() {}\n".repeat(LONG_FILE_LINES + 1);
         for (path, text) in [
             ("src/a.rs", long_body.clone()),
-            ("src/b.rs", format!("//! {LONG_FILE_REASON}: a table.\n{long_body}")),
+            (
+                "src/b.rs",
+                format!("//! {LONG_FILE_REASON}: a table.\n{long_body}"),
+            ),
             ("tests/c/d.rs", long_body.clone()),
             ("tests/e.rs", "fn g() {}\n".to_string()),
             ("bench/f.rs", long_body.clone()),

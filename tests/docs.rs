@@ -204,7 +204,9 @@ fn speed_table_rows(readme: &str) -> Vec<String> {
     let mut in_section = false;
     for line in readme.lines() {
         if line.starts_with("## ") {
-            in_section = line.trim_start_matches("## ").starts_with("How fast, how accurate");
+            in_section = line
+                .trim_start_matches("## ")
+                .starts_with("How fast, how accurate");
             continue;
         }
         if in_section && line.starts_with('|') {
@@ -243,9 +245,27 @@ fn every_number_in_the_readmes_speed_table_is_on_a_results_page() {
 /// Ordinal words: `first` to `twentieth`, `thirtieth`, `twenty-fifth`, `25th`.
 fn is_ordinal(word: &str) -> bool {
     const ORDINALS: &[&str] = &[
-        "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth",
-        "tenth", "eleventh", "twelfth", "thirteenth", "fourteenth", "fifteenth", "sixteenth",
-        "seventeenth", "eighteenth", "nineteenth", "twentieth", "thirtieth",
+        "first",
+        "second",
+        "third",
+        "fourth",
+        "fifth",
+        "sixth",
+        "seventh",
+        "eighth",
+        "ninth",
+        "tenth",
+        "eleventh",
+        "twelfth",
+        "thirteenth",
+        "fourteenth",
+        "fifteenth",
+        "sixteenth",
+        "seventeenth",
+        "eighteenth",
+        "nineteenth",
+        "twentieth",
+        "thirtieth",
     ];
     let last = word.rsplit('-').next().unwrap_or(word);
     ORDINALS.contains(&last)
@@ -264,7 +284,9 @@ fn lab_notebook_framing(text: &str) -> Vec<String> {
         .collect();
     let mut found = Vec::new();
     for pair in words.windows(2) {
-        let numbered = pair[1].trim_start_matches('#').starts_with(|c: char| c.is_ascii_digit());
+        let numbered = pair[1]
+            .trim_start_matches('#')
+            .starts_with(|c: char| c.is_ascii_digit());
         if (pair[0] == "issue" || pair[0] == "session") && numbered
             || (pair[1] == "pass" || pair[1] == "passes") && is_ordinal(pair[0])
         {
@@ -284,7 +306,11 @@ fn the_readme_is_a_guide_not_a_notebook() {
     let found: Vec<String> = pages
         .iter()
         .flat_map(|page| {
-            let name = page.strip_prefix(root()).unwrap_or(page).display().to_string();
+            let name = page
+                .strip_prefix(root())
+                .unwrap_or(page)
+                .display()
+                .to_string();
             lab_notebook_framing(&read(page))
                 .into_iter()
                 .map(move |f| format!("{name}: {f}"))
