@@ -8,6 +8,9 @@
 //! expanded, outside comments and string literals: doc links (`[`crate::report`]`) name a room
 //! without depending on it. Paths are resolved to the module they start from, so
 //! `super::outcome` in `models/launcher/mod.rs` is `crate::models::outcome`.
+//!
+//! The long-file rule covers the integration tests too (`tests/`): a test file is read as
+//! often as the code it checks.
 
 mod paths;
 
@@ -44,6 +47,13 @@ const LONG_FILE_LINES: usize = 700;
 const LONG_FILE_REASON: &str = "Over 700 lines";
 /// A room's own `mod.rs`, where an arrow inside the room starts or ends.
 const ROOM_FILE: &str = "mod.rs";
+
+/// The folders the long-file rule covers, from the repository root.
+const LONG_FILE_DIRS: &[&str] = &["src", "tests"];
+/// Files over [`LONG_FILE_LINES`] known to lack the header, from the repository root, each
+/// waiting for its owner to split it or say why. The check fails on any other such file, and
+/// on a listed one that no longer needs the entry, so the list only shrinks.
+const KNOWN_LONG_FILES: &[&str] = &["tests/engine/gap_diagnose.rs"];
 
 /// Circles among sub-rooms known and left for now: (room, the circle's sub-rooms). The check
 /// fails on any other circle, and on a listed one that is gone, so the list only shrinks. None
@@ -453,10 +463,14 @@ mod tests {
         assert!(circles(&arrows).is_empty());
     }
 
-    #[test]
-    fn long_files_say_why() {
+    /// Files over [`LONG_FILE_LINES`] lines whose first 40 lines do not say why, as paths from
+    /// the repository root.
+    fn unexplained_long_files(root: &Path) -> Vec<String> {
         let mut files = Vec::new();
-        rust_files(&src(), &mut files);
+        for dir in LONG_FILE_DIRS {
+            rust_files(&root.join(dir), &mut files);
+        }
+        files.sort();
         let mut unexplained = Vec::new();
         for file in files {
             let Ok(source) = std::fs::read_to_string(&file) else {
@@ -465,14 +479,69 @@ mod tests {
             let lines = source.lines().count();
             let header: String = source.lines().take(40).collect::<Vec<_>>().join("\n");
             if lines > LONG_FILE_LINES && !header.contains(LONG_FILE_REASON) {
-                unexplained.push(format!("{} ({lines} lines)", file.display()));
+                let rel = file.strip_prefix(root).unwrap_or(&file);
+                unexplained.push(format!("{} ({lines} lines)", rel.display()));
             }
         }
+        unexplained
+    }
+
+    #[test]
+    fn long_files_say_why() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let unexplained = unexplained_long_files(root);
+        let path_of = |entry: &String| entry.split(" (").next().unwrap_or("").to_string();
+        let new: Vec<&String> = unexplained
+            .iter()
+            .filter(|entry| !KNOWN_LONG_FILES.contains(&path_of(entry).as_str()))
+            .collect();
         assert!(
-            unexplained.is_empty(),
+            new.is_empty(),
             "files over {LONG_FILE_LINES} lines without \"{LONG_FILE_REASON}\" and a reason \
              in their first 40 lines:\n{}",
-            unexplained.join("\n")
+            new.iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join("\n")
+        );
+        let fixed: Vec<&&str> = KNOWN_LONG_FILES
+            .iter()
+            .filter(|known| !unexplained.iter().any(|entry| path_of(entry) == **known))
+            .collect();
+        assert!(
+            fixed.is_empty(),
+            "known long files that now say why or are short enough, to take off \
+             KNOWN_LONG_FILES: {fixed:?}"
+        );
+    }
+
+    #[test]
+    fn the_long_file_rule_reads_src_and_tests() {
+        let dir = std::env::temp_dir().join(format!("floors-long-{}", std::process::id()));
+        let long_body = "fn f() {}\n".repeat(LONG_FILE_LINES + 1);
+        for (path, text) in [
+            ("src/a.rs", long_body.clone()),
+            (
+                "src/b.rs",
+                format!("//! {LONG_FILE_REASON}: a table.\n{long_body}"),
+            ),
+            ("tests/c/d.rs", long_body.clone()),
+            ("tests/e.rs", "fn g() {}\n".to_string()),
+            ("bench/f.rs", long_body.clone()),
+        ] {
+            let file = dir.join(path);
+            std::fs::create_dir_all(file.parent().unwrap_or(&dir)).expect("temp dir");
+            std::fs::write(&file, text).expect("temp file");
+        }
+        let found = unexplained_long_files(&dir);
+        let _ = std::fs::remove_dir_all(&dir);
+        let lines = LONG_FILE_LINES + 1;
+        assert_eq!(
+            found,
+            [
+                format!("src/a.rs ({lines} lines)"),
+                format!("tests/c/d.rs ({lines} lines)")
+            ]
         );
     }
 }

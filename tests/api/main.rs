@@ -8,6 +8,7 @@ mod helpers;
 
 mod api_schemathesis;
 mod postgres_binary;
+mod readme_journeys;
 mod service_binary;
 mod service_bounds;
 mod service_campaigns;
