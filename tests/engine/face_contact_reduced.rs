@@ -157,10 +157,16 @@ fn where_its_estimate_holds_the_reduced_friction_is_within_the_tolerance_of_the_
 #[test]
 fn the_reduced_laws_damping_and_friction_only_dissipate() {
     // Tilted, turning, sliding heads across the lip's edge: each track's damping and friction
-    // power is non-negative, and the friction's power on the head (the lip fixed) is minus
-    // the tracks' friction power: every part's friction acts at the point whose slip it uses.
+    // power is non-negative, and the power balance of the contact on the head's rigid motion
+    // (the lip fixed) closes: F·v + τ·ω = −dU/dt − Σ damping power − Σ friction power, with
+    // dU/dt by central differences along the motion. Every part's friction acts at the point
+    // whose slip it uses and its normal law is the gradient of the stored energy, so nothing
+    // else may appear, but for the per-node parts' quadrature of the stored energy where the
+    // nodes move with the cuts (the strips beyond the lip's edge: 5e-4 of the force,
+    // face_contact.rs `GRADIENT_TOLERANCE`; a clamped head's rate of energy against its clamp
+    // dissipation, up to 1.6e-3 measured): within 2e-3 of the powers' magnitude, the exact
+    // contact's own bound against the continuum.
     let red = reduced(lip_contact(true, true)).with_reduced_tolerance(1.0);
-    let red0 = reduced(lip_contact(true, false)).with_reduced_tolerance(1.0);
     let mut rng = ChaCha8Rng::seed_from_u64(5303);
     let mut loaded = 0;
     for _ in 0..200 {
@@ -176,29 +182,31 @@ fn the_reduced_laws_damping_and_friction_only_dissipate() {
             rng.gen_range(-0.5..0.5),
         );
         let (_, f, t, tracks) = evaluate(&red, &pose, v, omega);
-        let (_, f0, t0, _) = evaluate(&red0, &pose, v, omega);
         if tracks.is_empty() {
             continue;
         }
         loaded += 1;
         for tr in &tracks {
-            assert!(
-                tr.damping_power >= 0.0,
-                "damping power {}",
-                tr.damping_power
-            );
-            assert!(
-                tr.friction_power >= 0.0,
-                "friction power {}",
-                tr.friction_power
-            );
+            assert!(tr.damping_power >= 0.0, "damping power {}", tr.damping_power);
+            assert!(tr.friction_power >= 0.0, "friction power {}", tr.friction_power);
         }
-        let (ff, tf) = (f - f0, t - t0);
-        let on_head = ff.dot(&v) + tf.dot(&omega);
-        let dissipated = power(&tracks, |t| t.friction_power);
+        let h = 1e-7;
+        let moved = |s: f64| {
+            Isometry3::from_parts(
+                Translation3::from(pose.translation.vector + v * s),
+                UnitQuaternion::from_scaled_axis(omega * s) * pose.rotation,
+            )
+        };
+        let energy = |s: f64| evaluate(&red, &moved(s), v, omega).0;
+        let du_dt = (energy(h) - energy(-h)) / (2.0 * h);
+        let on_head = f.dot(&v) + t.dot(&omega);
+        let damping = power(&tracks, |t| t.damping_power);
+        let friction = power(&tracks, |t| t.friction_power);
+        let scale = damping + friction + du_dt.abs() + f.norm() * v.norm() + t.norm() * omega.norm();
         assert!(
-            (on_head + dissipated).abs() <= 1e-9 * dissipated.max(1e-12),
-            "friction's power on the head {on_head} vs −{dissipated}"
+            (on_head + du_dt + damping + friction).abs() <= 2e-3 * scale,
+            "power on the head {on_head} vs −dU/dt {} − damping {damping} − friction {friction}",
+            -du_dt
         );
     }
     assert!(loaded >= 100, "{loaded} loaded states");
