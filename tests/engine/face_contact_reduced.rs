@@ -187,8 +187,16 @@ fn the_reduced_laws_damping_and_friction_only_dissipate() {
         }
         loaded += 1;
         for tr in &tracks {
-            assert!(tr.damping_power >= 0.0, "damping power {}", tr.damping_power);
-            assert!(tr.friction_power >= 0.0, "friction power {}", tr.friction_power);
+            assert!(
+                tr.damping_power >= 0.0,
+                "damping power {}",
+                tr.damping_power
+            );
+            assert!(
+                tr.friction_power >= 0.0,
+                "friction power {}",
+                tr.friction_power
+            );
         }
         let h = 1e-7;
         let moved = |s: f64| {
@@ -202,7 +210,8 @@ fn the_reduced_laws_damping_and_friction_only_dissipate() {
         let on_head = f.dot(&v) + t.dot(&omega);
         let damping = power(&tracks, |t| t.damping_power);
         let friction = power(&tracks, |t| t.friction_power);
-        let scale = damping + friction + du_dt.abs() + f.norm() * v.norm() + t.norm() * omega.norm();
+        let scale =
+            damping + friction + du_dt.abs() + f.norm() * v.norm() + t.norm() * omega.norm();
         assert!(
             (on_head + du_dt + damping + friction).abs() <= 2e-3 * scale,
             "power on the head {on_head} vs −dU/dt {} − damping {damping} − friction {friction}",
