@@ -29,6 +29,8 @@ pub(crate) struct Variant {
     pub(crate) face_contact: Option<FaceContact>,
     /// Where the exact face contact takes friction (a measurement; cases are per node).
     pub(crate) friction_rule: FrictionRule,
+    /// The reduced face law's tolerance (None: the contacts' default).
+    pub(crate) reduced_tolerance: Option<f64>,
 }
 
 impl Variant {
@@ -43,6 +45,7 @@ impl Variant {
             points_per_edge: None,
             face_contact: None,
             friction_rule: FrictionRule::PerNode,
+            reduced_tolerance: None,
         }
     }
 }
@@ -58,6 +61,9 @@ pub(crate) struct Measured {
     pub(crate) energy_residual_rel: Option<f64>,
     /// (name, value, kind) of every user quantity.
     pub(crate) quantities: Vec<(String, f64, QuantityKind)>,
+    /// The reduced face law's parts over the run, summed over its contacts (largest estimate
+    /// the largest): None when no contact uses it.
+    pub(crate) reduced: Option<railwear::physics::contact::ReducedShare>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -113,6 +119,9 @@ pub(crate) fn run_variant(
     model.initial_state[0] += v.nudge_m;
     for c in &mut model.system.contacts {
         c.friction_rule = v.friction_rule;
+        if let Some(tol) = v.reduced_tolerance {
+            c.reduced_tolerance = tol;
+        }
     }
     let mut options = run_options(&case)?;
     // Output is not engine work: no track samples (the wear integral sees every step anyway).
@@ -174,7 +183,25 @@ pub(crate) fn run_variant(
             .as_ref()
             .map(|e| e.residual_j.abs() / e.dissipated_j.max(1e-30)),
         quantities,
+        reduced: reduced_share(&model),
     })
+}
+
+/// The reduced face law's census of `model`'s contacts that use it, summed.
+fn reduced_share(model: &BuiltModel) -> Option<railwear::physics::contact::ReducedShare> {
+    let mut any = None;
+    for c in &model.system.contacts {
+        if c.face_contact != FaceContact::Reduced {
+            continue;
+        }
+        let s = c.reduced_census.snapshot();
+        let sum = any.get_or_insert(railwear::physics::contact::ReducedShare::default());
+        sum.closed_parts += s.closed_parts;
+        sum.per_node_parts += s.per_node_parts;
+        sum.over_tolerance_parts += s.over_tolerance_parts;
+        sum.largest_estimate = sum.largest_estimate.max(s.largest_estimate);
+    }
+    any
 }
 
 /// `x` replaces the worst difference so far (a NaN always does: it is reported, not hidden).
@@ -285,6 +312,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             points_per_edge: None,
             face_contact: None,
             friction_rule: FrictionRule::PerNode,
+            reduced_tolerance: None,
         },
         Variant {
             label: "full, tol, start moved 1 nm".into(),
@@ -295,6 +323,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
             points_per_edge: None,
             face_contact: None,
             friction_rule: FrictionRule::PerNode,
+            reduced_tolerance: None,
         },
     ];
     for m in &modes {
@@ -308,6 +337,7 @@ pub(crate) fn convergence(configs_dir: &Path, b: &ConvergenceBench) -> Result<Ve
                 points_per_edge: None,
                 face_contact: None,
                 friction_rule: FrictionRule::PerNode,
+                reduced_tolerance: None,
             });
         }
     }
@@ -529,6 +559,7 @@ pub(crate) fn ladder(
         points_per_edge,
         face_contact: None,
         friction_rule: FrictionRule::PerNode,
+        reduced_tolerance: None,
     };
     let points = b.points_per_edge;
     for case_name in b.case_names() {

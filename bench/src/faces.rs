@@ -104,7 +104,7 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
         for (label, m) in &measured {
             runs.row(vec![
                 Cell::text(case_name),
-                Cell::text(label),
+                Cell::text(label.as_str()),
                 Cell::Int(m.accepted),
                 Cell::opt(m.cpu_s),
                 Cell::opt(m.cpu_s.map(|c| 1e6 * c / m.accepted.max(1) as f64)),
@@ -167,5 +167,105 @@ pub(crate) fn faces(configs_dir: &Path, b: &ConvergenceBench) -> Result<Vec<Tabl
         "reference: Q(h) = Q∞ + C h^p through the last three lattice runs (h = 1/(n − 1)); \
          '-' where they are not monotone in h",
     );
+    Ok(vec![runs, quantities])
+}
+
+/// `reduced`: issue 53's comparison. For each case the exact face contact and the reduced face
+/// law (`face_contact = "reduced"`), each at the case tolerance without track recording: CPU
+/// cost, the reduced law's census (parts in closed form, largest friction estimate), and the
+/// friction power and every contact's wear rate of the reduced law against the exact one.
+pub(crate) fn reduced(
+    configs_dir: &Path,
+    cases: &str,
+    settle: f64,
+    window: f64,
+    tolerances: &[f64],
+) -> Result<Vec<Table>> {
+    let mut runs = Table::new(
+        "Reduced face law against the exact face contact: runs at the case tolerance (no track recording)",
+        &[
+            ("case", "case"),
+            ("variant", "face contact"),
+            ("accepted", "accepted steps"),
+            ("cpu_s", "CPU s"),
+            ("cpu_us_per_step", "CPU µs per accepted step"),
+            ("real_time_factor_cpu", "real-time factor (CPU)"),
+            ("energy_residual", "energy residual / dissipated"),
+            ("closed_share", "parts taken per part"),
+            ("over_tolerance", "parts over the tolerance"),
+            ("largest_estimate", "largest friction estimate used"),
+        ],
+    );
+    let mut quantities = Table::new(
+        "Reduced face law against the exact face contact: friction power and wear rates",
+        &[
+            ("case", "case"),
+            ("quantity", "quantity"),
+            ("exact", "exact"),
+            ("reduced", "reduced"),
+            ("difference", "Δ reduced vs exact"),
+        ],
+    );
+    for case_name in cases.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let mut measured = Vec::new();
+        let mut variants = vec![("exact".to_string(), FaceContact::Exact, None)];
+        for &tol in tolerances {
+            variants.push((
+                format!("reduced, tolerance {tol}"),
+                FaceContact::Reduced,
+                Some(tol),
+            ));
+        }
+        if tolerances.is_empty() {
+            variants.push(("reduced".into(), FaceContact::Reduced, None));
+        }
+        for (label, law, tol) in variants {
+            let mut v = Variant::plain(label.clone());
+            v.face_contact = Some(law);
+            v.reduced_tolerance = tol;
+            eprintln!("reduced: {case_name} {label} ...");
+            let m = run_variant(configs_dir, case_name, settle, window, &v)?;
+            runs.row(vec![
+                Cell::text(case_name),
+                Cell::text(&label),
+                Cell::Int(m.accepted),
+                Cell::opt(m.cpu_s),
+                Cell::opt(m.cpu_s.map(|c| 1e6 * c / m.accepted.max(1) as f64)),
+                Cell::opt(m.cpu_s.map(|c| m.simulated_s / c.max(1e-9))),
+                Cell::opt(m.energy_residual_rel),
+                Cell::opt(m.reduced.map(|r| r.closed_share())),
+                Cell::opt(m.reduced.map(|r| {
+                    r.over_tolerance_parts as f64
+                        / (r.closed_parts + r.per_node_parts).max(1) as f64
+                })),
+                Cell::opt(m.reduced.map(|r| r.largest_estimate)),
+            ]);
+            measured.push((label, m));
+        }
+        let exact = &measured[0].1;
+        for (label, red) in &measured[1..] {
+            for (i, (name, value, kind)) in exact.quantities.iter().enumerate() {
+                if *kind != QuantityKind::Relative || name.starts_with("response") {
+                    continue;
+                }
+                let other = red.quantities.get(i).map_or(f64::NAN, |q| q.1);
+                quantities.row(vec![
+                    Cell::text(format!("{case_name} ({label})")),
+                    Cell::text(name),
+                    Cell::Num(*value),
+                    Cell::Num(other),
+                    Cell::text(format!(
+                        "{:+.3} %",
+                        100.0 * (other - value) / value.abs().max(f64::MIN_POSITIVE)
+                    )),
+                ]);
+            }
+        }
+    }
+    runs.note(format!(
+        "settle {settle} s, window {window} s, full error control at the case tolerance; \
+         CPU s = this thread's user + system time (10 ms ticks)"
+    ));
+    runs.note(machine_note());
     Ok(vec![runs, quantities])
 }

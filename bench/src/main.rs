@@ -234,6 +234,22 @@ enum Command {
         #[arg(long)]
         friction_per_part: bool,
     },
+    /// Issue 53's reduced face law against the exact face contact: cost, census and the
+    /// friction power and wear rates of each case, one run of each law.
+    Reduced {
+        /// Cases (config names, comma list).
+        #[arg(long, default_value = "launcher-design,launcher-tight,launcher-loose")]
+        cases: String,
+        /// Settle time, s.
+        #[arg(long, default_value_t = 0.5)]
+        settle: f64,
+        /// Averaging window after the settle, s.
+        #[arg(long, default_value_t = 4.0)]
+        window: f64,
+        /// The reduced law's tolerances to run (comma list; empty: the contacts' default).
+        #[arg(long, default_value = "")]
+        tolerances: String,
+    },
     /// Issue 27's per-state face study: a case run with the lattice, its states recorded, and
     /// at each the contacts evaluated with the exact face contact, the exact contact with
     /// friction per part at its load centre (`FrictionRule::PerPart`), and the lattice at
@@ -486,6 +502,18 @@ fn main() -> Result<()> {
                 None => convergence(&cli.configs_dir, &bench)?,
             }
         }
+        Command::Reduced {
+            cases,
+            settle,
+            window,
+            tolerances,
+        } => faces::reduced(
+            &cli.configs_dir,
+            cases,
+            *settle,
+            *window,
+            &parse_list(tolerances, "--tolerances")?,
+        )?,
         Command::FaceStates {
             case,
             record_points,

@@ -337,6 +337,11 @@ impl FacePatch {
         }
     }
 
+    /// The inner face's frame: `ξ` is the world point `centre + u axis_u + v axis_v`.
+    pub fn frame(&self) -> (Point3<f64>, Vector3<f64>, Vector3<f64>) {
+        (self.centre, self.axis_u, self.axis_v)
+    }
+
     /// The penetration `w(ξ)` of the patch's balls into the face's plane (affine).
     pub fn depth(&self) -> Line {
         self.depth
@@ -426,8 +431,7 @@ impl FacePatch {
         kept || self.clip_at(&at)
     }
 
-    /// The clip of [`FacePatch::clip`] given the line's value `at[i]` at each vertex, some of
-    /// them negative.
+    /// [`FacePatch::clip`] given the line's value `at[i]` at each vertex, some negative.
     fn clip_at(&mut self, at: &[f64; MAX_VERTICES]) -> bool {
         let len = self.len;
         let mut out = [[0.0; 2]; MAX_VERTICES];

@@ -188,6 +188,7 @@ pub fn face_contact_record(case: &CaseSpec) -> Result<Value, RunError> {
     Ok(match face_contact(case)? {
         None => Value::Null,
         Some(FaceContact::Exact) => json!({"face_contact": FaceContact::Exact}),
+        Some(FaceContact::Reduced) => json!({"face_contact": FaceContact::Reduced}),
         Some(FaceContact::Lattice) => json!({
             "face_contact": FaceContact::Lattice,
             "contact_points_per_edge": case.simulation.contact_points_per_edge,

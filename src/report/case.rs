@@ -93,6 +93,36 @@ fn package_parts(
             "psd_x": psd.as_ref().map(|p| json!({"frequency_hz": p.frequency_hz, "density_m2_s4_per_hz": p.density})),
         },
         "track_samples": track_samples,
+        "reduced_face_law": reduced_face_law(model),
     });
     (summary, case_plots(case, r, psd.as_ref()))
+}
+
+/// How the reduced face law (`face_contact = "reduced"`) took its parts over the run, per
+/// contact that uses it: parts in closed form and at nodes, the share in closed form, and the
+/// largest friction estimate accepted against the tolerance; null when no contact uses it.
+fn reduced_face_law(model: &BuiltModel) -> Value {
+    use crate::physics::contact::FaceContact;
+    let rows: Vec<Value> = model
+        .system
+        .contacts
+        .iter()
+        .filter(|c| c.face_contact == FaceContact::Reduced)
+        .map(|c| {
+            let share = c.reduced_census.snapshot();
+            json!({
+                "contact": c.name,
+                "closed_form_parts": share.closed_parts,
+                "per_node_parts": share.per_node_parts,
+                "closed_form_share": share.closed_share(),
+                "largest_estimate": share.largest_estimate,
+                "tolerance": c.reduced_tolerance,
+            })
+        })
+        .collect();
+    if rows.is_empty() {
+        Value::Null
+    } else {
+        Value::Array(rows)
+    }
 }

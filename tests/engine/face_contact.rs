@@ -623,6 +623,23 @@ fn continuum_reference(
     (force, torque, gross)
 }
 
+/// The gross load `Σ (k w^e + c STEP(w) |ẇ|)` (N) of the head at `pose` moving with
+/// `(v, ω)` on the plane `y = 0` (Table 6.2's law), on `m × m` midpoint cells per face: the
+/// magnitude the face laws' quadrature errors scale with ([`continuum_reference`]).
+pub(crate) fn continuum_gross(
+    pose: &Isometry3<f64>,
+    v: Vector3<f64>,
+    omega: Vector3<f64>,
+    m: usize,
+) -> f64 {
+    let impact = table_6_2();
+    let mut gross = 0.0;
+    continuum_cells(pose, v, omega, m, &mut |c| {
+        gross += c.share * impact.force(c.w, c.wdot.abs());
+    });
+    gross
+}
+
 /// One pressed cell of the continuum: its share of the face law (`1/m²`), its depth `w` and
 /// closing rate `ẇ` against the plane `y = 0`, and its lever from the head's centre.
 pub struct ContinuumCell {

@@ -12,6 +12,7 @@ mod error_control;
 mod face_contact;
 mod face_contact_blocks;
 mod face_contact_closed_form;
+mod face_contact_reduced;
 mod face_contact_rules;
 mod face_friction_rule;
 mod gap_campaign;

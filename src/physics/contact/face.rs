@@ -14,10 +14,11 @@
 //! gradient of the stored energy up to the strips' quadrature error; a shoe sliding off a lip
 //! unloads continuously.
 
-use super::point::{friction_derivatives, Lump, PointOutputs};
+use super::point::{friction_derivatives, penetration_rate, Lump, PointOutputs};
+use super::reduced::ClosedPart;
 use super::Contact;
 use super::{JacobianScope, TrackLinearization};
-use crate::geometry::{inner_box_faces, FacePatch, Line, PlacedFace, QuadratureOrder};
+use crate::geometry::{inner_box_faces, FacePatch, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use crate::physics::step::StepKind;
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
@@ -35,6 +36,11 @@ pub enum FaceContact {
     /// bounded face's sides with a 5 × 5 rule: the lattice's limit of infinitely many points
     /// (docs/models.md "Exact face contact").
     Exact,
+    /// The exact face contact with the clamp-free parts of each pressed polygon (the closing
+    /// core and damping ramp) in closed form and their friction per part where its a-priori
+    /// estimate is within the contact's tolerance, the exact contact's nodes elsewhere
+    /// (`reduced.rs`; docs/models.md "Reduced face law").
+    Reduced,
 }
 
 /// Where the exact face contact evaluates friction. Cases always use [`FrictionRule::PerNode`];
@@ -280,6 +286,7 @@ impl Contact {
         out: &mut PointOutputs<'_, '_>,
     ) {
         let normal = face.plane.normal.into_inner();
+        let reduced = self.face_contact == FaceContact::Reduced;
         let mut deepest: Option<(f64, Point3<f64>)> = None;
         let side_faces_unlinearized = out.scope == JacobianScope::NewtonMatrix
             && out.linearizing()
@@ -293,6 +300,9 @@ impl Contact {
                 .then(|| (out.linearizations.take(), out.moments.take()));
             let mut each = |part: &FacePatch, beyond_side: bool| {
                 if beyond_side {
+                    if reduced {
+                        self.reduced_census.count_per_node();
+                    }
                     self.integrate_strip(part, fine, fa, fb, radius, face, out);
                     return;
                 }
@@ -302,6 +312,36 @@ impl Contact {
                     deepest = Some(d);
                 }
                 let mut each_part = |part: &FacePatch, rule: PartRule| {
+                    if reduced {
+                        // The clamp-free parts in closed form where the friction estimate
+                        // allows (`reduced.rs`); the rest at the nodes below.
+                        let closed = match rule {
+                            PartRule::Patch => Some(ClosedPart::Core),
+                            PartRule::Fixed(CLOSING_RAMP_RULE) => Some(ClosedPart::Ramp),
+                            _ => None,
+                        };
+                        match (closed, rule) {
+                            (Some(kind), _) => {
+                                if self.reduced_part(part, kind, fa, fb, radius, &normal, out) {
+                                    return;
+                                }
+                            }
+                            // The clamped parts' nodes with friction per part, on the rule
+                            // of this face (not where two rules are blended).
+                            (None, PartRule::Clamped(order)) if fine == 1.0 || fine == 0.0 => {
+                                let order = match rule.on_side_face() {
+                                    Some(PartRule::Clamped(side)) if fine == 0.0 => side,
+                                    _ => order,
+                                };
+                                if self.reduced_clamped_part(part, order, fa, fb, radius, face, out)
+                                {
+                                    return;
+                                }
+                            }
+                            (None, PartRule::Unloaded) => {}
+                            (None, _) => self.reduced_census.count_per_node(),
+                        }
+                    }
                     if matches!(rule, PartRule::Unloaded)
                         && self.unloaded_part(part, fa, fb, radius, &normal, out)
                     {
@@ -572,19 +612,4 @@ impl Contact {
         out.sum.add_unloaded(-0.25 * k * w_e_rate);
         true
     }
-}
-
-/// The penetration rate `ẇ = −n·v_rel` of the balls of `radius` on `patch` (affine in its `ξ`:
-/// a rigid relative motion).
-fn penetration_rate(
-    patch: &FacePatch,
-    fa: &BodyFrame,
-    fb: &BodyFrame,
-    radius: f64,
-    normal: &Vector3<f64>,
-) -> Line {
-    patch.affine(|x| {
-        let p = x - normal * radius;
-        -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
-    })
 }

@@ -38,12 +38,14 @@ mod face;
 mod geometry_cache;
 mod moments;
 mod point;
+mod reduced;
 
 pub use face::{FaceContact, FrictionRule};
 pub use geometry_cache::{GeometryCache, GeometryMode, PATCH_REUSE};
 pub(crate) use moments::Matrix6x12;
 pub use moments::TrackMoments;
 use point::{PointOutputs, TrackSum};
+pub use reduced::{ReducedCensus, ReducedShare, REDUCED_TOLERANCE};
 
 /// A contact definition between two bodies (one ADAMS CONTACT statement).
 #[derive(Debug, Clone)]
@@ -69,6 +71,12 @@ pub struct Contact {
     /// Where the exact face contact evaluates friction: at every node (the per-point law,
     /// always in a case) or per part (a measurement, `railwear-bench face-states`).
     pub friction_rule: FrictionRule,
+    /// The largest a-priori estimate of friction per part's relative error a part of the
+    /// reduced face law ([`FaceContact::Reduced`]) may have and take it (default
+    /// [`REDUCED_TOLERANCE`]); parts above it take the per-node law.
+    pub reduced_tolerance: f64,
+    /// How the reduced face law took its parts (shared by the contact's clones).
+    pub reduced_census: std::sync::Arc<ReducedCensus>,
     /// Contact points of each piece, in the piece's frame.
     points: Vec<Vec<ContactPoint>>,
 }
@@ -96,6 +104,8 @@ impl Contact {
             friction,
             face_contact: FaceContact::default(),
             friction_rule: FrictionRule::default(),
+            reduced_tolerance: REDUCED_TOLERANCE,
+            reduced_census: Default::default(),
             points: Vec::new(),
         };
         c.set_points_per_edge(DEFAULT_POINTS_PER_EDGE);
@@ -117,6 +127,12 @@ impl Contact {
     /// How the rounded boxes' faces are resolved (see [`FaceContact`]).
     pub fn with_face_contact(mut self, face_contact: FaceContact) -> Self {
         self.face_contact = face_contact;
+        self
+    }
+
+    /// The reduced face law's tolerance ([`Contact::reduced_tolerance`]).
+    pub fn with_reduced_tolerance(mut self, tolerance: f64) -> Self {
+        self.reduced_tolerance = tolerance;
         self
     }
 
@@ -420,7 +436,7 @@ impl Contact {
                 };
                 match (self.face_contact, shape) {
                     (
-                        FaceContact::Exact,
+                        FaceContact::Exact | FaceContact::Reduced,
                         ConvexShape::RoundedBox {
                             half_extents,
                             roundover,

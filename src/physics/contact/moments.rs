@@ -68,6 +68,29 @@ pub struct TrackMoments {
     force_qc: Matrix3<f64>,
 }
 
+/// A part's density moments for [`TrackMoments::add_part`]: about `origin` (world), with
+/// `a = ∂f_n/∂w` (N/m per unit share), `b = ∂f_n/∂ẇ` (N·s/m) and the normal force `f_n` (N)
+/// integrated against the part's share (each sum is what the nodes' `Σ` would be for a rule
+/// exact on the part).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PartDensities {
+    /// The reference point, world.
+    pub(super) origin: Point3<f64>,
+    /// The part's normal (the face's), world.
+    pub(super) normal: Vector3<f64>,
+    /// `Σ a`, `Σ a q`, `Σ a q qᵀ`.
+    pub(super) a0: f64,
+    pub(super) a1: Vector3<f64>,
+    pub(super) a2: Matrix3<f64>,
+    /// `Σ b`, `Σ b q`, `Σ b q qᵀ`.
+    pub(super) b0: f64,
+    pub(super) b1: Vector3<f64>,
+    pub(super) b2: Matrix3<f64>,
+    /// `Σ f_n`, `Σ f_n q`.
+    pub(super) f0: f64,
+    pub(super) f1: Vector3<f64>,
+}
+
 /// `M [q]×`, row by row `(m_i × q)ᵀ`: the same sums as nalgebra's product with
 /// `q.cross_matrix()` in the same order, without the products with its zeros (bit for bit up
 /// to the sign of a zero).
@@ -168,6 +191,60 @@ impl TrackMoments {
         // [F]× [q_c]× = q_c Fᵀ − (F·q_c) I.
         self.force_qc +=
             qc * lin.force.transpose() - Matrix3::from_diagonal_element(lin.force.dot(&qc));
+    }
+
+    /// Adds a whole part's derivatives at once (the reduced face law, `reduced.rs`): the sums
+    /// [`TrackMoments::add`] would take over a continuum of nodes on the part, all with the
+    /// same normal `n`, the same `∂F/∂f_n = g₀` (friction per part) and no slip derivative of
+    /// their own, given the part's density moments about `origin` (world points `p` of the
+    /// nodes, `q = p − origin`): `Σ a`, `Σ a q`, `Σ a q qᵀ` of `a = ∂f_n/∂w`, the same of
+    /// `b = ∂f_n/∂ẇ`, and `Σ f_n`, `Σ f_n q` of the normal force; `radius` is the balls'
+    /// (`c = p + radius n`). Each sum of [`TrackMoments`] is then a product of these with
+    /// `g₀` and `n` (the node terms are linear in `a`, `b`, `f_n` and at most quadratic in `q`).
+    pub(super) fn add_part(&mut self, part: &PartDensities, g0: &Vector3<f64>, radius: f64) {
+        if self.nodes == 0 {
+            self.origin = part.origin;
+        }
+        self.nodes += 1;
+        let n = part.normal;
+        // The part's moments about the track's origin: q = q_part + e.
+        let e = part.origin - self.origin;
+        let shift = |m0: f64, m1: &Vector3<f64>, m2: &Matrix3<f64>| {
+            let m1s = m1 + e * m0;
+            let m2s = m2 + m1 * e.transpose() + e * m1.transpose() + e * e.transpose() * m0;
+            (m1s, m2s)
+        };
+        let (a1, a2) = shift(part.a0, &part.a1, &part.a2);
+        let (b1, b2) = shift(part.b0, &part.b1, &part.b2);
+        let f1 = part.f1 + e * part.f0;
+        let (a0, b0, f0) = (part.a0, part.b0, part.f0);
+        let gx = g0.cross_matrix();
+        let nx = n.cross_matrix();
+        // Σ a g nᵀ, Σ a g (q × n)ᵀ, Σ a (q × g) nᵀ, Σ a (q × g)(q × n)ᵀ = −[g]× Σ a q qᵀ [n]×.
+        self.g_n += g0 * n.transpose() * a0;
+        self.g_qn += g0 * a1.cross(&n).transpose();
+        self.qg_n += a1.cross(g0) * n.transpose();
+        self.qg_qn -= gx * a2 * nx;
+        // D = −b g nᵀ at every node: Σ D, Σ D [q]× (nᵀ [q]× = (n × q)ᵀ), Σ [q]× D,
+        // Σ [q]× D [q]× = −Σ b (q × g)(n × q)ᵀ = −[g]× Σ b q qᵀ [n]×.
+        self.d -= g0 * n.transpose() * b0;
+        self.d_q -= g0 * n.cross(&b1).transpose();
+        self.q_d -= b1.cross(g0) * n.transpose();
+        self.q_d_q -= gx * b2 * nx;
+        if self.spin != Vector3::zeros() {
+            // q_c = q + radius n.
+            let u = self.spin;
+            let b_nqc = n.dot(&b1) + radius * b0;
+            self.d_qc -= g0 * b_nqc;
+            self.u_qc_d -= g0 * n.transpose() * (u.dot(&b1) + radius * u.dot(&n) * b0);
+            self.q_d_qc -= (b2 * n + b1 * radius).cross(g0);
+            self.u_qc_q_d -= (b2 * u + b1 * (radius * u.dot(&n))).cross(g0) * n.transpose();
+        }
+        // F = g f_n at every node.
+        self.force += g0 * f0;
+        self.q_force += f1.cross(g0);
+        let fc = f1 + n * (radius * f0);
+        self.force_qc += fc * g0.transpose() - Matrix3::from_diagonal_element(g0.dot(&fc));
     }
 
     /// Adds the track's blocks to `blocks` (`nb × nb`, source body `k` by target body `m`),
@@ -280,6 +357,124 @@ mod tests {
             for (a, b) in got.iter().zip(want.iter()) {
                 assert_eq!(a.to_bits(), b.to_bits(), "{got} vs {want}");
             }
+        }
+    }
+
+    #[test]
+    fn a_parts_moments_are_the_sum_of_its_nodes_records() {
+        // Nodes sharing a normal and ∂F/∂f_n (friction per part), each with its own a, b, f_n
+        // and point: `add_part` of their density sums (about a point away from the track's
+        // origin, so the shift is exercised) equals `add` node by node, field by field, to
+        // round-off, with the track spinning (the spin terms) and a node of another part first.
+        use nalgebra::UnitQuaternion;
+        let frame = |omega: Vector3<f64>| BodyFrame {
+            position: Vector3::new(0.1, -0.2, 0.3),
+            rotation: UnitQuaternion::identity(),
+            velocity: Vector3::zeros(),
+            angular_velocity: omega,
+        };
+        let (fa, fb) = (
+            frame(Vector3::new(0.3, -1.2, 0.7)),
+            frame(Vector3::new(-0.4, 0.1, 0.2)),
+        );
+        let n = Vector3::new(0.1, 0.97, -0.2).normalize();
+        let g0 = n - Vector3::new(0.9, 0.0, 0.4).normalize() * 0.17;
+        let radius = 5e-4;
+        let mut per_node = TrackMoments::new(0, 1, &fa, &fb);
+        let mut per_part = TrackMoments::new(0, 1, &fa, &fb);
+        let first = TrackLinearization {
+            body_a: 0,
+            body_b: 1,
+            deepest_point: Point3::new(0.02, 0.01, -0.03),
+            point: Point3::new(0.02, 0.01, -0.03),
+            centre: Point3::new(0.02, 0.0105, -0.03),
+            force: Vector3::new(1.0, 30.0, -2.0),
+            normal: Vector3::y(),
+            dfn_dw: 4e6,
+            dfn_dwdot: 2e4,
+            dforce_dfn: Vector3::new(0.1, 1.0, 0.0),
+            dforce_dslip: Matrix3::new(-3.0, 0.1, 0.0, 0.1, 0.0, 0.2, 0.0, 0.2, -5.0),
+        };
+        per_node.add(&first);
+        per_part.add(&first);
+        let origin = Point3::new(0.05, -0.01, 0.02);
+        let mut part = PartDensities {
+            origin,
+            normal: n,
+            a0: 0.0,
+            a1: Vector3::zeros(),
+            a2: Matrix3::zeros(),
+            b0: 0.0,
+            b1: Vector3::zeros(),
+            b2: Matrix3::zeros(),
+            f0: 0.0,
+            f1: Vector3::zeros(),
+        };
+        for i in 0..23 {
+            let x = i as f64;
+            let p = Point3::new(
+                0.04 + 0.003 * (1.3 * x).sin(),
+                -0.012 + 0.002 * (0.7 * x).cos(),
+                0.01 + 0.02 * (0.31 * x).sin(),
+            );
+            let (a, b, f) = (
+                1e6 * (1.5 + (2.1 * x).sin()),
+                3e3 * (1.2 + (0.9 * x).cos()),
+                2.0 + x,
+            );
+            per_node.add(&TrackLinearization {
+                body_a: 0,
+                body_b: 1,
+                deepest_point: p,
+                point: p,
+                centre: p + n * radius,
+                force: g0 * f,
+                normal: n,
+                dfn_dw: a,
+                dfn_dwdot: b,
+                dforce_dfn: g0,
+                dforce_dslip: Matrix3::zeros(),
+            });
+            let q = p - origin;
+            part.a0 += a;
+            part.a1 += q * a;
+            part.a2 += q * q.transpose() * a;
+            part.b0 += b;
+            part.b1 += q * b;
+            part.b2 += q * q.transpose() * b;
+            part.f0 += f;
+            part.f1 += q * f;
+        }
+        per_part.add_part(&part, &g0, radius);
+        let pairs: [(&Matrix3<f64>, &Matrix3<f64>); 11] = [
+            (&per_node.g_n, &per_part.g_n),
+            (&per_node.g_qn, &per_part.g_qn),
+            (&per_node.qg_n, &per_part.qg_n),
+            (&per_node.qg_qn, &per_part.qg_qn),
+            (&per_node.d, &per_part.d),
+            (&per_node.d_q, &per_part.d_q),
+            (&per_node.q_d, &per_part.q_d),
+            (&per_node.q_d_q, &per_part.q_d_q),
+            (&per_node.u_qc_d, &per_part.u_qc_d),
+            (&per_node.u_qc_q_d, &per_part.u_qc_q_d),
+            (&per_node.force_qc, &per_part.force_qc),
+        ];
+        for (k, (a, b)) in pairs.iter().enumerate() {
+            assert!(
+                (*a - *b).norm() <= 1e-12 * a.norm().max(1e-300),
+                "sum {k}: {a} vs {b}"
+            );
+        }
+        for (k, (a, b)) in [
+            (per_node.d_qc, per_part.d_qc),
+            (per_node.q_d_qc, per_part.q_d_qc),
+            (per_node.force, per_part.force),
+            (per_node.q_force, per_part.q_force),
+        ]
+        .iter()
+        .enumerate()
+        {
+            assert!((a - b).norm() <= 1e-12 * a.norm(), "vector {k}: {a} vs {b}");
         }
     }
 }

@@ -4,6 +4,7 @@
 //! points of the same law ([`super::face`]).
 
 use super::{PointLoad, TrackLinearization, TrackMoments};
+use crate::geometry::{FacePatch, Line};
 use crate::physics::body::BodyFrame;
 use crate::physics::friction::FrictionParams;
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -340,4 +341,19 @@ pub(super) fn friction_derivatives(
             -tangent * (fr.coefficient_derivative(0.0) * fn_mag),
         )
     }
+}
+
+/// The penetration rate `ẇ = −n·v_rel` of the balls of `radius` on `patch` (affine in its `ξ`:
+/// a rigid relative motion).
+pub(super) fn penetration_rate(
+    patch: &FacePatch,
+    fa: &BodyFrame,
+    fb: &BodyFrame,
+    radius: f64,
+    normal: &Vector3<f64>,
+) -> Line {
+    patch.affine(|x| {
+        let p = x - normal * radius;
+        -(fa.point_velocity(&p) - fb.point_velocity(&p)).dot(normal)
+    })
 }
