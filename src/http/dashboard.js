@@ -1,5 +1,8 @@
 "use strict";
-const state = { token: "" };
+// Who is signed in and what the page shows for them. `epoch` changes on every sign-in and
+// sign-out: an answer that arrives for an earlier epoch is dropped, so nothing a previous
+// token fetched reaches the page after it changed.
+const state = { token: "", me: null, timer: null, epoch: 0, polling: false, ticks: 0 };
 
 // The token lives in this tab's sessionStorage only (gone when the tab closes; never in
 // localStorage, which every later visitor of the browser profile could read). A token handed
@@ -15,23 +18,82 @@ function readToken() {
   document.getElementById("token").value = state.token;
 }
 
+// Empties every view and stops polling: what the last token fetched is gone.
+function clearAll() {
+  state.epoch += 1;
+  if (state.timer !== null) { clearInterval(state.timer); state.timer = null; }
+  state.me = null;
+  diag.may = false; diag.shown = null; diag.started = null; diag.starting.clear(); diag.campaigns.clear(); diag.jobs.clear();
+  state.ticks = 0; state.polling = false;
+  for (const id of ["jobs", "campaigns", "diagnoses"]) { document.getElementById(id).replaceChildren(); }
+  for (const id of ["report", "curve", "diagnosis", "whoami", "diagnoses-error", "diagnose-error"]) {
+    document.getElementById(id).replaceChildren();
+  }
+  const out = document.getElementById("diagnosis");
+  delete out.dataset.job; delete out.dataset.verdict; delete out.dataset.status;
+  delete document.getElementById("whoami").dataset.role;
+  document.getElementById("diagnose-options").hidden = true;
+  document.getElementById("result").textContent = "";
+  document.getElementById("result-title").textContent = "";
+  document.getElementById("result-box").hidden = true;
+}
+
 function signOut() {
+  clearAll();
   sessionStorage.removeItem("railwear-token");
   state.token = "";
   document.getElementById("token").value = "";
-  for (const id of ["jobs", "campaigns", "diagnoses"]) { document.getElementById(id).replaceChildren(); }
-  for (const id of ["report", "curve", "diagnosis"]) { document.getElementById(id).replaceChildren(); }
-  const result = document.getElementById("result");
-  result.textContent = ""; result.hidden = true;
   document.getElementById("error").textContent = "signed out";
 }
 
+// A token the service refuses (401): nothing of the previous user stays, polling stops.
+function refused(detail) {
+  clearAll();
+  sessionStorage.removeItem("railwear-token");
+  state.token = "";
+  document.getElementById("error").textContent = "token refused (" + detail + "); enter another";
+}
+
+// Signs in with the token in the field: asks who it is, then polls every second.
+async function signIn() {
+  clearAll();
+  const epoch = state.epoch;
+  const error = document.getElementById("error");
+  if (!state.token) { error.textContent = "enter a token"; return; }
+  error.textContent = "";
+  let me;
+  try { me = await api("/v1/whoami"); } catch (e) {
+    if (epoch === state.epoch && !(e instanceof Refused)) { error.textContent = String(e); }
+    return;
+  }
+  if (epoch !== state.epoch) { return; }
+  state.me = me;
+  diag.may = me.may.diagnose;
+  const who = document.getElementById("whoami");
+  who.replaceChildren(document.createTextNode("signed in as "), text("strong", me.name, "who-name"),
+    document.createTextNode(" (" + me.role + ")"));
+  who.dataset.role = me.role;
+  document.getElementById("diagnose-options").hidden = !diag.may;
+  state.timer = setInterval(poll, 1000);
+  poll();
+}
+
+// Thrown after a 401 (the page has already cleared itself).
+class Refused extends Error {}
+
 async function api(path, init) {
   const options = init || {};
+  const epoch = state.epoch;
   options.headers = Object.assign({ "Authorization": "Bearer " + state.token }, options.headers || {});
   const response = await fetch(path, options);
   const type = response.headers.get("content-type") || "";
   const body = type.includes("json") ? await response.json() : await response.text();
+  if (epoch !== state.epoch) { throw new Refused("signed out meanwhile"); }
+  if (response.status === 401) {
+    const detail = "401: " + (body && body.detail ? body.detail : response.statusText);
+    refused(detail);
+    throw new Refused(detail);
+  }
   if (!response.ok) {
     const detail = body && body.detail ? body.detail : response.statusText;
     throw new Error(response.status + ": " + detail);
@@ -48,71 +110,188 @@ function text(tag, content, cls) {
 
 function link(label, action) {
   const a = text("a", label);
-  a.addEventListener("click", action);
+  a.href = "#";
+  a.addEventListener("click", event => { event.preventDefault(); action(); });
   return a;
 }
 
-async function showResult(path) {
-  const pre = document.getElementById("result");
-  pre.hidden = false;
-  try {
-    const body = await api(path);
-    pre.textContent = typeof body === "string" ? body.slice(0, 20000) : JSON.stringify(body, null, 2);
-  } catch (e) { pre.textContent = String(e); }
+// One date format, always with its zone: "2024-05-01 08:30:00 UTC"; a date without a time
+// of day stays a date ("2024-05-01 UTC").
+function when(iso) {
+  if (iso == null) { return "n/a"; }
+  if (/^\d{4}-\d{2}-\d{2}$/.test(iso)) { return iso + " UTC"; }
+  const t = new Date(iso);
+  return isNaN(t) ? iso : t.toISOString().replace("T", " ").slice(0, 19) + " UTC";
 }
 
-function renderJobs(page) {
-  const tbody = document.getElementById("jobs");
-  tbody.replaceChildren();
-  for (const job of page.items) {
-    const row = document.createElement("tr");
-    row.id = "job-" + job.id;
-    row.dataset.status = job.status;
-    row.appendChild(text("td", job.id.slice(0, 8)));
-    row.appendChild(text("td", job.kind));
-    row.appendChild(text("td", job.status, "status status-" + job.status));
-    const progress = document.createElement("td");
-    if (job.progress) {
-      const bar = document.createElement("span"); bar.className = "bar";
-      const fill = document.createElement("span");
-      fill.style.width = Math.round(100 * job.progress.fraction) + "%";
-      bar.appendChild(fill); progress.appendChild(bar);
-      // A diagnosis counts simulations done, the others simulated time.
-      let label = " " + Math.round(100 * job.progress.fraction) + "% (" + (job.kind === "diagnose"
-        ? Math.round(job.progress.simulated_time_s) + " / " + Math.round(job.progress.end_time_s) + " simulations"
-        : "t = " + job.progress.simulated_time_s.toFixed(2) + " / " + job.progress.end_time_s.toFixed(2) + " s");
-      if (job.status === "running" && job.progress.eta_s != null) { label += ", ETA " + Math.round(job.progress.eta_s) + " s"; }
-      progress.appendChild(document.createTextNode(label + ")"));
+// A full job id in a cell: selectable and copyable whole (the table keeps it while it polls).
+function idCell(id) {
+  const td = document.createElement("td");
+  td.appendChild(text("code", id, "id"));
+  return td;
+}
+
+// True while the user has a text selection inside `el`: its rows are then left alone.
+function selecting(el) {
+  const sel = window.getSelection();
+  return sel && !sel.isCollapsed && sel.rangeCount > 0 && el.contains(sel.getRangeAt(0).commonAncestorContainer);
+}
+
+// Updates a table body in place: one row per item keyed by `key`, rebuilt only when what it
+// shows (`signature`) changed, rows in the items' order. Nothing is redrawn while the user
+// selects text in it.
+function updateRows(tbody, items, key, signature, build) {
+  if (selecting(tbody)) { return; }
+  const wanted = new Set(items.map(key));
+  for (const r of [...tbody.children]) { if (!wanted.has(r.id)) { r.remove(); } }
+  let before = tbody.firstChild;
+  for (const item of items) {
+    const id = key(item), sig = signature(item);
+    let r = document.getElementById(id);
+    if (r && r.parentNode !== tbody) { r = null; }
+    if (!r || r.dataset.sig !== sig) {
+      const fresh = build(item);
+      fresh.id = id; fresh.dataset.sig = sig;
+      if (r) { r.replaceWith(fresh); } else { tbody.insertBefore(fresh, before); }
+      r = fresh;
+    } else if (r !== before) {
+      tbody.insertBefore(r, before);
     }
-    if (job.children) {
-      // A sweep fanned out into one child job per point, run by any worker.
-      const c = job.children;
-      let label = " " + c.succeeded + "/" + c.total + " points done";
-      if (c.failed > 0) { label += ", " + c.failed + " failed"; }
-      if (c.cancelled > 0) { label += ", " + c.cancelled + " cancelled"; }
-      progress.appendChild(text("span", label, "children"));
-    }
-    row.appendChild(progress);
-    row.appendChild(text("td", job.created_at.replace("T", " ").slice(0, 19)));
-    const links = document.createElement("td");
-    if (job.status === "succeeded") {
-      links.appendChild(link("result", () => showResult(job.links.result)));
-      links.appendChild(link("tracks (CSV, every 100th)", () => showResult(job.links.self + "/tracks?format=csv&every=100")));
-    } else if (job.error) {
-      links.appendChild(text("span", job.error));
-    }
-    row.appendChild(links);
-    tbody.appendChild(row);
+    before = r.nextSibling;
   }
 }
 
-async function pollJobs() {
-  if (!state.token) { document.getElementById("error").textContent = "enter a token"; return; }
+// Percent done as shown: 100 % only once the job succeeded (a diagnosis' simulations can all
+// be done while it still writes its report).
+function percentDone(job) {
+  if (job.status === "succeeded") { return 100; }
+  return Math.min(99, Math.floor(100 * job.progress.fraction));
+}
+
+function progressCell(job) {
+  const cell = document.createElement("td");
+  if (job.progress) {
+    const pct = percentDone(job);
+    const bar = document.createElement("span"); bar.className = "bar";
+    const fill = document.createElement("span");
+    fill.style.width = pct + "%";
+    bar.appendChild(fill); cell.appendChild(bar);
+    let label = " " + pct + " %";
+    if (job.children) {
+      // A sweep's progress is its points' (their simulated times are not summed here).
+    } else if (job.kind === "diagnose") {
+      label += " (" + Math.round(job.progress.simulated_time_s) + " / " + Math.round(job.progress.end_time_s) + " simulations";
+    } else {
+      label += " (t = " + job.progress.simulated_time_s.toFixed(2) + " / " + job.progress.end_time_s.toFixed(2) + " s simulated";
+    }
+    if (!job.children) {
+      if (job.status === "running" && job.progress.eta_s != null) {
+        const eta = Math.round(job.progress.eta_s);
+        label += eta > 0 ? ", ETA " + eta + " s" : ", finishing";
+      }
+      label += ")";
+    }
+    cell.appendChild(document.createTextNode(label));
+  }
+  if (job.children) {
+    // A sweep fanned out into one child job per point, run by any worker.
+    const c = job.children;
+    let label = " " + c.succeeded + "/" + c.total + " points done";
+    if (c.failed > 0) { label += ", " + c.failed + " failed"; }
+    if (c.cancelled > 0) { label += ", " + c.cancelled + " cancelled"; }
+    cell.appendChild(text("span", label, "children"));
+  }
+  return cell;
+}
+
+const ACTIVE = new Set(["queued", "running", "waiting"]);
+
+// Whether the signed-in token may cancel this job: roles that submit jobs may cancel any,
+// others the jobs they started (a test engineer's diagnosis).
+function mayCancel(job) {
+  return ACTIVE.has(job.status) && state.me !== null && (state.me.may.submit_jobs || job.submitted_by === state.me.name);
+}
+
+// Asks for a job's cancellation (the button waits for the answer).
+function cancelButton(job, errorId) {
+  const button = text("button", job.cancel_requested ? "cancelling" : "Cancel", "cancel-job");
+  button.type = "button";
+  button.disabled = job.cancel_requested;
+  button.addEventListener("click", async () => {
+    button.disabled = true;
+    try { await api(job.links.cancel, { method: "POST" }); button.textContent = "cancelling"; } catch (e) {
+      if (!(e instanceof Refused)) { button.disabled = false; document.getElementById(errorId).textContent = String(e); }
+    }
+  });
+  return button;
+}
+
+// The tracks of a simulate job as a CSV file download (fetched with the token).
+function downloadLink(job) {
+  return link("download tracks (CSV)", async () => {
+    try {
+      const response = await fetch(job.links.tracks_csv, { headers: { "Authorization": "Bearer " + state.token } });
+      if (!response.ok) { throw new Error(response.status + ": tracks"); }
+      for (const old of document.querySelectorAll("a.tracks-download")) { URL.revokeObjectURL(old.href); old.remove(); }
+      const a = document.createElement("a");
+      a.href = URL.createObjectURL(await response.blob());
+      a.download = "railwear-" + job.id + "-tracks.csv";
+      a.className = "tracks-download";
+      a.hidden = true;
+      document.body.appendChild(a);
+      a.click();
+    } catch (e) { document.getElementById("error").textContent = String(e); }
+  });
+}
+
+async function showResult(job) {
+  const box = document.getElementById("result-box");
+  const pre = document.getElementById("result");
+  const epoch = state.epoch;
+  box.hidden = false;
+  document.getElementById("result-title").textContent = "Result of " + job.kind + " job " + job.id;
+  try {
+    const body = await api(job.links.result);
+    if (epoch === state.epoch) { pre.textContent = JSON.stringify(body, null, 2); }
+  } catch (e) { if (!(e instanceof Refused)) { pre.textContent = String(e); } }
+}
+
+function jobSignature(job) {
+  return JSON.stringify([job.status, job.progress, job.children, job.error, job.cancel_requested]);
+}
+
+function buildJobRow(job) {
+  const row = document.createElement("tr");
+  row.dataset.status = job.status;
+  row.appendChild(idCell(job.id));
+  row.appendChild(text("td", job.kind));
+  row.appendChild(text("td", job.status, "status status-" + job.status));
+  row.appendChild(progressCell(job));
+  row.appendChild(text("td", when(job.created_at)));
+  const links = document.createElement("td");
+  if (job.status === "succeeded") {
+    links.appendChild(link("result", () => showResult(job)));
+    if (job.kind === "simulate") { links.appendChild(downloadLink(job)); }
+  } else if (job.error) {
+    links.appendChild(text("span", job.error));
+  }
+  if (mayCancel(job)) { links.appendChild(cancelButton(job, "error")); }
+  row.appendChild(links);
+  return row;
+}
+
+function renderJobs(page) {
+  updateRows(document.getElementById("jobs"), page.items, j => "job-" + j.id, jobSignature, buildJobRow);
+}
+
+async function pollJobs(epoch) {
   try {
     // Submitted jobs only: a sweep's per-point child jobs show as its progress.
-    renderJobs(await api("/v1/jobs?limit=50&top_level=true"));
+    const page = await api("/v1/jobs?limit=50&top_level=true");
+    if (epoch !== state.epoch) { return; }
+    renderJobs(page);
     document.getElementById("error").textContent = "";
-  } catch (e) { document.getElementById("error").textContent = String(e); }
+  } catch (e) { if (!(e instanceof Refused)) { document.getElementById("error").textContent = String(e); } }
 }
 
 function curveSvg(report) {
@@ -161,29 +340,50 @@ async function loadReport() {
   const serial = document.getElementById("serial").value.trim();
   const out = document.getElementById("report");
   const plot = document.getElementById("curve");
+  const epoch = state.epoch;
   out.replaceChildren(); plot.replaceChildren();
   if (!serial) { return; }
   try {
     const compare = document.getElementById("compare").value.trim();
     const r = await api("/v1/rails/" + encodeURIComponent(serial) + "/report" +
       (compare ? "?compare=" + encodeURIComponent(compare) : ""));
+    if (epoch !== state.epoch) { return; }
     out.appendChild(text("div", "Rail " + r.serial + ": rattle space k_rs = " + r.rattle_space.toFixed(4) +
-      " (measured " + r.measurement.measured_at + " by " + r.measurement.measured_by + " at " + r.measurement.location + ")"));
+      " (measured " + when(r.measurement.measured_at) + " by " + r.measurement.measured_by + " at " + r.measurement.location + ")"));
     if (r.service_life) {
       const s = r.service_life;
-      out.appendChild(text("div", "K_SL = " + s.k_sl.toFixed(3) + " (bands 0.9: " + s.k_sl_band_90.toFixed(3) +
-        ", 0.8: " + s.k_sl_band_80.toFixed(3) + "); service life " + s.penalized_life_h.toFixed(0) + " h of " +
-        s.design_life_h.toFixed(0) + " h design (" + s.penalized_life_band_90_h.toFixed(0) + " / " +
-        s.penalized_life_band_80_h.toFixed(0) + " h conservative)", "status-succeeded"));
+      const life = text("div", "K_SL = " + s.k_sl.toFixed(3) + "; service life " + s.penalized_life_h.toFixed(0) +
+        " h of " + s.design_life_h.toFixed(0) + " h design", "status-succeeded");
+      life.id = "report-life";
+      out.appendChild(life);
+      const band = s.interval;
+      const spread = text("div", band
+        ? Math.round(100 * band.confidence) + " % interval over " + band.seeds + " seeds: K_SL " + band.k_sl_low.toFixed(4) +
+          " to " + band.k_sl_high.toFixed(4) + ", service life " + band.penalized_life_low_h.toFixed(0) + " to " +
+          band.penalized_life_high_h.toFixed(0) + " h. " + s.uncertainty
+        : "No interval: " + s.uncertainty, "interval");
+      spread.id = "report-interval";
+      out.appendChild(spread);
+      out.appendChild(text("div", "Conservative bands (Figure 6.68): 0.9 x K_SL = " + s.k_sl_band_90.toFixed(3) +
+        " (" + s.penalized_life_band_90_h.toFixed(0) + " h), 0.8 x K_SL = " + s.k_sl_band_80.toFixed(3) + " (" +
+        s.penalized_life_band_80_h.toFixed(0) + " h)."));
+    }
+    if (r.curve) {
+      const c = r.curve, f = c.fidelity;
+      const used = text("div", "Curve used: " + c.id + " (" + c.curve_key + ", version " + c.version + "; " + f.points +
+        " points, " + (f.duration_per_point_s == null ? "duration not recorded" : f.duration_per_point_s + " s") + " per point, " +
+        f.seeds + " seed" + (f.seeds === 1 ? "" : "s") + " per point; published " + when(c.published_at) + ")");
+      used.id = "report-curve";
+      out.appendChild(used);
     }
     if (r.missing_curve) { out.appendChild(text("div", r.missing_curve.detail, "status-cancelled")); }
     if (r.comparison) { out.appendChild(comparisonLine(r.comparison)); }
     const svg = curveSvg(r);
     if (svg) { plot.appendChild(svg); }
-  } catch (e) { out.appendChild(text("div", String(e), "status-failed")); }
+  } catch (e) { if (!(e instanceof Refused)) { out.appendChild(text("div", String(e), "status-failed")); } }
 }
 
-// K_SL and the penalized life under another stored curve (`?compare=<curve id>`, issue 26).
+// K_SL and the penalized life under another stored curve (`?compare=<curve id>`).
 function comparisonLine(c) {
   const line = c.k_sl == null ? c.detail :
     "Under curve " + c.curve_id + " (" + c.curve_key + ", version " + c.version +
@@ -197,7 +397,9 @@ function comparisonLine(c) {
 
 // ---- Diagnoses (issue 15): campaigns, diagnose jobs, their reports ----
 
-const diag = { may: false, campaigns: new Map(), shown: null, started: null };
+// Campaign ids whose "Start diagnosis" request is under way (their buttons wait).
+// `jobs`: the diagnose jobs seen, by id.
+const diag = { may: false, campaigns: new Map(), jobs: new Map(), shown: null, started: null, starting: new Set() };
 
 // Numbers with their units. Held-out errors are RMS standardized errors: multiples of each
 // observation's standard uncertainty (sigma).
@@ -209,14 +411,6 @@ const fmt = {
   bytes: n => n >= 1048576 ? (n / 1048576).toFixed(1) + " MiB" : n >= 1024 ? (n / 1024).toFixed(1) + " KiB" : n + " B",
   withUnit: (x, unit) => fmt.num(x, 3) + (unit ? " " + unit : ""),
 };
-
-async function loadWhoAmI() {
-  try {
-    const me = await api("/v1/whoami");
-    diag.may = me.may.diagnose;
-  } catch (e) { diag.may = false; }
-  document.getElementById("diagnose-options").hidden = !diag.may;
-}
 
 function diagnosisOptions() {
   const body = {};
@@ -232,9 +426,14 @@ function diagnosisOptions() {
   return body;
 }
 
+// One job per click: the button is disabled until the service answered.
 async function startDiagnosis(campaign) {
+  if (diag.starting.has(campaign.id)) { return; }
   const error = document.getElementById("diagnose-error");
+  const epoch = state.epoch;
   error.textContent = "";
+  diag.starting.add(campaign.id);
+  renderCampaigns([...diag.campaigns.values()]);
   try {
     const job = await api(campaign.links.self + "/diagnoses", {
       method: "POST",
@@ -245,85 +444,87 @@ async function startDiagnosis(campaign) {
     diag.started = job.id;
     diag.shown = null;
     showDiagnosisProgress(job);
-    pollDiagnoses();
-  } catch (e) { error.textContent = String(e); }
-}
-
-function renderCampaigns(page) {
-  const tbody = document.getElementById("campaigns");
-  tbody.replaceChildren();
-  diag.campaigns.clear();
-  for (const c of page.items) {
-    diag.campaigns.set(c.id, c);
-    const row = document.createElement("tr");
-    row.id = "campaign-" + c.id;
-    row.appendChild(text("td", c.name));
-    row.appendChild(text("td", c.created_at.replace("T", " ").slice(0, 19) + " by " + c.created_by));
-    const n = c.counts;
-    row.appendChild(text("td", n.tests + " / " + n.specimens + " / " + n.increments + " / " + n.accelerometer_records));
-    row.appendChild(text("td", fmt.bytes(c.content_bytes)));
-    const action = document.createElement("td");
-    if (diag.may) {
-      const button = text("button", "Start diagnosis", "start-diagnosis");
-      button.addEventListener("click", () => startDiagnosis(c));
-      action.appendChild(button);
+    diag.jobs.set(job.id, job);
+    renderDiagnoses([...diag.jobs.values()].sort((x, y) => x.created_at < y.created_at ? 1 : -1));
+  } catch (e) {
+    if (!(e instanceof Refused)) { error.textContent = String(e); }
+  } finally {
+    if (epoch === state.epoch) {
+      diag.starting.delete(campaign.id);
+      renderCampaigns([...diag.campaigns.values()]);
     }
-    row.appendChild(action);
-    tbody.appendChild(row);
   }
 }
 
-function progressCell(job) {
-  const cell = document.createElement("td");
-  if (job.progress) {
-    const bar = document.createElement("span"); bar.className = "bar";
-    const fill = document.createElement("span");
-    fill.style.width = Math.round(100 * job.progress.fraction) + "%";
-    bar.appendChild(fill); cell.appendChild(bar);
-    // A diagnosis reports simulations done of simulations planned.
-    let label = " " + Math.round(100 * job.progress.fraction) + "% (" + Math.round(job.progress.simulated_time_s) +
-      " / " + Math.round(job.progress.end_time_s) + " simulations";
-    if (job.status === "running" && job.progress.eta_s != null) { label += ", ETA " + Math.round(job.progress.eta_s) + " s"; }
-    cell.appendChild(document.createTextNode(label + ")"));
+function buildCampaignRow(c) {
+  const row = document.createElement("tr");
+  row.appendChild(text("td", c.name));
+  row.appendChild(text("td", when(c.created_at) + " by " + c.created_by));
+  const n = c.counts;
+  row.appendChild(text("td", n.tests + " / " + n.specimens + " / " + n.increments + " / " + n.accelerometer_records));
+  row.appendChild(text("td", fmt.bytes(c.content_bytes)));
+  const action = document.createElement("td");
+  if (diag.may) {
+    const button = text("button", "Start diagnosis", "start-diagnosis");
+    button.type = "button";
+    button.disabled = diag.starting.has(c.id);
+    button.addEventListener("click", () => startDiagnosis(c));
+    action.appendChild(button);
   }
-  return cell;
+  row.appendChild(action);
+  return row;
+}
+
+function renderCampaigns(items) {
+  diag.campaigns.clear();
+  for (const c of items) { diag.campaigns.set(c.id, c); }
+  updateRows(document.getElementById("campaigns"), items, c => "campaign-" + c.id,
+    c => JSON.stringify([c.name, diag.may, diag.starting.has(c.id)]), buildCampaignRow);
+}
+
+function buildDiagnosisRow(job) {
+  const row = document.createElement("tr");
+  row.dataset.status = job.status;
+  row.appendChild(idCell(job.id));
+  const campaign = diag.campaigns.get(job.params.campaign_id);
+  row.appendChild(text("td", campaign ? campaign.name : job.params.campaign_id));
+  row.appendChild(text("td", job.status, "status status-" + job.status));
+  row.appendChild(progressCell(job));
+  row.appendChild(text("td", when(job.created_at) + " by " + job.submitted_by));
+  const links = document.createElement("td");
+  if (job.status === "succeeded") {
+    links.appendChild(link("report", () => showDiagnosis(job)));
+  } else if (job.error) {
+    links.appendChild(text("span", job.error));
+  }
+  if (mayCancel(job)) { links.appendChild(cancelButton(job, "diagnose-error")); }
+  row.appendChild(links);
+  return row;
 }
 
 function renderDiagnoses(jobs) {
-  const tbody = document.getElementById("diagnoses");
-  tbody.replaceChildren();
+  updateRows(document.getElementById("diagnoses"), jobs, j => "diagnosis-" + j.id,
+    j => JSON.stringify([jobSignature(j), diag.campaigns.has(j.params.campaign_id)]), buildDiagnosisRow);
   for (const job of jobs) {
-    const row = document.createElement("tr");
-    row.id = "diagnosis-" + job.id;
-    row.dataset.status = job.status;
-    row.appendChild(text("td", job.id.slice(0, 8)));
-    const campaign = diag.campaigns.get(job.params.campaign_id);
-    row.appendChild(text("td", campaign ? campaign.name : job.params.campaign_id.slice(0, 8)));
-    row.appendChild(text("td", job.status, "status status-" + job.status));
-    row.appendChild(progressCell(job));
-    row.appendChild(text("td", job.created_at.replace("T", " ").slice(0, 19)));
-    const links = document.createElement("td");
-    if (job.status === "succeeded") {
-      links.appendChild(link("report", () => showDiagnosis(job)));
-    } else if (job.error) {
-      links.appendChild(text("span", job.error));
-    }
-    row.appendChild(links);
-    tbody.appendChild(row);
-    if (job.id === diag.started) {
-      if (job.status === "succeeded") { diag.started = null; showDiagnosis(job); }
-      else if (job.status === "failed" || job.status === "cancelled") { diag.started = null; showDiagnosisProgress(job); }
+    if (job.id !== diag.started) { continue; }
+    // The panel follows the job's row until its report is shown.
+    if (job.status === "succeeded") { diag.started = null; showDiagnosis(job); }
+    else {
+      if (!ACTIVE.has(job.status)) { diag.started = null; }
+      showDiagnosisProgress(job);
     }
   }
 }
 
 function showDiagnosisProgress(job) {
   const out = document.getElementById("diagnosis");
+  const line = job.error ? "Diagnosis " + job.id + " " + job.status + ": " + job.error
+    : "Diagnosis " + job.id + " " + job.status + "; its report shows here when it succeeds.";
+  if (out.dataset.job === job.id && out.dataset.status === job.status && out.textContent === line) { return; }
   out.replaceChildren();
   out.dataset.job = job.id;
+  out.dataset.status = job.status;
   delete out.dataset.verdict;
-  const line = job.error ? "Diagnosis " + job.id.slice(0, 8) + " " + job.status + ": " + job.error
-    : "Diagnosis " + job.id.slice(0, 8) + " " + job.status + "; its report shows here when it succeeds.";
   out.appendChild(text("div", line, "status-" + job.status));
 }
 
@@ -352,14 +553,17 @@ function interval(pair, unit) {
 async function showDiagnosis(job) {
   if (diag.shown === job.id) { return; }
   diag.shown = job.id;
+  const epoch = state.epoch;
   const out = document.getElementById("diagnosis");
   out.replaceChildren();
   out.dataset.job = job.id;
+  out.dataset.status = job.status;
   delete out.dataset.verdict;
   try {
     const result = await api(job.links.result);
+    if (epoch !== state.epoch) { return; }
     const r = result.summary;
-    out.appendChild(text("h3", "Diagnosis of " + r.campaign + " (job " + job.id.slice(0, 8) + ")"));
+    out.appendChild(text("h3", "Diagnosis of " + r.campaign + " (job " + job.id + ", started by " + job.submitted_by + ")"));
     const verdict = text("div", "", "verdict-line");
     verdict.appendChild(document.createTextNode("Verdict: "));
     verdict.appendChild(text("strong", r.verdict, "verdict"));
@@ -464,6 +668,7 @@ async function showDiagnosis(job) {
     const rank = name => order.indexOf(name) < 0 ? order.length : order.indexOf(name);
     for (const plot of result.plots.slice().sort((a, b) => rank(a.name) - rank(b.name))) {
       const response = await fetch(plot.url, { headers: { "Authorization": "Bearer " + state.token } });
+      if (epoch !== state.epoch) { return; }
       if (!response.ok) { plots.appendChild(text("div", plot.name + ": " + response.status, "status-failed")); continue; }
       const img = document.createElement("img");
       img.alt = plot.name;
@@ -473,31 +678,51 @@ async function showDiagnosis(job) {
     }
     out.dataset.verdict = r.verdict;
   } catch (e) {
+    if (e instanceof Refused || epoch !== state.epoch) { return; }
     diag.shown = null;
     out.appendChild(text("div", String(e), "status-failed"));
   }
 }
 
-async function pollDiagnoses() {
-  if (!state.token) { return; }
+// Every diagnosis, not only those among the latest jobs: the job list has no kind filter, so
+// the page walks all submitted jobs (100 a page) on the first poll and every tenth after it,
+// and the newest page on the others; diagnoses seen stay listed.
+async function pollDiagnoses(epoch, walk) {
   try {
-    renderCampaigns(await api("/v1/campaigns?limit=100"));
-    // Diagnoses among the latest 100 submitted jobs (the job list has no kind filter).
-    const page = await api("/v1/jobs?limit=100&top_level=true");
-    renderDiagnoses(page.items.filter(j => j.kind === "diagnose"));
+    const campaigns = await api("/v1/campaigns?limit=100");
+    if (epoch !== state.epoch) { return; }
+    renderCampaigns(campaigns.items);
+    let cursor = null, pages = 0;
+    do {
+      const page = await api("/v1/jobs?limit=100&top_level=true" + (cursor ? "&cursor=" + encodeURIComponent(cursor) : ""));
+      if (epoch !== state.epoch) { return; }
+      for (const job of page.items) { if (job.kind === "diagnose") { diag.jobs.set(job.id, job); } }
+      cursor = page.next_cursor;
+      pages += 1;
+    } while (walk && cursor && pages < 1000);
+    const jobs = [...diag.jobs.values()].sort((x, y) => x.created_at < y.created_at ? 1 : x.created_at > y.created_at ? -1 : 0);
+    renderDiagnoses(jobs);
     document.getElementById("diagnoses-error").textContent = "";
-  } catch (e) { document.getElementById("diagnoses-error").textContent = String(e); }
+  } catch (e) { if (!(e instanceof Refused) && epoch === state.epoch) { document.getElementById("diagnoses-error").textContent = String(e); } }
 }
 
-function poll() { pollJobs(); pollDiagnoses(); }
+// One poll at a time (a slow answer does not stack polls up).
+async function poll() {
+  if (state.polling || !state.token) { return; }
+  state.polling = true;
+  const epoch = state.epoch;
+  const walk = state.ticks % 10 === 0;
+  state.ticks += 1;
+  try { await Promise.all([pollJobs(epoch), pollDiagnoses(epoch, walk)]); } finally { if (epoch === state.epoch) { state.polling = false; } }
+}
 
-document.getElementById("save-token").addEventListener("click", () => {
+document.getElementById("token-form").addEventListener("submit", event => {
+  event.preventDefault();
   state.token = document.getElementById("token").value.trim();
-  sessionStorage.setItem("railwear-token", state.token);
-  loadWhoAmI().then(poll);
+  if (state.token) { sessionStorage.setItem("railwear-token", state.token); }
+  signIn();
 });
 document.getElementById("sign-out").addEventListener("click", signOut);
 document.getElementById("load-report").addEventListener("click", loadReport);
 readToken();
-loadWhoAmI().then(poll);
-setInterval(poll, 1000);
+if (state.token) { signIn(); } else { document.getElementById("error").textContent = "enter a token"; }
