@@ -5,6 +5,10 @@
 //! error the page did not expect (the browser's log, read through chromedriver). Skipped with
 //! a message when Chromium is absent, unless RAILWEAR_REQUIRE_BROWSER is set (`.ci/run` sets
 //! it and installs the browser).
+//!
+//! Over 700 lines: the WebDriver harness (sessions, console log, downloads) and each role's
+//! journey through the page share one file, as every journey needs the harness and nothing
+//! else does.
 
 use crate::helpers::{wait_for, Api, Runner, TestApp};
 use crate::support::{ENGINEER, PLANNER, TEST_ENGINEER};
