@@ -2,7 +2,7 @@
 // Who is signed in and what the page shows for them. `epoch` changes on every sign-in and
 // sign-out: an answer that arrives for an earlier epoch is dropped, so nothing a previous
 // token fetched reaches the page after it changed.
-const state = { token: "", me: null, timer: null, epoch: 0, polling: false, ticks: 0 };
+const state = { token: "", me: null, timer: null, epoch: 0, polling: false, ticks: 0, route: null };
 
 // The token lives in this tab's sessionStorage only (gone when the tab closes; never in
 // localStorage, which every later visitor of the browser profile could read). A token handed
@@ -25,17 +25,19 @@ function clearAll() {
   state.me = null;
   diag.may = false; diag.shown = null; diag.started = null; diag.starting.clear(); diag.campaigns.clear(); diag.jobs.clear();
   state.ticks = 0; state.polling = false;
-  for (const id of ["jobs", "campaigns", "diagnoses"]) { document.getElementById(id).replaceChildren(); }
-  for (const id of ["report", "curve", "diagnosis", "whoami", "diagnoses-error", "diagnose-error"]) {
+  for (const id of ["jobs", "campaigns", "diagnoses", "rails", "measurements", "curves"]) { document.getElementById(id).replaceChildren(); }
+  for (const id of ["report", "curve", "diagnosis", "whoami", "diagnoses-error", "diagnose-error", "job-page",
+    "curves-error", "jobs-note"]) {
     document.getElementById(id).replaceChildren();
   }
+  jobPage.id = null; jobPage.status = null;
+  jobList.cursors = [null]; jobList.index = 0; jobList.next = null; jobList.key = "";
+  state.route = null;
+  showView(null);
   const out = document.getElementById("diagnosis");
   delete out.dataset.job; delete out.dataset.verdict; delete out.dataset.status;
   delete document.getElementById("whoami").dataset.role;
   document.getElementById("diagnose-options").hidden = true;
-  document.getElementById("result").textContent = "";
-  document.getElementById("result-title").textContent = "";
-  document.getElementById("result-box").hidden = true;
 }
 
 function signOut() {
@@ -74,6 +76,7 @@ async function signIn() {
     document.createTextNode(" (" + me.role + ")"));
   who.dataset.role = me.role;
   document.getElementById("diagnose-options").hidden = !diag.may;
+  route();
   state.timer = setInterval(poll, 1000);
   poll();
 }
@@ -244,18 +247,6 @@ function downloadLink(job) {
   });
 }
 
-async function showResult(job) {
-  const box = document.getElementById("result-box");
-  const pre = document.getElementById("result");
-  const epoch = state.epoch;
-  box.hidden = false;
-  document.getElementById("result-title").textContent = "Result of " + job.kind + " job " + job.id;
-  try {
-    const body = await api(job.links.result);
-    if (epoch === state.epoch) { pre.textContent = JSON.stringify(body, null, 2); }
-  } catch (e) { if (!(e instanceof Refused)) { pre.textContent = String(e); } }
-}
-
 function jobSignature(job) {
   return JSON.stringify([job.status, job.progress, job.children, job.error, job.cancel_requested]);
 }
@@ -269,10 +260,9 @@ function buildJobRow(job) {
   row.appendChild(progressCell(job));
   row.appendChild(text("td", when(job.created_at)));
   const links = document.createElement("td");
-  if (job.status === "succeeded") {
-    links.appendChild(link("result", () => showResult(job)));
-    if (job.kind === "simulate") { links.appendChild(downloadLink(job)); }
-  } else if (job.error) {
+  links.appendChild(pageLink("page", "#/jobs/" + job.id, "job-page"));
+  if (job.status === "succeeded" && job.kind === "simulate") { links.appendChild(downloadLink(job)); }
+  else if (job.error) {
     links.appendChild(text("span", job.error));
   }
   if (mayCancel(job)) { links.appendChild(cancelButton(job, "error")); }
@@ -287,9 +277,11 @@ function renderJobs(page) {
 async function pollJobs(epoch) {
   try {
     // Submitted jobs only: a sweep's per-point child jobs show as its progress.
-    const page = await api("/v1/jobs?limit=50&top_level=true");
+    const page = await api(jobsUrl());
     if (epoch !== state.epoch) { return; }
-    renderJobs(page);
+    jobList.next = page.next_cursor;
+    renderJobs({ items: filterJobs(page.items) });
+    renderJobPager();
     document.getElementById("error").textContent = "";
   } catch (e) { if (!(e instanceof Refused)) { document.getElementById("error").textContent = String(e); } }
 }
@@ -409,8 +401,37 @@ const fmt = {
   sigma: x => fmt.num(x, 3) + " \u03c3",
   percent: x => (x == null || !isFinite(x)) ? "n/a" : (100 * x).toFixed(1) + " %",
   bytes: n => n >= 1048576 ? (n / 1048576).toFixed(1) + " MiB" : n >= 1024 ? (n / 1024).toFixed(1) + " KiB" : n + " B",
-  withUnit: (x, unit) => fmt.num(x, 3) + (unit ? " " + unit : ""),
+  // A dimensionless value (unit "1" or none) shows no unit.
+  withUnit: (x, unit) => fmt.num(x, 3) + (unit && unit !== "1" ? " " + unit : ""),
+  // p-values: three decimals, in scientific notation below 1e-3.
+  p: x => (x == null || !isFinite(x)) ? "n/a" : x === 0 ? "< 1e-300" : x < 1e-3 ? x.toExponential(1) : x.toFixed(3),
+  count: x => (x == null || !isFinite(x)) ? "n/a" : String(Math.round(x)),
 };
+
+// Why a candidate does not explain the gap, by the rule of docs/diagnosis.md: a held-out gain
+// above 2 nats, residuals consistent with noise (p >= alpha) and at least 50 % of the excess
+// chi-square removed. The report carries alpha; the two other thresholds are the rule's.
+function whyNot(e, alpha) {
+  const reasons = [];
+  if (!(e.held_out_gain > 2)) { reasons.push("held-out gain " + fmt.num(e.held_out_gain, 3) + " nats, not above 2"); }
+  if (!(e.residual_p_value >= alpha)) { reasons.push("residual p " + fmt.p(e.residual_p_value) + " < " + alpha); }
+  if (!(e.explained_share >= 0.5)) { reasons.push("removes " + fmt.percent(e.explained_share) + " of the excess, under 50 %"); }
+  return reasons.length > 0 ? "no: " + reasons.join("; ") : "no";
+}
+
+// A table with a caption (which interval level it shows).
+function captioned(t, caption) {
+  t.insertBefore(text("caption", caption), t.firstChild);
+  return t;
+}
+
+// A place for one of the report's figures, beside the table it illustrates.
+function figureSlot(name) {
+  const div = document.createElement("div");
+  div.className = "plots";
+  div.dataset.slot = name;
+  return div;
+}
 
 function diagnosisOptions() {
   const body = {};
@@ -493,7 +514,7 @@ function buildDiagnosisRow(job) {
   row.appendChild(text("td", when(job.created_at) + " by " + job.submitted_by));
   const links = document.createElement("td");
   if (job.status === "succeeded") {
-    links.appendChild(link("report", () => showDiagnosis(job)));
+    links.appendChild(pageLink("report", "#/diagnoses/" + job.id, "report"));
   } else if (job.error) {
     links.appendChild(text("span", job.error));
   }
@@ -583,17 +604,22 @@ async function showDiagnosis(job) {
       out.appendChild(text("div", "Held-out RMS standardized error: " + fmt.sigma(b.held_out_error_before) +
         " before, " + fmt.sigma(b.held_out_error_after) + " after; the gap shrinks by " + fmt.percent(b.shrink) +
         " (90 % interval " + fmt.percent(b.shrink_interval[0]) + " to " + fmt.percent(b.shrink_interval[1]) +
-        "); lack-of-fit p-value of what is left " + fmt.num(b.residual_p_value, 3) + ".", "best-effect"));
+        "); lack-of-fit p-value of what is left " + fmt.p(b.residual_p_value) + ".", "best-effect"));
       const params = b.parameters.map(p => row([
         p.effect, p.name, fmt.withUnit(p.value, p.unit),
         p.fitted ? interval(p.interval, p.unit) : "held at default",
         interval(p.bounds, p.unit),
       ]));
-      out.appendChild(table(["Effect", "Parameter", "Value", "95 % interval", "Physical bounds"], params));
+      const paramTable = captioned(table(["Effect", "Parameter", "Value", "Interval", "Physical bounds"], params),
+        "Fitted parameters; intervals at 95 %");
+      paramTable.id = "diagnosis-parameters";
+      out.appendChild(paramTable);
+      out.appendChild(figureSlot("before_after.svg"));
     } else {
       out.appendChild(text("div", "No effect named. Nominal model: held-out RMS standardized error " +
         fmt.sigma(r.nominal.held_out_error) + ", chi-square " + fmt.num(r.nominal.chi2, 3) + " on " +
-        fmt.num(r.nominal.dof, 3) + " degrees of freedom (p = " + fmt.num(r.nominal.p_value, 3) + ").", "best-effect"));
+        fmt.count(r.nominal.dof) + " degrees of freedom (p = " + fmt.p(r.nominal.p_value) + ").", "best-effect"));
+      out.appendChild(figureSlot("before_after.svg"));
     }
 
     out.appendChild(text("h4", "Ranking (held out: " + r.held_out + ")"));
@@ -601,17 +627,19 @@ async function showDiagnosis(job) {
     const ranking = r.ranking.concat(r.pairs).map((e, i) => {
       const mark = e.name === (r.best_effect && r.best_effect.name) ? "best"
         : runnersUp.has(e.name) ? "indistinguishable from the best" : "";
-      const tr = row([String(i + 1), e.name, fmt.num(e.held_out_gain, 3) + " nats" + (e.held_out_gain_interval
-        ? " (90 %: " + fmt.num(e.held_out_gain_interval[0], 3) + " to " + fmt.num(e.held_out_gain_interval[1], 3) + ")" : ""), fmt.sigma(e.held_out_error),
-        fmt.percent(e.explained_share), fmt.num(e.residual_p_value, 3), fmt.percent(e.p_first),
-        e.explains ? "yes" : "no", mark], runnersUp.has(e.name) ? "indistinguishable" : "");
+      const tr = row([String(i + 1), e.name, fmt.num(e.held_out_gain, 3) + " nats",
+        e.held_out_gain_interval ? interval(e.held_out_gain_interval, "nats") : "n/a", fmt.sigma(e.held_out_error),
+        fmt.percent(e.explained_share), fmt.p(e.residual_p_value), fmt.percent(e.p_first),
+        e.explains ? "yes" : whyNot(e, r.alpha), mark], runnersUp.has(e.name) ? "indistinguishable" : "");
       tr.dataset.effect = e.name;
       return tr;
     });
-    const rankTable = table(["#", "Effect", "Held-out log-likelihood gain", "Held-out RMS error",
-      "Excess chi-square removed", "Lack-of-fit p", "P(first), bootstrap", "Explains", ""], ranking);
+    const rankTable = captioned(table(["#", "Effect", "Held-out log-likelihood gain", "Gain interval",
+      "Held-out RMS error", "Excess chi-square removed", "Lack-of-fit p", "P(first), bootstrap", "Explains", ""], ranking),
+      "Candidates; gain intervals at 90 % (bootstrap over held-out groups)");
     rankTable.id = "diagnosis-ranking";
     out.appendChild(rankTable);
+    out.appendChild(figureSlot("ranking.svg"));
 
     out.appendChild(text("h4", "Where the nominal model misses (Holm-adjusted p < 0.05)"));
     const flagged = r.where.groups.filter(g => g.flagged);
@@ -621,7 +649,7 @@ async function showDiagnosis(job) {
       const groups = flagged.map(g => {
         const unit = g.by === "frequency_band" ? "dB (measured / model)" : "\u03c3";
         const tr = row([g.by, g.label, fmt.num(g.mean_residual, 3) + " " + unit, fmt.num(g.z, 3),
-          fmt.num(g.p_adjusted, 3), fmt.num(g.observations, 3)]);
+          fmt.p(g.p_adjusted), fmt.num(g.observations, 3)]);
         tr.className = "flagged";
         return tr;
       });
@@ -629,6 +657,7 @@ async function showDiagnosis(job) {
       whereTable.id = "diagnosis-where";
       out.appendChild(whereTable);
     }
+    out.appendChild(figureSlot("residuals.svg"));
 
     const budget = r.where.energy_budget;
     if (budget && budget.tests.length > 0) {
@@ -636,7 +665,7 @@ async function showDiagnosis(job) {
       const work = [];
       for (const t of budget.tests) {
         for (const c of t.contacts) {
-          work.push(row([t.test, c.contact, fmt.num(t.drive_j, 3), fmt.num(c.friction_j, 3), fmt.num(c.damping_j, 3),
+          work.push(row([t.test, c.contact, fmt.num(t.drive_j, 3) + " J", fmt.num(c.friction_j, 3) + " J", fmt.num(c.damping_j, 3) + " J",
             fmt.num(c.damping_to_friction, 3), fmt.percent(c.share_above_yield),
             fmt.num(c.lumped_archard_mm3, 3) + " / " + fmt.num(c.local_archard_mm3, 3) + " mm\u00b3"]));
         }
@@ -658,29 +687,331 @@ async function showDiagnosis(job) {
       neededTable.id = "diagnosis-budget-needed";
       out.appendChild(neededTable);
     }
+    out.appendChild(figureSlot("energy_budget.svg"));
 
-    // The figures, fetched with the token and shown as images (an <img> runs no script).
-    const plots = document.createElement("div");
-    plots.className = "plots";
-    out.appendChild(plots);
-    // In the report's order: where (residuals, energy budget), which, how far.
-    const order = ["residuals.svg", "energy_budget.svg", "ranking.svg", "before_after.svg"];
-    const rank = name => order.indexOf(name) < 0 ? order.length : order.indexOf(name);
-    for (const plot of result.plots.slice().sort((a, b) => rank(a.name) - rank(b.name))) {
-      const response = await fetch(plot.url, { headers: { "Authorization": "Bearer " + state.token } });
+    // Each figure beside the table it illustrates; any other at the end.
+    const rest = figureSlot("");
+    out.appendChild(rest);
+    for (const plot of result.plots) {
+      const slot = [...out.querySelectorAll("div[data-slot]")].find(d => d.dataset.slot === plot.name) || rest;
+      await showPlots([plot], slot, epoch);
       if (epoch !== state.epoch) { return; }
-      if (!response.ok) { plots.appendChild(text("div", plot.name + ": " + response.status, "status-failed")); continue; }
-      const img = document.createElement("img");
-      img.alt = plot.name;
-      img.dataset.plot = plot.name;
-      img.src = URL.createObjectURL(await response.blob());
-      plots.appendChild(img);
     }
     out.dataset.verdict = r.verdict;
   } catch (e) {
     if (e instanceof Refused || epoch !== state.epoch) { return; }
     diag.shown = null;
     out.appendChild(text("div", String(e), "status-failed"));
+  }
+}
+
+// ---- Pages with URLs: #/rails, #/rails/<serial>?compare=<curve id>, #/curves, #/jobs?kind=&status=&by=,
+// #/jobs/<id>, #/campaigns, #/diagnoses/<id>. Links can be bookmarked and shared; the token is never
+// part of them.
+
+function parseRoute() {
+  const hash = location.hash.startsWith("#/") ? location.hash.slice(2) : "";
+  const [path, query] = hash.split("?");
+  const parts = path.split("/").filter(p => p !== "").map(p => decodeURIComponent(p));
+  return { parts, params: new URLSearchParams(query || "") };
+}
+
+// Goes to a page; going to the page already shown shows it again (a report opened before a
+// sign-out opens after the next sign-in).
+function go(hash) {
+  if (location.hash === hash) { route(); } else { location.hash = hash; }
+}
+
+function pageLink(label, hash, cls) {
+  const a = text("a", label, cls);
+  a.href = hash;
+  a.addEventListener("click", event => { event.preventDefault(); go(hash); });
+  return a;
+}
+
+function showView(view) {
+  for (const s of document.querySelectorAll("section[data-view]")) { s.hidden = s.dataset.view !== view; }
+  const tab = view === "job" ? "jobs" : view === "rail" ? "rails" : view;
+  for (const a of document.querySelectorAll("#nav a")) { a.classList.toggle("active", a.dataset.nav === tab); }
+}
+
+// The page a role starts on when the address names none.
+function homeOf(me) {
+  return me.role === "planner" ? "rails" : me.role === "test_engineer" ? "campaigns" : "jobs";
+}
+
+function route() {
+  if (state.me === null) { showView(null); return; }
+  const { parts, params } = parseRoute();
+  const page = parts[0] || homeOf(state.me);
+  state.route = { page, id: parts[1] || null, params };
+  const epoch = state.epoch;
+  if (page === "jobs" && parts[1]) { showView("job"); loadJobPage(parts[1], epoch); }
+  else if (page === "jobs") { showView("jobs"); setJobFilters(params); pollJobs(epoch); }
+  else if (page === "rails" && parts[1]) { showView("rail"); loadRail(parts[1], params.get("compare") || "", epoch); }
+  else if (page === "rails") { showView("rails"); loadRails(epoch); }
+  else if (page === "curves") { showView("curves"); loadCurves(epoch); }
+  else if (page === "diagnoses" && parts[1]) { showView("campaigns"); openDiagnosis(parts[1], epoch); }
+  else { showView("campaigns"); }
+}
+
+// ---- Jobs: filters and pages ----
+
+// Cursors of the pages seen (index 0: the newest); `next`: the older page's.
+const jobList = { cursors: [null], index: 0, next: null, key: "" };
+
+function setJobFilters(params) {
+  const key = params.toString();
+  document.getElementById("filter-kind").value = params.get("kind") || "";
+  document.getElementById("filter-status").value = params.get("status") || "";
+  document.getElementById("filter-submitter").value = params.get("by") || "";
+  if (key !== jobList.key) { jobList.key = key; jobList.cursors = [null]; jobList.index = 0; jobList.next = null; }
+}
+
+function jobsUrl() {
+  const params = state.route.params;
+  let url = "/v1/jobs?limit=100&top_level=true";
+  if (params.get("status")) { url += "&status=" + encodeURIComponent(params.get("status")); }
+  const cursor = jobList.cursors[jobList.index];
+  if (cursor) { url += "&cursor=" + encodeURIComponent(cursor); }
+  return url;
+}
+
+// The list filters status; kind and submitter are matched within each page of 100 jobs (the
+// job list has no kind or submitter filter).
+function filterJobs(items) {
+  const params = state.route.params;
+  const kind = params.get("kind"), by = params.get("by");
+  return items.filter(j => (!kind || j.kind === kind) && (!by || j.submitted_by === by));
+}
+
+function renderJobPager() {
+  document.getElementById("jobs-newer").disabled = jobList.index === 0;
+  document.getElementById("jobs-older").disabled = !jobList.next;
+  document.getElementById("jobs-page").textContent = "page " + (jobList.index + 1);
+  const params = state.route.params;
+  document.getElementById("jobs-note").textContent = params.get("kind") || params.get("by")
+    ? "kind and submitter are matched within each page of 100 jobs" : "";
+}
+
+// ---- A job's page: parameters, status, attempts, duration, cancel, figures, downloads ----
+
+function seconds(s) {
+  if (s == null || !isFinite(s)) { return "n/a"; }
+  if (s < 60) { return s.toFixed(1) + " s"; }
+  const m = Math.floor(s / 60);
+  if (m < 60) { return m + " min " + Math.round(s - 60 * m) + " s"; }
+  return Math.floor(m / 60) + " h " + (m % 60) + " min";
+}
+
+function flatten(value, prefix, out) {
+  for (const key of Object.keys(value)) {
+    const v = value[key], name = prefix ? prefix + "." + key : key;
+    if (v !== null && typeof v === "object" && !Array.isArray(v)) { flatten(v, name, out); }
+    else { out.push([name, typeof v === "string" ? v : JSON.stringify(v)]); }
+  }
+  return out;
+}
+
+function keyValueTable(pairs, id) {
+  const t = table(["", ""], pairs.map(([k, v]) => row([k, v])));
+  t.id = id; t.className = "facts";
+  t.querySelector("thead").remove();
+  return t;
+}
+
+const jobPage = { id: null, status: null };
+
+async function loadJobPage(id, epoch) {
+  const out = document.getElementById("job-page");
+  if (selecting(out)) { return; }
+  try {
+    const job = await api("/v1/jobs/" + encodeURIComponent(id));
+    const attempts = await api(job.links.attempts);
+    if (epoch !== state.epoch || !state.route || state.route.id !== id) { return; }
+    const fresh = jobPage.id !== id || jobPage.status !== job.status;
+    jobPage.id = id; jobPage.status = job.status;
+    const page = document.createElement("div");
+    page.dataset.job = job.id; page.dataset.status = job.status;
+    const title = text("h2", job.kind + " job ");
+    title.appendChild(text("code", job.id, "id"));
+    page.appendChild(title);
+    const status = text("div", "", "job-status");
+    status.appendChild(text("strong", job.status, "status status-" + job.status));
+    const progress = progressCell(job);
+    while (progress.firstChild) { status.appendChild(progress.firstChild); }
+    if (mayCancel(job)) { status.appendChild(cancelButton(job, "error")); }
+    page.appendChild(status);
+    const end = job.finished_at ? new Date(job.finished_at) : new Date();
+    const duration = job.started_at ? (end - new Date(job.started_at)) / 1000 : null;
+    const facts = [
+      ["Submitted by", job.submitted_by], ["Created", when(job.created_at)],
+      ["Started", job.started_at ? when(job.started_at) : "not yet"],
+      ["Finished", job.finished_at ? when(job.finished_at) : "not yet"],
+      ["Duration (wall clock)", duration == null ? "n/a" : seconds(duration) + (job.finished_at ? "" : " so far")],
+      ["Attempts", String(job.attempt)], ["Seed", String(job.seed)], ["Code version", job.code_version],
+    ];
+    if (job.worker) { facts.push(["Worker", job.worker]); }
+    if (job.curve_key) { facts.push(["Curve key", job.curve_key]); }
+    if (job.error) { facts.push(["Error", job.error]); }
+    page.appendChild(keyValueTable(facts, "job-facts"));
+    page.appendChild(text("h3", "Parameters"));
+    page.appendChild(keyValueTable(flatten(job.params, "", []), "job-params"));
+    if (attempts.length > 0) {
+      page.appendChild(text("h3", "Attempts"));
+      const rows = attempts.map(a => row([String(a.attempt), a.worker, when(a.started_at),
+        a.ended_at ? when(a.ended_at) : "running", a.outcome]));
+      const t = table(["#", "Worker", "Started", "Ended", "Outcome"], rows);
+      t.id = "job-attempts";
+      page.appendChild(t);
+    }
+    if (job.status === "succeeded" && !fresh) { return; }
+    out.replaceChildren(page);
+    if (job.kind === "diagnose") { page.appendChild(pageLink("the diagnosis report", "#/diagnoses/" + job.id)); }
+    if (job.status !== "succeeded") { return; }
+    const result = await api(job.links.result);
+    if (epoch !== state.epoch || jobPage.id !== id) { return; }
+    page.appendChild(text("h3", "Downloads"));
+    const downloads = document.createElement("p");
+    if (job.kind === "simulate") { downloads.appendChild(downloadLink(job)); }
+    const json = document.createElement("a");
+    json.href = URL.createObjectURL(new Blob([JSON.stringify(result, null, 2)], { type: "application/json" }));
+    json.download = "railwear-" + job.id + "-result.json";
+    json.textContent = "result (JSON)";
+    downloads.appendChild(json);
+    page.appendChild(downloads);
+    if (result.plots.length > 0) {
+      page.appendChild(text("h3", "Figures"));
+      const plots = document.createElement("div");
+      plots.className = "plots";
+      page.appendChild(plots);
+      await showPlots(result.plots, plots, epoch);
+    }
+  } catch (e) {
+    if (!(e instanceof Refused) && epoch === state.epoch) { out.replaceChildren(text("div", String(e), "status-failed")); }
+  }
+}
+
+// Figures fetched with the token and shown as images (an <img> runs no script).
+async function showPlots(list, into, epoch) {
+  for (const plot of list) {
+    const response = await fetch(plot.url, { headers: { "Authorization": "Bearer " + state.token } });
+    if (epoch !== state.epoch) { return; }
+    if (!response.ok) { into.appendChild(text("div", plot.name + ": " + response.status, "status-failed")); continue; }
+    const figure = document.createElement("figure");
+    const img = document.createElement("img");
+    img.alt = plot.name;
+    img.dataset.plot = plot.name;
+    img.src = URL.createObjectURL(await response.blob());
+    figure.appendChild(img);
+    figure.appendChild(text("figcaption", plot.name));
+    into.appendChild(figure);
+  }
+}
+
+// ---- Rails ----
+
+async function loadRails(epoch) {
+  try {
+    const page = await api("/v1/rails?limit=100");
+    if (epoch !== state.epoch) { return; }
+    updateRows(document.getElementById("rails"), page.items, r => "rail-row-" + r.serial,
+      r => JSON.stringify([r.measurements]), r => {
+        const tr = document.createElement("tr");
+        const cell = document.createElement("td");
+        cell.appendChild(pageLink(r.serial, "#/rails/" + encodeURIComponent(r.serial)));
+        tr.appendChild(cell);
+        tr.appendChild(text("td", when(r.registered_at)));
+        tr.appendChild(text("td", String(r.measurements)));
+        return tr;
+      });
+  } catch (e) { if (!(e instanceof Refused)) { document.getElementById("error").textContent = String(e); } }
+}
+
+async function loadRail(serial, compare, epoch) {
+  document.getElementById("serial").value = serial;
+  document.getElementById("compare").value = compare;
+  document.getElementById("rail-title").textContent = "Rail " + serial;
+  const history = document.getElementById("measurements");
+  history.replaceChildren();
+  await loadReport();
+  try {
+    const page = await api("/v1/rails/" + encodeURIComponent(serial) + "/measurements?limit=100");
+    if (epoch !== state.epoch) { return; }
+    for (const m of page.items) {
+      history.appendChild(row([when(m.measured_at), m.measured_by, m.location, m.rattle_space.toFixed(4),
+        when(m.recorded_at) + " by " + m.recorded_by]));
+    }
+  } catch (e) { if (!(e instanceof Refused)) { history.appendChild(row([String(e)], "status-failed")); } }
+}
+
+// ---- Curves ----
+
+function fidelityText(f) {
+  return f.points + " points, " + (f.duration_per_point_s == null ? "duration not recorded"
+    : f.duration_per_point_s + " s per point") + ", " + f.seeds + " seed" + (f.seeds === 1 ? "" : "s");
+}
+
+async function publishCurve(c, force) {
+  const error = document.getElementById("curves-error");
+  error.replaceChildren();
+  const epoch = state.epoch;
+  try {
+    await api(c.links.publish, { method: "POST", headers: { "Content-Type": "application/json" },
+      body: JSON.stringify({ force }) });
+  } catch (e) {
+    if (e instanceof Refused) { return; }
+    error.appendChild(document.createTextNode(String(e) + " "));
+    if (!force && /force/.test(String(e))) {
+      const again = text("button", "Publish anyway", "publish-force");
+      again.type = "button";
+      again.addEventListener("click", () => publishCurve(c, true));
+      error.appendChild(again);
+    }
+  }
+  if (epoch === state.epoch) { loadCurves(epoch); }
+}
+
+async function loadCurves(epoch) {
+  try {
+    const page = await api("/v1/curves?limit=100");
+    if (epoch !== state.epoch) { return; }
+    const may = state.me && state.me.may.publish_curves;
+    updateRows(document.getElementById("curves"), page.items, c => "curve-" + c.id,
+      c => JSON.stringify([c.published, may]), c => {
+        const tr = document.createElement("tr");
+        tr.appendChild(text("td", String(c.id)));
+        tr.appendChild(text("td", c.curve_key + ", version " + c.version));
+        tr.appendChild(text("td", fidelityText(c.fidelity), "fidelity"));
+        tr.appendChild(text("td", c.rattle_space_range ? c.rattle_space_range[0] + " to " + c.rattle_space_range[1] : "n/a"));
+        const made = document.createElement("td");
+        made.appendChild(document.createTextNode(when(c.created_at) + " by " + c.created_by + " (code " + c.code_version + ") from sweep "));
+        made.appendChild(pageLink(c.job_id, "#/jobs/" + c.job_id, "id"));
+        tr.appendChild(made);
+        const published = document.createElement("td");
+        if (c.published) { published.textContent = when(c.published_at) + " by " + c.published_by; }
+        else if (may) {
+          const button = text("button", "Publish", "publish");
+          button.type = "button";
+          button.addEventListener("click", () => { button.disabled = true; publishCurve(c, false); });
+          published.appendChild(button);
+        } else { published.textContent = "not published"; }
+        tr.appendChild(published);
+        return tr;
+      });
+  } catch (e) { if (!(e instanceof Refused)) { document.getElementById("curves-error").textContent = String(e); } }
+}
+
+// ---- A diagnosis' page ----
+
+async function openDiagnosis(id, epoch) {
+  try {
+    const job = await api("/v1/jobs/" + encodeURIComponent(id));
+    if (epoch !== state.epoch) { return; }
+    if (job.status === "succeeded") { showDiagnosis(job); }
+    else { diag.started = ACTIVE.has(job.status) ? job.id : null; diag.shown = null; showDiagnosisProgress(job); }
+  } catch (e) {
+    if (!(e instanceof Refused)) { document.getElementById("diagnosis").replaceChildren(text("div", String(e), "status-failed")); }
   }
 }
 
@@ -713,7 +1044,10 @@ async function poll() {
   const epoch = state.epoch;
   const walk = state.ticks % 10 === 0;
   state.ticks += 1;
-  try { await Promise.all([pollJobs(epoch), pollDiagnoses(epoch, walk)]); } finally { if (epoch === state.epoch) { state.polling = false; } }
+  const r = state.route;
+  const jobs = r && r.page === "jobs" && !r.id ? pollJobs(epoch) : null;
+  const page = r && r.page === "jobs" && r.id && (jobPage.id !== r.id || ACTIVE.has(jobPage.status)) ? loadJobPage(r.id, epoch) : null;
+  try { await Promise.all([jobs, page, pollDiagnoses(epoch, walk)]); } finally { if (epoch === state.epoch) { state.polling = false; } }
 }
 
 document.getElementById("token-form").addEventListener("submit", event => {
@@ -723,6 +1057,32 @@ document.getElementById("token-form").addEventListener("submit", event => {
   signIn();
 });
 document.getElementById("sign-out").addEventListener("click", signOut);
-document.getElementById("load-report").addEventListener("click", loadReport);
+document.getElementById("rail-search").addEventListener("submit", event => {
+  event.preventDefault();
+  const serial = document.getElementById("serial").value.trim();
+  const compare = document.getElementById("compare").value.trim();
+  if (serial) { go("#/rails/" + encodeURIComponent(serial) + (compare ? "?compare=" + encodeURIComponent(compare) : "")); }
+});
+document.getElementById("job-filters").addEventListener("submit", event => {
+  event.preventDefault();
+  const params = new URLSearchParams();
+  for (const [key, id] of [["kind", "filter-kind"], ["status", "filter-status"], ["by", "filter-submitter"]]) {
+    const v = document.getElementById(id).value.trim();
+    if (v) { params.set(key, v); }
+  }
+  go("#/jobs" + (params.toString() ? "?" + params : ""));
+});
+document.getElementById("jobs-older").addEventListener("click", () => {
+  if (!jobList.next) { return; }
+  jobList.cursors = jobList.cursors.slice(0, jobList.index + 1).concat([jobList.next]);
+  jobList.index += 1;
+  pollJobs(state.epoch);
+});
+document.getElementById("jobs-newer").addEventListener("click", () => {
+  if (jobList.index === 0) { return; }
+  jobList.index -= 1;
+  pollJobs(state.epoch);
+});
+window.addEventListener("hashchange", route);
 readToken();
 if (state.token) { signIn(); } else { document.getElementById("error").textContent = "enter a token"; }

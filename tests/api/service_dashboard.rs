@@ -286,7 +286,10 @@ async fn dashboard_shows_a_job_reach_success() {
         let links = driver.script(&format!(
             "return document.querySelector('#job-{id}').textContent;"
         ));
-        assert!(links.as_str().unwrap().contains("result"), "{links}");
+        assert!(
+            links.as_str().unwrap().ends_with("pagedownload tracks (CSV)"),
+            "{links}"
+        );
         // Defect 2: progress reads 100 % only once the job ended (a diagnosis' simulations
         // can all be done while it still writes its report).
         assert_eq!(
@@ -297,21 +300,56 @@ async fn dashboard_shows_a_job_reach_success() {
             driver.script("return percentDone({status: 'succeeded', progress: {fraction: 1.0}});"),
             100
         );
-        // The result link loads the job's summary into the page.
+        // The job's page, by its URL: parameters as a table, attempts, its figures and the
+        // tracks as a CSV download.
         driver.script(&format!(
-            "document.querySelector('#job-{id} a').click(); return null;"
+            "document.querySelector('#job-{id} a.job-page').click(); return null;"
         ));
-        wait_for(Duration::from_secs(10), "result shown", || {
-            let text = driver.script("return document.getElementById('result').textContent;");
-            text.as_str()
-                .filter(|t| t.contains("force_sum_n"))
-                .map(|_| ())
+        let page = format!(
+            "const p = document.querySelector('#job-page > div'); \
+             return p && p.dataset.job === '{id}' && p.querySelector('.plots, h3') ? p.dataset.status : null;"
+        );
+        wait_for(Duration::from_secs(10), "the job page", || {
+            (driver.script(&page) == "succeeded").then_some(())
         });
-        // The tracks download as a CSV file: the same rows the API serves.
-        driver.script(&format!(
-            "[...document.querySelectorAll('#job-{id} a')]\
-             .find(a => a.textContent.startsWith('download tracks')).click(); return null;"
-        ));
+        assert_eq!(driver.script("return location.hash;"), format!("#/jobs/{id}"));
+        let params = driver.script(
+            "return Object.fromEntries([...document.querySelectorAll('#job-params tr')]\
+             .map(r => [r.children[0].textContent, r.children[1].textContent]));",
+        );
+        assert_eq!(params["steps"], "60");
+        assert_eq!(params["samples"], "50");
+        let facts = driver.script(
+            "return Object.fromEntries([...document.querySelectorAll('#job-facts tr')]\
+             .map(r => [r.children[0].textContent, r.children[1].textContent]));",
+        );
+        assert_eq!(facts["Attempts"], "1");
+        assert_eq!(facts["Submitted by"], "eng");
+        assert!(facts["Finished"].as_str().unwrap().ends_with(" UTC"), "{facts}");
+        assert_eq!(
+            driver.script("return document.querySelectorAll('#job-attempts tbody tr').length;"),
+            1
+        );
+        let result = api.get(&format!("/v1/jobs/{id}/result"), Some(ENGINEER)).json();
+        let names: Vec<Value> = result["plots"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].clone())
+            .collect();
+        assert!(!names.is_empty(), "{result}");
+        let figures = wait_for(Duration::from_secs(10), "the figures", || {
+            let v = driver.script(
+                "const imgs = [...document.querySelectorAll('#job-page img[data-plot]')]; \
+                 return imgs.length > 0 && imgs.every(i => i.complete) ? imgs.map(i => i.dataset.plot) : null;",
+            );
+            (!v.is_null()).then_some(v)
+        });
+        assert_eq!(figures, Value::Array(names));
+        driver.script(
+            "[...document.querySelectorAll('#job-page a')]\
+             .find(a => a.textContent.startsWith('download tracks')).click(); return null;",
+        );
         let downloaded = driver.downloaded(&format!("railwear-{id}-tracks.csv"));
         let csv = api.get(&format!("/v1/jobs/{id}/tracks?format=csv"), Some(ENGINEER));
         assert_eq!(csv.status, 200);
@@ -327,7 +365,8 @@ async fn dashboard_shows_a_job_reach_success() {
         assert!(driver
             .script("return localStorage.getItem('railwear-token');")
             .is_null());
-        assert_eq!(driver.script("return location.hash;"), "");
+        let address = driver.script("return location.href;");
+        assert!(!address.as_str().unwrap().contains(ENGINEER), "{address}");
         driver.assert_console_clean(&[]);
 
         // Defect 4: signing out clears everything, stays signed out and stops polling.
@@ -342,7 +381,7 @@ async fn dashboard_shows_a_job_reach_success() {
         driver.assert_quiet(3);
         let cleared = "return [document.querySelectorAll('#jobs tr').length, \
              document.getElementById('whoami').textContent, \
-             document.getElementById('result').textContent, \
+             document.getElementById('job-page').textContent, \
              document.getElementById('error').textContent];";
         assert_eq!(driver.script(cleared), json!([0, "", "", "signed out"]));
 
@@ -350,8 +389,8 @@ async fn dashboard_shows_a_job_reach_success() {
         // polling after its single 401.
         driver.sign_in(ENGINEER);
         driver.signed_in("engineer");
-        wait_for(Duration::from_secs(30), "the jobs again", || {
-            (driver.script(&row_status) == "succeeded").then_some(())
+        wait_for(Duration::from_secs(30), "the job page again", || {
+            (driver.script(&page) == "succeeded").then_some(())
         });
         driver.sign_in("not-a-token");
         let refused = wait_for(Duration::from_secs(30), "the refusal", || {
@@ -413,6 +452,13 @@ async fn dashboard_compares_a_rails_life_under_two_curves() {
 
         let driver = Driver::start(&chromium, &chromedriver);
         driver.goto(&api.url(&format!("/#token={PLANNER}")));
+        // A planner starts on the rails: the list links each rail's page.
+        driver.signed_in("planner");
+        wait_for(Duration::from_secs(30), "the rail listed", || {
+            (driver.script("return document.querySelector('#rail-row-R-9 a') !== null;") == true)
+                .then_some(())
+        });
+        assert_eq!(driver.script("return document.getElementById('view-rails').hidden;"), false);
         fill(&driver, "serial", "R-9");
         fill(&driver, "compare", &second.to_string());
         driver.script("document.getElementById('load-report').click(); return null;");
@@ -453,6 +499,56 @@ async fn dashboard_compares_a_rails_life_under_two_curves() {
                 && interval.ends_with(used["uncertainty"].as_str().unwrap()),
             "{interval} (API: {used})"
         );
+        assert_eq!(
+            driver.script("return location.hash;"),
+            format!("#/rails/R-9?compare={second}")
+        );
+        assert_eq!(
+            driver.script("return document.querySelectorAll('#measurements tr').length;"),
+            1,
+            "the measurement history"
+        );
+        // The page's URL opens the same report in a fresh load.
+        driver.goto("about:blank");
+        driver.goto(&api.url(&format!("/#/rails/R-9?compare={second}")));
+        let again = wait_for(Duration::from_secs(30), "the bookmarked report", || {
+            driver
+                .script(
+                    "const c = document.getElementById('report-comparison'); \
+                     return c ? c.textContent : null;",
+                )
+                .as_str()
+                .map(str::to_string)
+        });
+        assert_eq!(again, shown);
+        // The curves, each with its fidelity and the sweep that made it.
+        driver.goto("about:blank");
+        driver.goto(&api.url("/#/curves"));
+        let curves = api.get("/v1/curves", Some(PLANNER)).json();
+        for curve in curves["items"].as_array().unwrap() {
+            let id = curve["id"].as_i64().unwrap();
+            let seeds = curve["fidelity"]["seeds"].as_i64().unwrap();
+            let fidelity = wait_for(Duration::from_secs(30), "the curve listed", || {
+                driver
+                    .script(&format!(
+                        "const r = document.getElementById('curve-{id}'); \
+                         return r ? r.querySelector('.fidelity').textContent : null;"
+                    ))
+                    .as_str()
+                    .map(str::to_string)
+            });
+            let f = &curve["fidelity"];
+            let duration = match f["duration_per_point_s"].as_f64() {
+                Some(d) => format!("{d} s per point"),
+                None => "duration not recorded".to_string(),
+            };
+            let expected = format!(
+                "{} points, {duration}, {seeds} seed{}",
+                f["points"],
+                if seeds == 1 { "" } else { "s" }
+            );
+            assert_eq!(fidelity, expected);
+        }
         driver.assert_console_clean(&[]);
     })
     .await
@@ -659,16 +755,40 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
             );
             (!v.is_null()).then_some(v)
         });
-        // In the report's order: where (residuals, energy budget), which, how far.
+        // Each beside the table it illustrates: how far (after the fitted parameters), which
+        // (after the ranking), where (after the flagged groups, after the energy budget).
         assert_eq!(
             decoded,
             json!([
-                "residuals.svg",
-                "energy_budget.svg",
+                "before_after.svg",
                 "ranking.svg",
-                "before_after.svg"
+                "residuals.svg",
+                "energy_budget.svg"
             ])
         );
+        // A reason beside every "no" in the Explains column.
+        let explains = driver.script(
+            "return [...document.querySelectorAll('#diagnosis-ranking tbody tr')]\
+             .map(r => r.children[8].textContent);",
+        );
+        let entries: Vec<&Value> = report["ranking"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .chain(report["pairs"].as_array().unwrap())
+            .collect();
+        for (cell, entry) in explains.as_array().unwrap().iter().zip(&entries) {
+            let cell = cell.as_str().unwrap();
+            if entry["explains"] == true {
+                assert_eq!(cell, "yes");
+            } else {
+                assert!(cell.starts_with("no: "), "{cell} for {entry}");
+            }
+        }
+        // Each table says which interval level it shows.
+        let caption = driver
+            .script("return document.querySelector('#diagnosis-ranking caption').textContent;");
+        assert!(caption.as_str().unwrap().contains("90 %"), "{caption}");
         driver.assert_console_clean(&[REFUSED_OPTIONS]);
 
         // Defect 3: sign out, sign in, open the same report: it shows again.
@@ -767,6 +887,26 @@ async fn dashboard_lists_old_diagnoses_and_cancels_a_job() {
         wait_for(Duration::from_secs(30), "the row cancelled", || {
             (driver.script(&shown) == "cancelled").then_some(())
         });
+        // Filters by kind and paging: the old diagnosis is on the second page of 100.
+        driver.goto(&api.url("/#/jobs?kind=diagnose"));
+        let rows = "return [...document.querySelectorAll('#jobs tr')].map(r => r.id);";
+        wait_for(Duration::from_secs(30), "the older page offered", || {
+            (driver.script("return document.getElementById('jobs-older').disabled;") == false)
+                .then_some(())
+        });
+        assert_eq!(
+            driver.script(rows),
+            json!([]),
+            "no diagnosis among the newest 100"
+        );
+        driver.script("document.getElementById('jobs-older').click(); return null;");
+        wait_for(Duration::from_secs(30), "the diagnosis on page 2", || {
+            (driver.script(rows) == json!([format!("job-{old}")])).then_some(())
+        });
+        assert_eq!(
+            driver.script("return document.getElementById('jobs-page').textContent;"),
+            "page 2"
+        );
         driver.assert_console_clean(&[]);
     })
     .await
