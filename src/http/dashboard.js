@@ -38,6 +38,9 @@ function clearAll() {
   delete out.dataset.job; delete out.dataset.verdict; delete out.dataset.status;
   delete document.getElementById("whoami").dataset.role;
   document.getElementById("diagnose-options").hidden = true;
+  document.getElementById("submit-job").hidden = true;
+  document.getElementById("upload-campaign").hidden = true;
+  for (const id of ["submit-error", "upload-error"]) { document.getElementById(id).textContent = ""; }
 }
 
 function signOut() {
@@ -76,6 +79,8 @@ async function signIn() {
     document.createTextNode(" (" + me.role + ")"));
   who.dataset.role = me.role;
   document.getElementById("diagnose-options").hidden = !diag.may;
+  document.getElementById("submit-job").hidden = !me.may.submit_jobs;
+  document.getElementById("upload-campaign").hidden = !me.may.upload_campaigns;
   route();
   state.timer = setInterval(poll, 1000);
   poll();
@@ -369,10 +374,35 @@ async function loadReport() {
       out.appendChild(used);
     }
     if (r.missing_curve) { out.appendChild(text("div", r.missing_curve.detail, "status-cancelled")); }
-    if (r.comparison) { out.appendChild(comparisonLine(r.comparison)); }
+    if (r.comparison) {
+      out.appendChild(comparisonLine(r.comparison));
+      if (r.curve) {
+        const other = await api("/v1/curves/" + encodeURIComponent(r.comparison.curve_id));
+        if (epoch !== state.epoch) { return; }
+        const warning = fidelityWarning(r.curve, other);
+        if (warning) { out.appendChild(warning); }
+      }
+    }
     const svg = curveSvg(r);
     if (svg) { plot.appendChild(svg); }
   } catch (e) { if (!(e instanceof Refused)) { out.appendChild(text("div", String(e), "status-failed")); } }
+}
+
+// A compared curve with less simulation behind it than the report's: fewer points, shorter
+// runs or fewer seeds make its K_SL less certain, and the page says so.
+function fidelityWarning(used, other) {
+  const a = used.fidelity, b = other.fidelity, lower = [];
+  if (b.points < a.points) { lower.push(b.points + " points against " + a.points); }
+  if (b.duration_per_point_s != null && a.duration_per_point_s != null && b.duration_per_point_s < a.duration_per_point_s) {
+    lower.push(b.duration_per_point_s + " s per point against " + a.duration_per_point_s + " s");
+  }
+  if (b.seeds < a.seeds) { lower.push(b.seeds + " seed" + (b.seeds === 1 ? "" : "s") + " per point against " + a.seeds); }
+  if (lower.length === 0) { return null; }
+  const div = text("div", "Curve " + other.id + " has less simulation behind it than curve " + used.id + " (" +
+    lower.join(", ") + "): its K_SL is less certain" + (b.seeds < 2 ? ", and with one seed it has no interval" : "") + ".",
+    "status-cancelled");
+  div.id = "report-fidelity-warning";
+  return div;
 }
 
 // K_SL and the penalized life under another stored curve (`?compare=<curve id>`).
@@ -1084,5 +1114,41 @@ document.getElementById("jobs-newer").addEventListener("click", () => {
   pollJobs(state.epoch);
 });
 window.addEventListener("hashchange", route);
+
+// Submits a job; the button waits for the answer, then the page goes to the job's page.
+document.getElementById("submit-job").addEventListener("submit", async event => {
+  event.preventDefault();
+  const button = document.getElementById("submit-button");
+  const error = document.getElementById("submit-error");
+  error.textContent = "";
+  let params;
+  try { params = JSON.parse(document.getElementById("submit-params").value); } catch (e) {
+    error.textContent = "parameters: not JSON (" + e.message + ")"; return;
+  }
+  button.disabled = true;
+  try {
+    const job = await api("/v1/jobs", { method: "POST", headers: { "Content-Type": "application/json" },
+      body: JSON.stringify({ kind: document.getElementById("submit-kind").value, params }) });
+    go("#/jobs/" + job.id);
+  } catch (e) { if (!(e instanceof Refused)) { error.textContent = String(e); } }
+  finally { button.disabled = false; }
+});
+
+// Uploads a campaign document; the button waits for the answer.
+document.getElementById("upload-campaign").addEventListener("submit", async event => {
+  event.preventDefault();
+  const button = document.getElementById("upload-button");
+  const error = document.getElementById("upload-error");
+  const file = document.getElementById("campaign-file").files[0];
+  error.textContent = "";
+  if (!file) { error.textContent = "choose a campaign file"; return; }
+  button.disabled = true;
+  const epoch = state.epoch;
+  try {
+    await api("/v1/campaigns", { method: "POST", headers: { "Content-Type": "application/json" }, body: await file.text() });
+    if (epoch === state.epoch) { await pollDiagnoses(epoch, false); }
+  } catch (e) { if (!(e instanceof Refused)) { error.textContent = String(e); } }
+  finally { button.disabled = false; }
+});
 readToken();
 if (state.token) { signIn(); } else { document.getElementById("error").textContent = "enter a token"; }

@@ -106,6 +106,24 @@ impl Driver {
         )
     }
 
+    /// Chooses a file in a file input, as a user picking it would (WebDriver's send keys).
+    fn choose_file(&self, css: &str, path: &std::path::Path) {
+        let element = self.call(
+            "POST",
+            &format!("/session/{}/element", self.session),
+            Some(json!({ "using": "css selector", "value": css })),
+        );
+        let key = "element-6066-11e4-a52e-4f735466cecf";
+        let id = element[key]
+            .as_str()
+            .unwrap_or_else(|| panic!("no {css}: {element}"));
+        self.call(
+            "POST",
+            &format!("/session/{}/element/{id}/value", self.session),
+            Some(json!({ "text": path.to_string_lossy() })),
+        );
+    }
+
     /// The text of a file the browser downloaded, once it is complete.
     fn downloaded(&self, name: &str) -> String {
         let path = self.downloads.join(name);
@@ -355,6 +373,40 @@ async fn dashboard_shows_a_job_reach_success() {
         assert_eq!(csv.status, 200);
         assert_eq!(downloaded, csv.body);
         assert_eq!(csv.body.lines().count(), 51, "a header and the 50 samples");
+        // The engineer submits a job through the page and lands on its page, which follows
+        // it to success.
+        driver.goto(&api.url("/#/jobs"));
+        fill(&driver, "submit-kind", "simulate");
+        fill(
+            &driver,
+            "submit-params",
+            r#"{"steps": 5, "step_ms": 20, "samples": 10}"#,
+        );
+        driver.script("document.getElementById('submit-job').requestSubmit(); return null;");
+        let second = wait_for(Duration::from_secs(30), "the new job's page", || {
+            driver
+                .script("return location.hash;")
+                .as_str()
+                .and_then(|h| h.strip_prefix("#/jobs/"))
+                .filter(|h| *h != id)
+                .map(str::to_string)
+        });
+        let page_of = |job: &str| {
+            format!(
+                "const p = document.querySelector('#job-page > div'); \
+                 return p && p.dataset.job === '{job}' ? p.dataset.status : null;"
+            )
+        };
+        wait_for(Duration::from_secs(30), "the new job succeeded", || {
+            (driver.script(&page_of(&second)) == "succeeded").then_some(())
+        });
+        let submitted = api.get(&format!("/v1/jobs/{second}"), Some(ENGINEER)).json();
+        assert_eq!(submitted["params"]["steps"], 5, "{submitted}");
+        assert_eq!(submitted["submitted_by"], "eng");
+        driver.goto(&api.url(&format!("/#/jobs/{id}")));
+        wait_for(Duration::from_secs(30), "the first job's page", || {
+            (driver.script(&page) == "succeeded").then_some(())
+        });
         // Issue 29: the page ran above under its policy, which allows no inline script. The
         // token is in this tab's sessionStorage, not localStorage nor the address bar, and
         // signing out forgets it.
@@ -475,6 +527,17 @@ async fn dashboard_compares_a_rails_life_under_two_curves() {
             shown.contains(&format!("Under curve {second}"))
                 && shown.contains(&format!("K_SL = {k_sl:.3}")),
             "{shown} (API: {k_sl})"
+        );
+        // The compared curve has one seed per point against three: the page warns.
+        let warning = driver.script(
+            "const w = document.getElementById('report-fidelity-warning'); \
+             return w ? w.textContent : null;",
+        );
+        assert!(
+            warning
+                .as_str()
+                .is_some_and(|w| w.contains("(1 seed per point against 3)")),
+            "{warning}"
         );
         // The curve the report used and the interval over its seeds, as the API gives them.
         let curve = driver.script("return document.getElementById('report-curve').textContent;");
@@ -830,7 +893,29 @@ async fn dashboard_lists_old_diagnoses_and_cancels_a_job() {
     let app = TestApp::spawn_idle().await;
     let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let campaign_id = api.upload_campaign(CAMPAIGN);
+        // The test engineer uploads the campaign through the page.
+        let driver = Driver::start(&chromium, &chromedriver);
+        driver.goto(&api.url(&format!("/#token={TEST_ENGINEER}")));
+        driver.signed_in("test_engineer");
+        let campaign = railwear::gap::Campaign::from_toml_str(CAMPAIGN, std::path::Path::new("."))
+            .expect("campaign");
+        let file = driver.downloads.join("campaign.json");
+        std::fs::write(&file, serde_json::to_string(&campaign).unwrap()).expect("campaign file");
+        driver.choose_file("#campaign-file", &file);
+        driver.script("document.getElementById('upload-campaign').requestSubmit(); return null;");
+        let stored = wait_for(Duration::from_secs(30), "the campaign stored", || {
+            let list = api.get("/v1/campaigns", Some(TEST_ENGINEER)).json();
+            list["items"][0]["id"].as_str().map(str::to_string)
+        });
+        let listed = format!("return document.getElementById('campaign-{stored}') !== null;");
+        wait_for(Duration::from_secs(30), "the campaign listed", || {
+            (driver.script(&listed) == true).then_some(())
+        });
+        assert_eq!(
+            driver.script("return document.getElementById('upload-error').textContent;"),
+            ""
+        );
+        let campaign_id = stored;
         let r = api.post(
             &format!("/v1/campaigns/{campaign_id}/diagnoses"),
             Some(TEST_ENGINEER),
@@ -854,8 +939,8 @@ async fn dashboard_lists_old_diagnoses_and_cancels_a_job() {
             "the diagnosis is off the first page"
         );
 
-        let driver = Driver::start(&chromium, &chromedriver);
-        driver.goto(&api.url(&format!("/#token={TEST_ENGINEER}")));
+        driver.goto("about:blank");
+        driver.goto(&api.url("/#/campaigns"));
         driver.signed_in("test_engineer");
         let row = format!("return document.getElementById('diagnosis-{old}') !== null;");
         wait_for(Duration::from_secs(30), "the old diagnosis listed", || {
