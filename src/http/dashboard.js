@@ -40,7 +40,8 @@ function clearAll() {
   document.getElementById("diagnose-options").hidden = true;
   document.getElementById("submit-job").hidden = true;
   document.getElementById("upload-campaign").hidden = true;
-  for (const id of ["submit-error", "upload-error"]) { document.getElementById(id).textContent = ""; }
+  document.getElementById("record-measurement").hidden = true;
+  for (const id of ["submit-error", "upload-error", "m-error"]) { document.getElementById(id).textContent = ""; }
 }
 
 function signOut() {
@@ -81,6 +82,7 @@ async function signIn() {
   document.getElementById("diagnose-options").hidden = !diag.may;
   document.getElementById("submit-job").hidden = !me.may.submit_jobs;
   document.getElementById("upload-campaign").hidden = !me.may.upload_campaigns;
+  document.getElementById("record-measurement").hidden = !me.may.record_measurements;
   route();
   state.timer = setInterval(poll, 1000);
   poll();
@@ -291,44 +293,99 @@ async function pollJobs(epoch) {
   } catch (e) { if (!(e instanceof Refused)) { document.getElementById("error").textContent = String(e); } }
 }
 
+// Ticks at 1, 2 or 5 times a power of ten, about `n` of them over [lo, hi].
+function ticks(lo, hi, n) {
+  const raw = (hi - lo) / n, mag = Math.pow(10, Math.floor(Math.log10(raw)));
+  const step = [1, 2, 5, 10].map(f => f * mag).find(x => x >= raw);
+  const out = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) { out.push(Number(v.toPrecision(12))); }
+  return out;
+}
+
+// K_SL against rattle space, the axes fitted to the data: the curve with its swept points,
+// the 0.9 and 0.8 conservative bands, this rail (with the interval over seeds when there is
+// one) and the K_SL under a compared curve.
 function curveSvg(report) {
   const pts = report.k_sl_curve;
   if (!pts || pts.length === 0) { return null; }
-  const W = 480, H = 280, m = 40;
+  const W = 640, H = 360, left = 64, right = 16, top = 16, bottom = 48;
+  const life = report.service_life, band = life && life.interval;
+  const compared = report.comparison && report.comparison.k_sl != null ? report.comparison.k_sl : null;
   const xs = pts.map(p => p[0]).concat([report.rattle_space]);
-  const x0 = Math.min(...xs), x1 = Math.max(...xs);
-  const y0 = 0.0, y1 = 1.05;
-  const sx = x => m + (W - 2 * m) * (x - x0) / ((x1 - x0) || 1);
-  const sy = y => H - m - (H - 2 * m) * (y - y0) / (y1 - y0);
+  const ys = pts.map(p => p[1]).concat(pts.map(p => 0.8 * p[1]));
+  if (life) { ys.push(life.k_sl); }
+  if (band) { ys.push(band.k_sl_low, band.k_sl_high); }
+  if (compared != null) { ys.push(compared); }
+  const pad = (lo, hi) => { const d = (hi - lo) || Math.abs(hi) || 1; return [lo - 0.05 * d, hi + 0.05 * d]; };
+  const [x0, x1] = pad(Math.min(...xs), Math.max(...xs));
+  const [y0, y1] = pad(Math.min(...ys), Math.max(...ys));
+  const sx = x => left + (W - left - right) * (x - x0) / (x1 - x0);
+  const sy = y => H - bottom - (H - top - bottom) * (y - y0) / (y1 - y0);
   const ns = "http://www.w3.org/2000/svg";
   const svg = document.createElementNS(ns, "svg");
   svg.setAttribute("width", W); svg.setAttribute("height", H); svg.setAttribute("id", "curve-plot");
+  svg.setAttribute("viewBox", "0 0 " + W + " " + H);
+  const el = (tag, attrs, cls) => {
+    const e = document.createElementNS(ns, tag);
+    for (const [k, v] of Object.entries(attrs)) { e.setAttribute(k, v); }
+    if (cls) { e.setAttribute("class", cls); }
+    svg.appendChild(e);
+    return e;
+  };
+  const label = (x, y, s, anchor) => {
+    const t = el("text", { x, y, "font-size": 13, "text-anchor": anchor || "start" });
+    t.textContent = s;
+    return t;
+  };
+  for (const t of ticks(x0, x1, 6)) {
+    el("line", { x1: sx(t), y1: top, x2: sx(t), y2: H - bottom, stroke: "#eee" });
+    label(sx(t), H - bottom + 16, t.toString(), "middle");
+  }
+  for (const t of ticks(y0, y1, 5)) {
+    el("line", { x1: left, y1: sy(t), x2: W - right, y2: sy(t), stroke: "#eee" });
+    label(left - 6, sy(t) + 4, t.toString(), "end");
+  }
+  el("line", { x1: left, y1: H - bottom, x2: W - right, y2: H - bottom, stroke: "#444" });
+  el("line", { x1: left, y1: top, x2: left, y2: H - bottom, stroke: "#444" });
+  label((left + W - right) / 2, H - 10, "rattle space k_rs (dimensionless)", "middle");
+  const yTitle = label(16, (top + H - bottom) / 2, "K_SL", "middle");
+  yTitle.setAttribute("transform", "rotate(-90 16 " + (top + H - bottom) / 2 + ")");
   const line = (factor, color, dash) => {
-    const pl = document.createElementNS(ns, "polyline");
-    pl.setAttribute("points", pts.map(p => sx(p[0]) + "," + sy(factor * p[1])).join(" "));
-    pl.setAttribute("fill", "none"); pl.setAttribute("stroke", color);
-    if (dash) { pl.setAttribute("stroke-dasharray", "5,4"); }
-    svg.appendChild(pl);
+    const attrs = { points: pts.map(p => sx(p[0]) + "," + sy(factor * p[1])).join(" "), fill: "none", stroke: color, "stroke-width": 2 };
+    if (dash) { attrs["stroke-dasharray"] = dash; }
+    el("polyline", attrs);
   };
-  const axis = (xa, ya, xb, yb) => {
-    const l = document.createElementNS(ns, "line");
-    l.setAttribute("x1", xa); l.setAttribute("y1", ya); l.setAttribute("x2", xb); l.setAttribute("y2", yb);
-    l.setAttribute("stroke", "#444"); svg.appendChild(l);
-  };
-  const label = (x, y, s) => {
-    const t = document.createElementNS(ns, "text");
-    t.setAttribute("x", x); t.setAttribute("y", y); t.setAttribute("font-size", "11"); t.textContent = s;
-    svg.appendChild(t);
-  };
-  axis(m, H - m, W - m, H - m); axis(m, m, m, H - m);
-  label(W / 2 - 40, H - 8, "rattle space k_rs"); label(4, m - 8, "K_SL");
-  label(m - 4, H - m + 14, x0.toFixed(3)); label(W - m - 20, H - m + 14, x1.toFixed(3));
-  label(4, sy(1) + 4, "1.0"); label(4, sy(0.5) + 4, "0.5");
-  line(1.0, "#0a58ca", false); line(0.9, "#6c757d", true); line(0.8, "#adb5bd", true);
-  if (report.service_life) {
-    const c = document.createElementNS(ns, "circle");
-    c.setAttribute("cx", sx(report.rattle_space)); c.setAttribute("cy", sy(report.service_life.k_sl));
-    c.setAttribute("r", 5); c.setAttribute("fill", "#b02a37"); svg.appendChild(c);
+  line(0.9, "#6c757d", "6,4"); line(0.8, "#adb5bd", "2,3"); line(1.0, "#0a58ca", null);
+  for (const p of pts) { el("circle", { cx: sx(p[0]), cy: sy(p[1]), r: 4, fill: "#0a58ca" }, "point"); }
+  const legend = [["#0a58ca", null, "K_SL of the curve (swept points)"], ["#6c757d", "6,4", "0.9 x K_SL"], ["#adb5bd", "2,3", "0.8 x K_SL"]];
+  if (life) {
+    if (band) {
+      el("line", { x1: sx(report.rattle_space), y1: sy(band.k_sl_low), x2: sx(report.rattle_space), y2: sy(band.k_sl_high),
+        stroke: "#b02a37", "stroke-width": 2 }, "interval");
+      for (const y of [band.k_sl_low, band.k_sl_high]) {
+        el("line", { x1: sx(report.rattle_space) - 6, y1: sy(y), x2: sx(report.rattle_space) + 6, y2: sy(y), stroke: "#b02a37", "stroke-width": 2 });
+      }
+    }
+    el("circle", { cx: sx(report.rattle_space), cy: sy(life.k_sl), r: 6, fill: "#b02a37" }, "rail");
+    legend.push(["#b02a37", "dot", "this rail" + (band ? ", with the " + Math.round(100 * band.confidence) + " % interval over seeds" : "")]);
+  }
+  if (compared != null) {
+    const cx = sx(report.rattle_space) + 14, cy = sy(compared);
+    el("path", { d: "M" + cx + " " + (cy - 7) + " l7 7 l-7 7 l-7 -7 z", fill: "#fd7e14" }, "compared");
+    legend.push(["#fd7e14", "dot", "K_SL under curve " + report.comparison.curve_id]);
+  }
+  let ly = top + 10;
+  const lx = W - right - 290;
+  el("rect", { x: lx - 8, y: top, width: 290, height: 18 * legend.length + 8, fill: "white", stroke: "#ccc" }, "legend");
+  for (const [color, dash, name] of legend) {
+    if (dash === "dot") { el("circle", { cx: lx + 11, cy: ly, r: 5, fill: color }); }
+    else {
+      const attrs = { x1: lx, y1: ly, x2: lx + 22, y2: ly, stroke: color, "stroke-width": 2 };
+      if (dash) { attrs["stroke-dasharray"] = dash; }
+      el("line", attrs);
+    }
+    label(lx + 30, ly + 4, name).setAttribute("class", "legend-entry");
+    ly += 18;
   }
   return svg;
 }
@@ -1130,6 +1187,30 @@ document.getElementById("submit-job").addEventListener("submit", async event => 
     const job = await api("/v1/jobs", { method: "POST", headers: { "Content-Type": "application/json" },
       body: JSON.stringify({ kind: document.getElementById("submit-kind").value, params }) });
     go("#/jobs/" + job.id);
+  } catch (e) { if (!(e instanceof Refused)) { error.textContent = String(e); } }
+  finally { button.disabled = false; }
+});
+
+// Records a measurement of the rail shown; the button waits for the answer, then the report
+// and history show it.
+document.getElementById("record-measurement").addEventListener("submit", async event => {
+  event.preventDefault();
+  const button = document.getElementById("m-button");
+  const error = document.getElementById("m-error");
+  error.textContent = "";
+  let dimensions;
+  try { dimensions = JSON.parse(document.getElementById("m-dimensions").value); } catch (e) {
+    error.textContent = "dimensions: not JSON (" + e.message + ")"; return;
+  }
+  const serial = state.route && state.route.page === "rails" ? state.route.id : null;
+  if (!serial) { return; }
+  button.disabled = true;
+  try {
+    await api("/v1/rails/" + encodeURIComponent(serial) + "/measurements", { method: "POST",
+      headers: { "Content-Type": "application/json" }, body: JSON.stringify({
+        dimensions_mm: dimensions, measured_by: document.getElementById("m-by").value.trim(),
+        measured_at: document.getElementById("m-at").value.trim(), location: document.getElementById("m-location").value.trim() }) });
+    route();
   } catch (e) { if (!(e instanceof Refused)) { error.textContent = String(e); } }
   finally { button.disabled = false; }
 });
