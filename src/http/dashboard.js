@@ -728,6 +728,20 @@ async function showDiagnosis(job) {
     out.appendChild(rankTable);
     out.appendChild(figureSlot("ranking.svg"));
 
+    // Held-out predictions: what the nominal model and the best-ranked effect, each fitted
+    // without the observation's group, say each measured mass should be.
+    if (r.held_out_predictions && r.held_out_predictions.length > 0) {
+      out.appendChild(text("h4", "Held-out predictions per test"));
+      const predictions = r.held_out_predictions.map(h => row([h.test, String(h.increment), h.quantity,
+        fmt.num(h.measured_mg, 3) + " \u00b1 " + fmt.num(h.uncertainty_mg, 2) + " mg", fmt.num(h.nominal_mg, 3) + " mg",
+        h.effect + " (" + fmt.num(h.magnitude, 3) + ")", fmt.num(h.with_effect_mg, 3) + " mg"]));
+      const predictionTable = captioned(table(["Test", "Increment", "Quantity", "Measured (standard uncertainty)",
+        "Nominal model", "Best-ranked effect (magnitude)", "With it"], predictions),
+        "Each prediction fitted without its own group (held out: " + r.held_out + ")");
+      predictionTable.id = "diagnosis-predictions";
+      out.appendChild(predictionTable);
+    }
+
     out.appendChild(text("h4", "Where the nominal model misses (Holm-adjusted p < 0.05)"));
     const flagged = r.where.groups.filter(g => g.flagged);
     if (flagged.length === 0) {

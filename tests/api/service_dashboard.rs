@@ -888,6 +888,15 @@ async fn dashboard_starts_a_diagnosis_and_shows_its_report() {
                 assert!(cell.starts_with("no: "), "{cell} for {entry}");
             }
         }
+        // The per-test held-out predictions, one row each.
+        let predictions = report["held_out_predictions"]
+            .as_array()
+            .map_or(0, |p| p.len());
+        let shown = driver.script(
+            "const t = document.getElementById('diagnosis-predictions'); \
+             return t ? t.querySelectorAll('tbody tr').length : 0;",
+        );
+        assert_eq!(shown, predictions);
         // Each table says which interval level it shows.
         let caption = driver
             .script("return document.querySelector('#diagnosis-ranking caption').textContent;");
