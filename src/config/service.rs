@@ -127,13 +127,13 @@ impl Default for ServiceConfig {
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The settings file could not be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}")]
     Read {
         path: PathBuf,
         source: std::io::Error,
     },
     /// The settings file is not valid TOML for [`ServiceConfig`].
-    #[error("{path}: {source}")]
+    #[error("{path} is not valid settings TOML")]
     Parse {
         path: PathBuf,
         source: Box<toml::de::Error>,

@@ -290,13 +290,19 @@ impl Jobs {
         let result = match (job.status, &job.result) {
             (JobStatus::Succeeded, Some(result)) => result,
             (status, _) => {
+                let what_next = match status {
+                    JobStatus::Queued | JobStatus::Running | JobStatus::Waiting => {
+                        "wait until it has succeeded"
+                    }
+                    _ => "it will not finish: name a diagnosis that succeeded, or run one again",
+                };
                 return Err(invalid(
                     ".diagnosis",
                     format!(
-                        "names diagnosis {id}, which is {}: wait until it has succeeded",
+                        "names diagnosis {id}, which is {}: {what_next}",
                         status.as_str()
                     ),
-                ))
+                ));
             }
         };
         let carried = crate::gap::diagnose::carry::carried_wear_law(id, result)

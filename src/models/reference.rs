@@ -10,8 +10,9 @@ pub enum ReferenceError {
     #[error("config name `{0}` must use only letters, digits, '-' and '_'")]
     BadName(String),
     /// No `<name>.toml` in the configs directory (`service` is the service's settings, not a
-    /// model). Names the directory searched and what it holds.
-    #[error("no reference config named `{name}` in {} (known: {})", dir.display(), if known.is_empty() { "none: is the configs directory right? set RAILWEAR_CONFIGS_DIR".to_string() } else { known.join(", ") })]
+    /// model). Names what the directory holds; the directory itself only when it holds none
+    /// (a misconfigured server), so a client is not told the server's paths.
+    #[error("no reference config named `{name}` (known: {})", if known.is_empty() { format!("none in {}: is the configs directory right? set RAILWEAR_CONFIGS_DIR or --configs-dir", dir.display()) } else { known.join(", ") })]
     Unknown {
         name: String,
         dir: PathBuf,

@@ -26,14 +26,20 @@ fn assert_one_line_error(out: &Output, names: &[&str]) {
 }
 
 #[test]
-fn a_missing_case_file_is_one_line_naming_the_field() {
+fn a_missing_case_file_is_one_line_naming_the_file() {
     let out = railwear(&[
         "run",
         "/nonexistent/railwear-case.toml",
         "--duration",
         "0.1",
     ]);
-    assert_one_line_error(&out, &["`config`", "/nonexistent/railwear-case.toml"]);
+    assert_one_line_error(
+        &out,
+        &[
+            "cannot read the case file",
+            "/nonexistent/railwear-case.toml",
+        ],
+    );
 }
 
 #[test]
@@ -55,4 +61,40 @@ fn a_profile_missing_from_the_configs_directory_names_the_field_and_the_flag() {
     ]);
     std::fs::remove_dir_all(&dir).ok();
     assert_one_line_error(&out, &["`excitation.profile`", "--configs-dir", "profiles"]);
+}
+
+#[test]
+fn the_cli_refuses_what_the_api_refuses_with_the_same_field_and_rule() {
+    // The service checks a job's inline config with pipeline::resolve_case; `railwear run`
+    // must refuse the same file for the same reason (it once ran mu_dynamic = 1e6 to the end).
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(manifest.join("configs/rattle-box-c.toml")).unwrap();
+    let bad: String = text
+        .lines()
+        .map(|l| {
+            if l.trim_start().starts_with("mu_dynamic") {
+                "mu_dynamic = 1e6".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = std::env::temp_dir().join(format!("railwear-cli-bad-{}.toml", std::process::id()));
+    std::fs::write(&path, &bad).unwrap();
+    let out = railwear(&["run", path.to_str().unwrap(), "--duration", "0.01"]);
+    std::fs::remove_file(&path).ok();
+    // What the service answers to the same case sent inline as a simulate job's config.
+    let table: toml::Value = toml::from_str(&bad).unwrap();
+    let params = serde_json::json!({"config": serde_json::to_value(&table).unwrap()});
+    let configs = manifest.join("configs");
+    let api = railwear::pipeline::resolve_case(&params, &configs, |_| Ok(()));
+    let Err(railwear::pipeline::RunError::InvalidConfig { field, rule }) = api else {
+        panic!("the service's parser accepted mu_dynamic = 1e6");
+    };
+    assert_eq!(field, "config.rattle_box.friction.mu_dynamic");
+    assert_one_line_error(&out, &["`rattle_box.friction.mu_dynamic`", &rule]);
+    // And a duration past the service's bound names the flag with the service's rule.
+    let out = railwear(&["run", "configs/rattle-box-c.toml", "--duration", "1e9"]);
+    assert_one_line_error(&out, &["`--duration`", "24 h"]);
 }
