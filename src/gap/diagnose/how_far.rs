@@ -2,7 +2,14 @@
 //! and its bootstrap interval, the fitted magnitude with its profile-likelihood interval, and
 //! every measured mass's held-out prediction.
 
-use super::*;
+use super::candidate::Candidate;
+use super::emulator;
+use super::fit_problem::FitProblem;
+use super::noise;
+use super::options::{MIN_EXPLAINED_SHRINK, PROFILE_95};
+use super::report::{BestEffect, FittedParameter, GroupError, HeldOutPrediction, PartlyExplained};
+use super::stats;
+use crate::gap::Campaign;
 
 /// Every measured mass with the nominal prediction and `c`'s prediction at the magnitude
 /// fitted without the mass's group.

@@ -3,7 +3,7 @@
 //! energy budget. Horizontal labelled bars drawn by [`crate::report::figure::BarChart`]
 //! (plotters); the report's numbers are in its JSON.
 
-use super::{Report, Verdict};
+use super::report::{Report, Verdict};
 use crate::report::figure::{AxisSpec, Bar, BarChart};
 
 /// A bar chart with an axis of `scale` (its label `axis`).
