@@ -3,6 +3,51 @@
 
 use super::emulator::Emulator;
 use super::options::{MIN_EXPLAINED_SHARE, MIN_EXPLAINED_SHRINK, MIN_HELD_OUT_GAIN};
+use super::stats;
+
+/// Whether one held-out group is predicted within its noise (docs/diagnosis.md, "Every
+/// withheld group predicted").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct GroupTest {
+    /// Held-out RMS standardized error of the group.
+    pub(super) error: f64,
+    /// Upper-tail p-value of its held-out chi-square on its degrees of freedom.
+    pub(super) p: f64,
+    /// `p` adjusted by Holm's method across the held-out groups.
+    pub(super) p_adjusted: f64,
+    /// The largest RMS error Holm's first step accepts for the group: `sqrt(x / w)` with `x`
+    /// the chi-square quantile at `alpha / groups` on its degrees of freedom.
+    pub(super) bound: f64,
+}
+
+impl GroupTest {
+    /// Not predicted within its noise: Holm-adjusted p below `alpha`.
+    pub(super) fn fails(&self, alpha: f64) -> bool {
+        self.p_adjusted < alpha
+    }
+}
+
+/// Each held-out group's test: its held-out chi-square `r2[g]` (the group given the training
+/// groups, calibration scales integrated out) is a chi-square on its weighted observation
+/// count `w[g]` when the candidate holds, so its upper tail is the group's p-value; the
+/// p-values are adjusted across groups by Holm's step-down method (family-wise error rate
+/// `alpha`).
+pub(super) fn group_tests(r2: &[f64], w: &[f64], alpha: f64) -> Vec<GroupTest> {
+    let dof = |g: usize| w[g].round().max(1.0) as usize;
+    let p: Vec<f64> = (0..r2.len())
+        .map(|g| stats::chi2_sf(r2[g], dof(g)))
+        .collect();
+    let adjusted = stats::holm(&p);
+    let level = alpha / r2.len().max(1) as f64;
+    (0..r2.len())
+        .map(|g| GroupTest {
+            error: (r2[g] / w[g].max(1e-300)).sqrt(),
+            p: p[g],
+            p_adjusted: adjusted[g],
+            bound: (stats::chi2_isf(level, dof(g)) / w[g].max(1e-300)).sqrt(),
+        })
+        .collect()
+}
 
 /// One candidate's numbers.
 #[derive(Debug, Clone)]
@@ -53,8 +98,22 @@ impl Candidate {
         }
     }
 
-    /// Explains, but fitted at a magnitude bound or with a held-out shrink under
-    /// [`MIN_EXPLAINED_SHRINK`] (what `partly_explained` reports).
+    /// Each held-out group's test of being predicted within its noise ([`group_tests`]).
+    pub(super) fn group_tests(&self) -> Vec<GroupTest> {
+        group_tests(&self.held_r2, &self.held_w, self.alpha)
+    }
+
+    /// The held-out groups it does not predict within their noise.
+    pub(super) fn unpredicted_groups(&self) -> Vec<usize> {
+        let tests = self.group_tests();
+        (0..tests.len())
+            .filter(|&g| tests[g].fails(self.alpha))
+            .collect()
+    }
+
+    /// Explains, but fitted at a magnitude bound, with a held-out shrink under
+    /// [`MIN_EXPLAINED_SHRINK`], or leaving a held-out group it does not predict within its
+    /// noise (what `partly_explained` reports).
     pub(super) fn only_partly(&self, nominal: &Candidate, emulator: &Emulator) -> bool {
         let at_bound = self.spec.iter().any(|&(t, m)| {
             let b = emulator.effects[t].bound_for(m);
@@ -66,7 +125,7 @@ impl Candidate {
         } else {
             0.0
         };
-        at_bound || !(shrink >= MIN_EXPLAINED_SHRINK)
+        at_bound || !(shrink >= MIN_EXPLAINED_SHRINK) || !self.unpredicted_groups().is_empty()
     }
 
     pub(super) fn explains(&self, nominal: &Candidate) -> bool {

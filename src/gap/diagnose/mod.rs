@@ -44,6 +44,7 @@ pub mod carry;
 pub mod emulator;
 mod fit_problem;
 mod how_far;
+pub mod identification;
 #[cfg(test)]
 mod interaction_tests;
 mod joint_spread;

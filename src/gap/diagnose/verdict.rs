@@ -9,7 +9,9 @@ use super::fit_problem::{held_out_by_test, FitProblem, Model};
 use super::how_far::{best_effect, held_out_predictions, partly_explained};
 use super::one_group::{carried_by_one_group, one_group_single, seen_in_one_group, OneGroup};
 use super::options::{DiagnoseOptions, MIN_HELD_OUT_GAIN};
-use super::report::{EmulatorReport, NominalFit, PartlyExplained, RankEntry, Report, Verdict};
+use super::report::{
+    BestEffect, EmulatorReport, NominalFit, PartlyExplained, RankEntry, Report, Verdict,
+};
 use super::{location, stats};
 use crate::gap::{Campaign, GapError};
 
@@ -166,10 +168,6 @@ pub(super) fn judge(
         explains: c.explains(&nominal),
     };
     let ranking: Vec<RankEntry> = order.iter().map(|&i| entry(&singles[i], 1 + i)).collect();
-    let held_out_predictions = order
-        .first()
-        .map(|&i| held_out_predictions(campaign, problem, &singles[i]))
-        .unwrap_or_default();
     let pair_entries: Vec<RankEntry> = pairs
         .iter()
         .enumerate()
@@ -252,6 +250,12 @@ pub(super) fn judge(
     };
 
     let chosen_candidate: Option<&Candidate> = chosen.as_ref().map(|(c, _)| *c);
+    // What the verdict predicts for each withheld group: the named effect's or pair's fits
+    // without that group; with nothing named, the best-ranked single's.
+    let held_out_predictions = chosen_candidate
+        .or_else(|| order.first().map(|&i| &singles[i]))
+        .map(|c| held_out_predictions(campaign, problem, c))
+        .unwrap_or_default();
     let best_effect = chosen
         .as_ref()
         .map(|(c, _)| best_effect(problem, c, &nominal, &resamples));
@@ -335,6 +339,7 @@ pub(super) fn judge(
             text
         }
     };
+    let summary = summary + &parameter_notes(best_effect.as_ref());
     let report = Report {
         campaign: campaign.name.clone(),
         verdict,
@@ -353,7 +358,7 @@ pub(super) fn judge(
         },
         noise: problem.noise.report(),
         held_out: problem.held_out.clone(),
-        multiple_comparisons: "Holm step-down over every group of `where` (family-wise error rate 0.05)".into(),
+        multiple_comparisons: format!("Holm step-down over every group of `where` (family-wise error rate 0.05); over the held-out groups' errors with the named candidate (family-wise error rate alpha = {alpha})"),
         alpha,
         emulator: EmulatorReport {
             window_s: emulator.options.window_s,
@@ -373,6 +378,40 @@ pub(super) fn judge(
         code_version: crate::models::case::code_version().to_string(),
     };
     (report, carried)
+}
+
+/// What the summary adds on the named candidate's parameters: those the data do not identify
+/// (no value given for them) and those whose interval reaches a physical bound.
+fn parameter_notes(best: Option<&BestEffect>) -> String {
+    let Some(b) = best else {
+        return String::new();
+    };
+    let unidentified: Vec<String> = b
+        .parameters
+        .iter()
+        .filter(|p| p.fitted && !p.identified)
+        .map(|p| p.label())
+        .collect();
+    let at_bound: Vec<String> = b
+        .parameters
+        .iter()
+        .filter(|p| p.identified && !p.bounds_reached.is_empty())
+        .map(|p| format!("{} ({})", p.label(), p.bounds_reached.join(", ")))
+        .collect();
+    let mut out = String::new();
+    if !unidentified.is_empty() {
+        out.push_str(&format!(
+            "; not identified by the data: {}",
+            unidentified.join(", ")
+        ));
+    }
+    if !at_bound.is_empty() {
+        out.push_str(&format!(
+            "; 95 % interval reaching a physical bound: {}",
+            at_bound.join(", ")
+        ));
+    }
+    out
 }
 
 /// The nominal model and every single effect evaluated, when the nominal model shows a gap

@@ -229,4 +229,11 @@ pub struct FittedValue {
     pub interval: Option<[f64; 2]>,
     /// Fitted (false: held at the library default).
     pub fitted: bool,
+    /// Identified by the data (the report's `identified`).
+    #[serde(default = "identified_by_default")]
+    pub identified: bool,
+}
+
+fn identified_by_default() -> bool {
+    true
 }

@@ -231,6 +231,7 @@ pub fn run(
                             value: p.value,
                             interval: p.interval,
                             fitted: p.fitted,
+                            identified: p.identified,
                         })
                         .collect()
                 })

@@ -96,6 +96,12 @@ pub struct Scores {
     /// Of those, the share whose interval holds the drawn magnitude.
     #[serde(default)]
     pub magnitude_interval_coverage: f64,
+    /// 95 % interval coverage per parameter (`effect.parameter`, and the rows `magnitudes` and
+    /// `secondary parameters`) over the campaigns whose leading candidate (`explained` or
+    /// `partly_explained`) is exactly the truth: [intervals checked, holding the drawn value,
+    /// reported identified].
+    #[serde(default)]
+    pub coverage_by_parameter: BTreeMap<String, [usize; 3]>,
     /// Undetectable in-library campaigns reported no_gap (share).
     pub undetectable_no_gap: f64,
     /// Detectable single effects drawn without accelerometer records.
@@ -154,6 +160,12 @@ fn named_right(o: &Outcome) -> bool {
 /// every effect ("the diagnosis recovers its magnitude within the reported interval"), on
 /// campaigns drawn unlike the bench's defaults.
 fn interval_hits(o: &Outcome) -> Vec<(bool, bool)> {
+    parameter_hits(o).into_iter().map(|h| (h.1, h.2)).collect()
+}
+
+/// [`interval_hits`] with each parameter's name and whether the report gave it identified:
+/// (name, is it the magnitude, does the interval hold the drawn value, identified).
+fn parameter_hits(o: &Outcome) -> Vec<(String, bool, bool, bool)> {
     o.fitted
         .iter()
         .filter(|f| f.fitted)
@@ -164,9 +176,37 @@ fn interval_hits(o: &Outcome) -> Vec<(bool, bool)> {
             let info = crate::gap::effects::info(effect)?;
             let value = *drawn.parameters.get(parameter)?;
             let magnitude = info.parameters.first().is_some_and(|p| p.name == parameter);
-            Some((magnitude, holds([lo, hi], value)))
+            Some((
+                f.name.clone(),
+                magnitude,
+                holds([lo, hi], value),
+                f.identified,
+            ))
         })
         .collect()
+}
+
+/// [`Scores::coverage_by_parameter`] of the outcomes.
+fn coverage_by_parameter(outcomes: &[Outcome]) -> BTreeMap<String, [usize; 3]> {
+    let mut out: BTreeMap<String, [usize; 3]> = BTreeMap::new();
+    for (name, magnitude, held, identified) in outcomes
+        .iter()
+        .filter(|o| led_right(o) && o.scenario.in_library)
+        .flat_map(parameter_hits)
+    {
+        let kind = if magnitude {
+            "magnitudes"
+        } else {
+            "secondary parameters"
+        };
+        for key in [name, kind.to_string()] {
+            let row = out.entry(key).or_default();
+            row[0] += 1;
+            row[1] += usize::from(held);
+            row[2] += usize::from(identified);
+        }
+    }
+    out
 }
 
 /// Whether `[lo, hi]` holds `value`, to round-off: the diagnosis' candidate magnitudes are
@@ -347,6 +387,7 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             magnitude_hits.iter().filter(|h| **h).count(),
             magnitude_hits.len(),
         ),
+        coverage_by_parameter: coverage_by_parameter(&outcomes),
         undetectable_no_gap: share(
             undet.iter().filter(|o| o.verdict == Verdict::NoGap).count(),
             undet.len(),
@@ -453,6 +494,17 @@ impl Scores {
             "| undetectable in-library effects reported no_gap | {} | (right answer) |\n\n",
             pct(self.undetectable_no_gap)
         ));
+        if !self.coverage_by_parameter.is_empty() {
+            s.push_str("95 % interval coverage per parameter, where the leading candidate is the truth (explained or partly_explained):\n\n| parameter | intervals | holding the drawn value | reported identified |\n|---|---|---|---|\n");
+            for (name, [n, held, identified]) in &self.coverage_by_parameter {
+                s.push_str(&format!(
+                    "| {name} | {n} | {} | {} |\n",
+                    pct(share(*held, *n)),
+                    pct(share(*identified, *n))
+                ));
+            }
+            s.push('\n');
+        }
         let mut cols: Vec<String> = vec!["no_gap".into()];
         cols.extend(LIBRARY.iter().map(|e| e.name.to_string()));
         for row in self.confusion.values() {
@@ -616,6 +668,7 @@ mod tests {
             value: 0.5 * (lo + hi),
             interval: Some([lo, hi]),
             fitted,
+            identified: true,
         };
         let named = |delta: f64, verdict| {
             let mut o = outcome("friction_drift", true, verdict, Some("friction_drift"));
@@ -637,6 +690,13 @@ mod tests {
         assert_eq!(s.interval_coverage, 0.75);
         assert_eq!(s.magnitude_intervals_checked, 2);
         assert_eq!(s.magnitude_interval_coverage, 0.5);
+        // Per parameter, over the campaigns led right (the not_explained one is left out):
+        // [checked, held, identified].
+        let row = |n: &str| s.coverage_by_parameter[n];
+        assert_eq!(row("friction_drift.delta_mu"), [2, 1, 2]);
+        assert_eq!(row("friction_drift.slip_scale_m"), [2, 2, 2]);
+        assert_eq!(row("magnitudes"), [2, 1, 2]);
+        assert_eq!(row("secondary parameters"), [2, 2, 2]);
         // An endpoint one rounding step from the drawn value holds it; a real miss does not.
         let step = 0.01875 + (0.0225 - 0.01875) * 3.0 / 5.0;
         assert!(step < 0.021);
