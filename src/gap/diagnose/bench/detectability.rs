@@ -191,6 +191,7 @@ pub(super) fn detectability_in(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gap::diagnose::emulator::effect_with;
 
     /// A friction drift's mass readings after slip distances `l` (m): `delta (1 - e^(-l/s))`.
     fn drift_readings(delta: f64, slip_scale: f64) -> Vec<Observation> {

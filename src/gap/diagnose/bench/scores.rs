@@ -537,7 +537,11 @@ impl Scores {
 
 #[cfg(test)]
 mod tests {
+    use super::super::{FittedValue, Scenario};
     use super::*;
+    use crate::gap::diagnose::truth_fit::TruthFit;
+    use crate::gap::effects::Effect;
+
     fn outcome(truth: &str, in_library: bool, verdict: Verdict, chosen: Option<&str>) -> Outcome {
         Outcome {
             scenario: Scenario {
