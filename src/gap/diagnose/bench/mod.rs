@@ -54,6 +54,7 @@
 //!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
+mod coverage;
 mod detectability;
 mod run;
 mod scenarios;
