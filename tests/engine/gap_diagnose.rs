@@ -651,7 +651,8 @@ fn a_withheld_test_that_is_not_predicted_keeps_the_verdict_from_explained() {
     let r = diagnose_with(&c, &emulator(), &options()).unwrap();
     assert_eq!(r.verdict, Verdict::PartlyExplained, "{}", r.summary);
     let p = r.partly_explained.as_ref().unwrap();
-    assert_eq!(p.candidate, "third_body", "{}", r.summary);
+    // Abrasion leads (alone, or with a second effect the pairs tried beside it add).
+    assert!(p.candidate.contains("third_body"), "{}", r.summary);
     assert!(
         p.residual_p_value >= r.alpha,
         "the pooled lack of fit passes: {p:?}"
