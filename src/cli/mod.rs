@@ -584,13 +584,21 @@ pub fn diagnose(
     println!("{}: {}", report.campaign, report.summary);
     if let Some(b) = &report.best_effect {
         for p in &b.parameters {
-            let interval = match (p.fitted, p.interval) {
-                (true, Some([lo, hi])) => format!("95 % interval [{lo:.4e}, {hi:.4e}]"),
-                _ => "held at the library default".to_string(),
-            };
+            println!("  {}", p.describe());
+        }
+        println!("  held out, per group (error before -> after, the rule's bound):");
+        for g in &b.per_group {
             println!(
-                "  {}.{} = {:.4e} {} ({interval}; bounds [{}, {}])",
-                p.effect, p.name, p.value, p.unit, p.bounds[0], p.bounds[1]
+                "    {:<16} {:>8.2} -> {:>8.2}  bound {:>5.2}  {}",
+                g.group,
+                g.before,
+                g.after,
+                g.bound,
+                if g.predicted {
+                    "predicted".to_string()
+                } else {
+                    format!("NOT predicted (Holm-adjusted p = {:.1e})", g.p_adjusted)
+                }
             );
         }
     }

@@ -627,6 +627,108 @@ fn an_effect_fitted_at_its_bound_is_partly_explained() {
     assert_eq!(json["verdict"], "partly_explained");
 }
 
+/// `explained` needs every withheld test predicted within its noise. Abrasion at 0.4 of its
+/// bound on every test, and test T4 wearing 1 + `extra` times more besides, a pattern no
+/// effect makes (T4 is where abrasion acts least). The pooled tests still pass: the full-data
+/// lack of fit carries T4's few masses among every test's accelerometer channels, and the
+/// held-out log-likelihood gain and share are abrasion's. Held out, T4's masses are about
+/// `extra / 3 %` standard deviations off (5 % scatter over three specimens), a chi-square far
+/// above its bound on T4's degrees of freedom: `partly_explained`, naming T4 and by how much,
+/// while the other tests are predicted.
+#[test]
+fn a_withheld_test_that_is_not_predicted_keeps_the_verdict_from_explained() {
+    let extra = 0.2;
+    let c = campaign(
+        |t, k| {
+            let mut p = truth(t, k, 0.4, 0.0, 0.0);
+            if t == 4 {
+                *p.mass_mg.get_mut("cube").unwrap() *= 1.0 + extra;
+            }
+            p
+        },
+        3,
+    );
+    let r = diagnose_with(&c, &emulator(), &options()).unwrap();
+    assert_eq!(r.verdict, Verdict::PartlyExplained, "{}", r.summary);
+    let p = r.partly_explained.as_ref().unwrap();
+    // Abrasion leads (alone, or with a second effect the pairs tried beside it add).
+    assert!(p.candidate.contains("third_body"), "{}", r.summary);
+    assert!(
+        p.residual_p_value >= r.alpha,
+        "the pooled lack of fit passes: {p:?}"
+    );
+    let unpredicted: Vec<&str> = p.unpredicted.iter().map(|g| g.group.as_str()).collect();
+    assert_eq!(unpredicted, vec!["T4"], "{}", r.summary);
+    assert_eq!(p.cannot_predict, "T4");
+    let t4 = &p.unpredicted[0];
+    assert!(t4.after > t4.bound && t4.p_adjusted < r.alpha, "{t4:?}");
+    assert!(
+        r.summary.contains("T4 not predicted held out"),
+        "{}",
+        r.summary
+    );
+    let best = r.best_effect.as_ref().unwrap();
+    assert!(best
+        .per_group
+        .iter()
+        .filter(|g| g.group != "T4")
+        .all(|g| g.predicted));
+    // The same campaign without T4's extra wear is explained.
+    let clean = campaign(|t, k| truth(t, k, 0.4, 0.0, 0.0), 3);
+    let r = diagnose_with(&clean, &emulator(), &options()).unwrap();
+    assert_eq!(r.verdict, Verdict::Explained, "{}", r.summary);
+}
+
+/// A parameter the data cannot see is said not to be identified. Weighed only (no
+/// accelerometer records), a cross-axis drive's phase acts on the masses only through the
+/// product of share and phase gain: every phase of the profile fits with its own share (the
+/// gain from 0.73 to 2.27 needs shares from 0.93 to 0.3 of the bound), so the phase's 95 %
+/// interval is the whole circle and the report marks it not identified, with no value in the
+/// summary. With the records, the off-axis response separates them (the test above).
+#[test]
+fn a_phase_the_data_cannot_see_is_reported_not_identified() {
+    let mut c = campaign(|t, k| truth_phase(t, k, 0.3, 120.0), 5);
+    for t in &mut c.tests {
+        for s in &mut t.specimens {
+            s.accelerometers.clear();
+        }
+    }
+    let mut em = emulator();
+    for phase in [-180.0, -120.0, -60.0, 60.0, 120.0, 180.0] {
+        em.effects.push(cross_variant(phase));
+    }
+    let r = diagnose_with(&c, &em, &options()).unwrap();
+    let best = r.best_effect.as_ref().expect("an effect is named");
+    assert_eq!(best.name, "cross_axis", "{}", r.summary);
+    let phase = best
+        .parameters
+        .iter()
+        .find(|p| p.name == "phase_deg")
+        .unwrap();
+    assert!(phase.fitted && !phase.identified, "{phase:?}");
+    assert_eq!(phase.interval, Some([-180.0, 180.0]), "{phase:?}");
+    assert!(
+        r.summary
+            .contains("not identified by the data: cross_axis.phase_deg"),
+        "{}",
+        r.summary
+    );
+    // No value given: the label, then that the data do not identify it.
+    assert!(
+        phase
+            .describe()
+            .starts_with("cross_axis.phase_deg: not identified by the data"),
+        "{}",
+        phase.describe()
+    );
+    // The share is identified: its interval holds the truth and is narrower than its range.
+    let share = &best.parameters[0];
+    let true_share = 0.3 * share.bounds[1];
+    let [lo, hi] = share.interval.unwrap();
+    assert!(lo <= true_share && true_share <= hi, "{share:?}");
+    assert!(share.identified, "{share:?}");
+}
+
 /// Issue 26 item 4: abrasion and a cross-axis drive together. No single effect explains;
 /// the pair does, and its held-out error is no worse than its better member's alone (its
 /// fits include each member alone, so it never fits worse, and takes both only when both
@@ -657,6 +759,16 @@ fn a_pair_never_scores_worse_than_its_better_member() {
         let best = r.best_effect.as_ref().unwrap();
         assert_eq!(best.name, "third_body+cross_axis", "seed {seed}");
         assert!(best.held_out_error_after < better);
+        // The held-out predictions are the named pair's, both members fitted without each
+        // test, every withheld group predicted within the rule's bound.
+        assert!(r
+            .held_out_predictions
+            .iter()
+            .all(|m| m.effect == best.name && m.magnitudes.len() == 2));
+        assert!(best
+            .per_group
+            .iter()
+            .all(|g| g.predicted && g.after <= g.bound));
     }
 }
 

@@ -2,10 +2,21 @@
 //! and its bootstrap interval, the fitted magnitude with its profile-likelihood interval, and
 //! every measured mass's held-out prediction.
 
-use super::*;
+use super::candidate::Candidate;
+use super::emulator;
+use super::fit_problem::FitProblem;
+use super::identification;
+use super::noise;
+use super::options::{MIN_EXPLAINED_SHRINK, PROFILE_95};
+use super::report::{BestEffect, FittedParameter, GroupError, HeldOutPrediction, PartlyExplained};
+use super::stats;
+use crate::gap::Campaign;
 
-/// Every measured mass with the nominal prediction and `c`'s prediction at the magnitude
-/// fitted without the mass's group.
+/// Every measured mass with the nominal prediction and `c`'s prediction at the magnitudes
+/// fitted without the mass's group, with its 95 % interval: the prediction plus or minus 1.96
+/// times the observation's standard uncertainty about it (measurement and specimen scatter,
+/// the simulator's numerical and parameter uncertainty; the spread of the fold's fitted
+/// magnitudes is not in it).
 pub(super) fn held_out_predictions(
     campaign: &Campaign,
     problem: &FitProblem,
@@ -25,6 +36,8 @@ pub(super) fn held_out_predictions(
         .map(|(i, o)| {
             let g = problem.group[i];
             let mu = o.predicted(&nominal);
+            let with_effect = o.predicted(&folds[g]);
+            let u = problem.noise.u_marginal(o, with_effect);
             HeldOutPrediction {
                 group: problem.group_labels[g].clone(),
                 test: campaign.tests[o.test].id.clone(),
@@ -35,9 +48,19 @@ pub(super) fn held_out_predictions(
                 nominal_mg: mu,
                 effect: problem.name_of(&c.families),
                 magnitude: c.fold_specs[g].first().map_or(0.0, |s| s.1),
-                with_effect_mg: o.predicted(&folds[g]),
+                magnitudes: c.fold_specs[g].iter().map(|s| s.1).collect(),
+                with_effect_mg: with_effect,
+                interval_mg: [with_effect - 1.96 * u, with_effect + 1.96 * u],
             }
         })
+        .collect()
+}
+
+/// The physical bounds a fitted parameter's interval reaches, as the report names them.
+fn reached(p: &crate::gap::effects::ParameterInfo, interval: [f64; 2]) -> Vec<String> {
+    identification::bounds_reached(p, interval)
+        .into_iter()
+        .map(str::to_string)
         .collect()
 }
 
@@ -85,6 +108,8 @@ pub(super) fn best_effect(
                     bounds: [p.min, p.max],
                     fitted: true,
                     measured_from: None,
+                    identified: identification::identified(p, interval),
+                    bounds_reached: reached(p, interval),
                 });
                 continue;
             }
@@ -103,6 +128,8 @@ pub(super) fn best_effect(
                     bounds: [p.min, p.max],
                     fitted: false,
                     measured_from: Some(mv.source.clone()),
+                    identified: true,
+                    bounds_reached: Vec::new(),
                 });
                 continue;
             }
@@ -116,6 +143,8 @@ pub(super) fn best_effect(
                 bounds: [p.min, p.max],
                 fitted: profiled.is_some(),
                 measured_from: None,
+                identified: profiled.is_some_and(|iv| identification::identified(p, iv)),
+                bounds_reached: profiled.map(|iv| reached(p, iv)).unwrap_or_default(),
             });
         }
     }
@@ -134,11 +163,17 @@ pub(super) fn best_effect(
             stats::quantile(&shrinks, 0.95),
         ],
         residual_p_value: c.residual_p,
-        per_group: (0..problem.groups)
-            .map(|g| GroupError {
+        per_group: c
+            .group_tests()
+            .iter()
+            .enumerate()
+            .map(|(g, t)| GroupError {
                 group: problem.group_labels[g].clone(),
                 before: (nominal.held_r2[g] / nominal.held_w[g].max(1e-300)).sqrt(),
-                after: (c.held_r2[g] / c.held_w[g].max(1e-300)).sqrt(),
+                after: t.error,
+                p_adjusted: t.p_adjusted,
+                bound: t.bound,
+                predicted: !t.fails(c.alpha),
             })
             .collect(),
     }
@@ -439,13 +474,30 @@ pub(super) fn partly_explained(
             100.0 * MIN_EXPLAINED_SHRINK
         ));
     }
+    let unpredicted: Vec<GroupError> = b
+        .per_group
+        .iter()
+        .filter(|g| !g.predicted)
+        .cloned()
+        .collect();
+    for g in &unpredicted {
+        reasons.push(format!(
+            "{} not predicted held out: error {:.2} > {:.2} (Holm-adjusted p = {:.1e})",
+            g.group, g.after, g.bound, g.p_adjusted
+        ));
+    }
     if reasons.is_empty() {
         return None;
     }
-    let worst = b
-        .per_group
+    let worst = unpredicted
         .iter()
-        .max_by(|x, y| x.after.total_cmp(&y.after))?;
+        .max_by(|x, y| (x.after / x.bound).total_cmp(&(y.after / y.bound)))
+        .or_else(|| {
+            b.per_group
+                .iter()
+                .max_by(|x, y| x.after.total_cmp(&y.after))
+        })?
+        .clone();
     Some(PartlyExplained {
         candidate: b.name.clone(),
         reasons,
@@ -455,6 +507,7 @@ pub(super) fn partly_explained(
         chi2_left: c.chi2,
         dof: c.dof,
         residual_p_value: c.residual_p,
+        unpredicted,
         cannot_predict: worst.group.clone(),
         cannot_predict_error: [worst.before, worst.after],
     })

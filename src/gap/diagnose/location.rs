@@ -13,8 +13,9 @@
 //! that band, so a band lights up when the tests whose work falls there are the ones that miss.
 
 use super::emulator::{PRESSURE_BANDS, SLIP_BANDS};
+use super::fit_problem::FitProblem;
 use super::noise::{Quantity, CHANNELS};
-use super::{stats, FitProblem};
+use super::stats;
 use crate::analysis::spectra::welch_psd;
 use crate::gap::accel::AccelLocation;
 use crate::gap::Campaign;

@@ -27,7 +27,7 @@
 //! ([`NoiseModel::u_marginal`]) is `sqrt(u² + (2 e_cal μ)²)`.
 
 use super::emulator::{mean_square, Emulator, TestPredictions};
-use super::DiagnoseOptions;
+use super::options::DiagnoseOptions;
 use crate::gap::accel::AccelLocation;
 use crate::gap::Campaign;
 use serde::{Deserialize, Serialize};

@@ -4,10 +4,11 @@
 //! together at the pair's fit, and a dynamics partner of the leading dynamics single bisected
 //! beside it and followed to where its fits land.
 
+use super::candidate::{requests_of, Candidate};
+use super::fit_problem::{FitProblem, Model};
+use super::options::Simulating;
 use super::secondary_values::{midpoints_beside, profile_values};
-use super::{
-    requests_of, singles_if_gap, singles_unexplained, Candidate, FitProblem, Model, Simulating,
-};
+use super::verdict::{singles_if_gap, singles_unexplained};
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::effects::Acts;
 use crate::gap::GapError;

@@ -2,7 +2,8 @@
 //! take (its members' secondary values chosen with the other member on), and the fit of two
 //! tables' magnitudes (docs/diagnosis.md, "Exact pairs", "A pair's secondary values").
 
-use super::{unless_beaten, Candidate, Fit, FitProblem, Model};
+use super::candidate::Candidate;
+use super::fit_problem::{unless_beaten, Fit, FitProblem, Model};
 use crate::gap::effects::Acts;
 
 impl FitProblem<'_> {

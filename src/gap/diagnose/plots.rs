@@ -3,7 +3,7 @@
 //! energy budget. Horizontal labelled bars drawn by [`crate::report::figure::BarChart`]
 //! (plotters); the report's numbers are in its JSON.
 
-use super::{Report, Verdict};
+use super::report::{Report, Verdict};
 use crate::report::figure::{AxisSpec, Bar, BarChart};
 
 /// A bar chart with an axis of `scale` (its label `axis`).
@@ -31,6 +31,21 @@ fn verdict_words(verdict: Verdict) -> &'static str {
         Verdict::Explained => "explained",
         Verdict::PartlyExplained => "partly explained",
         Verdict::NotExplained => "not explained",
+    }
+}
+
+/// The title's note on the parameters the data do not identify (none: empty).
+fn not_identified(b: &super::report::BestEffect) -> String {
+    let names: Vec<String> = b
+        .parameters
+        .iter()
+        .filter(|p| p.fitted && !p.identified)
+        .map(|p| p.label())
+        .collect();
+    if names.is_empty() {
+        String::new()
+    } else {
+        format!("; not identified by the data: {}", names.join(", "))
     }
 }
 
@@ -93,10 +108,11 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
     let before_after = match &report.best_effect {
         Some(b) => bar_chart(
             &format!(
-                "{}: held-out RMS standardized error, nominal vs {} (shrink {:.0} %)",
+                "{}: held-out RMS standardized error, nominal vs {} (shrink {:.0} %; red: a group it does not predict within its bound){}",
                 report.campaign,
                 b.name,
-                100.0 * b.shrink
+                100.0 * b.shrink,
+                not_identified(b)
             ),
             AxisSpec::auto("held-out RMS standardized error per held-out group"),
             b.per_group
@@ -106,8 +122,14 @@ pub fn plots(report: &Report) -> Vec<(String, String)> {
                     value: g.before,
                     second: Some(g.after),
                     whisker: None,
-                    note: format!("{:.2} -> {:.2}", g.before, g.after),
-                    highlight: false,
+                    note: format!(
+                        "{:.2} -> {:.2} (bound {:.2}{})",
+                        g.before,
+                        g.after,
+                        g.bound,
+                        if g.predicted { "" } else { ", not predicted" }
+                    ),
+                    highlight: !g.predicted,
                 })
                 .collect(),
             &[1.0],

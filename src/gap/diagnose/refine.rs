@@ -13,11 +13,13 @@
 //!    ([`Emulator::add_pair`]), and every dynamics member refined at the magnitudes the
 //!    pair's fits land on (module `pair_search`).
 
+use super::candidate::{requests_of, Candidate};
+use super::fit_problem::{FitProblem, Model};
+use super::options::{DiagnoseOptions, Simulating, REFINE_CONTENDERS, SECONDARY_CONTENDERS};
+use super::pair_search;
+use super::report::Report;
 use super::secondary_values::{midpoints_beside, profile_values};
-use super::{
-    diagnose_with, pair_search, requests_of, singles_if_gap, Candidate, DiagnoseOptions,
-    FitProblem, Model, Report, Simulating, REFINE_CONTENDERS, SECONDARY_CONTENDERS,
-};
+use super::verdict::{diagnose_with, singles_if_gap};
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::effects::Acts;
 use crate::gap::window::WindowCache;

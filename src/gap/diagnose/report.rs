@@ -11,11 +11,14 @@ use serde::{Deserialize, Serialize};
 pub enum Verdict {
     /// The nominal model agrees with the measurements within their uncertainty.
     NoGap,
-    /// An effect (or a pair) explains the gap on held-out tests.
+    /// An effect (or a pair) explains the gap on held-out tests: it passes the explaining
+    /// rule, shrinks the held-out error, is fitted inside its bounds and predicts every
+    /// held-out group within its noise (Holm-adjusted).
     Explained,
     /// An effect (or a pair) passes the explaining rule but is fitted at its physical bound,
-    /// or shrinks the held-out error by less than [`super::MIN_EXPLAINED_SHRINK`]: named, with
-    /// what it leaves and the test it cannot predict ([`Report::partly_explained`]).
+    /// shrinks the held-out error by less than [`super::MIN_EXPLAINED_SHRINK`] or leaves a
+    /// held-out group it does not predict within its noise: named, with what it leaves and the
+    /// groups it cannot predict ([`Report::partly_explained`]).
     PartlyExplained,
     /// There is a gap and no effect of the library explains it.
     NotExplained,
@@ -30,7 +33,8 @@ pub struct FittedParameter {
     pub name: String,
     /// Unit.
     pub unit: String,
-    /// Value (fitted on all tests, or the library default when not fitted).
+    /// Value the predictions use (fitted on all tests, measured, or the library default when
+    /// not fitted). Not a measurement of the parameter unless `identified`.
     pub value: f64,
     /// 95 % profile-likelihood interval (fitted parameters), clipped to the bounds.
     pub interval: Option<[f64; 2]>,
@@ -42,6 +46,69 @@ pub struct FittedParameter {
     /// interval is the measurement's 95 %).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub measured_from: Option<String>,
+    /// The data identify it: measured, or fitted with a 95 % interval spanning less than
+    /// [`UNIDENTIFIED_SHARE`](super::identification::UNIDENTIFIED_SHARE) of its physical
+    /// range. False when held at the library default or when the interval spans (nearly) the
+    /// whole range: `value` is then the search's choice, not the data's.
+    #[serde(default = "identified_by_default")]
+    pub identified: bool,
+    /// The physical bounds its 95 % interval reaches (`min`, `max`): the data would take it
+    /// there or beyond.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bounds_reached: Vec<String>,
+}
+
+fn identified_by_default() -> bool {
+    true
+}
+
+impl FittedParameter {
+    /// `effect.name`.
+    pub fn label(&self) -> String {
+        format!("{}.{}", self.effect, self.name)
+    }
+
+    /// The parameter as the text summary gives it: its value and interval when identified;
+    /// otherwise no value, only the interval that says the data do not measure it.
+    pub fn describe(&self) -> String {
+        let reached = if self.bounds_reached.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; its interval reaches the physical {} bound",
+                self.bounds_reached.join(" and ")
+            )
+        };
+        match (self.identified, self.fitted, self.interval, &self.measured_from) {
+            (true, _, Some([lo, hi]), Some(source)) => format!(
+                "{} = {:.4e} {} (measured by {source}: 95 % interval [{lo:.4e}, {hi:.4e}])",
+                self.label(),
+                self.value,
+                self.unit
+            ),
+            (true, true, Some([lo, hi]), None) => format!(
+                "{} = {:.4e} {} (95 % interval [{lo:.4e}, {hi:.4e}]; bounds [{}, {}]{reached})",
+                self.label(),
+                self.value,
+                self.unit,
+                self.bounds[0],
+                self.bounds[1]
+            ),
+            (false, true, Some([lo, hi]), _) => format!(
+                "{}: not identified by the data (95 % interval [{lo:.4e}, {hi:.4e}] {} spans its physical range [{}, {}])",
+                self.label(),
+                self.unit,
+                self.bounds[0],
+                self.bounds[1]
+            ),
+            _ => format!(
+                "{}: held at the library default {:.4e} {} (not fitted)",
+                self.label(),
+                self.value,
+                self.unit
+            ),
+        }
+    }
 }
 
 /// The chosen effect and how far it closes the gap.
@@ -74,6 +141,21 @@ pub struct GroupError {
     pub before: f64,
     /// With the effect.
     pub after: f64,
+    /// Holm-adjusted p-value of the group's held-out chi-square with the effect (across the
+    /// held-out groups).
+    #[serde(default)]
+    pub p_adjusted: f64,
+    /// The largest held-out error the rule accepts for the group (Holm's first step, at the
+    /// report's `alpha`, on the group's degrees of freedom).
+    #[serde(default)]
+    pub bound: f64,
+    /// Predicted within its noise: Holm-adjusted p-value at least `alpha`.
+    #[serde(default = "predicted_by_default")]
+    pub predicted: bool,
+}
+
+fn predicted_by_default() -> bool {
+    true
 }
 
 /// One candidate in the ranking.
@@ -172,9 +254,10 @@ pub struct Report {
     pub alpha: f64,
     /// Predictions.
     pub emulator: EmulatorReport,
-    /// Held-out predictions of every measured mass: the nominal model's and the best-ranked
-    /// single effect's, fitted without the observation's group (what the model, given the
-    /// other tests, says this test should have lost).
+    /// Held-out predictions of every measured mass: the nominal model's and the verdict's
+    /// effect or pair's (the best-ranked single's when none is named), fitted without the
+    /// observation's group, with an interval (what the model, given the other tests, says
+    /// this test should have lost).
     #[serde(default)]
     pub held_out_predictions: Vec<HeldOutPrediction>,
     /// Why the verdict is `partly_explained`: the leading candidate, what it leaves, the test
@@ -205,7 +288,12 @@ pub struct PartlyExplained {
     pub dof: f64,
     /// Lack-of-fit p-value of what it leaves.
     pub residual_p_value: f64,
-    /// The held-out group it predicts worst (largest held-out error with it).
+    /// The held-out groups it does not predict within their noise (Holm-adjusted p below
+    /// `alpha`), with their errors and bounds.
+    #[serde(default)]
+    pub unpredicted: Vec<GroupError>,
+    /// The held-out group it predicts worst: the unpredicted group furthest above its bound,
+    /// or, when every group is predicted, the one with the largest held-out error.
     pub cannot_predict: String,
     /// That group's held-out RMS standardized error, nominal and with the candidate.
     pub cannot_predict_error: [f64; 2],
@@ -248,10 +336,18 @@ pub struct HeldOutPrediction {
     pub uncertainty_mg: f64,
     /// Nominal model, mg.
     pub nominal_mg: f64,
-    /// Best-ranked single effect (name), fitted on the other groups.
+    /// The verdict's effect or pair (`a+b`; the best-ranked single when none is named),
+    /// fitted on the other groups.
     pub effect: String,
-    /// Its magnitude fitted without this group.
+    /// Its (first member's) magnitude fitted without this group.
     pub magnitude: f64,
+    /// Every member's magnitude fitted without this group, in the order of the names.
+    #[serde(default)]
+    pub magnitudes: Vec<f64>,
     /// The prediction with it, mg.
     pub with_effect_mg: f64,
+    /// 95 % interval of the prediction: plus or minus 1.96 standard uncertainties of the
+    /// observation about it, mg.
+    #[serde(default)]
+    pub interval_mg: [f64; 2],
 }

@@ -13,6 +13,11 @@ pub fn chi2_sf(x: f64, dof: usize) -> f64 {
     ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(x.max(0.0)))
 }
 
+/// The `x` whose upper chi-square tail (`dof` degrees of freedom, at least 1) is `p`.
+pub fn chi2_isf(p: f64, dof: usize) -> f64 {
+    ChiSquared::new(dof.max(1) as f64).map_or(f64::NAN, |d| d.inverse_cdf(1.0 - p.clamp(0.0, 1.0)))
+}
+
 /// Lack-of-fit p-value of a fit with `k` parameters leaving `chi2` over a weighted
 /// observation count `n`: the chi-square tail at `n - k` degrees of freedom (at least 1).
 pub fn lack_of_fit_p(chi2: f64, n: f64, k: f64) -> f64 {

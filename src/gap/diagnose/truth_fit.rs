@@ -6,7 +6,9 @@
 //! and the search did not reach it.
 
 use super::emulator::Emulator;
-use super::{stats, FitProblem, Simulating};
+use super::fit_problem::FitProblem;
+use super::options::Simulating;
+use super::stats;
 use crate::gap::effects::{Acts, Effect};
 use crate::gap::GapError;
 use serde::{Deserialize, Serialize};
