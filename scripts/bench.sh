@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds railwear in release once and runs every benchmark of railwear-bench, printing the
 # markdown tables to stdout (progress goes to stderr). Benchmarks, not tests: nothing fails on a
-# slow number. See docs/benchmarks.md for the last recorded tables and their caveats.
+# slow number. See docs/journal/benchmarks.md for the last recorded tables and their caveats.
 #
 # Usage: scripts/bench.sh [--quick] [--with-peers] [--json]
 #   --quick       short windows (engine 1 s, launcher 1 s, memory 10 s, sweep 0.1 s, load 5 s

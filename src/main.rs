@@ -87,7 +87,7 @@ enum Command {
         #[arg(long, default_value_t = 1.0)]
         settle: f64,
         /// Markdown page to write.
-        #[arg(long, default_value = "docs/validation.md")]
+        #[arg(long, default_value = "docs/results/validation.md")]
         out: PathBuf,
         /// Directory of reference configs and profiles.
         #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
@@ -226,7 +226,7 @@ enum Command {
     },
     /// IMPACT stiffness k and exponent e (eq. 2.7) for a sphere on a flat, fitted by least
     /// squares to a quasistatic model of thesis 2.3.1 (Hertz, fully plastic, Jackson-Green,
-    /// Kogut-Etsion); prints the fit with its range and weighting (docs/errata.md section 3).
+    /// Kogut-Etsion); prints the fit with its range and weighting (docs/results/errata.md section 3).
     /// Materials default to 7075-T73 for both bodies.
     ContactFit {
         /// hertz, fully_plastic, jackson_green or kogut_etsion (`-` for `_` allowed).

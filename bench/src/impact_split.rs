@@ -762,7 +762,7 @@ pub(crate) fn impact_split(configs_dir: &Path, b: &ImpactSplitBench) -> Result<V
             case.simulation.duration_s = b.window;
             let model = build(&case, configs_dir)?;
             let options = run_options(&case)?;
-            // The tolerance ladder's loosest passing factor on C (docs/benchmarks.md).
+            // The tolerance ladder's loosest passing factor on C (docs/journal/benchmarks.md).
             let mut loose_case = case.clone();
             loose_case.simulation.rel_tolerance *= LOOSE_FACTOR;
             loose_case.simulation.abs_tolerance_m *= LOOSE_FACTOR;

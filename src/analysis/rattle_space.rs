@@ -8,7 +8,7 @@
 //!
 //! The thesis' dimension drawings (Figures 6.29, 6.30) did not survive, so the physical meaning of
 //! each letter in [`LauncherDimensions`] is inferred from the role it plays in eq. 6.1-6.2; the
-//! decisions are listed in `docs/launcher-dimensions.md`.
+//! decisions are listed in `docs/reference/launcher-dimensions.md`.
 
 use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
@@ -118,7 +118,7 @@ pub const LOOSE_MATERIAL_CONDITION_MM: f64 = 0.1955;
 /// through which the shoe's neck passes; above the lips the chamber holds the shoe's head
 /// (flange). The missile hangs below the rail. The shoe letters B..E and the other rail letters do
 /// not enter eq. 6.1-6.2 and are not fields here. Letter meanings are inferred from eq. 6.1-6.2 (the
-/// drawings are lost); see `docs/launcher-dimensions.md`.
+/// drawings are lost); see `docs/reference/launcher-dimensions.md`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, utoipa::ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LauncherDimensions {

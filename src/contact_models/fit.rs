@@ -42,7 +42,7 @@ impl FitSpace {
         }
     }
 
-    /// How the residuals are weighted, in words (docs/errata.md section 3: the exponent depends
+    /// How the residuals are weighted, in words (docs/results/errata.md section 3: the exponent depends
     /// on it, so it is stated with every fit).
     pub fn weighting(&self) -> &'static str {
         match self {
@@ -225,7 +225,7 @@ impl ImpactFitRow {
 }
 
 /// Thesis Table 2.1 as printed (damping and penetration depth are 0 in every column).
-/// The Hertz stiffness and the J-G/K-E rows are errata (docs/errata.md); kept as data so that
+/// The Hertz stiffness and the J-G/K-E rows are errata (docs/results/errata.md); kept as data so that
 /// Table 2.2 can be reproduced, not as recommended values.
 pub fn table_2_1_parameters() -> [ImpactFitRow; 4] {
     [

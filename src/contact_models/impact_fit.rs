@@ -1,7 +1,7 @@
 //! The IMPACT spring `k w^e` (eq. 2.7) for a sphere on a flat, fitted to one quasistatic model
 //! of thesis 2.3.1: what `railwear contact-fit` prints and what the validation anchors use. The
 //! fit's range and weighting travel with its result, because the exponent depends on both
-//! (docs/errata.md section 3).
+//! (docs/results/errata.md section 3).
 
 use super::fit::{fit_model, FitSpace, PowerLawFit};
 use super::quasistatic::{QuasistaticModel, SphereOnFlat};
@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// Thesis 2.3.1 fits over 0-1 mm of interference, m.
 pub const DEFAULT_MAX_INTERFERENCE_M: f64 = 1.0e-3;
-/// Samples of the fit: 400, as the errata's fits (docs/errata.md section 3); more change the
+/// Samples of the fit: 400, as the errata's fits (docs/results/errata.md section 3); more change the
 /// J-G and K-E exponents by under 1e-3.
 pub const DEFAULT_SAMPLES: usize = 400;
 

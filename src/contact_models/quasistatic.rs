@@ -1,7 +1,7 @@
 //! Sphere (radius R) pressed on a flat: normal force and contact area versus interference w,
 //! thesis eq. 2.5-2.42, in SI (m, N, m², Pa).
 //!
-//! Reading of the thesis used here (see docs/errata.md):
+//! Reading of the thesis used here (see docs/results/errata.md):
 //! - Jackson-Green (JG) and Kogut-Etsion (KE) give the normalised *load* F* = F/F_c versus
 //!   w* = w/w_c; eq. 2.21 is labelled P_c but is the critical load F_c. The thesis then
 //!   multiplies that load by the normalised area (eq. 2.33, 2.42), which is dimensionally a

@@ -159,7 +159,7 @@ impl EffectKind {
                 models: BOTH,
                 parameters: ClearanceGrowthParameters::PARAMETERS,
                 reason: "the thesis' model keeps the nominal enclosure; cases C and D ran 4.5 h on one specimen (thesis 5.5), their rate rising 1.53 -> 2.33 and 0.17 -> 0.87 mg/h",
-                limitation: Some("the opening is a rate per test hour, not computed from the simulated wear: railwear's simulated wear is two orders below the measured (docs/validation.md), so it would open nothing"),
+                limitation: Some("the opening is a rate per test hour, not computed from the simulated wear: railwear's simulated wear is two orders below the measured (docs/results/validation.md), so it would open nothing"),
             },
             Self::FrictionDrift => EffectInfo {
                 name: FrictionDriftParameters::NAME,

@@ -1,4 +1,4 @@
-//! The exactly integrated face contact (issue 27; docs/models.md "Exact face contact"): the
+//! The exactly integrated face contact (issue 27; docs/reference/models.md "Exact face contact"): the
 //! part of one face of a rounded box's inner box that presses into a (possibly bounded) face,
 //! and a quadrature over it that is exact for the IMPACT law's polynomial densities.
 //!
@@ -28,7 +28,7 @@
 //! energy, which is continuous across the side: the region boundary terms of the two parts'
 //! gradients cancel, so no force acts on the cut line, and a shoe sliding off a lip unloads
 //! continuously even when a whole face crosses the edge at once. `w` is not polynomial there;
-//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/models.md gives the measured error).
+//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/reference/models.md gives the measured error).
 //!
 //! Hot path: fixed-size arrays only, no heap allocation.
 

@@ -1,4 +1,4 @@
-//! Bit-for-bit checks of the exact face contact's geometry shortcuts (docs/performance.md,
+//! Bit-for-bit checks of the exact face contact's geometry shortcuts (docs/journal/performance.md,
 //! seventeenth pass): a split's parts, an inner face's parts from one pressed square, and the
 //! signed distance within a reach.
 

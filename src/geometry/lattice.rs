@@ -1,6 +1,6 @@
 //! The contact points of a convex piece: material points on its surface, each a small ball,
 //! whose stiffness shares resolve a face contact over the face (SPEC §2 "Passivity",
-//! docs/models.md "Contact formulation").
+//! docs/reference/models.md "Contact formulation").
 //!
 //! A rounded box is its inner box ⊕ ball(roundover). Its contact points are the surface nodes
 //! of an `n × n × n` lattice on the inner box, each a ball of the roundover radius, so a ball

@@ -15,7 +15,7 @@
 //!   (`polytope_clip`); edge and vertex pieces are integrated along one coordinate of closed
 //!   form sections (disk ∩ convex polygon, `disk_polygon`) with Gauss–Legendre on sub-intervals
 //!   split at every kink and with node clustering at tangencies (`quadrature`), which is
-//!   exact to round-off in the tests (see docs/geometry.md for the measured bounds).
+//!   exact to round-off in the tests (see docs/reference/geometry.md for the measured bounds).
 //!
 //! Hot path (about 10⁶ calls per simulated second): no heap allocation, fixed-size arrays only.
 

@@ -1,5 +1,5 @@
 //! Closed-form monomial moments `∫_P (u − u₀)^a (v − v₀)^b dA` of a polygon `P` in a face's
-//! material coordinates, `a + b <= 3` (docs/models.md "Exact face contact", "Closed-form
+//! material coordinates, `a + b <= 3` (docs/reference/models.md "Exact face contact", "Closed-form
 //! parts"): every density of the IMPACT law with `e = 2` on a part of a pressed face where
 //! `w` and `ẇ` are affine (the stored energy `k w³/3`, the clamp's dissipation `k w² ẇ`, the
 //! force `k w² + c ẇ` and its first moments) is a polynomial of degree at most 3 in `ξ`, so

@@ -50,7 +50,7 @@ impl Caller {
     /// write campaigns, admins everything; every role may read rails, jobs, curves and
     /// campaigns (a planner sees whether the sweep a report needs is running). Measured data
     /// is written only by those who measure it: engineers, who tune and run the model, do not
-    /// upload campaigns, as they do not record rail measurements (docs/campaigns.md).
+    /// upload campaigns, as they do not record rail measurements (docs/reference/campaigns.md).
     pub fn allowed(&self, area: Area, method: &Method) -> bool {
         let read = method == Method::GET || method == Method::HEAD;
         match (self.role, area) {

@@ -120,7 +120,7 @@ impl From<CampaignSummary> for CampaignView {
 
 /// A test campaign (format version 1): physical tests with their configuration and their
 /// measurements. Units are in the key names. Unknown keys are refused at every level. See
-/// docs/campaigns.md.
+/// docs/reference/campaigns.md.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CampaignDocument {
@@ -412,7 +412,7 @@ pub async fn get_campaign(
 ///
 /// The job simulates the campaign's tests (its progress is the fraction of those simulations
 /// done), then locates the sim-to-real gap and ranks the library's effects on held-out tests
-/// (docs/diagnosis.md). `GET /v1/jobs/{id}` follows it; once it succeeded,
+/// (docs/results/diagnosis.md). `GET /v1/jobs/{id}` follows it; once it succeeded,
 /// `GET /v1/jobs/{id}/result` holds the report as `summary` and lists its SVG figures, served
 /// by `GET /v1/jobs/{id}/plots/{name}`. `POST /v1/jobs/{id}/cancel` stops it. The params are
 /// checked at submission (a broken rule is a 422 naming the field, e.g. `window_s` or

@@ -495,7 +495,7 @@ const fmt = {
   count: x => (x == null || !isFinite(x)) ? "n/a" : String(Math.round(x)),
 };
 
-// Why a candidate does not explain the gap, by the rule of docs/diagnosis.md: a held-out gain
+// Why a candidate does not explain the gap, by the rule of docs/results/diagnosis.md: a held-out gain
 // above 2 nats, residuals consistent with noise (p >= alpha) and at least 50 % of the excess
 // chi-square removed. The report carries alpha; the two other thresholds are the rule's.
 function whyNot(e, alpha) {

@@ -178,7 +178,7 @@ pub fn write_state(
 ///
 /// This is the mass a single touching point meets. A face that lands flat engages all its
 /// points within the damping ramp, which locks the rotation: the pressed patch then meets the
-/// body's translational mass `m` (docs/models.md, "Where position-only error control's
+/// body's translational mass `m` (docs/reference/models.md, "Where position-only error control's
 /// difference comes from": on the rattle boxes the impulse map
 /// ([`super::impact_map`]) with `m` reproduces the resolved arrests
 /// to 0.1 %, with the first point's mass it misses them by 40 %).

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 /// Relative bound on the balance residual: |residual| <= this × the energy throughput
 /// (max of the drive and applied work and the dissipated work) + [`ENERGY_BALANCE_FLOOR_J`].
-/// Measured on the reference cases: 1e-4 to 3e-3 (docs/validation.md).
+/// Measured on the reference cases: 1e-4 to 3e-3 (docs/results/validation.md).
 pub const ENERGY_BALANCE_TOLERANCE: f64 = 1e-2;
 
 /// Absolute floor of the residual bound, J (round-off on a resting body).

@@ -3,7 +3,7 @@
 //! `F = max(0, k w^e + c_max STEP(w, 0, 0, d, 1) wdot)` for `w > 0`, zero otherwise, with `w` the
 //! penetration and `wdot` its rate (positive while approaching). The damping always resists
 //! approach. Eq. 2.2 as printed (`- c_max wdot STEP`) uses the gap coordinate's rate; read with
-//! `wdot` as the penetration rate its sign is reversed (an erratum, see docs/errata.md).
+//! `wdot` as the penetration rate its sign is reversed (an erratum, see docs/results/errata.md).
 
 use super::step::StepKind;
 use crate::field_error::FieldError;

@@ -17,7 +17,7 @@
 //! ([`super::local_dopri5`]), under the same error control. The force is smooth between
 //! `w = 0`, `w = d` and the clamp's switch (`N` reaching 0); the steps land on those points
 //! (event location on a cubic Hermite interpolant, then a step of exactly that length), each
-//! side using its own smooth formula, so the method keeps its order. docs/models.md,
+//! side using its own smooth formula, so the method keeps its order. docs/reference/models.md,
 //! "Contact-local impulse map", gives the assumptions and the measured error.
 
 use super::friction::FrictionParams;

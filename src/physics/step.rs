@@ -138,7 +138,7 @@ const COS_TAYLOR: [f64; 9] = [
 ///
 /// Why not libm: its `sincos` was 9.5 % of a launcher run's samples (perf), with its range
 /// reduction and rounding-mode save. A Horner form of these polynomials cut instructions but
-/// no time (docs/performance.md, seventeenth pass: the chain's latency); evaluated as Estrin's
+/// no time (docs/journal/performance.md, seventeenth pass: the chain's latency); evaluated as Estrin's
 /// tree it takes 1.5-9 % off the launcher's CPU time, run to run, and 5.4 % of its
 /// instructions (twenty-fourth pass).
 #[inline]

@@ -20,7 +20,7 @@
 //!
 //! The touching contact's law, events and error control are the 1-D map's
 //! (`impact_map::integrate`); with no support the equations and the steps are the
-//! 1-D map's, bit for bit. docs/models.md, "The supported impulse map", gives the
+//! 1-D map's, bit for bit. docs/reference/models.md, "The supported impulse map", gives the
 //! assumptions, the error bound and the measured error.
 
 use super::friction::FrictionParams;

@@ -21,7 +21,7 @@ pub fn sweep_offsets_mm(n: usize) -> Vec<f64> {
 /// sweep will cover a rail).
 ///
 /// Every point is `base.with_material_condition(offset)`: rail dimensions grow by the offset,
-/// shoe dimensions shrink by it (docs/launcher-dimensions.md). The range is given as one of
+/// shoe dimensions shrink by it (docs/reference/launcher-dimensions.md). The range is given as one of
 /// - `rattle_space_range: {"min": k1, "max": k2}`: points evenly spaced in k_rs, or
 /// - `offset_mm_range: {"min": d1, "max": d2}`: points evenly spaced in the offset, mm,
 /// - neither: the thesis' tolerance band, offsets -0.201 to +0.1955 mm (k_rs 0.8317 to 0.7684).
@@ -260,7 +260,7 @@ impl SweepRange {
                         format!(
                             "[{min}, {max}] mm leaves the offsets at which the base dimensions \
                              stay a valid rail, [{:.4}, {:.4}] mm (assembly and +-50 % of \
-                             design, docs/launcher-dimensions.md)",
+                             design, docs/reference/launcher-dimensions.md)",
                             limits_mm.0, limits_mm.1
                         ),
                     )

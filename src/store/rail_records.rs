@@ -193,7 +193,7 @@ pub fn publish_refusal(
 
 /// Why a curve whose provenance is `candidate` rests on a coarser face contact than one whose
 /// provenance is `published`, or `None`: swept on the contact-point lattice against the exact
-/// face contact, the lattice's continuum limit (docs/models.md "Exact face contact"; the
+/// face contact, the lattice's continuum limit (docs/reference/models.md "Exact face contact"; the
 /// launcher's 5-point lattice is 2-4 % off its wear rates). Curves swept before the face
 /// contact was recorded (no `face_contact` in their provenance) are not compared.
 fn contact_shortfall(

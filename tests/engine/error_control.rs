@@ -148,7 +148,7 @@ fn without_the_work_test_the_account_shows_integrator_loss_never_gain() {
     // of the impact energy numerically and the account, still kept, shows it as a negative
     // residual. It must never show energy created: no rise without drive, and no positive
     // residual beyond the balance bound. On the 5-point lattice: on case C's 3 points per edge
-    // (its default since the twenty-first pass of docs/performance.md) the tilted drop lands
+    // (its default since the twenty-first pass of docs/journal/performance.md) the tilted drop lands
     // on an edge's 3 points, the unresolved transient's quadrature overestimates the damping
     // work and the residual reads +0.57 % of the dissipated work (bound 0.5 %), while the
     // mechanical energy still never rises (4e-19 J). So the one-sided residual bound holds

@@ -212,7 +212,7 @@ pub(crate) fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
 /// Relative bound on `F + ∂U/∂x` and on the power balance: the pressed polygons are
 /// integrated exactly; the strips beyond the lip's edge (at most a roundover wide) by a 5 × 5
 /// Gauss rule on a non-polynomial `w`, whose error is what is left (measured worst 1.6e-4 of
-/// the contact's power over these poses; docs/models.md "Exact face contact").
+/// the contact's power over these poses; docs/reference/models.md "Exact face contact").
 const GRADIENT_TOLERANCE: f64 = 5e-4;
 
 #[test]
@@ -493,7 +493,7 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     // launcher-design without excitation, settled for 1 s from its assembly state (lattice,
     // 33 points per edge): the contact force and torque on the missile of the lattice at
     // 9, 17 and 33 points per edge approach the exact face contact's, each refinement closer.
-    // The lattice is the exact contact's discretisation (docs/models.md "Exact face
+    // The lattice is the exact contact's discretisation (docs/reference/models.md "Exact face
     // contact"); what it resolves last are the side faces' slivers, 0.47 mm deep here against
     // a lattice row spacing of 0.27 mm at 33 points.
     let mut case =
@@ -694,7 +694,7 @@ pub fn continuum_cells(
 
 #[test]
 fn the_exact_face_contact_is_the_continuum_integral_at_impact_states() {
-    // The loose launcher's impacts (docs/performance.md, eleventh pass) press a shoe head a
+    // The loose launcher's impacts (docs/journal/performance.md, eleventh pass) press a shoe head a
     // few hundredths of a millimetre into a face while it closes on one side and separates on
     // the other: the damping term c STEP(w) ẇ dominates the law, the STEP ramps over the
     // band w < d = 0.01 mm, and the force clamps to zero where the face separates. None of
@@ -802,7 +802,7 @@ fn at_loose_launcher_states_the_lattice_converges_to_the_exact_face_contact_at_f
     // heads rattling across the lips' edges, tilted, hitting the walls and the roof). At each,
     // the shoe-rail contacts' forces with the lattice at 33, 65 and 129 points per edge
     // against the exact face contact. The lattice is a trapezoid rule of the same continuum
-    // (docs/models.md "Exact face contact") whose errors are first order in its spacing
+    // (docs/reference/models.md "Exact face contact") whose errors are first order in its spacing
     // h = 1/(n − 1) of a box edge: each of a pressed face's 4 edge rows lacks the half weight
     // its side face's rule gives it (1/(2(n − 1)) of the law each: 2/(n − 1)), and each lip
     // edge across a head of width 2a over a lip overlap b cuts a column at most h a / b of

@@ -1,5 +1,5 @@
 //! The exact face contact's closed forms: the monomial moments of a pressed polygon
-//! ([`PolygonMoments`], docs/models.md "Closed-form parts") against an independent fine
+//! ([`PolygonMoments`], docs/reference/models.md "Closed-form parts") against an independent fine
 //! quadrature on random clipped polygons, and the stored energy and the dissipation of heads
 //! that press and separate at once (where the clamp holds over a whole part, that part is
 //! integrated in closed form) against the continuum by a brute-force midpoint rule.

@@ -1,4 +1,4 @@
-//! The reduced face law (`face_contact = "reduced"`, docs/models.md "Reduced face law")
+//! The reduced face law (`face_contact = "reduced"`, docs/reference/models.md "Reduced face law")
 //! against the exact per-node contact on the same states: the same stored energy (both exact
 //! for `k w³/3`), forces within the exact contact's own ramp-rule bound where friction is off,
 //! friction within the tolerance its a-priori estimate enforces, damping and friction only

@@ -199,7 +199,7 @@ fn the_strips_damping_resultant_is_measured_against_a_converged_reference() {
     // closing rate 1 mm/s) over the strips, whose STEP ramps over w < d = 0.01 mm along a
     // curve across each 0.5 mm strip. The 64-slice reference must agree with 256 slices
     // within 1e-3 of its value (it resolves the ramp). The contact's two-slice rule is held
-    // to the accuracy docs/performance.md (thirteenth pass) states for it, 5 % per strip
+    // to the accuracy docs/journal/performance.md (thirteenth pass) states for it, 5 % per strip
     // (3.7 % measured); one slice, the option that pass rejected, is only reported.
     let face = lip(true);
     let impact = super::face_contact::table_6_2();

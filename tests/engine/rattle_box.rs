@@ -34,7 +34,7 @@ fn run_c(
 #[test]
 fn halving_tolerances_changes_friction_power_by_less_than_two_percent() {
     // 16 s of 15 g, 20 Hz after a 0.5 s settle: the rattle is chaotic, and 3-8 s averages
-    // scatter by about 2 % between any two trajectories (docs/performance.md), so the 2 %
+    // scatter by about 2 % between any two trajectories (docs/journal/performance.md), so the 2 %
     // statement needs about 640 impacts. The two runs go on two threads.
     let (p1, p2) = std::thread::scope(|s| {
         let a = s.spawn(|| run_c(0.5, 16.0, 1.0, None));
@@ -102,7 +102,7 @@ fn the_work_tests_allowances_hold_the_driven_account_to_twice_their_share() {
     // Each step's work quadrature may err by `energy_rel` × (its own work + the work of a step
     // as long at the run's mean power so far), so a run's estimated errors add up to at most
     // 2 `energy_rel` of its throughput: the balance of the account, with the 15 g drive on. The
-    // power samples are the Newton iterates', the step's start among them (docs/performance.md,
+    // power samples are the Newton iterates', the step's start among them (docs/journal/performance.md,
     // twenty-third pass), which the estimate does not see: 1.70e-3 here since, 1.04e-3 before.
     let case = load_case(&configs().join("rattle-box-c.toml")).expect("case C loads");
     let energy_rel = case

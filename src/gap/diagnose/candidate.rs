@@ -5,7 +5,7 @@ use super::emulator::Emulator;
 use super::options::{MIN_EXPLAINED_SHARE, MIN_EXPLAINED_SHRINK, MIN_HELD_OUT_GAIN};
 use super::stats;
 
-/// Whether one held-out group is predicted within its noise (docs/diagnosis.md, "Every
+/// Whether one held-out group is predicted within its noise (docs/results/diagnosis.md, "Every
 /// withheld group predicted").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct GroupTest {

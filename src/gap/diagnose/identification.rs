@@ -1,4 +1,4 @@
-//! Whether the data identify a fitted parameter (docs/diagnosis.md, "Identified or said not to
+//! Whether the data identify a fitted parameter (docs/results/diagnosis.md, "Identified or said not to
 //! be"): a 95 % interval that spans (nearly) the parameter's whole physical range says the
 //! data do not measure it, and the report then gives no point value as a measurement; an
 //! interval that reaches a physical bound says the fit would go beyond what the library

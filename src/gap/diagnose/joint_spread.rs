@@ -1,5 +1,5 @@
 //! The initial-state spread of two dynamics effects together: what a joint point's
-//! settle-shifted twin adds to the model's uncertainty (docs/diagnosis.md, "Two dynamics
+//! settle-shifted twin adds to the model's uncertainty (docs/results/diagnosis.md, "Two dynamics
 //! effects together").
 //!
 //! The noise model takes the spread of a window's wear over initial states from the

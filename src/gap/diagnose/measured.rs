@@ -1,4 +1,4 @@
-//! Secondary values the data measure before any fit (docs/diagnosis.md, "Measured secondary
+//! Secondary values the data measure before any fit (docs/results/diagnosis.md, "Measured secondary
 //! values"): a campaign's input accelerometer records (on the driven tube or rail) carry the
 //! drive itself, so a cross-axis drive's phase is read from them, not profiled.
 //!

@@ -315,7 +315,7 @@ pub struct NoiseReport {
     pub friction_mass_rel: f64,
 }
 
-/// The model's independent relative variance of one observation (docs/diagnosis.md,
+/// The model's independent relative variance of one observation (docs/results/diagnosis.md,
 /// "Uncertainty"): the numerical spread squared, plus the friction sensitivity squared, plus for
 /// masses the wear coefficient's relative uncertainty squared. The accelerometer calibration is
 /// not here: it is one scale per channel ([`gaussian`]).

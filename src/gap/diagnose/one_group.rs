@@ -1,5 +1,5 @@
 //! An effect one held-out group carries: held out, it has nothing to be fitted on, so the
-//! campaign cannot confirm it (docs/diagnosis.md, "Seen in one test").
+//! campaign cannot confirm it (docs/results/diagnosis.md, "Seen in one test").
 
 use super::candidate::Candidate;
 use super::fit_problem::FitProblem;

@@ -1,4 +1,4 @@
-//! Step 3 of the refinement, the pairs (docs/diagnosis.md, "Exact pairs", "A pair's
+//! Step 3 of the refinement, the pairs (docs/results/diagnosis.md, "Exact pairs", "A pair's
 //! secondary values", "A pair's landing"): exact dynamics + wear-law pair tables and their
 //! members' variants made exact together, the tables of two dynamics effects simulated
 //! together at the pair's fit, and a dynamics partner of the leading dynamics single bisected
@@ -358,7 +358,7 @@ const LANDING_TOLERANCE: f64 = 0.05;
 /// such landing holds a joint point. The bisection simulated each variant beside `other`
 /// only where the best table's fit landed; between there and 0 a variant's fit rests on the
 /// product of the two ratios, while a secondary value that makes the effect act sooner (a
-/// friction drift's shorter slip scale) lands well inside that range (docs/diagnosis.md,
+/// friction drift's shorter slip scale) lands well inside that range (docs/results/diagnosis.md,
 /// "A pair's landing"). Returns where the best table's pair fit lands after the passes.
 fn land_beside(
     sim: Simulating,

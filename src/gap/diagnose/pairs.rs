@@ -1,6 +1,6 @@
 //! Pairs of effects: which pairs to try given the singles, the table combinations a pair may
 //! take (its members' secondary values chosen with the other member on), and the fit of two
-//! tables' magnitudes (docs/diagnosis.md, "Exact pairs", "A pair's secondary values").
+//! tables' magnitudes (docs/results/diagnosis.md, "Exact pairs", "A pair's secondary values").
 
 use super::candidate::Candidate;
 use super::fit_problem::{unless_beaten, Fit, FitProblem, Model};

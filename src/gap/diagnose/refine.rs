@@ -1,5 +1,5 @@
 //! Adaptive refinement of the emulator at what the contending candidates' fits land on
-//! (docs/diagnosis.md, "Adaptive refinement", "Secondary parameters", "Exact pairs"):
+//! (docs/results/diagnosis.md, "Adaptive refinement", "Secondary parameters", "Exact pairs"):
 //!
 //! 1. the dynamics tables of the best single effects, at their fitted magnitudes;
 //! 2. when no single effect explains and the leading ones leave lack-of-fit, their secondary
@@ -144,7 +144,7 @@ fn secondary(sim: Simulating, emulator: &mut Emulator) -> Result<(), GapError> {
             order.sort_by(|a, b| b.held_ll().total_cmp(&a.held_ll()));
             // The best by held-out likelihood, and every single that explains only partly: when
             // one test carries what they explain, the held-out likelihood does not rank them
-            // (docs/diagnosis.md, "Seen in one test").
+            // (docs/results/diagnosis.md, "Seen in one test").
             let mut leaders: Vec<(usize, f64)> = order
                 .iter()
                 .take(SECONDARY_CONTENDERS)

@@ -190,7 +190,7 @@ pub(super) fn judge(
         // When the held-out error the first leaves hardly shrinks because one group carries
         // what it explains, no held-out fit predicts that group and the held-out likelihood
         // ranks the explaining singles by how they mispredict it: they are ranked by their
-        // full-data AICc instead (docs/diagnosis.md, "Seen in one test").
+        // full-data AICc instead (docs/results/diagnosis.md, "Seen in one test").
         let c = &singles[first];
         let best =
             if c.only_partly(&nominal, emulator) && carried_by_one_group(problem, c).is_some() {

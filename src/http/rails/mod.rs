@@ -40,7 +40,7 @@ pub struct MeasurementRequest {
     /// Rear-shoe and rail dimensions of eq. 6.1-6.2 (thesis Figures 6.29, 6.30), mm, as an
     /// object of named fields (a positional array is refused: its order is not documented).
     /// Checked for assembly: shoe head wider than the rail slot, neck narrower than it, each
-    /// value in its plausible range (docs/launcher-dimensions.md).
+    /// value in its plausible range (docs/reference/launcher-dimensions.md).
     #[serde(deserialize_with = "named_dimensions")]
     pub dimensions_mm: LauncherDimensions,
     /// Who measured (name or badge), 1-200 characters.

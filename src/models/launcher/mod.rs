@@ -9,7 +9,7 @@
 //! and faces that can meet (every piece of a contact is tested against every face of it):
 //! - shoe heads against the lip tops (floor), the chamber roof and the two chamber walls. The
 //!   neck is left out: eq. 6.1 makes the neck's slot clearance equal to the head's chamber
-//!   clearance (`docs/launcher-dimensions.md`), so the head walls carry the transverse contact,
+//!   clearance (`docs/reference/launcher-dimensions.md`), so the head walls carry the transverse contact,
 //!   and an unbounded lip-top plane would swallow a neck that hangs through the slot. Coplanar
 //!   faces (left and right lip tops) are used once, or the weight would be carried twice;
 //! - the front pad against the rail's bottom face;
@@ -73,7 +73,7 @@ pub const CONTACT_NAMES: [&str; 5] = [
 /// exactly. The contact-point lattice is not converged on the launcher (friction power and
 /// shoe wear move by per cents from 5 to 17 points per edge, and a shoe head over a lip's edge
 /// gets a staircase of the face law); the exact contact is its continuum limit
-/// (docs/performance.md, eleventh and eighteenth passes).
+/// (docs/journal/performance.md, eleventh and eighteenth passes).
 pub const FACE_CONTACT: FaceContact = FaceContact::Exact;
 
 /// Index of the rear leaf spring in `system.forces`.

@@ -23,7 +23,7 @@ use std::sync::Arc;
 /// How the rattle box's faces are resolved when a case does not say (`simulation.face_contact`):
 /// the contact-point lattice, converged here at 3 points per edge (friction power and wear
 /// within 0.06 % of the exact contact at the default 5) at about a third of the exact
-/// contact's cost (docs/performance.md, tenth and fourteenth passes).
+/// contact's cost (docs/journal/performance.md, tenth and fourteenth passes).
 pub const FACE_CONTACT: FaceContact = FaceContact::Lattice;
 
 /// Wall thickness of the rattle-box tube, m (estimate: 1/8 in; it only sets how far each

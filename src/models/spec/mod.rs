@@ -14,7 +14,7 @@
 //! ADAMS units (N, mm, s) and converted with [`ContactSpec::to_impact_params`]; friction is the
 //! engine's own [`FrictionParams`](crate::physics::friction::FrictionParams), read from and
 //! written to mm/s by [`in_mm_per_s`](crate::physics::friction::in_mm_per_s). Values the thesis
-//! does not give are engineering estimates, flagged `estimate` in `docs/models.md`.
+//! does not give are engineering estimates, flagged `estimate` in `docs/reference/models.md`.
 
 use crate::field_error::FieldError;
 use launcher::LauncherSpec;

@@ -176,32 +176,32 @@ pub struct SimulationSpec {
     #[serde(default = "default_record_interval_s")]
     pub record_interval_s: f64,
     /// Relative tolerance on each step's dissipated and drive work, dimensionless (the energy
-    /// account's quadrature, docs/models.md "Energy account"): each step's quadrature error
+    /// account's quadrature, docs/reference/models.md "Energy account"): each step's quadrature error
     /// within this share of its work plus a step's work at the run's mean power. Default 10 ×
     /// `rel_tolerance` (1e-3): the account closes within 0.5 % of the throughput
-    /// (docs/performance.md, twenty-first pass). 0 switches the check off (the account is
+    /// (docs/journal/performance.md, twenty-first pass). 0 switches the check off (the account is
     /// still kept, by the same quadrature, and may not close).
     #[serde(default)]
     pub energy_rel_tolerance: Option<f64>,
     /// Which state entries the implicit integrators' local error test weighs: `full` (default;
     /// positions, rotations, velocities, angular velocities) or `positions` (poses only, the
     /// analogue of ADAMS WSTIFF-I3: velocities in conditional accuracy). The energy account's
-    /// work test (`energy_rel_tolerance`) applies in both. docs/performance.md, seventh pass.
+    /// work test (`energy_rel_tolerance`) applies in both. docs/journal/performance.md, seventh pass.
     #[serde(default)]
     pub error_control: crate::physics::integrator::ErrorControl,
-    /// Contact points per box edge (docs/models.md "Contact formulation"): each face of a
+    /// Contact points per box edge (docs/reference/models.md "Contact formulation"): each face of a
     /// rounded box is resolved by `n × n` points whose stiffness shares sum to the thesis' face
     /// law. Default 5 (25 per face); more points resolve rocking and edge contacts more finely
     /// at a proportional cost in contact evaluation; range 2 (corners only) to 33.
     #[serde(default = "default_contact_points_per_edge")]
     pub contact_points_per_edge: usize,
-    /// How rounded boxes' faces are resolved (docs/models.md "Exact face contact"): `lattice`
+    /// How rounded boxes' faces are resolved (docs/reference/models.md "Exact face contact"): `lattice`
     /// (`contact_points_per_edge` points per edge) or `exact` (each face integrated over its
     /// pressed polygon, exact for the IMPACT force, torque and stored energy at an integer
     /// exponent; `contact_points_per_edge` then unused by boxes). Absent: the model's own
     /// default, `exact` for launchers (the lattice is not converged there) and `lattice` for
     /// rattle boxes (converged at 3 points per edge, about a third of the exact contact's
-    /// cost); docs/performance.md, eighteenth pass.
+    /// cost); docs/journal/performance.md, eighteenth pass.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub face_contact: Option<crate::physics::contact::FaceContact>,
 }

@@ -3,7 +3,7 @@
 //!
 //! [`crate::physics::impact_map`] carries one contact's normal transient with the rest of the system
 //! frozen. On the rattle boxes that misses 1.5-2.3 % of `∫N|v_slip| dt`: while the wall arrests
-//! the cube, the floor's load rises, and a frozen floor cannot show it (docs/models.md, "Where
+//! the cube, the floor's load rises, and a frozen floor cannot show it (docs/reference/models.md, "Where
 //! position-only error control's difference comes from"). Here the whole body moves instead:
 //! its six degrees of freedom (position, unit quaternion, world velocity, body-frame angular
 //! velocity, as in [`crate::physics::system`]) under gravity, its force elements and every contact it
@@ -57,7 +57,7 @@ pub struct BodyTransientSettings {
     /// penetration (21 µm), so the contact forces are as accurate as the velocities.
     pub position_tolerance_m: f64,
     /// Length of the transient, s. Default 2e-5 s: the rattle boxes' arrests end within
-    /// 1e-6..1e-5 s (docs/models.md).
+    /// 1e-6..1e-5 s (docs/reference/models.md).
     pub horizon_s: f64,
     /// Most step attempts (accepted and rejected) before [`TransientEnd::StepLimit`].
     /// Default 1e5.

@@ -1,4 +1,4 @@
-//! The exactly integrated face contact (issue 27; docs/models.md "Exact face contact"): a
+//! The exactly integrated face contact (issue 27; docs/reference/models.md "Exact face contact"): a
 //! rounded box's faces resolved by the continuum the contact-point lattice converges to,
 //! integrated over each pressed polygon by a rule exact for the IMPACT law's polynomial
 //! densities ([`crate::geometry::face_patch`]).
@@ -34,19 +34,19 @@ pub enum FaceContact {
     /// Each face integrated over its pressed polygon with a Gauss rule exact for the IMPACT
     /// law's force, torque and stored energy (integer exponent), and over the strips beyond a
     /// bounded face's sides with a 5 × 5 rule: the lattice's limit of infinitely many points
-    /// (docs/models.md "Exact face contact").
+    /// (docs/reference/models.md "Exact face contact").
     Exact,
     /// The exact face contact with the clamp-free parts of each pressed polygon (the closing
     /// core and damping ramp) in closed form and their friction per part where its a-priori
     /// estimate is within the contact's tolerance, the exact contact's nodes elsewhere
-    /// (`reduced.rs`; docs/models.md "Reduced face law").
+    /// (`reduced.rs`; docs/reference/models.md "Reduced face law").
     Reduced,
 }
 
 /// Where the exact face contact evaluates friction. Cases always use [`FrictionRule::PerNode`];
 /// the other rule is a measurement of the cheaper friction that issue 27's cost target would
 /// need (`railwear-bench face-states` and `convergence --faces .. --friction-per-part`,
-/// docs/performance.md twentieth pass), with its own Jacobian (`Contact::end_lump`).
+/// docs/journal/performance.md twentieth pass), with its own Jacobian (`Contact::end_lump`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FrictionRule {
     /// Every quadrature node is a point of the per-material-point law, friction included.
@@ -86,7 +86,7 @@ const FACING: (f64, f64) = (0.3, 0.5);
 /// faces are then pressed in slivers at most `w` high along at most `P`: of a facing face
 /// pressed whole they carry about `w P / ((e + 1) A)` of the load. A face pressed in part
 /// (tilted, or over a lip's edge) gives them more, so what the matrix loses is measured as
-/// Newton's contraction (docs/models.md "The Newton matrix leaves out the side faces"); beyond
+/// Newton's contraction (docs/reference/models.md "The Newton matrix leaves out the side faces"); beyond
 /// the gate (a degenerate or narrow face, a deep press) every node is linearized.
 const SIDE_SHARE_MAX: f64 = 0.02;
 

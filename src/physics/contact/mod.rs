@@ -1,5 +1,5 @@
 //! Contact between a body's convex pieces and another body's planar faces (thesis 2.5, 6.5;
-//! SPEC §2 "Passivity"; docs/models.md "Contact formulation").
+//! SPEC §2 "Passivity"; docs/reference/models.md "Contact formulation").
 //!
 //! Each piece carries fixed contact points on its surface ([`crate::geometry::lattice`]): small
 //! balls whose stiffness and damping shares `β` sum to 1 over any face of the piece. Every
@@ -15,7 +15,7 @@
 //! - a face pressed uniformly by `w` gives `Σ β k w^e = k w^e`, the thesis' law for the face.
 //!
 //! With [`FaceContact::Exact`] a rounded box's faces are instead integrated over their pressed
-//! polygons (the lattice's limit; `face.rs`, docs/models.md "Exact face contact"): its
+//! polygons (the lattice's limit; `face.rs`, docs/reference/models.md "Exact face contact"): its
 //! quadrature nodes are points of the same law (`point.rs`).
 //!
 //! Each touching (piece, face) pair is one track: its normal force is the points' sum, its
@@ -229,7 +229,7 @@ pub enum JacobianScope {
     /// (turned more than 72.5° from the plane) while they are pressed in slivers, and takes a
     /// facing face's strips beyond a bounded face's side on 9 nodes instead of 50 (per-node
     /// friction). Every force is still evaluated at every node; only derivatives are left out.
-    /// What that costs Newton is its contraction, measured and bounded in docs/models.md "The
+    /// What that costs Newton is its contraction, measured and bounded in docs/reference/models.md "The
     /// Newton matrix leaves out the side faces".
     NewtonMatrix,
 }

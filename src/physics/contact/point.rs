@@ -1,5 +1,5 @@
 //! One contact point's IMPACT force and Coulomb friction (the per-material-point law of
-//! docs/models.md "Contact formulation"), and a track's sums over its points: shared by the
+//! docs/reference/models.md "Contact formulation"), and a track's sums over its points: shared by the
 //! contact-point lattice and the exactly integrated face contact, whose quadrature nodes are
 //! points of the same law ([`super::face`]).
 

@@ -1,4 +1,4 @@
-//! The reduced-order face law (`face_contact = "reduced"`, docs/models.md "Reduced face
+//! The reduced-order face law (`face_contact = "reduced"`, docs/reference/models.md "Reduced face
 //! law"): the exact face contact ([`super::face`]) with every part of a pressed polygon
 //! taking one friction at its load centre where a computable bound says it is within the
 //! contact's tolerance of the per-material-point law, and the parts where the IMPACT density

@@ -75,7 +75,7 @@ const SD_GAMMA: f64 = 1.0 - 1.0 / SQRT2;
 
 /// Alexander's two-stage L-stable SDIRK of order 2, with the first-order estimate
 /// `hγ (k2 - k1)` for the error. Its energy account stays on the trapezoid rule. Measured on
-/// rattle box C (settle 0.5 s + 2 s, docs/performance.md, fourteenth pass): the trapezoid
+/// rattle box C (settle 0.5 s + 2 s, docs/journal/performance.md, fourteenth pass): the trapezoid
 /// leaves 1.3 % of the throughput unaccounted; its own quadrature `b = (0, 1 - γ, γ)` without
 /// the work test 52 %, with it 0 failures but 25x TR-BDF2's accepted steps.
 pub(super) const SDIRK2: DirkTableau = DirkTableau {

@@ -163,7 +163,7 @@ pub struct Integrator {
 /// The energy account's throughput over the accepted steps so far: the work test's per-time
 /// floor ([`Tolerances::energy_rel`]).
 ///
-/// The account is judged against the run's throughput (docs/models.md "Energy account"), so
+/// The account is judged against the run's throughput (docs/reference/models.md "Energy account"), so
 /// a step's allowance is `energy_rel` of its own work plus that of a step of the same size at
 /// the run's mean power: the allowances sum to at most `2 energy_rel` of the throughput, and a
 /// step that does little work (a light slide, a cube in flight) is no longer held to a
@@ -354,7 +354,7 @@ impl Integrator {
     /// refreshed at `z` ([`MultibodySystem::refresh_patches`]). `Δz` is Newton's last update,
     /// so the tracks and powers lie within it of the accepted state; the derivative, which the
     /// next step's stages integrate, is off by its square. This replaces an evaluation of every
-    /// contact at the accepted state (docs/performance.md, twenty-third pass).
+    /// contact at the accepted state (docs/journal/performance.md, twenty-third pass).
     fn start_from_last_iterate(
         &mut self,
         sys: &MultibodySystem,

@@ -1,6 +1,6 @@
 //! The carrier: the kinematic body that carries a model's excitation (the launcher's rail, the
 //! rattle box's tube), whose rigid motion the integrators take out of each dynamic body's
-//! position and velocity before they apply the relative tolerance (docs/performance.md,
+//! position and velocity before they apply the relative tolerance (docs/journal/performance.md,
 //! twenty-second pass).
 
 use super::*;

@@ -39,7 +39,7 @@ impl Emulator {
     }
 
     /// Tables `a` at `ma` and `b` at `mb` together: the product of their ratios times an
-    /// interaction the joint simulations measure (docs/diagnosis.md, "Two dynamics effects
+    /// interaction the joint simulations measure (docs/results/diagnosis.md, "Two dynamics effects
     /// together"). With `u`, `v` each magnitude over its bound, the interaction of a quantity
     /// is `exp(u v h(u, v))` (a product that is 0 at the joint points: `+ u v h`), where
     /// `h_i = ln(joint_i / product_i) / (u_i v_i)` at each joint point is interpolated by

@@ -129,7 +129,7 @@ pub struct JointPoint {
     /// The simulated predictions.
     pub predictions: TestPredictions,
     /// The same two effects entering the excitation [`SETTLE_SHIFT_S`] later: the spread of
-    /// a window's wear over initial states with both on (docs/diagnosis.md, "Two dynamics
+    /// a window's wear over initial states with both on (docs/results/diagnosis.md, "Two dynamics
     /// effects together"). Two effects together may make the motion depend on the state it
     /// starts from where neither alone does; None in an emulator saved before it was kept.
     #[serde(default)]
