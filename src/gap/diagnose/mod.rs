@@ -29,7 +29,8 @@
 //!    is then judged again leave-one-increment-out, and an effect that passes there is named
 //!    `partly_explained` (confirmed within that test only).
 //! 5. **How far**: held-out RMS standardized error before and after, the shrink and its
-//!    bootstrap interval, and the fitted magnitude with its profile-likelihood interval.//!
+//!    bootstrap interval, and the fitted magnitude with its profile-likelihood interval.
+//!
 //! The rooms: [`options`] (the options and the constants of the rules), `fit_problem` (the
 //! data, noise model and folds, and each candidate's fit), `candidate` (one candidate's
 //! numbers and the explaining rule), `verdict` (the verdict from the candidates), `one_group`
