@@ -76,8 +76,8 @@ async fn invalid_job_parameters_are_422_naming_the_field_and_store_nothing() {
             ("overrides an array", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":[1,2]}}"#), "params.overrides", None),
             ("params typo", raw(r#"{"kind":"simulate","params":{"confg":"rattle-box-c"}}"#), "params.confg", None),
             ("no config", raw(r#"{"kind":"simulate","params":{"seed":3}}"#), "params.config", None),
-            // Names the directory searched.
-            ("config not a model", raw(r#"{"kind":"simulate","params":{"config":"service"}}"#), "params.config", Some("configs")),
+            // Names the configs that exist (not the server's path to them).
+            ("config not a model", raw(r#"{"kind":"simulate","params":{"config":"service"}}"#), "params.config", Some("rattle-box-c")),
             ("unknown config", raw(r#"{"kind":"simulate","params":{"config":"no-such-case"}}"#), "params.config", None),
             ("seed 2^53", raw(r#"{"kind":"simulate","params":{"config":"rattle-box-c","seed":9007199254740992}}"#), "params.seed", None),
             // Sweeps: point counts, launcher-only, labels that must select something real.
