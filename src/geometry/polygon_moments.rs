@@ -265,7 +265,7 @@ impl PolygonMoments {
     /// boundaries `lo(u)`, `hi(u)` are straight, so `∫_lo^hi (v − v₀)^b dv` is a polynomial of
     /// degree `b + 1` in `u` and the slice's integrand is `e^{iθ(u)}` times a polynomial of
     /// degree <= 4, whose antiderivative is elementary (repeated integration by parts; a
-    /// slice whose phase span is below [`PHASE_SPAN_MIN`] takes a 5-point Gauss rule, within
+    /// slice whose phase span is below `PHASE_SPAN_MIN` takes a 5-point Gauss rule, within
     /// about 1e-11 of it).
     pub fn of_phase(verts: &[[f64; 2]], theta0: f64, beta: f64) -> (Self, Self) {
         let origin = verts.first().copied().unwrap_or([0.0; 2]);

@@ -12,7 +12,7 @@ use crate::gap::effects::ParameterInfo;
 pub const UNIDENTIFIED_SHARE: f64 = 0.9;
 
 /// Whether a parameter is tabulated on a log scale: positive bounds more than a factor 20
-/// apart (the scale the profile's values are spread on, [`super::secondary_values`]).
+/// apart (the scale the profile's values are spread on, `super::secondary_values`).
 pub fn log_scale(p: &ParameterInfo) -> bool {
     p.min > 0.0 && p.max / p.min > 20.0
 }

@@ -36,7 +36,7 @@
 //! numbers and the explaining rule), `verdict` (the verdict from the candidates), `one_group`
 //! (an effect one held-out group carries), `how_far`, `pairs` and `pair_search`, `refine`
 //! (adaptive refinement) and `run` (the whole diagnosis from a campaign); the [`emulator`]
-//! and the [`bench`] are rooms of their own.
+//! and the `bench` are rooms of their own.
 
 pub mod bench;
 pub mod budget;

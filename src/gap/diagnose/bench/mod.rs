@@ -4,8 +4,8 @@
 //! dynamics effect with a wear-law effect and of two dynamics effects, the rig-only effects,
 //! two noise levels), each diagnosed without its truth, then scored against the truth.
 //!
-//! The bench's rooms: [`scenarios`] draws the campaigns, [`detectability`] measures what the
-//! data could show, [`run`](mod@run) diagnoses each campaign, [`scores`] scores the answers.
+//! The bench's rooms: `scenarios` draws the campaigns, `detectability` measures what the
+//! data could show, `run` diagnoses each campaign, `scores` scores the answers.
 //!
 //! A **wrong name** is a confident name that is not the truth: an `explained` verdict naming
 //! an effect the rig did not inject (any name, for a control or a rig-only effect). A pair is
@@ -209,7 +209,7 @@ pub struct Outcome {
     pub flagged: Vec<String>,
     /// The truth simulated in the emulator at its drawn values and scored on the campaign
     /// (library effects only): whether the library's model of the truth itself fits within
-    /// the noise ([`truth_fit`]).
+    /// the noise (`truth_fit`).
     #[serde(default)]
     pub truth_fit: Option<TruthFit>,
     /// A pair: the lowest AICc the diagnosis found for either member alone. The pair is
