@@ -199,6 +199,30 @@ fn facing_share(facing: f64) -> f64 {
 }
 
 impl Contact {
+    /// The normal-force density of a clamped part along its `u` (the part is turned along `w`:
+    /// `w` depends on `u` alone, `ẇ` is affine): at `u`, the density at `v = 0` and its slope
+    /// in `v`, zero where the part does not press. What
+    /// [`FacePatch::for_each_node_clamped`] cuts at.
+    pub(super) fn clamped_density<'a>(
+        &'a self,
+        part: &FacePatch,
+        fa: &BodyFrame,
+        fb: &BodyFrame,
+        radius: f64,
+        normal: &Vector3<f64>,
+    ) -> impl Fn(f64) -> (f64, f64) + 'a {
+        let depth = part.depth();
+        let rate = penetration_rate(part, fa, fb, radius, normal);
+        move |u: f64| {
+            let w = depth.at([u, 0.0]);
+            if w <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let (spring, damping) = self.impact.force_parts(w);
+            let r0 = rate.at([u, 0.0]);
+            (spring + damping * r0, damping * (rate.at([u, 1.0]) - r0))
+        }
+    }
     /// The pressed polygon `patch` cut where the per-point normal force
     /// `max(0, k w^e + c STEP(w, 0, 0, d, 1) ẇ)` changes form, each part with its rule (`None`:
     /// the patch rule). `w` and `ẇ` are affine in `ξ` (a rigid
@@ -555,18 +579,7 @@ impl Contact {
             }
             PartRule::Fixed(rule) => part.for_each_node(rule, &mut visit),
             PartRule::Clamped(rule) => {
-                // Turned along `w`: `w` depends on `u` alone, `ẇ` is affine.
-                let depth = part.depth();
-                let rate = penetration_rate(part, fa, fb, radius, &normal);
-                let sign = |u: f64| {
-                    let w = depth.at([u, 0.0]);
-                    if w <= 0.0 {
-                        return (0.0, 0.0);
-                    }
-                    let (spring, damping) = self.impact.force_parts(w);
-                    let r0 = rate.at([u, 0.0]);
-                    (spring + damping * r0, damping * (rate.at([u, 1.0]) - r0))
-                };
+                let sign = self.clamped_density(part, fa, fb, radius, &normal);
                 part.for_each_node_clamped(rule, sign, &mut visit);
             }
         }

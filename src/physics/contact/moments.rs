@@ -91,6 +91,24 @@ pub(super) struct PartDensities {
     pub(super) f1: Vector3<f64>,
 }
 
+impl PartDensities {
+    /// No density yet, about `origin` with `normal`: what a part's sums start from.
+    pub(super) fn empty(origin: Point3<f64>, normal: Vector3<f64>) -> Self {
+        Self {
+            origin,
+            normal,
+            a0: 0.0,
+            a1: Vector3::zeros(),
+            a2: Matrix3::zeros(),
+            b0: 0.0,
+            b1: Vector3::zeros(),
+            b2: Matrix3::zeros(),
+            f0: 0.0,
+            f1: Vector3::zeros(),
+        }
+    }
+}
+
 /// `M [q]×`, row by row `(m_i × q)ᵀ`: the same sums as nalgebra's product with
 /// `q.cross_matrix()` in the same order, without the products with its zeros (bit for bit up
 /// to the sign of a zero).
@@ -398,18 +416,7 @@ mod tests {
         per_node.add(&first);
         per_part.add(&first);
         let origin = Point3::new(0.05, -0.01, 0.02);
-        let mut part = PartDensities {
-            origin,
-            normal: n,
-            a0: 0.0,
-            a1: Vector3::zeros(),
-            a2: Matrix3::zeros(),
-            b0: 0.0,
-            b1: Vector3::zeros(),
-            b2: Matrix3::zeros(),
-            f0: 0.0,
-            f1: Vector3::zeros(),
-        };
+        let mut part = PartDensities::empty(origin, n);
         for i in 0..23 {
             let x = i as f64;
             let p = Point3::new(

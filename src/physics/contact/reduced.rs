@@ -467,31 +467,10 @@ impl Contact {
             return false;
         }
         let offset = face.plane.offset;
-        let depth = part.depth();
-        let rate = penetration_rate(part, fa, fb, radius, &normal);
-        let sign = |u: f64| {
-            let w = depth.at([u, 0.0]);
-            if w <= 0.0 {
-                return (0.0, 0.0);
-            }
-            let (spring, damping) = self.impact.force_parts(w);
-            let r0 = rate.at([u, 0.0]);
-            (spring + damping * r0, damping * (rate.at([u, 1.0]) - r0))
-        };
+        let sign = self.clamped_density(part, fa, fb, radius, &normal);
         let (centre, _, _) = part.frame();
         let origin = centre - normal * radius;
-        let mut d = PartDensities {
-            origin,
-            normal,
-            a0: 0.0,
-            a1: Vector3::zeros(),
-            a2: Matrix3::zeros(),
-            b0: 0.0,
-            b1: Vector3::zeros(),
-            b2: Matrix3::zeros(),
-            f0: 0.0,
-            f1: Vector3::zeros(),
-        };
+        let mut d = PartDensities::empty(origin, normal);
         let (mut energy, mut damping_power) = (0.0, 0.0);
         let linearizing = out.linearizing();
         part.for_each_node_clamped(rule, sign, &mut |x, share| {
