@@ -67,10 +67,17 @@ pub fn replacement_for(head: &[u8]) -> Option<Vec<u8>> {
         _ => "the request was refused before it reached the service",
     };
     let problem = Problem::new(status, "bad-request-head", "Malformed request head", detail);
-    let body = serde_json::to_vec(&problem).ok()?;
+    closing_answer(status_line, &problem, "")
+}
+
+/// A whole HTTP/1.1 answer carrying `problem` as problem+json under `status_line`, with the
+/// header lines `extra` (each ending in CRLF), that closes the connection: for answers written
+/// below axum (hyper's refusals here, the connection caps in [`super::server`]).
+pub(super) fn closing_answer(status_line: &str, problem: &Problem, extra: &str) -> Option<Vec<u8>> {
+    let body = serde_json::to_vec(problem).ok()?;
     let mut out = format!(
         "{status_line}\r\ncontent-type: application/problem+json\r\ncontent-length: {}\r\n\
-         connection: close\r\n\r\n",
+         {extra}connection: close\r\n\r\n",
         body.len()
     )
     .into_bytes();

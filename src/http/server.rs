@@ -14,7 +14,7 @@
 //!   `Retry-After` and `Connection: close`, written before anything is read (a server may answer
 //!   early), within a short write deadline so a client that does not read cannot hold the task.
 
-use super::connection::ProblemIo;
+use super::connection::{closing_answer, ProblemIo};
 use super::problem::{BodyDeadlinePassed, Problem};
 use axum::extract::Request;
 use axum::http::StatusCode;
@@ -121,18 +121,13 @@ fn admit(census: &Arc<Mutex<Census>>, peer: IpAddr, limits: &Limits) -> Result<A
 
 /// The whole HTTP/1.1 answer for a refused connection.
 fn refusal_bytes(problem: &Problem) -> Vec<u8> {
-    let body = serde_json::to_vec(problem).unwrap_or_default();
     let status = StatusCode::from_u16(problem.status).unwrap_or(StatusCode::SERVICE_UNAVAILABLE);
-    let mut out = format!(
-        "HTTP/1.1 {} {}\r\ncontent-type: application/problem+json\r\ncontent-length: {}\r\n\
-         retry-after: 1\r\nconnection: close\r\n\r\n",
+    let status_line = format!(
+        "HTTP/1.1 {} {}",
         status.as_u16(),
-        status.canonical_reason().unwrap_or(""),
-        body.len()
-    )
-    .into_bytes();
-    out.extend_from_slice(&body);
-    out
+        status.canonical_reason().unwrap_or("")
+    );
+    closing_answer(&status_line, problem, "retry-after: 1\r\n").unwrap_or_default()
 }
 
 async fn refuse(mut stream: TcpStream, problem: Problem) {
