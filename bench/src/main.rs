@@ -24,19 +24,15 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
-mod body_hybrid;
 mod budget;
 mod convergence;
 mod engine;
 mod face_states;
 mod faces;
-mod impact_map;
-mod impact_split;
 mod launcher;
 mod load;
 mod missiles;
 mod peers;
-mod supported_hybrid;
 mod sweep;
 mod sweep_procs;
 mod table;
@@ -44,7 +40,6 @@ mod table;
 use budget::*;
 use convergence::*;
 use engine::*;
-use impact_map::*;
 use launcher::*;
 use load::*;
 use missiles::*;
@@ -141,51 +136,6 @@ enum Command {
         /// Windows (s) of the duration-linearity table, comma list (empty: no table).
         #[arg(long, default_value = "")]
         durations: String,
-    },
-    /// Issue 28's contact-local impulse map: CPU cost of one evaluation (median over batches).
-    ImpactMap {
-        /// Timed batches (the median is reported).
-        #[arg(long, default_value_t = 201)]
-        batches: usize,
-        /// Evaluations per batch.
-        #[arg(long, default_value_t = 20)]
-        per_batch: usize,
-    },
-    /// Issue 28's study: where position-only error control's difference in friction power
-    /// comes from, split into each contact's approach transient after touch and the rest.
-    ImpactSplit {
-        /// Cases (config names, comma list).
-        #[arg(long, default_value = "rattle-box-c")]
-        cases: String,
-        /// Settle time, s.
-        #[arg(long, default_value_t = 0.5)]
-        settle: f64,
-        /// Averaging window after the settle, s.
-        #[arg(long, default_value_t = 8.0)]
-        window: f64,
-        /// Approach window after each touch, µs.
-        #[arg(long, default_value_t = 10.0)]
-        window_us: f64,
-        /// |ẇ| above which a step counts as fast normal motion, m/s.
-        #[arg(long, default_value_t = 1e-3)]
-        fast_rate: f64,
-        /// Only the hybrids' comparison: the full run for its touches, the resolved restarts
-        /// from the touch and the two hybrids (map, body transient) in full control.
-        #[arg(long)]
-        hybrid_only: bool,
-        /// The body transient's relative tolerance.
-        #[arg(long, default_value_t = 1e-8)]
-        transient_rtol: f64,
-        /// The body transient's horizon, µs (the map's is 20 µs).
-        #[arg(long, default_value_t = 20.0)]
-        transient_horizon_us: f64,
-        /// The supported map's supports without the frozen rotation's velocity offset (the
-        /// cube translating: each support point moves with the touching point).
-        #[arg(long)]
-        supports_translating: bool,
-        /// The supported map's relative tolerance.
-        #[arg(long, default_value_t = 1e-10)]
-        supported_rtol: f64,
     },
     /// Issue 16's error-control decision: user quantities (friction power, wear rate and
     /// above-cutoff share per contact, response PSD in 1/3-octave bands to 500 Hz) at the
@@ -533,33 +483,6 @@ fn main() -> Result<()> {
                 settle: *settle,
                 window: *window,
                 every: *every,
-            },
-        )?,
-        Command::ImpactMap { batches, per_batch } => impact_map_cost(*batches, *per_batch)?,
-        Command::ImpactSplit {
-            cases,
-            settle,
-            window,
-            window_us,
-            fast_rate,
-            hybrid_only,
-            transient_rtol,
-            transient_horizon_us,
-            supports_translating,
-            supported_rtol,
-        } => impact_split::impact_split(
-            &cli.configs_dir,
-            &impact_split::ImpactSplitBench {
-                cases: cases.clone(),
-                settle: *settle,
-                window: *window,
-                approach_s: *window_us * 1e-6,
-                fast_rate_m_s: *fast_rate,
-                hybrid_only: *hybrid_only,
-                transient_rtol: *transient_rtol,
-                transient_horizon_s: *transient_horizon_us * 1e-6,
-                supports_translating: *supports_translating,
-                supported_rtol: *supported_rtol,
             },
         )?,
         Command::Missiles {

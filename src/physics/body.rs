@@ -169,30 +169,3 @@ pub fn write_state(
     s[7..10].copy_from_slice(velocity.as_slice());
     s[10..13].copy_from_slice(wb.as_slice());
 }
-
-/// Effective mass of one free rigid body at a point along a direction, kg: `1 / (u·K u)` with
-/// `K = I₃/m − [r]× I_w⁻¹ [r]×` the body's inverse mass seen at the point (the velocity change
-/// there per unit impulse), `r` the lever arm from the centre of mass to the point and `I_w` the
-/// inertia in world axes (`rotation` takes body axes to world). `direction` need not be unit
-/// length. None when the inertia is singular or the direction is zero or not finite.
-///
-/// This is the mass a single touching point meets. A face that lands flat engages all its
-/// points within the damping ramp, which locks the rotation: the pressed patch then meets the
-/// body's translational mass `m` (docs/reference/models.md, "Where position-only error control's
-/// difference comes from": on the rattle boxes the impulse map
-/// ([`super::impact_map`]) with `m` reproduces the resolved arrests
-/// to 0.1 %, with the first point's mass it misses them by 40 %).
-pub fn effective_mass(
-    mass: &MassProperties,
-    rotation: &UnitQuaternion<f64>,
-    lever_arm: &Vector3<f64>,
-    direction: &Vector3<f64>,
-) -> Option<f64> {
-    let u = direction.try_normalize(0.0)?;
-    let r = rotation.to_rotation_matrix();
-    let inverse_inertia = r.matrix() * mass.inertia.try_inverse()? * r.matrix().transpose();
-    let skew = lever_arm.cross_matrix();
-    let k: Matrix3<f64> = Matrix3::identity() / mass.mass - skew * inverse_inertia * skew;
-    let inverse = u.dot(&(k * u));
-    (inverse.is_finite() && inverse > 0.0).then(|| 1.0 / inverse)
-}

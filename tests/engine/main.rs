@@ -1,7 +1,6 @@
 //! The engine test binary: physics, models, the gap diagnosis, checkpoints, closed forms, energy
 //! and error control, called as a library (no HTTP, no store). One module per concern.
 
-mod body_transient;
 mod carrier_frame;
 mod checkpoint_resume;
 mod cli_errors;
@@ -21,11 +20,9 @@ mod gap_diagnose_simulated;
 mod gap_effects;
 mod gap_mechanisms;
 mod gap_rig;
-mod impact_map;
 mod launcher_model;
 mod launcher_trend;
 mod multi_missile;
 mod newton_matrix;
 mod rattle_box;
 mod step_diagnostics;
-mod supported_impact_map;

@@ -2,7 +2,51 @@
 //! implicit methods (whose tableaus and stage loop are in `dirk.rs`).
 
 use super::*;
-use crate::physics::local_dopri5::{DOPRI5_A, DOPRI5_E};
+
+/// Coupling coefficients `a_ij` of the Dormand–Prince tableau (Hairer, Nørsett & Wanner,
+/// *Solving ODEs I*, II.5); the last row is the fifth-order weights (FSAL). The nodes `c_i` are
+/// in `attempt_dopri5` below.
+const DOPRI5_A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+
+/// Fifth- minus fourth-order weights: the embedded local error estimate `h Σ e_i k_i`.
+const DOPRI5_E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
 
 impl Integrator {
     /// The energy account's quadrature error on this attempt over its tolerance
