@@ -64,6 +64,17 @@ pub fn run(
         report.wall_s,
         end / report.wall_s.max(1e-9)
     );
+    let w = report.rate_window;
+    println!(
+        "rates and means over {:.3} s from t = {:.3} s ({})",
+        w.length_s,
+        w.start_s,
+        if w.after_ramp {
+            "after the excitation's ramp-in"
+        } else {
+            "ramp-in included: the run ends before its ramp does"
+        }
+    );
     println!(
         "mean normal force {:.4} N, mean friction power {:.5} W (dissipated), mean N·|v_slip| {:.5} W (what the wear law integrates)",
         report.mean_normal_force_n, report.mean_friction_power_w, report.mean_normal_slip_power_w

@@ -29,7 +29,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// Version of the checkpoint layout; bump it whenever a checkpointed type changes shape.
-pub const CHECKPOINT_FORMAT: u32 = 1;
+pub const CHECKPOINT_FORMAT: u32 = 2;
 
 /// Largest checkpoint decoded, bytes (after decompression): a guard against a corrupt length.
 const MAX_DECODED_BYTES: u64 = 4 << 30;

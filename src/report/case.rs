@@ -81,6 +81,7 @@ fn package_parts(
         },
         "simulated_s": simulated,
         "window_s": r.window_s,
+        "rate_window": r.rate_window,
         "mean_normal_force_n": r.mean_normal_force_n,
         "mean_normal_slip_power_w": r.mean_normal_slip_power_w,
         "mean_friction_power_w": r.mean_friction_power_w,

@@ -338,6 +338,7 @@ pub fn build(
     spec: &LauncherSpec,
     motion: BaseMotion,
 ) -> Result<BuiltModel, RunError> {
+    let rate_start_s = BuiltModel::rate_start(case.simulation.settle_s, &motion);
     let d = &spec.dimensions;
     let m = &spec.missile;
     let inertia = m.inertia_kg_m2();
@@ -638,6 +639,7 @@ pub fn build(
         system,
         initial_state: y,
         excitation_start_s: case.simulation.settle_s,
+        rate_start_s,
         end_time_s: case.simulation.settle_s + case.simulation.duration_s,
         contact_materials: vec![(mat, mat); 5 * stations],
         response_body: MISSILE,

@@ -42,6 +42,7 @@ pub fn wall(inward: Vector3<f64>, distance_from_origin: f64) -> HalfSpace {
 /// Builds the rattle box system. The cube starts resting on the tube floor at its static
 /// penetration (IMPACT spring alone carrying the weight), centred in the tube.
 pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> BuiltModel {
+    let rate_start_s = BuiltModel::rate_start(case.simulation.settle_s, &motion);
     let side = spec.cube_side_m;
     let half = 0.5 * side;
     let l = 0.5 * spec.tube_inner_side_m;
@@ -139,6 +140,7 @@ pub fn build(case: &CaseSpec, spec: &RattleBoxSpec, motion: BaseMotion) -> Built
         system,
         initial_state: y,
         excitation_start_s: case.simulation.settle_s,
+        rate_start_s,
         end_time_s: case.simulation.settle_s + case.simulation.duration_s,
         contact_materials: vec![(mat, mat)],
         response_body: 0,

@@ -22,10 +22,14 @@ use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod rate_window;
 mod report;
 mod soundness;
 
+pub use rate_window::RateWindow;
 pub use report::{BodyReport, ContactReport, RunReport};
+
+use rate_window::Cumulative;
 
 use parts::run_parts;
 
@@ -39,12 +43,24 @@ pub struct BuiltModel {
     pub initial_state: Vec<f64>,
     /// Time at which the excitation starts (end of settle), s.
     pub excitation_start_s: f64,
+    /// Start of the rate window: the end of the excitation's ramp-in (settle + ramp), s; the
+    /// run's rates are taken from here to the end ([`RateWindow`]).
+    pub rate_start_s: f64,
     /// End of the run, s.
     pub end_time_s: f64,
     /// Material of body a and body b of each contact (same order as `system.contacts`).
     pub contact_materials: Vec<(Material, Material)>,
     /// Body whose acceleration is reported (spectra, VDV).
     pub response_body: usize,
+}
+
+impl BuiltModel {
+    /// Start of the rate window of a model whose excitation starts at `excitation_start_s`
+    /// and moves its base with `motion`: the end of the motion's ramp-in, not before the
+    /// excitation starts.
+    pub fn rate_start(excitation_start_s: f64, motion: &crate::excitation::BaseMotion) -> f64 {
+        excitation_start_s.max(motion.settle_s() + motion.ramp_s())
+    }
 }
 
 /// How a run is integrated, limited and post-processed.
@@ -137,6 +153,8 @@ struct Observed {
     /// and at the last one, J.
     friction_at_window_start: Option<Vec<f64>>,
     friction_now: Vec<f64>,
+    /// The cumulative quantities at the rate window's start, once the run has passed it.
+    rate_base: Option<Cumulative>,
     tracks_out: Vec<TrackSample>,
     next_record: f64,
     next_resp: f64,
@@ -165,6 +183,7 @@ impl Observed {
             prev_sums: None,
             friction_at_window_start: None,
             friction_now: vec![0.0; ncontacts],
+            rate_base: None,
             tracks_out: Vec::new(),
             next_record: t0,
             next_resp: t0,
@@ -172,6 +191,21 @@ impl Observed {
             prev_vel: None,
             wear_history: Vec::new(),
             next_history: t0,
+        }
+    }
+
+    /// The cumulative quantities now, stamped `t_s` (the last accepted step's time).
+    fn cumulative(&self, t_s: f64) -> Cumulative {
+        Cumulative {
+            t_s,
+            normal: self.normal_int.clone(),
+            normal_slip: self.power_int.clone(),
+            friction: self.friction_now.clone(),
+            volume: self
+                .accs
+                .iter()
+                .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
+                .collect(),
         }
     }
 
@@ -369,6 +403,14 @@ fn run_whole(
             return;
         }
         extra(v);
+        // The step that passes the rate window's start: the cumulative quantities before it,
+        // to be interpolated to the start once this step is added (`rate_window`).
+        let rate_start = model.rate_start_s;
+        let crossing = st.rate_base.is_none() && rate_start > t0 && v.t >= rate_start;
+        let before = match &st.prev_sums {
+            Some((tp, _, _)) if crossing => Some(st.cumulative(*tp)),
+            _ => None,
+        };
         // Friction work over the window: read off the energy account, so the report's friction
         // power is the account's.
         if st.friction_at_window_start.is_none() {
@@ -434,6 +476,13 @@ fn run_whole(
                 }
             }
         }
+        if crossing {
+            let after = st.cumulative(v.t);
+            st.rate_base = Some(match before {
+                Some(b) => b.interpolate_to(&after, rate_start),
+                None => after,
+            });
+        }
         if v.t >= st.next_history {
             st.next_history = v.t + history_dt;
             let vols = st
@@ -494,6 +543,7 @@ fn run_whole(
         peak,
         friction_at_window_start,
         friction_now,
+        rate_base,
         tracks_out,
         resp_vel,
         wear_history,
@@ -525,6 +575,39 @@ fn run_whole(
         );
     }
     let window = (model.end_time_s - t0).max(f64::MIN_POSITIVE);
+    // Rates over the rate window: from the ramp-in's end when the run passed it, else over the
+    // whole excited window (`rate_window`).
+    let rate_base = rate_base.filter(|b| model.end_time_s - b.t_s > 0.0);
+    let rate_window = match &rate_base {
+        Some(b) => RateWindow {
+            start_s: b.t_s,
+            length_s: model.end_time_s - b.t_s,
+            after_ramp: true,
+        },
+        None => RateWindow {
+            start_s: t0,
+            length_s: window,
+            after_ramp: model.rate_start_s <= t0,
+        },
+    };
+    let rate_span = rate_window.length_s.max(f64::MIN_POSITIVE);
+    let over_rate_window = |now: &[f64], base: fn(&Cumulative) -> &Vec<f64>| -> Vec<f64> {
+        match &rate_base {
+            Some(b) => now.iter().zip(base(b)).map(|(n, b)| n - b).collect(),
+            None => now.to_vec(),
+        }
+    };
+    let normal_rate_window = over_rate_window(&normal_int, |b| &b.normal);
+    let normal_slip_rate_window = over_rate_window(&power_int, |b| &b.normal_slip);
+    let friction_rate_window = match &rate_base {
+        Some(b) => friction_now
+            .iter()
+            .zip(&b.friction)
+            .map(|(n, b)| n - b)
+            .collect(),
+        None => friction_window.clone(),
+    };
+    let mut body_rate = vec![0.0; sys.bodies.len()];
     let mut contacts = Vec::with_capacity(ncontacts);
     let mut body_mass = vec![0.0; sys.bodies.len()];
     for (ci, c) in sys.contacts.iter().enumerate() {
@@ -544,7 +627,14 @@ fn run_whole(
         let (wa, wb) = options.volume_split.split(total.volume_m3, ma, mb)?;
         body_mass[c.body_a] += wa.mass_kg;
         body_mass[c.body_b] += wb.mass_kg;
-        let per_h = S_PER_H / window;
+        let rate_volume = match &rate_base {
+            Some(b) => (total.volume_m3 - b.volume[ci]).max(0.0),
+            None => total.volume_m3,
+        };
+        let (ra, rb) = options.volume_split.split(rate_volume, ma, mb)?;
+        let per_h = S_PER_H / rate_span;
+        body_rate[c.body_a] += ra.mass_kg * MG_PER_KG * per_h;
+        body_rate[c.body_b] += rb.mass_kg * MG_PER_KG * per_h;
         contacts.push(ContactReport {
             name: c.name.clone(),
             body_a: sys.bodies[c.body_a].name.clone(),
@@ -552,12 +642,12 @@ fn run_whole(
             work_share_above_cutoff: total.work_share_above_cutoff(),
             mass_a_mg: wa.mass_kg * MG_PER_KG,
             mass_b_mg: wb.mass_kg * MG_PER_KG,
-            mass_rate_mg_per_h: (wa.mass_kg + wb.mass_kg) * MG_PER_KG * per_h,
-            mass_rate_a_mg_per_h: wa.mass_kg * MG_PER_KG * per_h,
-            mass_rate_b_mg_per_h: wb.mass_kg * MG_PER_KG * per_h,
-            mean_normal_force_n: normal_int[ci] / window,
-            mean_normal_slip_power_w: power_int[ci] / window,
-            mean_friction_power_w: friction_window[ci] / window,
+            mass_rate_mg_per_h: (ra.mass_kg + rb.mass_kg) * MG_PER_KG * per_h,
+            mass_rate_a_mg_per_h: ra.mass_kg * MG_PER_KG * per_h,
+            mass_rate_b_mg_per_h: rb.mass_kg * MG_PER_KG * per_h,
+            mean_normal_force_n: normal_rate_window[ci] / rate_span,
+            mean_normal_slip_power_w: normal_slip_rate_window[ci] / rate_span,
+            mean_friction_power_w: friction_rate_window[ci] / rate_span,
             friction_work_j: friction_window[ci],
             peak_normal_force_n: peak[ci],
             wear: total,
@@ -570,7 +660,7 @@ fn run_whole(
         .map(|(i, b)| BodyReport {
             name: b.name.clone(),
             mass_mg: body_mass[i] * MG_PER_KG,
-            mass_rate_mg_per_h: body_mass[i] * MG_PER_KG * S_PER_H / window,
+            mass_rate_mg_per_h: body_rate[i],
         })
         .collect();
     let mut response_acceleration = Vec::with_capacity(resp_vel.len());
@@ -587,12 +677,13 @@ fn run_whole(
         base_acceleration.push(a);
     }
     Ok(RunReport {
-        mean_normal_force_n: normal_int.iter().sum::<f64>() / window,
-        mean_normal_slip_power_w: power_int.iter().sum::<f64>() / window,
-        mean_friction_power_w: friction_window.iter().sum::<f64>() / window,
+        mean_normal_force_n: normal_rate_window.iter().sum::<f64>() / rate_span,
+        mean_normal_slip_power_w: normal_slip_rate_window.iter().sum::<f64>() / rate_span,
+        mean_friction_power_w: friction_rate_window.iter().sum::<f64>() / rate_span,
         contacts,
         bodies,
         window_s: window,
+        rate_window,
         integrator: stats.integrator,
         wall_s: stats.wall_s,
         tracks: tracks_out,

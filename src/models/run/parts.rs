@@ -49,6 +49,7 @@ pub(super) fn run_parts(
             system: part.system.clone(),
             initial_state: part.state_from(&model.system, &model.initial_state),
             excitation_start_s: model.excitation_start_s,
+            rate_start_s: model.rate_start_s,
             end_time_s: model.end_time_s,
             contact_materials: part
                 .contacts
@@ -95,8 +96,10 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
     let mut histories = Vec::new();
     let mut audits = Vec::new();
     let mut window_s = 0.0;
+    let mut rate_window = None;
     for (part, (r, holds_response)) in parts.iter().zip(reports) {
         window_s = r.window_s;
+        rate_window.get_or_insert(r.rate_window);
         for (local, c) in r.contacts.into_iter().enumerate() {
             contacts[part.contacts[local]] = Some(c);
         }
@@ -177,6 +180,11 @@ fn merge_reports(model: &BuiltModel, parts: &[Part], reports: Vec<(RunReport, bo
             })
             .collect(),
         window_s,
+        rate_window: rate_window.unwrap_or(super::RateWindow {
+            start_s: model.excitation_start_s,
+            length_s: window_s,
+            after_ramp: false,
+        }),
         mean_normal_force_n: mean_n,
         mean_normal_slip_power_w: mean_p,
         mean_friction_power_w: mean_friction,

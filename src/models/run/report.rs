@@ -8,7 +8,8 @@ use crate::physics::track::TrackSample;
 use crate::wear::integrate::WearTotals;
 use serde::{Deserialize, Serialize};
 
-/// Wear and loading of one contact over the excitation window.
+/// Wear and loading of one contact: totals over the excitation window, rates and means over
+/// the rate window ([`super::RateWindow`]: after the excitation's ramp-in).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ContactReport {
     /// Contact name.
@@ -26,22 +27,22 @@ pub struct ContactReport {
     pub mass_a_mg: f64,
     /// Wear mass charged to body b, mg.
     pub mass_b_mg: f64,
-    /// Total wear-mass rate of the contact, mg/h.
+    /// Total wear-mass rate of the contact over the rate window, mg/h.
     pub mass_rate_mg_per_h: f64,
     /// Wear-mass rate charged to body a, mg/h.
     pub mass_rate_a_mg_per_h: f64,
     /// Wear-mass rate charged to body b, mg/h.
     pub mass_rate_b_mg_per_h: f64,
-    /// Time-averaged normal force, N.
+    /// Time-averaged normal force over the rate window, N.
     pub mean_normal_force_n: f64,
-    /// Time-averaged normal-load-times-slip power Σ N |v_slip| over the window, W: what the
+    /// Time-averaged normal-load-times-slip power Σ N |v_slip| over the rate window, W: what the
     /// Archard law integrates (wear volume = K/H × this work). Not a dissipated power: friction
     /// dissipates μ times it where the contact slides.
     pub mean_normal_slip_power_w: f64,
-    /// Time-averaged power dissipated by friction over the window, W: the energy account's
-    /// friction work over the window divided by its length.
+    /// Time-averaged power dissipated by friction over the rate window, W: the energy account's
+    /// friction work over the rate window divided by its length.
     pub mean_friction_power_w: f64,
-    /// Work dissipated by friction over the window, J (the energy account's).
+    /// Work dissipated by friction over the excitation window, J (the energy account's).
     pub friction_work_j: f64,
     /// Largest normal force seen, N.
     pub peak_normal_force_n: f64,
@@ -54,7 +55,7 @@ pub struct BodyReport {
     pub name: String,
     /// Wear mass, mg.
     pub mass_mg: f64,
-    /// Wear-mass rate over the excitation window, mg/h.
+    /// Wear-mass rate over the rate window, mg/h.
     pub mass_rate_mg_per_h: f64,
 }
 
@@ -66,15 +67,19 @@ pub struct RunReport {
     pub contacts: Vec<ContactReport>,
     /// Per body.
     pub bodies: Vec<BodyReport>,
-    /// Length of the averaging (excitation) window, s.
+    /// Length of the excitation window (settle's end to the run's end), s: the totals (wear
+    /// mass, friction work) are over it.
     pub window_s: f64,
-    /// Time-averaged total normal force over the window, N.
+    /// Where the rates (mean force and powers, wear-mass rates) are taken: from the end of the
+    /// excitation's ramp-in to the run's end.
+    pub rate_window: super::RateWindow,
+    /// Time-averaged total normal force over the rate window, N.
     pub mean_normal_force_n: f64,
-    /// Time-averaged total normal-load-times-slip power Σ N |v_slip| over the window, W (what
+    /// Time-averaged total normal-load-times-slip power Σ N |v_slip| over the rate window, W (what
     /// the wear law integrates).
     pub mean_normal_slip_power_w: f64,
-    /// Time-averaged total power dissipated by friction over the window, W (the energy
-    /// account's friction work over the window / its length).
+    /// Time-averaged total power dissipated by friction over the rate window, W (the energy
+    /// account's friction work over the rate window / its length).
     pub mean_friction_power_w: f64,
     /// Integrator counters.
     pub integrator: IntegratorStats,
