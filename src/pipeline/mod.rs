@@ -34,8 +34,8 @@ pub use sweep::*;
 pub use sweep_range::*;
 
 use crate::field_error::FieldError;
-pub use crate::models::outcome::{CaseOutcome, RunError};
-pub use crate::physics::control::{Progress, RunControl};
+pub use crate::models::outcome::{CaseOutcome, RunError, SavedRun};
+pub use crate::physics::control::{Progress, RecordChunk, RecordSink, RunControl};
 
 /// A typed job plan as its canonical JSON, what a job stores at submission (every number
 /// round-trips exactly).

@@ -385,7 +385,7 @@ pub fn sweep_point_from(
     replica: usize,
     configs_dir: &Path,
     control: &RunControl,
-    resume: Option<&[u8]>,
+    resume: Option<super::SavedRun<'_>>,
 ) -> Result<SweepPoint, RunError> {
     let offset_mm = *plan
         .offsets_mm

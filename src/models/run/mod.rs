@@ -22,10 +22,13 @@ use crate::wear::WearError;
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod records;
 mod report;
 mod soundness;
 
 pub use report::{BodyReport, ContactReport, RunReport};
+
+use records::{Appended, RecordMark, RecordWriter, VelocitySample};
 
 use parts::run_parts;
 
@@ -85,12 +88,17 @@ pub enum ModelRunError {
 /// A model run stopped at an accepted step: everything [`run_model_from`] needs to finish it
 /// with the result of the uninterrupted run, bit for bit. A model integrated part by part
 /// keeps the reports of the parts already finished and the checkpoint of the one running.
+/// What the run handed to its record sink before is not repeated here
+/// ([`records`](self::records)): serialized, a checkpoint holds the records since the last
+/// chunk, and one read back is whole again after [`ModelCheckpoint::restore_records`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ModelCheckpoint {
     /// Reports of the finished parts, in part order (empty for a model run whole).
-    finished_parts: Vec<RunReport>,
+    finished_parts: Appended<RunReport>,
     /// The run in progress: the engine's state and what the observer accumulated.
     current: WholeCheckpoint,
+    /// The record chunks written before the checkpoint.
+    records: RecordMark,
 }
 
 impl ModelCheckpoint {
@@ -107,6 +115,27 @@ impl ModelCheckpoint {
     /// Parts already finished (0 for a model run whole).
     pub fn finished_parts(&self) -> usize {
         self.finished_parts.len()
+    }
+
+    /// Record chunks the run handed to its record sink before the checkpoint.
+    pub fn record_chunks(&self) -> u64 {
+        self.records.chunks()
+    }
+
+    /// Puts the records together again from `chunks`, the record chunks of the run in order
+    /// from the first (those after the ones the checkpoint counts are ignored); a checkpoint
+    /// read back must be restored before it is resumed (also with no chunks, when it
+    /// follows none). Refused, with the reason, when the chunks are not those the checkpoint
+    /// follows.
+    pub fn restore_records(&mut self, chunks: &[Vec<u8>]) -> Result<(), String> {
+        records::restore(self, chunks)
+    }
+
+    /// True when no record is missing (restored, or never written out).
+    fn complete(&self) -> bool {
+        self.finished_parts.complete()
+            && self.current.observed.tracks_out.complete()
+            && self.current.observed.resp_vel.complete()
     }
 }
 
@@ -137,10 +166,10 @@ struct Observed {
     /// and at the last one, J.
     friction_at_window_start: Option<Vec<f64>>,
     friction_now: Vec<f64>,
-    tracks_out: Vec<TrackSample>,
+    tracks_out: Appended<TrackSample>,
     next_record: f64,
     next_resp: f64,
-    resp_vel: Vec<(f64, [f64; 3])>,
+    resp_vel: Appended<VelocitySample>,
     prev_vel: Option<(f64, nalgebra::Vector3<f64>)>,
     wear_history: Vec<(f64, Vec<f64>)>,
     next_history: f64,
@@ -165,10 +194,10 @@ impl Observed {
             prev_sums: None,
             friction_at_window_start: None,
             friction_now: vec![0.0; ncontacts],
-            tracks_out: Vec::new(),
+            tracks_out: Appended::default(),
             next_record: t0,
             next_resp: t0,
-            resp_vel: Vec::new(),
+            resp_vel: Appended::default(),
             prev_vel: None,
             wear_history: Vec::new(),
             next_history: t0,
@@ -214,20 +243,39 @@ pub fn run_model_from(
     control: &RunControl,
     resume: Option<ModelCheckpoint>,
 ) -> Result<RunReport, ModelRunError> {
+    if let Some(cp) = resume.as_ref().filter(|cp| !cp.complete()) {
+        return Err(bad_checkpoint(format!(
+            "the checkpoint follows {} record chunks that were not restored",
+            cp.record_chunks()
+        )));
+    }
     let parts = independent_parts(&model.system);
+    let mark = resume
+        .as_ref()
+        .map(|cp| cp.records.clone())
+        .unwrap_or_default();
+    let mut writer = RecordWriter::new(control.record_sink.clone(), mark);
     if parts.len() > 1 {
-        return run_parts(model, &parts, options, control, resume);
+        return run_parts(model, &parts, options, control, resume, &mut writer);
     }
-    match resume {
-        Some(cp) if !cp.finished_parts.is_empty() => Err(bad_checkpoint(format!(
-            "{} finished parts, the model runs whole",
-            cp.finished_parts.len()
-        ))),
-        Some(cp) => run_whole(model, options, control, &mut |_| {}, Some(cp.current))
-            .map_err(|e| e.within_parts(Vec::new())),
-        None => run_whole(model, options, control, &mut |_| {}, None)
-            .map_err(|e| e.within_parts(Vec::new())),
-    }
+    let result = match resume {
+        Some(cp) if cp.finished_parts.len() > 0 => {
+            return Err(bad_checkpoint(format!(
+                "{} finished parts, the model runs whole",
+                cp.finished_parts.len()
+            )))
+        }
+        Some(cp) => run_whole(
+            model,
+            options,
+            control,
+            &mut |_| {},
+            Some(cp.current),
+            &mut writer,
+        ),
+        None => run_whole(model, options, control, &mut |_| {}, None, &mut writer),
+    };
+    result.map_err(|e| e.within_parts(Appended::default(), writer.mark()))
 }
 
 fn bad_checkpoint(reason: String) -> ModelRunError {
@@ -260,14 +308,19 @@ impl From<WearError> for WholeError {
 
 impl WholeError {
     /// The model-level error; a checkpoint is kept with the reports of the parts finished
-    /// before it.
-    fn within_parts(self, finished_parts: Vec<RunReport>) -> ModelRunError {
+    /// before it and the mark of the record chunks written before it.
+    fn within_parts(
+        self,
+        finished_parts: Appended<RunReport>,
+        records: RecordMark,
+    ) -> ModelRunError {
         match self {
             WholeError::Run(e) => e,
             WholeError::Checkpointed(current) => {
                 ModelRunError::Checkpointed(Box::new(ModelCheckpoint {
                     finished_parts,
                     current: *current,
+                    records,
                 }))
             }
         }
@@ -289,8 +342,16 @@ pub fn run_model_observed(
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
 ) -> Result<RunReport, ModelRunError> {
-    run_whole(model, options, &control.without_checkpoint(), extra, None)
-        .map_err(|e| e.within_parts(Vec::new()))
+    let mut writer = RecordWriter::new(None, RecordMark::default());
+    run_whole(
+        model,
+        options,
+        &control.without_checkpoint(),
+        extra,
+        None,
+        &mut writer,
+    )
+    .map_err(|e| e.within_parts(Appended::default(), RecordMark::default()))
 }
 
 /// The states a run of `model` passes through, one per `every_s` of simulated time (the first
@@ -315,13 +376,15 @@ pub fn record_states(
     Ok(states)
 }
 
-/// The run of a model integrated as one system (from `resume`, its checkpoint, if given).
+/// The run of a model integrated as one system (from `resume`, its checkpoint, if given),
+/// writing its records to `writer` as they grow ([`records`](self::records)).
 fn run_whole(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
     resume: Option<WholeCheckpoint>,
+    writer: &mut RecordWriter,
 ) -> Result<RunReport, WholeError> {
     let sys = &model.system;
     let t0 = model.excitation_start_s;
@@ -446,7 +509,7 @@ fn run_whole(
         // Track samples for export.
         if options.record_interval_s >= 0.0 && v.t >= st.next_record {
             st.next_record = v.t + options.record_interval_s;
-            record_tracks(v, &mut st.tracks_out);
+            record_tracks(v, st.tracks_out.items_mut());
         }
         // Response velocity, linearly interpolated onto the uniform grid.
         if let Some(off) = resp_offset {
@@ -461,6 +524,7 @@ fn run_whole(
             }
             st.prev_vel = Some((v.t, vel));
         }
+        writer.samples(&mut st.tracks_out, &mut st.resp_vel, false);
     };
     let mut y = model.initial_state.clone();
     let result = simulate_from(
@@ -487,6 +551,10 @@ fn run_whole(
         }
         Err(e) => return Err(e.into()),
     };
+    if writer.part_of_several {
+        // The part's last samples, before its report follows them.
+        writer.samples(&mut st.tracks_out, &mut st.resp_vel, true);
+    }
     let Observed {
         mut accs,
         normal_int,
@@ -573,6 +641,7 @@ fn run_whole(
             mass_rate_mg_per_h: body_mass[i] * MG_PER_KG * S_PER_H / window,
         })
         .collect();
+    let resp_vel = resp_vel.into_items();
     let mut response_acceleration = Vec::with_capacity(resp_vel.len());
     let mut base_acceleration = Vec::with_capacity(resp_vel.len());
     for w in resp_vel.windows(2) {
@@ -595,7 +664,7 @@ fn run_whole(
         window_s: window,
         integrator: stats.integrator,
         wall_s: stats.wall_s,
-        tracks: tracks_out,
+        tracks: tracks_out.into_items(),
         response_acceleration,
         response_rate_hz: options.response_rate_hz,
         base_acceleration,
