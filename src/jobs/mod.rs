@@ -301,8 +301,9 @@ impl Jobs {
                     invalid(
                         "",
                         format!(
-                            "must be {{\"diagnosis\": \"<diagnose job id>\"}} or the record \
-                             a stored sweep shows for it: {e}"
+                            "must be {{\"diagnosis\": \"<diagnose job id>\"}}, or the whole \
+                             record a stored sweep shows for it (diagnosis, effect, parameters, \
+                             verdict, note): {e}"
                         ),
                     )
                 })?;
