@@ -53,11 +53,11 @@ pub fn parent_progress(
         ends.iter().sum::<f64>() / ends.len() as f64
     };
     let end_time_s = ends.iter().sum::<f64>() + mean_end * (total - ends.len()) as f64;
-    let eta_s = if fraction >= 1.0 {
-        Some(0.0)
-    } else {
-        started_ms.and_then(|_| points_eta_s(children, total, now_ms))
-    };
+    // A point whose fraction reads 1 may still be storing its result: while one runs, the ETA
+    // is the points'.
+    let eta_s = started_ms
+        .and_then(|_| points_eta_s(children, total, now_ms))
+        .or((fraction >= 1.0).then_some(0.0));
     Some(JobProgress {
         simulated_time_s: simulated,
         end_time_s,

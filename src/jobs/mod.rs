@@ -2,6 +2,7 @@
 //! heartbeats, fenced completion, cancellation, progress. Computations run on tokio's blocking
 //! threads through the [`CaseRunner`] interface.
 
+mod checkpoints;
 pub mod family;
 pub mod host;
 pub mod inputs;
@@ -10,31 +11,6 @@ use crate::field_error::FieldError;
 /// The job records live with the store that keeps them (`store::job_records`).
 pub use crate::store::job_records as model;
 pub mod runner;
-/// The first field of a submitted diagnosed wear-law record that is not the diagnosis' own
-/// (`parameters.<name>` for a parameter), or None when the records agree.
-fn differing_field(
-    submitted: &crate::pipeline::DiagnosedWearLaw,
-    carried: &crate::pipeline::DiagnosedWearLaw,
-) -> Option<String> {
-    if submitted.effect != carried.effect {
-        return Some("effect".into());
-    }
-    if submitted.verdict != carried.verdict {
-        return Some("verdict".into());
-    }
-    if submitted.note != carried.note {
-        return Some("note".into());
-    }
-    let names = submitted.parameters.keys().chain(carried.parameters.keys());
-    for name in names {
-        let (a, b) = (submitted.parameters.get(name), carried.parameters.get(name));
-        if a.map(|v| v.to_bits()) != b.map(|v| v.to_bits()) {
-            return Some(format!("parameters.{name}"));
-        }
-    }
-    None
-}
-
 #[cfg(test)]
 mod runner_tests;
 pub mod worker;
@@ -518,4 +494,29 @@ pub(crate) fn scoped_idempotency_key(submitted_by: &str, kind: JobKind, key: &st
 /// Lower-case hex of bytes.
 pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The first field of a submitted diagnosed wear-law record that is not the diagnosis' own
+/// (`parameters.<name>` for a parameter), or None when the records agree.
+fn differing_field(
+    submitted: &crate::pipeline::DiagnosedWearLaw,
+    carried: &crate::pipeline::DiagnosedWearLaw,
+) -> Option<String> {
+    if submitted.effect != carried.effect {
+        return Some("effect".into());
+    }
+    if submitted.verdict != carried.verdict {
+        return Some("verdict".into());
+    }
+    if submitted.note != carried.note {
+        return Some("note".into());
+    }
+    let names = submitted.parameters.keys().chain(carried.parameters.keys());
+    for name in names {
+        let (a, b) = (submitted.parameters.get(name), carried.parameters.get(name));
+        if a.map(|v| v.to_bits()) != b.map(|v| v.to_bits()) {
+            return Some(format!("parameters.{name}"));
+        }
+    }
+    None
 }

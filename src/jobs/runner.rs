@@ -1,6 +1,8 @@
-//! The one narrow interface between the job queue and the simulation library: [`CaseRunner`].
-//! The queue never looks inside a computation; it hands over kind + params + [`RunControl`] and
-//! stores what comes back.
+//! What the job queue runs: [`CaseRunner`], the trait between the queue and a computation (the
+//! queue never looks inside one; it hands over kind + params + [`RunControl`] and stores what
+//! comes back), and [`LibraryRunner`], the production computation: `pipeline` for simulate,
+//! sweep and calibrate jobs, `gap::diagnose` for diagnoses (`gap` stands above `pipeline`, so
+//! a diagnosis cannot run behind it).
 
 pub use super::inputs::{JobInputs, StoredInput};
 use super::model::JobKind;

@@ -1,4 +1,5 @@
-//! The one narrow interface between the service (jobs) and the simulation library.
+//! The library's door for the service's simulate, sweep and calibrate jobs, and the parser of
+//! a diagnosis' options (the diagnosis itself runs in `gap`, which stands on this door).
 //!
 //! A job hands a case configuration (JSON, the same schema as the TOML files in `configs/`)
 //! and a [`RunControl`]; it gets back a [`CaseOutcome`] or a [`RunError`].

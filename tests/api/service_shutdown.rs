@@ -316,7 +316,7 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
         .checkpoint_s
         .expect("the released attempt stored a checkpoint");
     assert!(
-        checkpoint_s >= 0.8 * SIMULATE_END_S && checkpoint_s < SIMULATE_END_S,
+        (0.8 * SIMULATE_END_S..SIMULATE_END_S).contains(&checkpoint_s),
         "checkpoint at {checkpoint_s} s"
     );
     let stored = store.load_checkpoint(uuid).await.unwrap().expect("stored");

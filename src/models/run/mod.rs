@@ -3,7 +3,6 @@
 //! friction power `Σ N |v_slip|`, and collects what the reports need.
 
 use crate::physics::body::BodyKind;
-use crate::physics::contact::TrackState;
 use crate::physics::control::RunControl;
 use crate::physics::integrator::IntegratorSettings;
 use crate::physics::partition::independent_parts;
@@ -25,12 +24,14 @@ mod parts;
 mod records;
 mod report;
 mod soundness;
+mod track_samples;
 
 pub use report::{BodyReport, ContactReport, RunReport};
 
 use records::{Appended, RecordMark, RecordWriter, VelocitySample};
 
 use parts::run_parts;
+use track_samples::record_tracks;
 
 /// A model ready to run: the system, its initial state and what each contact wears.
 pub struct BuiltModel {
@@ -684,38 +685,4 @@ fn base_acceleration_at(sys: &MultibodySystem, t: f64) -> [f64; 3] {
         }
     }
     [0.0; 3]
-}
-
-fn record_tracks(v: &StepView, out: &mut Vec<TrackSample>) {
-    let sys = v.system;
-    let mut ws = sys.workspace();
-    sys.frames(v.t, v.state, &mut ws);
-    for tr in v.tracks {
-        out.push(track_sample(v.t, tr, sys, &ws.frames));
-    }
-}
-
-fn track_sample(
-    t: f64,
-    tr: &TrackState,
-    sys: &MultibodySystem,
-    frames: &[crate::physics::body::BodyFrame],
-) -> TrackSample {
-    let c = &sys.contacts[tr.contact as usize];
-    let pa = frames[c.body_a].to_local(&tr.point);
-    let pb = frames[c.body_b].to_local(&tr.point);
-    TrackSample {
-        time_s: t,
-        contact: tr.contact,
-        track: tr.track,
-        normal_force_n: tr.normal_force,
-        slip_velocity_m_s: [tr.slip_velocity.x, tr.slip_velocity.y, tr.slip_velocity.z],
-        slip_speed_m_s: tr.slip_speed,
-        penetration_m: tr.penetration,
-        penetration_rate_m_s: tr.penetration_rate,
-        area_m2: tr.area,
-        pressure_pa: tr.pressure(),
-        point_in_a_m: [pa.x, pa.y, pa.z],
-        point_in_b_m: [pb.x, pb.y, pb.z],
-    }
 }
