@@ -75,6 +75,7 @@ pub(crate) fn sweep_procs(
             poll: Duration::from_millis(100),
             max_attempts: 3,
             track_block_samples: 4096,
+            record_chunk_samples: 8192,
             shutdown_grace: Duration::from_secs(5),
         },
         railwear::jobs::CurveDefaults {

@@ -91,6 +91,10 @@ pub struct ServiceConfig {
     pub log_format: String,
     /// Samples per stored contact-track block (each block is compressed on its own).
     pub track_block_samples: usize,
+    /// Samples (track samples, or response samples) a running simulation gathers before it
+    /// stores them as a record chunk: a shutdown checkpoint carries fewer than this many of
+    /// each, so its size and write time stay bounded however long the run.
+    pub checkpoint_chunk_samples: usize,
     /// Rail-report defaults.
     pub report: ReportSettings,
     /// Tokens accepted in addition to those stored in the database.
@@ -117,6 +121,7 @@ impl Default for ServiceConfig {
             max_connections_per_peer: 256,
             log_format: "text".into(),
             track_block_samples: 16_384,
+            checkpoint_chunk_samples: 8_192,
             report: ReportSettings::default(),
             tokens: Vec::new(),
         }
@@ -313,6 +318,9 @@ impl ServiceConfig {
         if self.track_block_samples == 0 {
             return Err(FieldError::new("track_block_samples", "must be at least 1").into());
         }
+        if self.checkpoint_chunk_samples == 0 {
+            return Err(FieldError::new("checkpoint_chunk_samples", "must be at least 1").into());
+        }
         if self.log_format != "text" && self.log_format != "json" {
             return Err(FieldError::new("log_format", "must be `text` or `json`").into());
         }
@@ -353,7 +361,8 @@ impl ServiceConfig {
         dir.canonicalize().unwrap_or(dir)
     }
 
-    /// Worker-pool settings (lease, heartbeat, poll, attempts, track blocks, shutdown grace).
+    /// Worker-pool settings (lease, heartbeat, poll, attempts, track blocks, record chunks,
+    /// shutdown grace).
     pub fn worker_settings(&self) -> crate::jobs::WorkerSettings {
         crate::jobs::WorkerSettings {
             lease: std::time::Duration::from_secs_f64(self.lease_s),
@@ -361,6 +370,7 @@ impl ServiceConfig {
             poll: std::time::Duration::from_millis(self.poll_interval_ms.max(1)),
             max_attempts: self.max_attempts,
             track_block_samples: self.track_block_samples,
+            record_chunk_samples: self.checkpoint_chunk_samples,
             shutdown_grace: std::time::Duration::from_secs_f64(self.shutdown_grace_s),
         }
     }

@@ -196,8 +196,7 @@ function progressCell(job) {
     }
     if (!job.children) {
       if (job.status === "running" && job.progress.eta_s != null) {
-        const eta = Math.round(job.progress.eta_s);
-        label += eta > 0 ? ", ETA " + eta + " s" : ", finishing";
+        label += etaText(job.progress.eta_s);
       }
       label += ")";
     }
@@ -209,9 +208,22 @@ function progressCell(job) {
     let label = " " + c.succeeded + "/" + c.total + " points done";
     if (c.failed > 0) { label += ", " + c.failed + " failed"; }
     if (c.cancelled > 0) { label += ", " + c.cancelled + " cancelled"; }
+    // A waiting sweep's ETA is its points' (measured point durations once one has finished).
+    if (job.status === "waiting" && job.progress && job.progress.eta_s != null) {
+      label += etaText(job.progress.eta_s);
+    }
     cell.appendChild(text("span", label, "children"));
   }
+  if (job.status === "queued" && !job.progress) {
+    // No worker has it yet: no ETA would be honest.
+    cell.appendChild(text("span", "waiting for a worker", "children"));
+  }
   return cell;
+}
+
+function etaText(etaS) {
+  const eta = Math.round(etaS);
+  return eta > 0 ? ", ETA " + eta + " s" : ", finishing";
 }
 
 const ACTIVE = new Set(["queued", "running", "waiting"]);

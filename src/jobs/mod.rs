@@ -2,6 +2,7 @@
 //! heartbeats, fenced completion, cancellation, progress. Computations run on tokio's blocking
 //! threads through the [`CaseRunner`] interface.
 
+mod checkpoints;
 pub mod family;
 pub mod host;
 pub mod inputs;
@@ -44,6 +45,9 @@ pub struct WorkerSettings {
     pub max_attempts: u32,
     /// Samples per stored track block.
     pub track_block_samples: usize,
+    /// Samples a running simulation gathers per stored record chunk
+    /// ([`crate::pipeline::RecordSink::chunk_samples`]).
+    pub record_chunk_samples: usize,
     /// At shutdown, how long a running attempt gets to stop before its job is given back.
     pub shutdown_grace: Duration,
 }
@@ -252,8 +256,10 @@ impl Jobs {
 
     /// A sweep's `wear_law = {"diagnosis": "<id>"}` becomes the diagnosis' fitted mechanism
     /// ([`crate::pipeline::DiagnosedWearLaw`], read from the stored report once, here), so the
-    /// sweep, its points and its curve carry one record. Anything but that bare form of an
-    /// object is refused: the resolved form is the service's to write.
+    /// sweep, its points and its curve carry one record. The resolved record itself (what a
+    /// stored sweep's params show, so that they can be submitted again) is accepted when it is
+    /// the one the diagnosis gives; anything else is refused, naming the field that differs:
+    /// the resolved form is the service's to write.
     async fn resolve_diagnosed_wear_law(
         &self,
         params: &mut serde_json::Value,
@@ -264,12 +270,23 @@ impl Jobs {
         let invalid = |field: &str, rule: String| {
             SubmitError::Invalid(FieldError::new(format!("params.wear_law{field}"), rule))
         };
-        if let Some(key) = law.keys().find(|k| k.as_str() != "diagnosis") {
-            return Err(invalid(
-                "",
-                format!("`{key}` is not known: give only {{\"diagnosis\": \"<diagnose job id>\"}}"),
-            ));
-        }
+        // The resolved form, as read back from a stored sweep.
+        let submitted_record = if law.len() > 1 || !law.contains_key("diagnosis") {
+            let record: crate::pipeline::DiagnosedWearLaw =
+                serde_json::from_value(serde_json::Value::Object(law.clone())).map_err(|e| {
+                    invalid(
+                        "",
+                        format!(
+                            "must be {{\"diagnosis\": \"<diagnose job id>\"}}, or the whole \
+                             record a stored sweep shows for it (diagnosis, effect, parameters, \
+                             verdict, note): {e}"
+                        ),
+                    )
+                })?;
+            Some(record)
+        } else {
+            None
+        };
         let id = law
             .get("diagnosis")
             .and_then(|v| v.as_str())
@@ -307,6 +324,17 @@ impl Jobs {
         };
         let carried = crate::gap::diagnose::carry::carried_wear_law(id, result)
             .map_err(|e| SubmitError::Invalid(e.at("params")))?;
+        if let Some(submitted) = submitted_record {
+            if let Some(field) = differing_field(&submitted, &carried) {
+                return Err(invalid(
+                    &format!(".{field}"),
+                    format!(
+                        "differs from what diagnosis {id} gives: give only \
+                         {{\"diagnosis\": \"{id}\"}}, or the record unchanged"
+                    ),
+                ));
+            }
+        }
         let value = serde_json::to_value(&carried).map_err(|e| invalid("", e.to_string()))?;
         if let Some(map) = params.as_object_mut() {
             map.insert("wear_law".into(), value);
@@ -466,4 +494,29 @@ pub(crate) fn scoped_idempotency_key(submitted_by: &str, kind: JobKind, key: &st
 /// Lower-case hex of bytes.
 pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The first field of a submitted diagnosed wear-law record that is not the diagnosis' own
+/// (`parameters.<name>` for a parameter), or None when the records agree.
+fn differing_field(
+    submitted: &crate::pipeline::DiagnosedWearLaw,
+    carried: &crate::pipeline::DiagnosedWearLaw,
+) -> Option<String> {
+    if submitted.effect != carried.effect {
+        return Some("effect".into());
+    }
+    if submitted.verdict != carried.verdict {
+        return Some("verdict".into());
+    }
+    if submitted.note != carried.note {
+        return Some("note".into());
+    }
+    let names = submitted.parameters.keys().chain(carried.parameters.keys());
+    for name in names {
+        let (a, b) = (submitted.parameters.get(name), carried.parameters.get(name));
+        if a.map(|v| v.to_bits()) != b.map(|v| v.to_bits()) {
+            return Some(format!("parameters.{name}"));
+        }
+    }
+    None
 }

@@ -1,6 +1,8 @@
-//! The one narrow interface between the job queue and the simulation library: [`CaseRunner`].
-//! The queue never looks inside a computation; it hands over kind + params + [`RunControl`] and
-//! stores what comes back.
+//! What the job queue runs: [`CaseRunner`], the trait between the queue and a computation (the
+//! queue never looks inside one; it hands over kind + params + [`RunControl`] and stores what
+//! comes back), and [`LibraryRunner`], the production computation: `pipeline` for simulate,
+//! sweep and calibrate jobs, `gap::diagnose` for diagnoses (`gap` stands above `pipeline`, so
+//! a diagnosis cannot run behind it).
 
 pub use super::inputs::{JobInputs, StoredInput};
 use super::model::JobKind;
@@ -8,7 +10,7 @@ use crate::analysis::penalization::PenalizationCurve;
 use crate::field_error::FieldError;
 use crate::physics::track::TrackSample;
 use crate::pipeline::{
-    plan_from_json, plan_to_json, CalibrateParams, DiagnosePlan, RunControl, RunError,
+    plan_from_json, plan_to_json, CalibrateParams, DiagnosePlan, RunControl, RunError, SavedRun,
     SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary,
 };
 use std::path::PathBuf;
@@ -82,8 +84,9 @@ pub trait CaseRunner: Send + Sync {
     ) -> Result<JobOutput, RunError>;
 
     /// [`CaseRunner::run`] from the job's stored `plan`, with the `inputs` the worker read for
-    /// it ([`CaseRunner::stored_inputs`]), resuming from `checkpoint`, the bytes of an earlier
-    /// attempt's [`RunError::Checkpointed`] for this job. A computation that can checkpoint
+    /// it ([`CaseRunner::stored_inputs`]), resuming from `checkpoint`: the bytes of an earlier
+    /// attempt's [`RunError::Checkpointed`] for this job with the record chunks its attempts
+    /// handed to [`RunControl::record_sink`] before it. A computation that can checkpoint
     /// returns [`RunError::Checkpointed`] at its next step boundary after
     /// [`RunControl::request_checkpoint`], resumes from a checkpoint to the result of an
     /// uninterrupted run, and starts over (saying why) from one that does not fit. The default
@@ -95,7 +98,7 @@ pub trait CaseRunner: Send + Sync {
         plan: Option<&serde_json::Value>,
         inputs: &JobInputs,
         control: &RunControl,
-        checkpoint: Option<&[u8]>,
+        checkpoint: Option<SavedRun<'_>>,
     ) -> Result<JobOutput, RunError> {
         let _ = (plan, inputs, checkpoint);
         self.run(kind, params, control)
@@ -331,7 +334,7 @@ impl CaseRunner for LibraryRunner {
         stored: Option<&serde_json::Value>,
         inputs: &JobInputs,
         control: &RunControl,
-        checkpoint: Option<&[u8]>,
+        checkpoint: Option<SavedRun<'_>>,
     ) -> Result<JobOutput, RunError> {
         let plan = self.job_plan(kind, params, stored)?;
         let control = &match plan {
@@ -525,13 +528,13 @@ pub fn run_diagnosis(
     // counts simulations, not one window's simulated time.
     // Its windows keep no checkpoint: a request stops the diagnosis as cancelled.
     let inner = RunControl::new(control.cancel.clone(), std::sync::Arc::new(|_| {}));
+    // The stage after the last simulation (fits, ranking, held-out tests, report and plots)
+    // counts as one more unit, so the job reads 100 % only once the report is made.
+    let units = std::sync::atomic::AtomicUsize::new(1);
     let report_progress = |done: usize, total: usize| {
-        let total = total.max(1);
-        (control.progress)(crate::physics::control::Progress {
-            simulated_time_s: done as f64,
-            end_time_s: total as f64,
-            fraction: (done as f64 / total as f64).clamp(0.0, 1.0),
-        });
+        let total = total.max(1) + 1;
+        units.fetch_max(total, std::sync::atomic::Ordering::SeqCst);
+        (control.progress)(diagnosis_progress(done.min(total - 1), total));
     };
     let cache = crate::gap::window::WindowCache::new();
     let (report, _) = crate::gap::diagnose::diagnose(
@@ -558,11 +561,23 @@ pub fn run_diagnosis(
         field: "report".into(),
         rule: format!("could not be serialized: {e}"),
     })?;
+    let plots = crate::gap::diagnose::plots::plots(&report);
+    let total = units.load(std::sync::atomic::Ordering::SeqCst);
+    (control.progress)(diagnosis_progress(total, total));
     Ok(JobOutput {
         summary,
-        plots: crate::gap::diagnose::plots::plots(&report),
+        plots,
         ..JobOutput::default()
     })
+}
+
+/// A diagnosis' progress: `done` of `total` units (its simulations, then the final stage).
+fn diagnosis_progress(done: usize, total: usize) -> crate::physics::control::Progress {
+    crate::physics::control::Progress {
+        simulated_time_s: done as f64,
+        end_time_s: total as f64,
+        fraction: (done as f64 / total as f64).clamp(0.0, 1.0),
+    }
 }
 
 /// A sweep job's output from its outcome (sequential or assembled): the outcome as summary, the

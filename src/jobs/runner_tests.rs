@@ -317,3 +317,47 @@ fn every_kind_refuses_a_stored_plan_of_another() {
         );
     }
 }
+
+#[test]
+fn a_diagnosis_reads_100_percent_only_once_its_report_is_made() {
+    // The small campaign's diagnosis, run to its end with every progress call kept.
+    let runner = LibraryRunner::new(configs());
+    let kind = JobKind::Diagnose;
+    let (submitted, content) = diagnosis_params();
+    let plan = runner.submit_plan(&kind, &submitted, 5).unwrap().unwrap();
+    let calls = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let kept = calls.clone();
+    let control = RunControl {
+        progress: std::sync::Arc::new(move |p| kept.lock().unwrap().push(p)),
+        ..RunControl::silent()
+    };
+    let inputs = JobInputs {
+        campaign: Some(content),
+    };
+    runner
+        .run_from(
+            &kind,
+            &with_seed(&submitted, 5),
+            Some(&plan),
+            &inputs,
+            &control,
+            None,
+        )
+        .expect("the diagnosis runs");
+    let calls = calls.lock().unwrap();
+    let (last, before) = calls.split_last().expect("progress was reported");
+    // The final stage counts: 100 % is the last call, made after the report, and no call
+    // before it reads 100 %.
+    assert_eq!(last.fraction, 1.0);
+    assert_eq!(last.simulated_time_s, last.end_time_s);
+    assert!(before.len() >= 2, "{} calls", calls.len());
+    for p in before {
+        assert!(
+            p.fraction < 1.0,
+            "{} of {} units read {} before the report was made",
+            p.simulated_time_s,
+            p.end_time_s,
+            p.fraction
+        );
+    }
+}

@@ -6,6 +6,10 @@
 //! a simulation stops at its next accepted step with its complete state, which is stored
 //! (fenced by the attempt) before the job is released; the next attempt resumes from it. A
 //! computation that cannot checkpoint stops as cancelled and the job is released without one.
+//! While it runs, a simulation hands its growing records to the attempt in chunks
+//! ([`RunControl::record_sink`]), which stores them as they come: the checkpoint written at
+//! shutdown then holds only the run's state and the records since the last chunk, so its
+//! write time is bounded however long the run (docs/reference/operations.md).
 //!
 //! A job the runner splits ([`super::CaseRunner::fan_out`], a sweep) is not run: the attempt
 //! stores its child jobs and leaves it waiting. When its last child succeeds the store re-queues
@@ -15,11 +19,10 @@ use super::inputs::JobInputs;
 use super::model::{JobKind, JobProgress, JobRecord, JobStatus};
 use super::runner::FanOutPlan;
 use super::Jobs;
-use crate::pipeline::{Progress, RunControl, RunError};
+use crate::pipeline::{Progress, RecordChunk, RecordSink, RunControl, RunError, SavedRun};
 use crate::store::{
     clock, tracks, CurveFidelity, FanOut, FanOutResult, Finish, NewChild, NewCurve, ReleaseOutcome,
 };
-use crate::store::{JobCheckpoint, NewCheckpoint};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -115,6 +118,14 @@ impl Jobs {
             Work::Run(_) => self.stored_checkpoint(id, attempt).await,
             _ => None,
         };
+        // The record chunks the checkpoint follows (the library checks which it needs).
+        let record_chunks = match &resume {
+            Some(_) => self.store.load_record_chunks(id).await.unwrap_or_else(|e| {
+                tracing::warn!(job = %id, attempt, error = %e, "reading the record chunks failed: the checkpoint will not fit");
+                Vec::new()
+            }),
+            None => Vec::new(),
+        };
         let cancel = Arc::new(AtomicBool::new(job.cancel_requested));
         let checkpoint = Arc::new(AtomicBool::new(false));
         self.running_flags().insert(id, Arc::clone(&cancel));
@@ -144,6 +155,7 @@ impl Jobs {
 
         let latest: Arc<Mutex<Option<Progress>>> = Arc::new(Mutex::new(None));
         let sink = Arc::clone(&latest);
+        let (chunk_tx, mut chunks) = tokio::sync::mpsc::unbounded_channel::<RecordChunk>();
         let control = RunControl {
             progress_interval: crate::physics::control::DEFAULT_PROGRESS_INTERVAL,
             cancel: Arc::clone(&cancel),
@@ -152,6 +164,13 @@ impl Jobs {
                 if let Ok(mut slot) = sink.lock() {
                     *slot = Some(p);
                 }
+            }),
+            record_sink: Some(RecordSink {
+                chunk_samples: self.settings.record_chunk_samples,
+                write: Arc::new(move |chunk: RecordChunk| {
+                    // The attempt may be gone (grace spent): the chunk is then not needed.
+                    let _ = chunk_tx.send(chunk);
+                }),
             }),
         };
         let stop = control.clone();
@@ -163,7 +182,10 @@ impl Jobs {
                 plan.as_ref(),
                 &inputs,
                 &control,
-                resume.as_ref().map(|c| c.data.as_slice()),
+                resume.as_ref().map(|c| SavedRun {
+                    checkpoint: &c.data,
+                    record_chunks: &record_chunks,
+                }),
             ),
             Work::Assemble(Ok(summaries)) => {
                 runner.assemble(&kind, &params, plan.as_ref(), &summaries)
@@ -184,6 +206,7 @@ impl Jobs {
         let outcome = loop {
             tokio::select! {
                 result = &mut computation => break Some(result),
+                Some(chunk) = chunks.recv() => self.save_record_chunk(id, attempt, chunk).await,
                 _ = shutdown_begun(&mut stopping), if give_back_by.is_none() => {
                     tracing::info!(job = %id, attempt, "shutdown: asking the attempt for a checkpoint to give its job back");
                     stop.request_checkpoint();
@@ -288,7 +311,13 @@ impl Jobs {
             // checkpoint stored first (while this attempt still holds the lease).
             self.running_flags().remove(&id);
             let checkpoint_s = match saved {
-                Some(cp) => self.save_checkpoint(id, attempt, cp).await,
+                Some(cp) => {
+                    // The chunks the checkpoint follows are stored before it.
+                    while let Ok(chunk) = chunks.try_recv() {
+                        self.save_record_chunk(id, attempt, chunk).await;
+                    }
+                    self.save_checkpoint(id, attempt, cp).await
+                }
                 None => None,
             };
             self.metrics.attempt_released(id, checkpoint_s);
@@ -374,64 +403,6 @@ impl Jobs {
                 None
             }
         }
-    }
-
-    /// The checkpoint stored for job `id` by an earlier attempt, if any.
-    async fn stored_checkpoint(&self, id: uuid::Uuid, attempt: i64) -> Option<JobCheckpoint> {
-        match self.store.load_checkpoint(id).await {
-            Ok(Some(cp)) => {
-                tracing::info!(
-                    job = %id,
-                    attempt,
-                    from_attempt = cp.attempt,
-                    simulated_s = cp.simulated_s,
-                    "resuming from the stored checkpoint"
-                );
-                Some(cp)
-            }
-            Ok(None) => None,
-            Err(e) => {
-                tracing::warn!(job = %id, attempt, error = %e, "reading the checkpoint failed: running from the start");
-                None
-            }
-        }
-    }
-
-    /// Store the checkpoint attempt `attempt` stopped with (fenced by the attempt; retried on
-    /// transient errors). Its simulated time once stored.
-    async fn save_checkpoint(
-        &self,
-        id: uuid::Uuid,
-        attempt: i64,
-        cp: crate::models::outcome::Checkpoint,
-    ) -> Option<f64> {
-        let t = cp.simulated_time_s;
-        let new = NewCheckpoint {
-            simulated_s: t,
-            end_s: cp.end_time_s,
-            data: cp.bytes,
-        };
-        for retry in 0..3u32 {
-            match self
-                .store
-                .save_checkpoint(id, attempt, new.clone(), clock::now_ms())
-                .await
-            {
-                Ok(true) => {
-                    tracing::info!(job = %id, attempt, simulated_s = t, bytes = new.data.len(), "checkpoint stored");
-                    return Some(t);
-                }
-                Ok(false) => {
-                    tracing::warn!(job = %id, attempt, "stale attempt; checkpoint discarded");
-                    return None;
-                }
-                Err(e) => {
-                    tracing::warn!(job = %id, attempt, retry, error = %e, "storing the checkpoint failed");
-                    tokio::time::sleep(Duration::from_millis(100 << retry)).await;
-                }
-            }
-        }
-        None
     }
 
     /// Give attempt `attempt` back to the queue (shutdown). A cancellation requested

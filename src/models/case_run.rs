@@ -5,7 +5,7 @@
 
 use super::case::{build, run_options};
 use super::checkpoint::{self, RunIdentity};
-use super::outcome::RunError;
+use super::outcome::{RunError, SavedRun};
 use super::run::{run_model_from, BuiltModel, ModelRunError, RunOptions, RunReport};
 use super::spec::CaseSpec;
 use crate::physics::control::RunControl;
@@ -22,20 +22,24 @@ pub struct CaseRun {
     pub report: RunReport,
 }
 
-/// Builds and runs a case, resuming from `resume` (bytes of a [`RunError::Checkpointed`] of the
-/// same case and code) when it fits; a checkpoint that does not is logged and the run restarts
+/// Builds and runs a case, resuming from `resume` (the bytes of a [`RunError::Checkpointed`] of
+/// the same case and code, with the record chunks written before it) when it fits; a checkpoint that does not is logged and the run restarts
 /// from t = 0. A checkpoint request ([`RunControl::request_checkpoint`]) ends the run with
 /// [`RunError::Checkpointed`] at its next accepted step.
 pub fn run_case_model(
     case: &CaseSpec,
     configs_dir: &Path,
     control: &RunControl,
-    resume: Option<&[u8]>,
+    resume: Option<SavedRun<'_>>,
 ) -> Result<CaseRun, RunError> {
     let model = build(case, configs_dir)?;
     let options = run_options(case)?;
     let identity = RunIdentity::of(case, &model, configs_dir);
-    let resume = resume.and_then(|bytes| match checkpoint::decode(bytes, &identity) {
+    let resume = resume.and_then(|saved| match checkpoint::decode(
+        saved.checkpoint,
+        &identity,
+        saved.record_chunks,
+    ) {
         Ok(cp) => {
             tracing::info!(case = %case.name, time_s = cp.time_s(), "resuming from checkpoint");
             Some(cp)

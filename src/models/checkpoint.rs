@@ -13,7 +13,12 @@
 //! samples the checkpoint carries.
 //!
 //! What is rebuilt rather than stored: the model (geometry, bodies, contacts, the excitation
-//! signal from its seed) and the run options, all from the case.
+//! signal from its seed) and the run options, all from the case. What the run handed to its
+//! record sink before the checkpoint (track samples, response, finished parts' reports:
+//! `models::run`'s record chunks) is not repeated: the checkpoint holds the records since the
+//! last chunk and the chained SHA-256 of the chunks, and [`decode`] takes the chunks back. So
+//! a checkpoint's size is bounded by a chunk's worth of records plus the run's state, however
+//! long the run.
 
 use super::case::{code_version, resolve_excitation};
 use super::outcome::Checkpoint;
@@ -29,7 +34,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// Version of the checkpoint layout; bump it whenever a checkpointed type changes shape.
-pub const CHECKPOINT_FORMAT: u32 = 2;
+pub const CHECKPOINT_FORMAT: u32 = 3;
 
 /// Largest checkpoint decoded, bytes (after decompression): a guard against a corrupt length.
 const MAX_DECODED_BYTES: u64 = 4 << 30;
@@ -98,6 +103,9 @@ pub enum CheckpointError {
     /// Unreadable.
     #[error("unreadable checkpoint: {0}")]
     Decode(String),
+    /// The record chunks given are not those the checkpoint follows.
+    #[error("checkpoint without its records: {0}")]
+    Records(String),
     /// Could not be written.
     #[error("checkpoint could not be encoded: {0}")]
     Encode(String),
@@ -130,9 +138,15 @@ pub fn encode(identity: &RunIdentity, cp: &ModelCheckpoint) -> Result<Checkpoint
     })
 }
 
-/// Decodes a checkpoint for the run identified by `expected`: the format, code version and
-/// case are checked before the body is read.
-pub fn decode(bytes: &[u8], expected: &RunIdentity) -> Result<ModelCheckpoint, CheckpointError> {
+/// Decodes a checkpoint for the run identified by `expected`, with the record chunks the run
+/// wrote before it (in order from the first; none for a run without a record sink): the
+/// format, code version and case are checked before the body is read, the chunks' chain
+/// after.
+pub fn decode(
+    bytes: &[u8],
+    expected: &RunIdentity,
+    record_chunks: &[Vec<u8>],
+) -> Result<ModelCheckpoint, CheckpointError> {
     let dec = |e: bincode::Error| CheckpointError::Decode(e.to_string());
     let mut z = ZlibDecoder::new(bytes);
     let format: u32 = codec().deserialize_from(&mut z).map_err(dec)?;
@@ -151,7 +165,7 @@ pub fn decode(bytes: &[u8], expected: &RunIdentity) -> Result<ModelCheckpoint, C
             expected: expected.case_sha256.clone(),
         });
     }
-    let cp: ModelCheckpoint = codec().deserialize_from(&mut z).map_err(dec)?;
+    let mut cp: ModelCheckpoint = codec().deserialize_from(&mut z).map_err(dec)?;
     if cp.time_s().to_bits() != header.simulated_time_s.to_bits()
         || cp.finished_parts() as u64 != header.finished_parts
     {
@@ -159,5 +173,7 @@ pub fn decode(bytes: &[u8], expected: &RunIdentity) -> Result<ModelCheckpoint, C
             "the header does not match the body".into(),
         ));
     }
+    cp.restore_records(record_chunks)
+        .map_err(CheckpointError::Records)?;
     Ok(cp)
 }

@@ -49,6 +49,28 @@ impl From<crate::field_error::FieldError> for RunError {
     }
 }
 
+/// A stopped run as its caller kept it, to resume from: the checkpoint's bytes and the record
+/// chunks the run handed to its record sink
+/// ([`RunControl::record_sink`](crate::physics::control::RunControl)) before it, in order from
+/// the first (empty when it had no sink).
+#[derive(Debug, Clone, Copy)]
+pub struct SavedRun<'a> {
+    /// [`Checkpoint::bytes`].
+    pub checkpoint: &'a [u8],
+    /// The record chunks' bytes.
+    pub record_chunks: &'a [Vec<u8>],
+}
+
+impl<'a> SavedRun<'a> {
+    /// A checkpoint of a run that wrote no record chunks.
+    pub fn without_chunks(checkpoint: &'a [u8]) -> Self {
+        Self {
+            checkpoint,
+            record_chunks: &[],
+        }
+    }
+}
+
 /// A stored checkpoint: its bytes and where it stands.
 #[derive(Clone, PartialEq)]
 pub struct Checkpoint {

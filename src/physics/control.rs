@@ -1,6 +1,7 @@
-//! The engine's run hooks: a cancellation flag, a checkpoint request and a progress sink the
-//! caller hands to [`simulate`](super::simulate::simulate) (the engine owns its hooks, as
-//! rapier's pipeline does; the service passes them in through `pipeline`).
+//! The engine's run hooks: a cancellation flag, a checkpoint request, a progress sink and a
+//! sink for the run's recorded samples the caller hands to
+//! [`simulate`](super::simulate::simulate) (the engine owns its hooks, as rapier's pipeline
+//! does; the service passes them in through `pipeline`).
 
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -33,6 +34,32 @@ pub struct RunControl {
     /// the sink after every accepted step, so a sink that acts on the simulated time acts at
     /// the same step in every run (deterministic tests of checkpoints).
     pub progress_interval: std::time::Duration,
+    /// Where a run that can checkpoint writes its recorded samples as they accumulate (None:
+    /// they stay in the run and a checkpoint carries them all). What is handed here is not
+    /// repeated in a checkpoint, so a checkpoint stays small however long the run; resuming
+    /// needs the chunks back (`models::checkpoint`).
+    pub record_sink: Option<RecordSink>,
+}
+
+/// Where a run's recorded samples go as they accumulate, and how many make a chunk.
+#[derive(Clone)]
+pub struct RecordSink {
+    /// Samples of one record (track samples, or response samples) that make a chunk: a
+    /// checkpoint carries fewer than this many of each. Larger chunks mean fewer writes and a
+    /// larger checkpoint; at least 1.
+    pub chunk_samples: usize,
+    /// Called from the simulation thread with each chunk, in order.
+    pub write: Arc<dyn Fn(RecordChunk) + Send + Sync>,
+}
+
+/// One chunk of a run's recorded samples, in the order the run wrote them: the `seq`-th since
+/// t = 0 (a resumed run goes on counting from its checkpoint). Opaque bytes to the caller.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecordChunk {
+    /// Position in the run's sequence of chunks, from 0.
+    pub seq: u64,
+    /// The encoded chunk.
+    pub bytes: Vec<u8>,
 }
 
 /// Wall time between progress calls of a [`RunControl::new`] control: 200 ms, a few
@@ -47,6 +74,7 @@ impl RunControl {
             checkpoint: Arc::new(AtomicBool::new(false)),
             progress,
             progress_interval: DEFAULT_PROGRESS_INTERVAL,
+            record_sink: None,
         }
     }
 
@@ -74,8 +102,9 @@ impl RunControl {
         self.cancel.store(true, Ordering::SeqCst);
     }
 
-    /// The same cancel flag and progress sink without the checkpoint request: for runs whose
-    /// caller cannot keep a checkpoint (a request then stops them as a cancellation).
+    /// The same cancel flag and progress sink without the checkpoint request and the record
+    /// sink: for runs whose caller cannot keep a checkpoint (a request then stops them as a
+    /// cancellation).
     pub fn without_checkpoint(&self) -> Self {
         Self {
             progress_interval: self.progress_interval,

@@ -1,4 +1,5 @@
-//! The one narrow interface between the service (jobs) and the simulation library.
+//! The library's door for the service's simulate, sweep and calibrate jobs, and the parser of
+//! a diagnosis' options (the diagnosis itself runs in `gap`, which stands on this door).
 //!
 //! A job hands a case configuration (JSON, the same schema as the TOML files in `configs/`)
 //! and a [`RunControl`]; it gets back a [`CaseOutcome`] or a [`RunError`].
@@ -34,8 +35,8 @@ pub use sweep::*;
 pub use sweep_range::*;
 
 use crate::field_error::FieldError;
-pub use crate::models::outcome::{CaseOutcome, RunError};
-pub use crate::physics::control::{Progress, RunControl};
+pub use crate::models::outcome::{CaseOutcome, RunError, SavedRun};
+pub use crate::physics::control::{Progress, RecordChunk, RecordSink, RunControl};
 
 /// A typed job plan as its canonical JSON, what a job stores at submission (every number
 /// round-trips exactly).

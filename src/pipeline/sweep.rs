@@ -385,7 +385,7 @@ pub fn sweep_point_from(
     replica: usize,
     configs_dir: &Path,
     control: &RunControl,
-    resume: Option<&[u8]>,
+    resume: Option<super::SavedRun<'_>>,
 ) -> Result<SweepPoint, RunError> {
     let offset_mm = *plan
         .offsets_mm
@@ -405,7 +405,9 @@ pub fn sweep_point_from(
         .as_ref()
         .and_then(|l| l.rattle_space().ok())
         .unwrap_or(f64::NAN);
-    let (report, _) = super::run::run_case_from(&case, configs_dir, control, resume)?;
+    // A point needs the run's report, not its packaging (summary JSON, plots): not made.
+    let report =
+        crate::models::case_run::run_case_model(&case, configs_dir, control, resume)?.report;
     let rail_wear_rate_mg_per_h = report
         .bodies
         .iter()

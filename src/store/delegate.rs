@@ -288,6 +288,25 @@ macro_rules! portable_store_methods {
             Box::pin(<$shared>::load_checkpoint(&self.pool, id))
         }
 
+        fn save_record_chunk(
+            &self,
+            id: ::uuid::Uuid,
+            attempt: i64,
+            seq: u64,
+            data: Vec<u8>,
+        ) -> $crate::store::StoreFuture<'_, bool> {
+            Box::pin(<$shared>::save_record_chunk(
+                &self.pool, id, attempt, seq, data,
+            ))
+        }
+
+        fn load_record_chunks(
+            &self,
+            id: ::uuid::Uuid,
+        ) -> $crate::store::StoreFuture<'_, Vec<Vec<u8>>> {
+            Box::pin(<$shared>::load_record_chunks(&self.pool, id))
+        }
+
         fn job_plan(
             &self,
             id: ::uuid::Uuid,

@@ -6,8 +6,11 @@ use utoipa::ToSchema;
 
 /// Kind of computation a job runs. The set is open: a new kind is one variant here plus one arm
 /// in the production runner.
+// Read from text only (`try_from = "String"`): serde_json answers a unit enum given a number
+// with a syntax error ("expected value"), which named no field; as text, `{"kind": 1}` is a
+// type error at `kind`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, ToSchema)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", try_from = "String")]
 pub enum JobKind {
     /// One case: a model config (by name or inline) with overrides -> wear, tracks, plots.
     Simulate,
@@ -46,6 +49,19 @@ impl JobKind {
             "diagnose" => Some(JobKind::Diagnose),
             _ => None,
         }
+    }
+}
+
+impl TryFrom<String> for JobKind {
+    type Error = String;
+
+    fn try_from(text: String) -> Result<Self, Self::Error> {
+        JobKind::parse(&text).ok_or_else(|| {
+            format!(
+                "unknown variant `{text}`, expected one of `simulate`, `sweep`, `calibrate`, \
+                 `sweep_point`, `diagnose`"
+            )
+        })
     }
 }
 

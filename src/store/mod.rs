@@ -528,6 +528,18 @@ pub trait Store: Send + Sync {
     ) -> StoreFuture<'_, bool>;
     /// The job's stored checkpoint, if any.
     fn load_checkpoint(&self, id: Uuid) -> StoreFuture<'_, Option<JobCheckpoint>>;
+    /// Store record chunk `seq` of job `id`'s run (migration 0010; replacing one of the same
+    /// number) only while attempt `attempt` holds the running lease. False when the attempt
+    /// is stale (nothing written). The chunks are deleted when the job ends.
+    fn save_record_chunk(
+        &self,
+        id: Uuid,
+        attempt: i64,
+        seq: u64,
+        data: Vec<u8>,
+    ) -> StoreFuture<'_, bool>;
+    /// The job's stored record chunks from number 0 on, in order, up to the first gap.
+    fn load_record_chunks(&self, id: Uuid) -> StoreFuture<'_, Vec<Vec<u8>>>;
     /// The typed plan stored with the job at submission ([`NewJob::plan`]), if any.
     fn job_plan(&self, id: Uuid) -> StoreFuture<'_, Option<serde_json::Value>>;
 }

@@ -19,7 +19,7 @@ use super::job_records::{JobProgress, JobRecord, JobStatus};
 use super::rows::{
     child_of, corrupt, cut_page, records, AttemptRow, CampaignContentRow, CampaignRow, ChildRow,
     CurveRow, DbUuid, HostLeaseRow, JobRow, KeyedJobRow, LostRow, MeasurementRow, ParentLinkRow,
-    PlanRow, TokenRow, CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
+    PlanRow, RecordChunkRow, TokenRow, CAMPAIGN_SUMMARY, CURVE_SELECT, JOB_COLUMNS,
 };
 use super::Role;
 use super::{
@@ -57,6 +57,7 @@ where
     CampaignContentRow: for<'r> FromRow<'r, DB::Row>,
     JobCheckpoint: for<'r> FromRow<'r, DB::Row>,
     PlanRow: for<'r> FromRow<'r, DB::Row>,
+    RecordChunkRow: for<'r> FromRow<'r, DB::Row>,
     for<'c> &'c mut DB::Connection: Executor<'c, Database = DB>,
     for<'q> DB::Arguments<'q>: IntoArguments<'q, DB>,
     for<'q> bool: Encode<'q, DB> + Decode<'q, DB> + Type<DB>,
@@ -999,6 +1000,65 @@ where
         .bind(DbUuid(id))
         .fetch_optional(pool)
         .await?)
+    }
+
+    /// Stores record chunk `seq` of job `id` while `attempt` holds the running lease (one
+    /// statement: the insert happens only if the job row says so). False for a stale attempt.
+    pub(crate) async fn save_record_chunk(
+        pool: &Pool<DB>,
+        id: Uuid,
+        attempt: i64,
+        seq: u64,
+        data: Vec<u8>,
+    ) -> Result<bool, StoreError> {
+        let seq = i64::try_from(seq).map_err(|e| StoreError::Corrupt(e.to_string()))?;
+        let mut tx = Self::begin_write(pool).await?;
+        // A write that changes nothing, so that PostgreSQL locks the job row as the other
+        // fenced writes do (a claim cannot slip in between).
+        let owned: Option<(i64,)> = sqlx::query_as(
+            "UPDATE jobs SET attempt = attempt \
+             WHERE id = $1 AND attempt = $2 AND status = 'running' RETURNING seq",
+        )
+        .bind(DbUuid(id))
+        .bind(attempt)
+        .fetch_optional(&mut *tx)
+        .await?;
+        if owned.is_none() {
+            tx.rollback().await?;
+            return Ok(false);
+        }
+        sqlx::query(
+            "INSERT INTO job_record_chunks (job_id, seq, attempt, data) VALUES ($1, $2, $3, $4) \
+             ON CONFLICT (job_id, seq) DO UPDATE SET attempt = excluded.attempt, \
+             data = excluded.data",
+        )
+        .bind(DbUuid(id))
+        .bind(seq)
+        .bind(attempt)
+        .bind(data)
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(true)
+    }
+
+    /// Job `id`'s record chunks from number 0 on, in order, up to the first gap.
+    pub(crate) async fn load_record_chunks(
+        pool: &Pool<DB>,
+        id: Uuid,
+    ) -> Result<Vec<Vec<u8>>, StoreError> {
+        let rows: Vec<RecordChunkRow> = sqlx::query_as(
+            "SELECT seq, data FROM job_record_chunks WHERE job_id = $1 ORDER BY seq",
+        )
+        .bind(DbUuid(id))
+        .fetch_all(pool)
+        .await?;
+        Ok(rows
+            .into_iter()
+            .enumerate()
+            .take_while(|(i, row)| row.seq == *i as i64)
+            .map(|(_, row)| row.data)
+            .collect())
     }
 
     /// The plan stored with job `id` at submission (none: no such job, or none stored).

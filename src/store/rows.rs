@@ -248,6 +248,13 @@ impl PlanRow {
     }
 }
 
+/// One stored record chunk of a job's run, as `Store::load_record_chunks` reads it.
+#[derive(sqlx::FromRow)]
+pub(crate) struct RecordChunkRow {
+    pub(crate) seq: i64,
+    pub(crate) data: Vec<u8>,
+}
+
 /// The parent link a finishing job's update returns.
 #[derive(sqlx::FromRow)]
 pub(crate) struct ParentLinkRow {

@@ -19,6 +19,7 @@ mod service_hostile;
 mod service_jobs;
 mod service_metrics;
 mod service_openapi;
+mod service_probes;
 mod service_queue;
 mod service_rails;
 mod service_shutdown;

@@ -2,10 +2,12 @@
 //! (`LibraryRunner`, the shipped `configs/`) and no workers, so nothing runs: job parameters
 //! are checked completely at submission (422 problem+json naming the field, nothing stored),
 //! authorization comes before body parsing, every error is problem+json, drawn seeds are
-//! below 2^53, and /metrics counts HTTP requests per route and never prints -0.
+//! below 2^53, and /metrics counts HTTP requests per route and never prints -0. A job's
+//! stored params, read back, are a request that submits the same job again (a sweep's
+//! diagnosed wear-law record included, refused naming the field once altered).
 
 use crate::helpers::{Api, Runner, TestApp};
-use crate::support::{ENGINEER, PLANNER};
+use crate::support::{ENGINEER, PLANNER, TEST_ENGINEER};
 use serde_json::json;
 
 fn stored_jobs(api: &Api) -> usize {
@@ -195,6 +197,94 @@ async fn roles_are_checked_before_the_body_and_every_error_is_a_problem() {
             "{}",
             r.body
         );
+    })
+    .await
+    .unwrap();
+    app.stop().await;
+}
+
+/// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
+const CAMPAIGN: &str = include_str!("../fixtures/small-campaign.toml");
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_jobs_stored_params_submit_the_same_job_again() {
+    let app = TestApp::spawn_with(Runner::Library, true, |_| {}).await;
+    let api = app.api.clone();
+    tokio::task::spawn_blocking(move || {
+        // A diagnosis whose wear-law effect a sweep carries: the fixture's masses twenty times
+        // over, a gap impact wear explains.
+        let mut text = CAMPAIGN.to_string();
+        for (measured, scaled) in [
+            ("0.004", "0.08"),
+            ("0.005", "0.1"),
+            ("0.002", "0.04"),
+            ("0.003", "0.06"),
+        ] {
+            text = text.replace(&format!("cube = {measured} "), &format!("cube = {scaled} "));
+        }
+        let campaign = api.upload_campaign(&text);
+        let r = api.post(
+            &format!("/v1/campaigns/{campaign}/diagnoses"),
+            Some(TEST_ENGINEER),
+            r#"{"window_s": 0.1, "settle_s": 0.02, "grid_points": 2, "effects": ["impact_wear"]}"#,
+        );
+        assert_eq!(r.status, 201, "{}", r.body);
+        let diagnosis = r.json()["id"].as_str().unwrap().to_string();
+        api.wait_job(
+            &diagnosis,
+            railwear::jobs::JobStatus::Succeeded,
+            std::time::Duration::from_secs(300),
+        );
+
+        let submit =
+            |body: &serde_json::Value| api.post("/v1/jobs", Some(ENGINEER), &body.to_string());
+        let sweep = json!({"kind": "sweep", "params": {"points": 2,
+            "wear_law": {"diagnosis": diagnosis},
+            "overrides": {"simulation": {"duration_s": 0.05, "settle_s": 0.01}}}});
+        for first in [
+            json!({"kind": "simulate", "params": {"config": "rattle-box-c",
+                "overrides": {"simulation": {"settle_s": 0.01, "duration_s": 0.01}}}}),
+            sweep,
+        ] {
+            let r = submit(&first);
+            assert_eq!(r.status, 201, "{}", r.body);
+            let job = r.json();
+            let id = job["id"].as_str().unwrap();
+            api.cancel_job(id);
+            // GET the job, POST its kind and params back: a new job with the same params.
+            let stored = api.get_json(&format!("/v1/jobs/{id}"));
+            let again = json!({"kind": stored["kind"], "params": stored["params"]});
+            let r = submit(&again);
+            assert_eq!(r.status, 201, "resubmitting {again}: {}", r.body);
+            let second = r.json();
+            assert_ne!(second["id"], stored["id"]);
+            assert_eq!(second["params"], stored["params"], "{second}");
+            api.cancel_job(second["id"].as_str().unwrap());
+            if stored["kind"] != "sweep" {
+                continue;
+            }
+            // The stored diagnosed wear law is the diagnosis' record: altered, it is refused
+            // naming the field that differs.
+            let law = &stored["params"]["wear_law"];
+            assert_eq!(law["diagnosis"], diagnosis.as_str(), "{stored}");
+            let name = law["parameters"]
+                .as_object()
+                .and_then(|p| p.keys().next().cloned())
+                .expect("the record has parameters");
+            let mut altered = again.clone();
+            let value = &mut altered["params"]["wear_law"]["parameters"][&name];
+            *value = json!(value.as_f64().unwrap() * 2.0 + 1.0);
+            let p = submit(&altered).problem(422);
+            assert_eq!(
+                p["field"],
+                format!("params.wear_law.parameters.{name}"),
+                "{p}"
+            );
+            let mut altered = again.clone();
+            altered["params"]["wear_law"]["effect"] = json!("third_body");
+            let p = submit(&altered).problem(422);
+            assert_eq!(p["field"], "params.wear_law.effect", "{p}");
+        }
     })
     .await
     .unwrap();

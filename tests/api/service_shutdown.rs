@@ -3,8 +3,9 @@
 //! `released`), within the shutdown grace even when the computation does not stop; the next
 //! worker runs the job to a result identical to an uninterrupted run. A sweep keeps the points
 //! that finished (the sweep-level checkpoint) and re-runs only the rest. A real simulation
-//! (the library runner) stops with a mid-run checkpoint, which the next worker resumes from to
-//! the uninterrupted run's result.
+//! (the library runner) stopped late (past 80 %) stores its records in chunks as it runs and a
+//! checkpoint much smaller than them at the stop; the next worker resumes from both to the
+//! uninterrupted run's result.
 
 use crate::helpers::{Api, Runner, TestApp};
 use crate::support::runner::{start, start_library, test_config};
@@ -261,9 +262,10 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     second.stop().await;
 }
 
-/// Rattle box C, 50 ms settle and 1.2 s excited: a few seconds of computation.
-const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":1.2}},"seed":8}}"#;
-const SIMULATE_END_S: f64 = 1.25;
+/// Rattle box C, 50 ms settle and 5 s excited, recording about every accepted step: a few
+/// seconds of computation and tens of thousands of track samples.
+const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":5.0,"record_interval_s":1e-5}},"seed":8}}"#;
+const SIMULATE_END_S: f64 = 5.05;
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
@@ -286,12 +288,13 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
     config.workers = 1;
     config.shutdown_grace_s = 5.0;
     config.lease_s = 60.0; // only the release can hand the job on this fast
+    config.checkpoint_chunk_samples = 1024; // many chunks in a short run
     let first = start_library(config.clone(), true).await;
     let store = first.state.store.clone();
     let first_jobs = first.state.jobs.clone();
     let api = Api::new(&format!("http://{}", first.addr));
     let id =
-        tokio::task::spawn_blocking(move || submit_until_progress(&api, SIMULATE_BODY, 0.15, LONG))
+        tokio::task::spawn_blocking(move || submit_until_progress(&api, SIMULATE_BODY, 0.8, LONG))
             .await
             .unwrap();
     let asked = Instant::now();
@@ -313,11 +316,28 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
         .checkpoint_s
         .expect("the released attempt stored a checkpoint");
     assert!(
-        checkpoint_s > 0.0 && checkpoint_s < SIMULATE_END_S,
+        (0.8 * SIMULATE_END_S..SIMULATE_END_S).contains(&checkpoint_s),
         "checkpoint at {checkpoint_s} s"
     );
     let stored = store.load_checkpoint(uuid).await.unwrap().expect("stored");
     assert_eq!(stored.simulated_s, checkpoint_s);
+    // The records went out in chunks as the run went; the checkpoint carries the run's state
+    // and less than a chunk's worth of records, far less than the records themselves.
+    let chunks = store.load_record_chunks(uuid).await.unwrap();
+    let chunk_bytes: usize = chunks.iter().map(Vec::len).sum();
+    let largest = chunks.iter().map(Vec::len).max().unwrap_or(0);
+    eprintln!(
+        "checkpoint at {checkpoint_s} s: {} bytes; {} record chunks, {chunk_bytes} bytes, the \
+         largest {largest}",
+        stored.data.len(),
+        chunks.len()
+    );
+    assert!(chunks.len() >= 20, "{} record chunks stored", chunks.len());
+    assert!(
+        4 * stored.data.len() < chunk_bytes,
+        "checkpoint of {} bytes beside {chunk_bytes} bytes of chunks",
+        stored.data.len()
+    );
     assert_eq!(stored.end_s, SIMULATE_END_S);
     assert_eq!(stored.attempt, 1);
     // The job's progress stands at the checkpoint.
@@ -376,6 +396,10 @@ async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it
         store.load_checkpoint(uuid).await.unwrap(),
         None,
         "the checkpoint is deleted when the job ends"
+    );
+    assert!(
+        store.load_record_chunks(uuid).await.unwrap().is_empty(),
+        "the record chunks are deleted when the job ends"
     );
     second.stop().await;
 }

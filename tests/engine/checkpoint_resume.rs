@@ -4,16 +4,24 @@
 //! the launcher, interrupted at several steps (before the first step, in the settle, in the
 //! excited window, twice in a row). A checkpoint of another case, code version or format is
 //! not resumed: the run restarts from t = 0 (and gives that case's own result).
+//!
+//! With a record sink the run hands its growing records over in chunks as it goes, and a
+//! checkpoint carries only the state and the records since the last chunk: on a run long enough
+//! for many chunks, the checkpoint at 80 % is no larger than twice the one at 20 % (without a
+//! sink it grows with the run), and resumed with its chunks the run still ends bit for bit as
+//! the uninterrupted one; with chunks missing or altered the checkpoint is refused.
 
 use railwear::models::case::{build, code_version, load_case};
 use railwear::models::checkpoint::{self, CheckpointError, RunIdentity};
 use railwear::models::spec::CaseSpec;
 use railwear::physics::energy::ENERGY_BALANCE_TOLERANCE;
 use railwear::physics::track::TrackSample;
-use railwear::pipeline::{run_case_from, Progress, RunControl, RunError};
+use railwear::pipeline::{
+    run_case_from, Progress, RecordChunk, RecordSink, RunControl, RunError, SavedRun,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 fn configs() -> PathBuf {
@@ -83,6 +91,11 @@ fn checkpoint_past(fraction: f64) -> RunControl {
 /// Runs `case` to the end from `resume`; the results, the energy account's closure and the
 /// time the run resumed from.
 fn finish(case: &CaseSpec, resume: Option<&[u8]>) -> (Results, Option<f64>) {
+    finish_saved(case, resume.map(SavedRun::without_chunks))
+}
+
+/// [`finish`] from a checkpoint with its record chunks.
+fn finish_saved(case: &CaseSpec, resume: Option<SavedRun<'_>>) -> (Results, Option<f64>) {
     let started = std::time::Instant::now();
     let (report, outcome) = run_case_from(case, &configs(), &RunControl::silent(), resume)
         .unwrap_or_else(|e| panic!("{}: {e}", case.name));
@@ -113,6 +126,15 @@ fn finish(case: &CaseSpec, resume: Option<&[u8]>) -> (Results, Option<f64>) {
 
 /// Runs `case` from `resume` until the checkpoint `control` asks for; its bytes and time.
 fn stop(case: &CaseSpec, resume: Option<&[u8]>, control: &RunControl) -> (Vec<u8>, f64) {
+    stop_saved(case, resume.map(SavedRun::without_chunks), control)
+}
+
+/// [`stop`] from a checkpoint with its record chunks.
+fn stop_saved(
+    case: &CaseSpec,
+    resume: Option<SavedRun<'_>>,
+    control: &RunControl,
+) -> (Vec<u8>, f64) {
     match run_case_from(case, &configs(), control, resume) {
         Err(RunError::Checkpointed(cp)) => {
             let end = case.simulation.settle_s + case.simulation.duration_s;
@@ -219,7 +241,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     let model = build(&case, &dir).expect("model");
     let identity = RunIdentity::of(&case, &model, &dir);
     assert_eq!(identity.code_version, code_version());
-    let decoded = checkpoint::decode(&bytes, &identity).expect("its own checkpoint decodes");
+    let decoded = checkpoint::decode(&bytes, &identity, &[]).expect("its own checkpoint decodes");
     assert_eq!(decoded.time_s(), t);
 
     // Another case: another seed of the same model.
@@ -229,7 +251,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     let other_identity = RunIdentity::of(&other, &other_model, &dir);
     assert_ne!(other_identity.case_sha256, identity.case_sha256);
     assert!(matches!(
-        checkpoint::decode(&bytes, &other_identity),
+        checkpoint::decode(&bytes, &other_identity, &[]),
         Err(CheckpointError::Case { .. })
     ));
     let (expected_other, _) = finish(&other, None);
@@ -247,7 +269,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     )
     .expect("encode");
     assert!(matches!(
-        checkpoint::decode(&foreign.bytes, &identity),
+        checkpoint::decode(&foreign.bytes, &identity, &[]),
         Err(CheckpointError::CodeVersion { .. })
     ));
     let (expected, _) = finish(&case, None);
@@ -263,7 +285,7 @@ fn a_checkpoint_of_another_case_code_version_or_format_restarts_from_zero() {
     std::io::Write::write_all(&mut z, &(checkpoint::CHECKPOINT_FORMAT + 1).to_le_bytes()).unwrap();
     let other_format = z.finish().unwrap();
     assert!(matches!(
-        checkpoint::decode(&other_format, &identity),
+        checkpoint::decode(&other_format, &identity, &[]),
         Err(CheckpointError::Format { .. })
     ));
     let (got, resumed) = finish(&case, Some(&other_format));
@@ -286,7 +308,7 @@ fn the_checkpoint_bytes_round_trip() {
     let (bytes, _) = stop(&case, None, &checkpoint_at(0.1));
     let model = build(&case, Path::new(&dir)).expect("model");
     let identity = RunIdentity::of(&case, &model, &dir);
-    let decoded = checkpoint::decode(&bytes, &identity).expect("decode");
+    let decoded = checkpoint::decode(&bytes, &identity, &[]).expect("decode");
     let again = checkpoint::encode(&identity, &decoded).expect("encode");
     assert_eq!(
         again.bytes, bytes,
@@ -308,10 +330,10 @@ fn a_launcher_run_part_by_part_resumes_bit_identically_in_either_part() {
     let (expected, _) = finish(&case, None);
     // In the first part, then (resumed from it) in the second.
     let (first, t1) = stop(&case, None, &checkpoint_past(0.2));
-    let cp = checkpoint::decode(&first, &identity).expect("decode");
+    let cp = checkpoint::decode(&first, &identity, &[]).expect("decode");
     assert_eq!(cp.finished_parts(), 0);
     let (second, t2) = stop(&case, Some(&first), &checkpoint_past(0.6));
-    let cp = checkpoint::decode(&second, &identity).expect("decode");
+    let cp = checkpoint::decode(&second, &identity, &[]).expect("decode");
     assert_eq!(
         cp.finished_parts(),
         1,
@@ -322,5 +344,178 @@ fn a_launcher_run_part_by_part_resumes_bit_identically_in_either_part() {
         let (got, resumed) = finish(&case, Some(bytes));
         assert_eq!(resumed, Some(t));
         assert_results_equal(&got, &expected, "launcher-m299-2");
+    }
+}
+
+/// The record chunks a run hands to its sink, kept by number as a store keeps them (a chunk
+/// written again replaces the one of its number).
+#[derive(Clone)]
+struct Chunks {
+    kept: Arc<Mutex<Vec<Vec<u8>>>>,
+    samples: usize,
+}
+
+impl Chunks {
+    /// Chunks of `samples` samples each.
+    fn of(samples: usize) -> Self {
+        Self {
+            kept: Arc::default(),
+            samples,
+        }
+    }
+
+    /// `control` with its records handed here.
+    fn sink_of(&self, control: RunControl) -> RunControl {
+        let kept = self.kept.clone();
+        RunControl {
+            record_sink: Some(RecordSink {
+                chunk_samples: self.samples,
+                write: Arc::new(move |chunk: RecordChunk| {
+                    let mut kept = kept.lock().expect("chunks");
+                    let seq = chunk.seq as usize;
+                    assert!(seq <= kept.len(), "chunk {seq} after {} chunks", kept.len());
+                    kept.truncate(seq);
+                    kept.push(chunk.bytes);
+                }),
+            }),
+            ..control
+        }
+    }
+
+    fn taken(&self) -> Vec<Vec<u8>> {
+        self.kept.lock().expect("chunks").clone()
+    }
+}
+
+#[test]
+fn with_a_record_sink_the_checkpoint_stays_small_and_the_run_resumes_bit_identically() {
+    // Rattle box C recording about every accepted step, chunks of 1024 samples: many chunks
+    // in a short run.
+    let dir = configs();
+    let mut case = short_case("rattle-box-c.toml", 0.02, 1.5);
+    case.simulation.record_interval_s = 1e-5;
+    let end = case.simulation.settle_s + case.simulation.duration_s;
+    let (expected, _) = finish(&case, None);
+    let model = build(&case, &dir).expect("model");
+    let identity = RunIdentity::of(&case, &model, &dir);
+
+    let chunks = Chunks::of(1024);
+    let (early, t_early) = stop_saved(&case, None, &chunks.sink_of(checkpoint_at(0.2 * end)));
+    let early_chunks = chunks.taken();
+    let (late, t_late) = stop_saved(
+        &case,
+        Some(SavedRun {
+            checkpoint: &early,
+            record_chunks: &early_chunks,
+        }),
+        &chunks.sink_of(checkpoint_at(0.8 * end)),
+    );
+    let late_chunks = chunks.taken();
+    let late_cp = checkpoint::decode(&late, &identity, &late_chunks).expect("decode");
+    let largest_chunk = late_chunks.iter().map(Vec::len).max().unwrap_or(0);
+    eprintln!(
+        "checkpoints with a record sink: {} bytes at {t_early} s, {} bytes at {t_late} s; \
+         {} chunks, the largest {largest_chunk} bytes",
+        early.len(),
+        late.len(),
+        late_chunks.len()
+    );
+    assert_eq!(late_cp.record_chunks() as usize, late_chunks.len());
+    assert!(
+        late_chunks.len() >= 3 * early_chunks.len().max(1) && late_chunks.len() >= 8,
+        "{} chunks at 20 %, {} at 80 %: too few to show the bound",
+        early_chunks.len(),
+        late_chunks.len()
+    );
+    // What a checkpoint carries beyond the run's state (which does not grow) is less than a
+    // chunk's worth of each record: the one at 80 % exceeds the one at 20 % by less than
+    // two chunks, and is less than twice its size.
+    assert!(
+        late.len() < early.len() + 2 * largest_chunk,
+        "checkpoint at 80 %: {} bytes, at 20 %: {} bytes, chunks up to {largest_chunk} bytes",
+        late.len(),
+        early.len()
+    );
+    assert!(late.len() < 2 * early.len());
+    // Without a sink the checkpoint carries every record and grows with the run.
+    let (whole, _) = stop(&case, None, &checkpoint_at(0.8 * end));
+    assert!(
+        whole.len() > 2 * late.len(),
+        "a checkpoint without chunks ({} bytes) is not larger than one with ({} bytes)",
+        whole.len(),
+        late.len()
+    );
+
+    // Resumed with its chunks (and the later ones the store may hold), bit for bit.
+    for (bytes, t, kept) in [
+        (&early, t_early, &late_chunks),
+        (&late, t_late, &late_chunks),
+    ] {
+        let (got, resumed) = finish_saved(
+            &case,
+            Some(SavedRun {
+                checkpoint: bytes,
+                record_chunks: kept,
+            }),
+        );
+        assert_eq!(resumed, Some(t));
+        assert_results_equal(&got, &expected, "rattle box C, recorded every step");
+    }
+
+    // Chunks missing or altered: refused, and the run starts over to the same result.
+    let mut altered = late_chunks.clone();
+    altered[1][10] ^= 1;
+    for (kept, what) in [(&late_chunks[..2], "missing"), (&altered[..], "altered")] {
+        assert!(
+            matches!(
+                checkpoint::decode(&late, &identity, kept),
+                Err(CheckpointError::Records(_))
+            ),
+            "{what} chunks were accepted"
+        );
+        let (got, resumed) = finish_saved(
+            &case,
+            Some(SavedRun {
+                checkpoint: &late,
+                record_chunks: kept,
+            }),
+        );
+        assert_eq!(resumed, None, "resumed with {what} chunks");
+        assert_results_equal(&got, &expected, what);
+    }
+}
+
+#[test]
+fn a_launcher_run_part_by_part_with_a_record_sink_resumes_bit_identically() {
+    // The first part's report goes out as a chunk when it finishes; resumed in the second
+    // part, the run takes it back.
+    let case = short_case("launcher-m299-2.toml", 0.05, 0.25);
+    let (expected, _) = finish(&case, None);
+    let chunks = Chunks::of(64);
+    let (first, t1) = stop_saved(&case, None, &chunks.sink_of(checkpoint_past(0.2)));
+    let first_chunks = chunks.taken();
+    let (second, t2) = stop_saved(
+        &case,
+        Some(SavedRun {
+            checkpoint: &first,
+            record_chunks: &first_chunks,
+        }),
+        &chunks.sink_of(checkpoint_past(0.6)),
+    );
+    let second_chunks = chunks.taken();
+    assert!(
+        second_chunks.len() > first_chunks.len(),
+        "the finished part wrote no chunk"
+    );
+    for (bytes, t) in [(&first, t1), (&second, t2)] {
+        let (got, resumed) = finish_saved(
+            &case,
+            Some(SavedRun {
+                checkpoint: bytes,
+                record_chunks: &second_chunks,
+            }),
+        );
+        assert_eq!(resumed, Some(t));
+        assert_results_equal(&got, &expected, "launcher-m299-2 with chunks");
     }
 }

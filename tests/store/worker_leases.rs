@@ -249,9 +249,11 @@ async fn postgres_release_is_fenced_and_yields_to_cancellation() {
     release_is_fenced_and_yields_to_cancellation(store).await;
 }
 
-/// Checkpoints (migration 0007): stored only by the attempt holding the lease (recorded on the
-/// attempt, progress moved to its time), replaced by a later save, kept across the release
-/// for the next attempt, and deleted when the job ends, whichever way it ends.
+/// Checkpoints (migration 0007) and record chunks (migration 0010): stored only by the attempt
+/// holding the lease (a checkpoint recorded on the attempt, progress moved to its time),
+/// replaced by a later save of the same one, kept across the release for the next attempt, and
+/// deleted when the job ends, whichever way it ends. Chunks are read from number 0 up to the
+/// first gap.
 async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
     use railwear::store::{Finish, NewCheckpoint};
     let job = |n: u128| numbered_job(0xc4ec_0000, n);
@@ -270,6 +272,22 @@ async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
         .await
         .unwrap());
     assert_eq!(store.load_checkpoint(a.id).await.unwrap(), None);
+    assert!(!store
+        .save_record_chunk(a.id, 2, 0, vec![9; 10])
+        .await
+        .unwrap());
+    assert!(store.load_record_chunks(a.id).await.unwrap().is_empty());
+    for (seq, fill) in [(0, 10u8), (1, 11), (1, 12), (3, 13)] {
+        assert!(store
+            .save_record_chunk(a.id, 1, seq, vec![fill; 10])
+            .await
+            .unwrap());
+    }
+    assert_eq!(
+        store.load_record_chunks(a.id).await.unwrap(),
+        vec![vec![10u8; 10], vec![12u8; 10]],
+        "chunk 1 replaced; chunk 3 is past the gap"
+    );
     assert!(store
         .save_checkpoint(a.id, 1, checkpoint(0.5, 1), 2_100)
         .await
@@ -310,10 +328,20 @@ async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
     let again = store.claim_job("w2", 2_300, 60_000).await.unwrap().unwrap();
     assert_eq!((again.id, again.attempt), (a.id, 2));
     assert!(store.load_checkpoint(a.id).await.unwrap().is_some());
+    assert_eq!(store.load_record_chunks(a.id).await.unwrap().len(), 2);
     assert!(!store
         .save_checkpoint(a.id, 1, checkpoint(0.9, 3), 2_350)
         .await
         .unwrap());
+    assert!(!store
+        .save_record_chunk(a.id, 1, 2, vec![14; 10])
+        .await
+        .unwrap());
+    assert!(store
+        .save_record_chunk(a.id, 2, 2, vec![15; 10])
+        .await
+        .unwrap());
+    assert_eq!(store.load_record_chunks(a.id).await.unwrap().len(), 4);
     assert_eq!(store.attempts(a.id).await.unwrap()[1].checkpoint_s, None);
     // The job ends: the checkpoint goes with it.
     assert!(store
@@ -321,10 +349,15 @@ async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
         .await
         .unwrap());
     assert_eq!(store.load_checkpoint(a.id).await.unwrap(), None);
+    assert!(store.load_record_chunks(a.id).await.unwrap().is_empty());
     // A queued job with a checkpoint, cancelled: gone too.
     let b = store.claim_job("w", 2_500, 60_000).await.unwrap().unwrap();
     assert!(store
         .save_checkpoint(b.id, 1, checkpoint(0.25, 4), 2_550)
+        .await
+        .unwrap());
+    assert!(store
+        .save_record_chunk(b.id, 1, 0, vec![16; 10])
         .await
         .unwrap());
     store.release_job(b.id, 1, 2_600).await.unwrap();
@@ -334,6 +367,7 @@ async fn checkpoints_are_fenced_and_end_with_the_job(store: Arc<dyn Store>) {
         JobStatus::Cancelled
     );
     assert_eq!(store.load_checkpoint(b.id).await.unwrap(), None);
+    assert!(store.load_record_chunks(b.id).await.unwrap().is_empty());
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -11,9 +11,8 @@ use crate::physics::simulate::{
 };
 use crate::physics::system::MultibodySystem;
 use crate::physics::track::TrackSample;
-use crate::units::{MG_PER_KG, S_PER_H};
 use crate::wear::allocation::VolumeSplit;
-use crate::wear::integrate::{TrackLoad, WearAccumulator, WearTotals};
+use crate::wear::integrate::{TrackLoad, WearAccumulator};
 use crate::wear::law::WearLaw;
 use crate::wear::material::Material;
 use crate::wear::mechanism::WearMechanism;
@@ -22,17 +21,21 @@ use serde::{Deserialize, Serialize};
 
 mod parts;
 mod rate_window;
+mod records;
 mod report;
 mod samples;
 mod soundness;
+mod window_reports;
 
 pub use rate_window::RateWindow;
 pub use report::{BodyReport, ContactReport, RunReport};
 
 use rate_window::Cumulative;
+use records::{Appended, RecordMark, RecordWriter, VelocitySample};
 
 use parts::run_parts;
 use samples::{base_acceleration_at, record_tracks};
+use window_reports::{window_reports, Totals, WindowReports};
 
 /// A model ready to run: the system, its initial state and what each contact wears.
 pub struct BuiltModel {
@@ -102,12 +105,17 @@ pub enum ModelRunError {
 /// A model run stopped at an accepted step: everything [`run_model_from`] needs to finish it
 /// with the result of the uninterrupted run, bit for bit. A model integrated part by part
 /// keeps the reports of the parts already finished and the checkpoint of the one running.
+/// What the run handed to its record sink before is not repeated here
+/// ([`records`](self::records)): serialized, a checkpoint holds the records since the last
+/// chunk, and one read back is whole again after [`ModelCheckpoint::restore_records`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ModelCheckpoint {
     /// Reports of the finished parts, in part order (empty for a model run whole).
-    finished_parts: Vec<RunReport>,
+    finished_parts: Appended<RunReport>,
     /// The run in progress: the engine's state and what the observer accumulated.
     current: WholeCheckpoint,
+    /// The record chunks written before the checkpoint.
+    records: RecordMark,
 }
 
 impl ModelCheckpoint {
@@ -124,6 +132,27 @@ impl ModelCheckpoint {
     /// Parts already finished (0 for a model run whole).
     pub fn finished_parts(&self) -> usize {
         self.finished_parts.len()
+    }
+
+    /// Record chunks the run handed to its record sink before the checkpoint.
+    pub fn record_chunks(&self) -> u64 {
+        self.records.chunks()
+    }
+
+    /// Puts the records together again from `chunks`, the record chunks of the run in order
+    /// from the first (those after the ones the checkpoint counts are ignored); a checkpoint
+    /// read back must be restored before it is resumed (also with no chunks, when it
+    /// follows none). Refused, with the reason, when the chunks are not those the checkpoint
+    /// follows.
+    pub fn restore_records(&mut self, chunks: &[Vec<u8>]) -> Result<(), String> {
+        records::restore(self, chunks)
+    }
+
+    /// True when no record is missing (restored, or never written out).
+    fn complete(&self) -> bool {
+        self.finished_parts.complete()
+            && self.current.observed.tracks_out.complete()
+            && self.current.observed.resp_vel.complete()
     }
 }
 
@@ -156,10 +185,10 @@ struct Observed {
     friction_now: Vec<f64>,
     /// The cumulative quantities at the rate window's start, once the run has passed it.
     rate_base: Option<Cumulative>,
-    tracks_out: Vec<TrackSample>,
+    tracks_out: Appended<TrackSample>,
     next_record: f64,
     next_resp: f64,
-    resp_vel: Vec<(f64, [f64; 3])>,
+    resp_vel: Appended<VelocitySample>,
     prev_vel: Option<(f64, nalgebra::Vector3<f64>)>,
     wear_history: Vec<(f64, Vec<f64>)>,
     next_history: f64,
@@ -185,10 +214,10 @@ impl Observed {
             friction_at_window_start: None,
             friction_now: vec![0.0; ncontacts],
             rate_base: None,
-            tracks_out: Vec::new(),
+            tracks_out: Appended::default(),
             next_record: t0,
             next_resp: t0,
-            resp_vel: Vec::new(),
+            resp_vel: Appended::default(),
             prev_vel: None,
             wear_history: Vec::new(),
             next_history: t0,
@@ -249,20 +278,39 @@ pub fn run_model_from(
     control: &RunControl,
     resume: Option<ModelCheckpoint>,
 ) -> Result<RunReport, ModelRunError> {
+    if let Some(cp) = resume.as_ref().filter(|cp| !cp.complete()) {
+        return Err(bad_checkpoint(format!(
+            "the checkpoint follows {} record chunks that were not restored",
+            cp.record_chunks()
+        )));
+    }
     let parts = independent_parts(&model.system);
+    let mark = resume
+        .as_ref()
+        .map(|cp| cp.records.clone())
+        .unwrap_or_default();
+    let mut writer = RecordWriter::new(control.record_sink.clone(), mark);
     if parts.len() > 1 {
-        return run_parts(model, &parts, options, control, resume);
+        return run_parts(model, &parts, options, control, resume, &mut writer);
     }
-    match resume {
-        Some(cp) if !cp.finished_parts.is_empty() => Err(bad_checkpoint(format!(
-            "{} finished parts, the model runs whole",
-            cp.finished_parts.len()
-        ))),
-        Some(cp) => run_whole(model, options, control, &mut |_| {}, Some(cp.current))
-            .map_err(|e| e.within_parts(Vec::new())),
-        None => run_whole(model, options, control, &mut |_| {}, None)
-            .map_err(|e| e.within_parts(Vec::new())),
-    }
+    let result = match resume {
+        Some(cp) if cp.finished_parts.len() > 0 => {
+            return Err(bad_checkpoint(format!(
+                "{} finished parts, the model runs whole",
+                cp.finished_parts.len()
+            )))
+        }
+        Some(cp) => run_whole(
+            model,
+            options,
+            control,
+            &mut |_| {},
+            Some(cp.current),
+            &mut writer,
+        ),
+        None => run_whole(model, options, control, &mut |_| {}, None, &mut writer),
+    };
+    result.map_err(|e| e.within_parts(Appended::default(), writer.mark()))
 }
 
 fn bad_checkpoint(reason: String) -> ModelRunError {
@@ -295,14 +343,19 @@ impl From<WearError> for WholeError {
 
 impl WholeError {
     /// The model-level error; a checkpoint is kept with the reports of the parts finished
-    /// before it.
-    fn within_parts(self, finished_parts: Vec<RunReport>) -> ModelRunError {
+    /// before it and the mark of the record chunks written before it.
+    fn within_parts(
+        self,
+        finished_parts: Appended<RunReport>,
+        records: RecordMark,
+    ) -> ModelRunError {
         match self {
             WholeError::Run(e) => e,
             WholeError::Checkpointed(current) => {
                 ModelRunError::Checkpointed(Box::new(ModelCheckpoint {
                     finished_parts,
                     current: *current,
+                    records,
                 }))
             }
         }
@@ -324,8 +377,16 @@ pub fn run_model_observed(
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
 ) -> Result<RunReport, ModelRunError> {
-    run_whole(model, options, &control.without_checkpoint(), extra, None)
-        .map_err(|e| e.within_parts(Vec::new()))
+    let mut writer = RecordWriter::new(None, RecordMark::default());
+    run_whole(
+        model,
+        options,
+        &control.without_checkpoint(),
+        extra,
+        None,
+        &mut writer,
+    )
+    .map_err(|e| e.within_parts(Appended::default(), RecordMark::default()))
 }
 
 /// The states a run of `model` passes through, one per `every_s` of simulated time (the first
@@ -350,13 +411,15 @@ pub fn record_states(
     Ok(states)
 }
 
-/// The run of a model integrated as one system (from `resume`, its checkpoint, if given).
+/// The run of a model integrated as one system (from `resume`, its checkpoint, if given),
+/// writing its records to `writer` as they grow ([`records`](self::records)).
 fn run_whole(
     model: &BuiltModel,
     options: &RunOptions,
     control: &RunControl,
     extra: &mut dyn FnMut(&StepView),
     resume: Option<WholeCheckpoint>,
+    writer: &mut RecordWriter,
 ) -> Result<RunReport, WholeError> {
     let sys = &model.system;
     let t0 = model.excitation_start_s;
@@ -496,7 +559,7 @@ fn run_whole(
         // Track samples for export.
         if options.record_interval_s >= 0.0 && v.t >= st.next_record {
             st.next_record = v.t + options.record_interval_s;
-            record_tracks(v, &mut st.tracks_out);
+            record_tracks(v, st.tracks_out.items_mut());
         }
         // Response velocity, linearly interpolated onto the uniform grid.
         if let Some(off) = resp_offset {
@@ -511,6 +574,7 @@ fn run_whole(
             }
             st.prev_vel = Some((v.t, vel));
         }
+        writer.samples(&mut st.tracks_out, &mut st.resp_vel, false);
     };
     let mut y = model.initial_state.clone();
     let result = simulate_from(
@@ -537,6 +601,10 @@ fn run_whole(
         }
         Err(e) => return Err(e.into()),
     };
+    if writer.part_of_several {
+        // The part's last samples, before its report follows them.
+        writer.samples(&mut st.tracks_out, &mut st.resp_vel, true);
+    }
     let Observed {
         mut accs,
         normal_int,
@@ -575,95 +643,25 @@ fn run_whole(
              results are suspect"
         );
     }
-    let window = (model.end_time_s - t0).max(f64::MIN_POSITIVE);
-    // Rates over the rate window: from the ramp-in's end when the run passed it, else over the
-    // whole excited window (`rate_window`).
-    let rate_base = rate_base.filter(|b| model.end_time_s - b.t_s > 0.0);
-    let rate_window = match &rate_base {
-        Some(b) => RateWindow {
-            start_s: b.t_s,
-            length_s: model.end_time_s - b.t_s,
-            after_ramp: true,
-        },
-        None => RateWindow {
-            start_s: t0,
-            length_s: window,
-            after_ramp: model.rate_start_s <= t0,
-        },
+    let totals = Totals {
+        accs: &mut accs,
+        normal_int: &normal_int,
+        normal_slip_int: &power_int,
+        peak: &peak,
+        friction_window: &friction_window,
+        friction_now: &friction_now,
+        rate_base,
     };
-    let rate_span = rate_window.length_s.max(f64::MIN_POSITIVE);
-    let over_rate_window = |now: &[f64], base: fn(&Cumulative) -> &Vec<f64>| -> Vec<f64> {
-        match &rate_base {
-            Some(b) => now.iter().zip(base(b)).map(|(n, b)| n - b).collect(),
-            None => now.to_vec(),
-        }
-    };
-    let normal_rate_window = over_rate_window(&normal_int, |b| &b.normal);
-    let normal_slip_rate_window = over_rate_window(&power_int, |b| &b.normal_slip);
-    let friction_rate_window = match &rate_base {
-        Some(b) => friction_now
-            .iter()
-            .zip(&b.friction)
-            .map(|(n, b)| n - b)
-            .collect(),
-        None => friction_window.clone(),
-    };
-    let mut body_rate = vec![0.0; sys.bodies.len()];
-    let mut contacts = Vec::with_capacity(ncontacts);
-    let mut body_mass = vec![0.0; sys.bodies.len()];
-    for (ci, c) in sys.contacts.iter().enumerate() {
-        let mut total: Option<WearTotals> = None;
-        for a in accs[ci].iter_mut().filter_map(|a| a.take()) {
-            let t = a.acc.finish();
-            match &mut total {
-                Some(tot) => tot.merge(&t)?,
-                None => total = Some(t),
-            }
-        }
-        let total = match total {
-            Some(t) => t,
-            None => WearAccumulator::new(law)?.finish(),
-        };
-        let (ma, mb) = &model.contact_materials[ci];
-        let (wa, wb) = options.volume_split.split(total.volume_m3, ma, mb)?;
-        body_mass[c.body_a] += wa.mass_kg;
-        body_mass[c.body_b] += wb.mass_kg;
-        let rate_volume = match &rate_base {
-            Some(b) => (total.volume_m3 - b.volume[ci]).max(0.0),
-            None => total.volume_m3,
-        };
-        let (ra, rb) = options.volume_split.split(rate_volume, ma, mb)?;
-        let per_h = S_PER_H / rate_span;
-        body_rate[c.body_a] += ra.mass_kg * MG_PER_KG * per_h;
-        body_rate[c.body_b] += rb.mass_kg * MG_PER_KG * per_h;
-        contacts.push(ContactReport {
-            name: c.name.clone(),
-            body_a: sys.bodies[c.body_a].name.clone(),
-            body_b: sys.bodies[c.body_b].name.clone(),
-            work_share_above_cutoff: total.work_share_above_cutoff(),
-            mass_a_mg: wa.mass_kg * MG_PER_KG,
-            mass_b_mg: wb.mass_kg * MG_PER_KG,
-            mass_rate_mg_per_h: (ra.mass_kg + rb.mass_kg) * MG_PER_KG * per_h,
-            mass_rate_a_mg_per_h: ra.mass_kg * MG_PER_KG * per_h,
-            mass_rate_b_mg_per_h: rb.mass_kg * MG_PER_KG * per_h,
-            mean_normal_force_n: normal_rate_window[ci] / rate_span,
-            mean_normal_slip_power_w: normal_slip_rate_window[ci] / rate_span,
-            mean_friction_power_w: friction_rate_window[ci] / rate_span,
-            friction_work_j: friction_window[ci],
-            peak_normal_force_n: peak[ci],
-            wear: total,
-        });
-    }
-    let bodies = sys
-        .bodies
-        .iter()
-        .enumerate()
-        .map(|(i, b)| BodyReport {
-            name: b.name.clone(),
-            mass_mg: body_mass[i] * MG_PER_KG,
-            mass_rate_mg_per_h: body_rate[i],
-        })
-        .collect();
+    let WindowReports {
+        contacts,
+        bodies,
+        window_s: window,
+        rate_window,
+        mean_normal_force_n,
+        mean_normal_slip_power_w,
+        mean_friction_power_w,
+    } = window_reports(model, options, totals)?;
+    let resp_vel = resp_vel.into_items();
     let mut response_acceleration = Vec::with_capacity(resp_vel.len());
     let mut base_acceleration = Vec::with_capacity(resp_vel.len());
     for w in resp_vel.windows(2) {
@@ -678,16 +676,16 @@ fn run_whole(
         base_acceleration.push(a);
     }
     Ok(RunReport {
-        mean_normal_force_n: normal_rate_window.iter().sum::<f64>() / rate_span,
-        mean_normal_slip_power_w: normal_slip_rate_window.iter().sum::<f64>() / rate_span,
-        mean_friction_power_w: friction_rate_window.iter().sum::<f64>() / rate_span,
+        mean_normal_force_n,
+        mean_normal_slip_power_w,
+        mean_friction_power_w,
         contacts,
         bodies,
         window_s: window,
         rate_window,
         integrator: stats.integrator,
         wall_s: stats.wall_s,
-        tracks: tracks_out,
+        tracks: tracks_out.into_items(),
         response_acceleration,
         response_rate_hz: options.response_rate_hz,
         base_acceleration,

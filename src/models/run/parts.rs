@@ -2,6 +2,7 @@
 //! integrated on its own ([`crate::physics::partition`]) and the reports merged back into the
 //! model's order, so the merged report reads as the whole model's.
 
+use super::records::{Appended, RecordWriter};
 use super::{
     bad_checkpoint, run_whole, BodyReport, BuiltModel, ContactReport, ModelCheckpoint,
     ModelRunError, RunOptions, RunReport,
@@ -13,16 +14,18 @@ use crate::physics::integrator::IntegratorStats;
 use crate::physics::partition::Part;
 
 /// Runs each independent part on its own and merges the reports (from a checkpoint: the
-/// finished parts' reports, the part in progress from its checkpoint, then the rest).
+/// finished parts' reports, the part in progress from its checkpoint, then the rest); each
+/// part writes its records to `writer`, and its report when it finishes.
 pub(super) fn run_parts(
     model: &BuiltModel,
     parts: &[Part],
     options: &RunOptions,
     control: &RunControl,
     resume: Option<ModelCheckpoint>,
+    writer: &mut RecordWriter,
 ) -> Result<RunReport, ModelRunError> {
     let count = parts.len() as f64;
-    let (mut finished, mut current) = match resume {
+    let (mut finished, mut current): (Appended<RunReport>, _) = match resume {
         Some(cp) if cp.finished_parts.len() >= parts.len() => {
             return Err(bad_checkpoint(format!(
                 "{} finished parts of a model with {} parts",
@@ -31,8 +34,9 @@ pub(super) fn run_parts(
             )))
         }
         Some(cp) => (cp.finished_parts, Some(cp.current)),
-        None => (Vec::new(), None),
+        None => (Appended::default(), None),
     };
+    writer.part_of_several = true;
     let first = finished.len();
     for (i, part) in parts.iter().enumerate().skip(first) {
         let response_body = part
@@ -69,14 +73,22 @@ pub(super) fn run_parts(
             }),
             ..control.clone()
         };
-        match run_whole(&sub, options, &sub_control, &mut |_| {}, current.take()) {
-            Ok(report) => finished.push(report),
-            Err(e) => return Err(e.within_parts(finished)),
+        writer.part = i as u32;
+        match run_whole(
+            &sub,
+            options,
+            &sub_control,
+            &mut |_| {},
+            current.take(),
+            writer,
+        ) {
+            Ok(report) => writer.part_finished(&mut finished, report),
+            Err(e) => return Err(e.within_parts(finished, writer.mark())),
         }
     }
     let reports = parts
         .iter()
-        .zip(finished)
+        .zip(finished.into_items())
         .map(|(part, report)| (report, part.bodies.contains(&model.response_body)))
         .collect();
     Ok(merge_reports(model, parts, reports))
