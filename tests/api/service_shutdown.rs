@@ -262,10 +262,11 @@ async fn a_stopped_sweep_keeps_its_finished_points_and_resumes_to_the_same_resul
     second.stop().await;
 }
 
-/// Rattle box C, 50 ms settle and 5 s excited, recording about every accepted step: a few
-/// seconds of computation and tens of thousands of track samples.
-const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":5.0,"record_interval_s":1e-5}},"seed":8}}"#;
-const SIMULATE_END_S: f64 = 5.05;
+/// Rattle box C, 50 ms settle and 12 s excited, recording about every accepted step: about ten
+/// seconds of computation (the last 20 % leave time to stop it on a loaded machine) and tens
+/// of thousands of track samples.
+const SIMULATE_BODY: &str = r#"{"kind":"simulate","params":{"config":"rattle-box-c","overrides":{"simulation":{"settle_s":0.05,"duration_s":12.0,"record_interval_s":1e-5}},"seed":8}}"#;
+const SIMULATE_END_S: f64 = 12.05;
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_stopped_simulation_stores_a_checkpoint_and_the_next_worker_resumes_it_identically() {
