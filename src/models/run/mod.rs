@@ -106,7 +106,7 @@ pub enum ModelRunError {
 /// with the result of the uninterrupted run, bit for bit. A model integrated part by part
 /// keeps the reports of the parts already finished and the checkpoint of the one running.
 /// What the run handed to its record sink before is not repeated here
-/// ([`records`](self::records)): serialized, a checkpoint holds the records since the last
+/// (`records`): serialized, a checkpoint holds the records since the last
 /// chunk, and one read back is whole again after [`ModelCheckpoint::restore_records`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ModelCheckpoint {
@@ -412,7 +412,7 @@ pub fn record_states(
 }
 
 /// The run of a model integrated as one system (from `resume`, its checkpoint, if given),
-/// writing its records to `writer` as they grow ([`records`](self::records)).
+/// writing its records to `writer` as they grow (`records`).
 fn run_whole(
     model: &BuiltModel,
     options: &RunOptions,
