@@ -20,6 +20,7 @@ mod gap_diagnose;
 mod gap_diagnose_simulated;
 mod gap_effects;
 mod gap_mechanisms;
+mod gap_next_test;
 mod gap_rig;
 mod impact_map;
 mod launcher_model;

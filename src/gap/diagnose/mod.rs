@@ -51,6 +51,7 @@ mod interaction_tests;
 mod joint_spread;
 pub mod location;
 pub mod measured;
+pub mod next_test;
 pub mod noise;
 mod one_group;
 pub mod options;
@@ -69,9 +70,10 @@ mod verdict;
 
 pub use fit_problem::FitProblem;
 pub use options::{
-    check_options, DiagnoseOptions, Simulating, MIN_EXPLAINED_SHARE, MIN_EXPLAINED_SHRINK,
+    check_effects, check_options, DiagnoseOptions, Simulating, MIN_EXPLAINED_SHARE, MIN_EXPLAINED_SHRINK,
     MIN_HELD_OUT_GAIN, PROFILE_95, REFINE_CONTENDERS, REFINE_ROUNDS, SECONDARY_CONTENDERS,
 };
+pub use next_test::{propose as propose_next_tests, ProposedTest};
 pub use refine::diagnose_refining;
 pub use report::*;
 pub use run::diagnose;

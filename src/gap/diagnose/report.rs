@@ -264,6 +264,11 @@ pub struct Report {
     /// it cannot predict (None for the other verdicts).
     #[serde(default)]
     pub partly_explained: Option<PartlyExplained>,
+    /// The tests that would best separate the leading candidate from its rivals, cheapest
+    /// decisive first (docs/results/diagnosis.md, "The next test"); empty when the verdict is
+    /// `no_gap` or `explained` without indistinguishable candidates.
+    #[serde(default)]
+    pub next_tests: Vec<super::next_test::ProposedTest>,
     /// railwear version.
     pub code_version: String,
 }

@@ -375,6 +375,7 @@ pub(super) fn judge(
         },
         held_out_predictions,
         partly_explained: partly,
+        next_tests: Vec::new(),
         code_version: crate::models::case::code_version().to_string(),
     };
     (report, carried)
