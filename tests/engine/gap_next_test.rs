@@ -135,7 +135,11 @@ fn a_one_test_effect_gets_a_next_test_that_confirms_it() {
         assert!((t.separation_nats - least).abs() <= 1e-12 * least.abs().max(1.0));
         assert_eq!(t.decisive, least > 20f64.ln());
         // Abrasion only adds wear: its prediction is never below the nominal's.
-        let nominal = t.predictions.iter().find(|p| p.candidate == "none").unwrap();
+        let nominal = t
+            .predictions
+            .iter()
+            .find(|p| p.candidate == "none")
+            .unwrap();
         for (a, b) in t.predictions[0].mass_mg.iter().zip(&nominal.mass_mg) {
             assert!(a >= b, "{a} < {b}");
         }
@@ -149,7 +153,11 @@ fn a_one_test_effect_gets_a_next_test_that_confirms_it() {
     }
     // The first proposal carries the effect: decisive against the nominal model.
     let proposed = &next[0];
-    let against_nominal = proposed.rivals.iter().find(|r| r.candidate == "none").unwrap();
+    let against_nominal = proposed
+        .rivals
+        .iter()
+        .find(|r| r.candidate == "none")
+        .unwrap();
     assert!(against_nominal.decisive, "{proposed:#?}");
 
     // The rig runs the proposed test under the same truth; the campaign appends it.

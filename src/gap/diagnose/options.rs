@@ -206,7 +206,10 @@ pub fn check_effects(
     for (i, name) in effects.iter().enumerate() {
         let field = format!("effects[{i}]");
         let info = crate::gap::effects::info(name).ok_or_else(|| {
-            let known: Vec<&str> = crate::gap::effects::LIBRARY.iter().map(|e| e.name).collect();
+            let known: Vec<&str> = crate::gap::effects::LIBRARY
+                .iter()
+                .map(|e| e.name)
+                .collect();
             GapError::field(
                 field.clone(),
                 format!("unknown effect `{name}` (known: {})", known.join(", ")),
@@ -260,7 +263,11 @@ mod option_tests {
             Some("grid_points")
         );
         let mut o = DiagnoseOptions::default();
-        o.emulator.effects = Some(vec!["third_body".into(), "cross_axis".into(), "third_body".into()]);
+        o.emulator.effects = Some(vec![
+            "third_body".into(),
+            "cross_axis".into(),
+            "third_body".into(),
+        ]);
         let e = check_options(&o).unwrap_err();
         assert_eq!(e.field_path(), Some("effects[2]"), "{e}");
         assert!(e.to_string().contains("twice"), "{e}");

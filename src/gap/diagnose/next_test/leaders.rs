@@ -40,7 +40,10 @@ pub fn leaders(report: &Report) -> Result<Option<(Leader, Vec<Leader>)>, GapErro
         return Ok(None);
     }
     let mut entries: Vec<&RankEntry> = report.ranking.iter().chain(&report.pairs).collect();
-    entries.sort_by(|a, b| b.held_out_log_likelihood.total_cmp(&a.held_out_log_likelihood));
+    entries.sort_by(|a, b| {
+        b.held_out_log_likelihood
+            .total_cmp(&a.held_out_log_likelihood)
+    });
     let focal = match &report.best_effect {
         Some(best) => named(best)?,
         None => match entries.iter().find(|e| e.held_out_gain > 0.0) {

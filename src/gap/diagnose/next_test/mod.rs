@@ -201,7 +201,10 @@ struct Ranked {
 
 impl Ranked {
     fn separation(&self) -> f64 {
-        self.separations.iter().copied().fold(f64::INFINITY, f64::min)
+        self.separations
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
     }
 
     fn decisive(&self) -> bool {
@@ -410,7 +413,12 @@ fn test_noise(
     ];
     let mut accel_model_rel_var = [0.0; 6];
     for (v, label) in accel_model_rel_var.iter_mut().zip(labels) {
-        *v = n.numerical_accel_rel.get(label).copied().unwrap_or(0.0).powi(2);
+        *v = n
+            .numerical_accel_rel
+            .get(label)
+            .copied()
+            .unwrap_or(0.0)
+            .powi(2);
     }
     TestNoise {
         mass_rel: n.mass_repeatability_rel,

@@ -106,7 +106,11 @@ pub fn setups(campaign: &Campaign, configs_dir: &Path) -> Vec<Setup> {
         };
         if let Ok(case) = template.case(0, configs_dir) {
             if case.model == model {
-                cases.push((template, case, format!("{config}, a case the campaign lacks")));
+                cases.push((
+                    template,
+                    case,
+                    format!("{config}, a case the campaign lacks"),
+                ));
             }
         }
     }
@@ -116,7 +120,10 @@ pub fn setups(campaign: &Campaign, configs_dir: &Path) -> Vec<Setup> {
     for (template, case, change) in &cases {
         let label = case_label(template, case);
         let tone = single_tone(case, configs_dir);
-        out.push((0, setup(template.clone(), &label, change.clone(), tone.as_ref())));
+        out.push((
+            0,
+            setup(template.clone(), &label, change.clone(), tone.as_ref()),
+        ));
         let Some((tone, settle_s, ramp)) = tone else {
             continue;
         };
