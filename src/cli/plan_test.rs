@@ -90,7 +90,7 @@ pub(crate) fn next_tests_text(tests: &[ProposedTest]) -> String {
     );
     for t in tests {
         out.push_str(&format!(
-            "\n  {:<8} {}; {} x {:.1} h x {} specimen(s), records {}; {:.0} test hours; {:.1} nats ({})",
+            "\n  {:<8} {}; {} x {:.1} h x {} specimen(s), records {}; {:.1} test hours; {:.1} nats ({})",
             t.test.id,
             t.change,
             t.increments,
