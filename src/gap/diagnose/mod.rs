@@ -35,8 +35,9 @@
 //! data, noise model and folds, and each candidate's fit), `candidate` (one candidate's
 //! numbers and the explaining rule), `verdict` (the verdict from the candidates), `one_group`
 //! (an effect one held-out group carries), `how_far`, `pairs` and `pair_search`, `refine`
-//! (adaptive refinement) and `run` (the whole diagnosis from a campaign); the [`emulator`]
-//! and the `bench` are rooms of their own.
+//! (adaptive refinement) and `run` (the whole diagnosis from a campaign); the [`emulator`],
+//! the [`next_test`] planner (the tests that would separate the leading candidates) and the
+//! `bench` are rooms of their own.
 
 pub mod bench;
 pub mod budget;
