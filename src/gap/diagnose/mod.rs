@@ -70,7 +70,7 @@ pub mod truth_fit;
 mod verdict;
 
 pub use fit_problem::FitProblem;
-pub use next_test::{propose as propose_next_tests, ProposedTest};
+pub use next_test::propose as propose_next_tests;
 pub use options::{
     check_effects, check_options, DiagnoseOptions, Simulating, MIN_EXPLAINED_SHARE,
     MIN_EXPLAINED_SHRINK, MIN_HELD_OUT_GAIN, PROFILE_95, REFINE_CONTENDERS, REFINE_ROUNDS,

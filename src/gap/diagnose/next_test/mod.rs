@@ -23,12 +23,11 @@ pub mod setups;
 use super::emulator::slots::{plan, predictions_of, simulate_slots, Slot};
 use super::options::Simulating;
 use super::prediction::Prediction;
-use super::report::Report;
-use crate::gap::campaign::{Campaign, CampaignTest};
+use super::report::{CandidateReading, ProposedTest, Report, RivalSeparation};
+use crate::gap::campaign::Campaign;
 use crate::gap::GapError;
 use leaders::{leaders, Leader};
 use separation::{expected_log_lr, Readings, TestNoise};
-use serde::{Deserialize, Serialize};
 use setups::{schedules, setups, test_entry, Schedule, Setup};
 
 /// Expected log-likelihood ratio a test must give the true candidate over each rival to be
@@ -41,74 +40,6 @@ pub const MAX_PROPOSED: usize = 5;
 /// Sensor noise assumed for proposed records when the campaign has none to take it from, RMS
 /// m/s² (the bench rig's).
 pub const ASSUMED_SENSOR_NOISE_M_S2: f64 = 0.5;
-
-/// A test the diagnosis proposes to run next.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ProposedTest {
-    /// The campaign test entry (specimens with empty increments): what the rig runs and the
-    /// campaign appends.
-    pub test: CampaignTest,
-    /// Case (config and rattle space).
-    pub case: String,
-    /// What it changes from the campaign, in words.
-    pub change: String,
-    /// Axis of the drive tone (`x`, `y`, `z`), when the drive is one sine tone.
-    pub drive_axis: Option<String>,
-    /// Peak level of the tone, g.
-    pub level_g: Option<f64>,
-    /// Frequency of the tone, Hz.
-    pub frequency_hz: Option<f64>,
-    /// Increments per specimen.
-    pub increments: usize,
-    /// Excited duration of each increment, s.
-    pub increment_duration_s: f64,
-    /// Specimens.
-    pub repeats: usize,
-    /// Input and response accelerometer records asked for.
-    pub accelerometers: bool,
-    /// Test hours: increments x length x repeats.
-    pub cost_h: f64,
-    /// The leading candidate, then the rivals it is told from.
-    pub separates: Vec<String>,
-    /// The smallest expected log-likelihood ratio between the leading candidate and a rival,
-    /// nats.
-    pub separation_nats: f64,
-    /// The ratio exceeds ln 20 against every rival.
-    pub decisive: bool,
-    /// Per rival: the expected log-likelihood ratio.
-    pub rivals: Vec<RivalSeparation>,
-    /// What each candidate predicts the test reads.
-    pub predictions: Vec<CandidateReading>,
-    /// What each outcome would decide, in words.
-    pub decides: Vec<String>,
-}
-
-/// How well a proposed test tells the leading candidate from one rival.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RivalSeparation {
-    /// The rival (`none`: the nominal model).
-    pub candidate: String,
-    /// Expected log-likelihood ratio, nats.
-    pub expected_log_lr: f64,
-    /// Above ln 20.
-    pub decisive: bool,
-}
-
-/// A candidate's prediction of a proposed test: the first weighed component's mass per
-/// increment with its 95 % interval (the mean of the repeats).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CandidateReading {
-    /// Candidate (`none`: the nominal model).
-    pub candidate: String,
-    /// Quantity (`mass cube`).
-    pub quantity: String,
-    /// Per increment, mg.
-    pub mass_mg: Vec<f64>,
-    /// 95 % interval per increment, mg: plus or minus 1.96 standard uncertainties of the
-    /// reading (scatter of the repeats' mean, the simulator's numerical and parameter
-    /// uncertainty, quantisation).
-    pub interval_mg: Vec<[f64; 2]>,
-}
 
 /// The next tests for `report` on `campaign` (module documentation); empty when the report
 /// wants none. Simulates every setup with each candidate; a setup the simulator or an effect
