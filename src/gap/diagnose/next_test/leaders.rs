@@ -1,7 +1,7 @@
 //! The candidates a next test must separate, read from a report: the one the verdict leans on
-//! (the named effect or pair at its fitted values; with nothing named, the best held out) and
-//! its rivals (the nominal model, the candidates the report cannot tell from it, then the next
-//! best held out).
+//! (the named effect or pair at its fitted values; with nothing named, the one that fits within
+//! the noise, else the best held out) and its rivals (the nominal model, the candidates the
+//! report cannot tell from it, then the next best held out among those that contend).
 
 use super::super::report::{BestEffect, RankEntry, Report, Verdict};
 use crate::gap::diagnose::emulator::effect_with;
@@ -34,7 +34,9 @@ pub fn wants_next_test(report: &Report) -> bool {
 }
 
 /// The leading candidate and its rivals, or None when the report wants no next test or no
-/// candidate improves on the nominal model held out (nothing to confirm).
+/// candidate contends (nothing to confirm). With nothing named, the leading candidate is the
+/// one that fits every observation within the noise and removes the most of the gap (one test
+/// carries it, so held out it gains nothing), else the best held out.
 pub fn leaders(report: &Report) -> Result<Option<(Leader, Vec<Leader>)>, GapError> {
     if !wants_next_test(report) {
         return Ok(None);
@@ -44,12 +46,23 @@ pub fn leaders(report: &Report) -> Result<Option<(Leader, Vec<Leader>)>, GapErro
         b.held_out_log_likelihood
             .total_cmp(&a.held_out_log_likelihood)
     });
+    // A candidate that fits every observation within the noise while removing some of the
+    // gap, though held out it gains nothing (one test carries it: held out, nothing to fit it
+    // on), is a contender the next test must confirm or refute.
+    let fits = |e: &RankEntry| e.residual_p_value >= report.alpha && e.explained_share > 0.0;
+    let contends = |e: &RankEntry| e.held_out_gain > 0.0 || fits(e);
     let focal = match &report.best_effect {
         Some(best) => named(best)?,
-        None => match entries.iter().find(|e| e.held_out_gain > 0.0) {
-            Some(e) => from_entry(e)?,
-            None => return Ok(None),
-        },
+        None => {
+            let fitting = entries
+                .iter()
+                .filter(|e| fits(e))
+                .max_by(|a, b| a.explained_share.total_cmp(&b.explained_share));
+            match fitting.or_else(|| entries.iter().find(|e| e.held_out_gain > 0.0)) {
+                Some(e) => from_entry(e)?,
+                None => return Ok(None),
+            }
+        }
     };
     let mut rivals = vec![Leader {
         name: "none".into(),
@@ -57,7 +70,7 @@ pub fn leaders(report: &Report) -> Result<Option<(Leader, Vec<Leader>)>, GapErro
     }];
     let by_name = |name: &str| entries.iter().find(|e| e.name == name).copied();
     let indistinguishable = report.indistinguishable.iter().filter_map(|n| by_name(n));
-    let next_best = entries.iter().copied().filter(|e| e.held_out_gain > 0.0);
+    let next_best = entries.iter().copied().filter(|e| contends(e));
     for e in indistinguishable.chain(next_best) {
         if rivals.len() > MAX_RIVALS {
             break;
