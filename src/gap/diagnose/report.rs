@@ -165,6 +165,10 @@ pub struct RankEntry {
     pub name: String,
     /// Fitted magnitudes (full data), in the order of the names.
     pub magnitudes: Vec<f64>,
+    /// Each member's secondary parameters where its fit took a variant table (other values
+    /// than the library defaults), in the order of the names; empty maps for the defaults.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub secondary: Vec<std::collections::BTreeMap<String, f64>>,
     /// Parameters fitted.
     pub parameters: usize,
     /// Held-out log-likelihood (sum over held-out groups).

@@ -109,14 +109,19 @@ fn named(best: &BestEffect) -> Result<Leader, GapError> {
     })
 }
 
-/// A ranked candidate at its fitted magnitudes, its secondary parameters at the library
-/// defaults (the ranking does not carry a variant's values).
+/// A ranked candidate at its fitted magnitudes and the secondary values of the tables its fit
+/// took (the library defaults where it took the default table).
 fn from_entry(e: &RankEntry) -> Result<Leader, GapError> {
+    let defaults = BTreeMap::new();
     let effects = e
         .name
         .split('+')
         .zip(&e.magnitudes)
-        .map(|(member, &m)| Ok(effect_with(library_info(member)?, m, &BTreeMap::new())))
+        .enumerate()
+        .map(|(i, (member, &m))| {
+            let secondary = e.secondary.get(i).unwrap_or(&defaults);
+            Ok(effect_with(library_info(member)?, m, secondary))
+        })
         .collect::<Result<Vec<_>, GapError>>()?;
     Ok(Leader {
         name: e.name.clone(),
