@@ -176,6 +176,9 @@ enum Command {
         #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
     },
+    /// The next tests of a diagnosed campaign, planned again from its report: what would best
+    /// separate the leading candidate from its rivals, as campaign entries to append.
+    PlanTest(railwear::cli::PlanTestArgs),
     /// Blind check of the diagnosis: campaigns drawn from the virtual rig (controls, library
     /// effects from barely to clearly detectable, rig-only effects), diagnosed without their
     /// truth, scored against it. Prints the scores and the confusion table.
@@ -202,6 +205,10 @@ enum Command {
         /// Write each campaign's diagnosis report (with its truth) as <DIR>/<rig seed>.json.
         #[arg(long)]
         reports: Option<PathBuf>,
+        /// For each campaign left partly or not explained while its truth is detectable, run
+        /// the top proposed next test on the rig under the same truth, append it, diagnose again.
+        #[arg(long)]
+        confirm: bool,
         /// Keep only the campaigns with these rig seeds (seed x 1000 + index in the draw),
         /// each as the full bench draws it: `--only 1039,1042`.
         #[arg(long, value_delimiter = ',')]
@@ -639,6 +646,10 @@ async fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::PlanTest(args) => {
+            init_logging(false);
+            railwear::cli::plan_test(args)
+        }
         Command::DiagnoseBench {
             campaigns,
             seed,
@@ -647,6 +658,7 @@ async fn run(cli: Cli) -> Result<()> {
             threads,
             truth,
             reports,
+            confirm,
             only,
             out,
             emulator_file,
@@ -659,6 +671,7 @@ async fn run(cli: Cli) -> Result<()> {
                 rig_window_s: *window_s,
                 truth_filter: truth.clone(),
                 reports_dir: reports.clone(),
+                confirm: *confirm,
                 only_seeds: only.clone(),
                 ..Default::default()
             };

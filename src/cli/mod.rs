@@ -1,9 +1,12 @@
 //! Command-line front ends of the library: `railwear run`, `validate`, `campaign check`,
-//! `rig`, `effects`, `diagnose`, and `contact-fit` ([`contact_fit`]).
+//! `rig`, `effects`, `diagnose`, `plan-test`, and `contact-fit` ([`contact_fit`]).
 //! (anyhow is allowed here: this is the binary edge.)
 
 mod case_file;
 pub mod contact_fit;
+mod plan_test;
+
+pub use plan_test::{plan_test, PlanTestArgs};
 
 use case_file::checked_case;
 
@@ -596,6 +599,7 @@ pub fn diagnose(
         );
     }
     println!("\n{}", report.location.energy_budget.table());
+    println!("\n{}", plan_test::next_tests_text(&report.next_tests));
     println!("report and plots in {}", dir.display());
     Ok(())
 }

@@ -458,6 +458,7 @@ pub async fn submit_diagnosis(
         .get_campaign(id)
         .await?
         .ok_or_else(|| Problem::not_found(format!("no campaign {id}")))?;
+    check_effects_against(&state, &options, &record.content).await?;
     let submitted = state
         .jobs
         .submit_diagnosis(
@@ -473,6 +474,36 @@ pub async fn submit_diagnosis(
             crate::jobs::SubmitError::Store(e) => Problem::from(e),
         })?;
     super::jobs::submitted_response(submitted)
+}
+
+/// The effects a diagnosis asks for, against the stored campaign (one rule set with the CLI:
+/// `gap::diagnose::check_effects`): each once and applying to every test's model, else a 422
+/// naming `effects[i]`. A list that is not one of strings is left to the plan's own check.
+async fn check_effects_against(
+    state: &AppState,
+    options: &serde_json::Value,
+    content: &str,
+) -> Result<(), Problem> {
+    let Some(names) = options
+        .get("effects")
+        .and_then(serde_json::Value::as_array)
+        .and_then(|a| {
+            a.iter()
+                .map(|v| v.as_str().map(str::to_string))
+                .collect::<Option<Vec<String>>>()
+        })
+    else {
+        return Ok(());
+    };
+    let campaign = Campaign::from_json_str(content).map_err(|e| Problem::internal(&e))?;
+    let configs_dir = state.config.configs_dir.clone();
+    // Resolving each test's case builds its model: a blocking thread.
+    tokio::task::spawn_blocking(move || {
+        crate::gap::diagnose::check_effects(&campaign, &names, &configs_dir)
+    })
+    .await
+    .map_err(|e| Problem::internal(&e))?
+    .map_err(campaign_problem)
 }
 
 #[cfg(test)]

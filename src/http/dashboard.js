@@ -754,6 +754,30 @@ async function showDiagnosis(job) {
       out.appendChild(predictionTable);
     }
 
+    // The next tests: what would best tell the leading candidate from its rivals, cheapest
+    // decisive first (expected log-likelihood ratio above ln 20 against every rival).
+    const next = r.next_tests || [];
+    if (next.length > 0) {
+      out.appendChild(text("h4", "Next tests: to tell " + next[0].separates[0] + " from " +
+        next[0].separates.slice(1).join(", ")));
+      const proposals = next.map(t => {
+        const tr = row([t.test.id, t.case, t.change,
+          t.increments + " \u00d7 " + fmt.num(t.increment_duration_s / 3600, 3) + " h \u00d7 " + t.repeats,
+          t.accelerometers ? "on" : "off", fmt.num(t.cost_h, 3) + " h",
+          fmt.num(t.separation_nats, 3) + " nats" + (t.decisive ? " (decisive)" : ""),
+          t.decides.join(" ")], t.decisive ? "decisive" : "");
+        tr.dataset.test = t.test.id;
+        return tr;
+      });
+      const nextTable = captioned(table(["Test", "Case", "What changes", "Increments \u00d7 length \u00d7 specimens",
+        "Records", "Test hours", "Expected separation", "What each outcome decides"], proposals),
+        "Each test's smallest expected log-likelihood ratio between the leading candidate and a rival");
+      nextTable.id = "diagnosis-next-tests";
+      out.appendChild(nextTable);
+    } else {
+      out.appendChild(text("div", "Next tests: none (nothing left to separate).", "next-tests-none"));
+    }
+
     out.appendChild(text("h4", "Where the nominal model misses (Holm-adjusted p < 0.05)"));
     const flagged = r.where.groups.filter(g => g.flagged);
     if (flagged.length === 0) {

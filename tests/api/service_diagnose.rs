@@ -48,6 +48,24 @@ async fn a_test_engineer_diagnoses_a_campaign_over_http() {
             let p = post(TEST_ENGINEER, &bad).problem(422);
             assert_eq!(p["field"], field, "{p}");
         }
+        // What the campaign contradicts: a launcher's spring preload loss on a rattle-box
+        // campaign, and one effect asked for twice, each named with the rule.
+        for (bad, field, rule) in [
+            (
+                json!({"effects": ["third_body", "preload_loss"]}),
+                "effects[1]",
+                "does not apply to test C's rattle_box model",
+            ),
+            (
+                json!({"effects": ["third_body", "cross_axis", "third_body"]}),
+                "effects[2]",
+                "asked for twice",
+            ),
+        ] {
+            let p = post(TEST_ENGINEER, &bad).problem(422);
+            assert_eq!(p["field"], field, "{p}");
+            assert!(p["detail"].as_str().unwrap_or("").contains(rule), "{p}");
+        }
         let unknown = format!("/v1/campaigns/{}/diagnoses", uuid::Uuid::new_v4());
         api.post(&unknown, Some(TEST_ENGINEER), &good.to_string())
             .problem(404);

@@ -19,6 +19,7 @@ mod gap_diagnose;
 mod gap_diagnose_simulated;
 mod gap_effects;
 mod gap_mechanisms;
+mod gap_next_test;
 mod gap_rig;
 mod launcher_model;
 mod launcher_trend;

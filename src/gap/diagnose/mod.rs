@@ -35,8 +35,9 @@
 //! data, noise model and folds, and each candidate's fit), `candidate` (one candidate's
 //! numbers and the explaining rule), `verdict` (the verdict from the candidates), `one_group`
 //! (an effect one held-out group carries), `how_far`, `pairs` and `pair_search`, `refine`
-//! (adaptive refinement) and `run` (the whole diagnosis from a campaign); the [`emulator`]
-//! and the `bench` are rooms of their own.
+//! (adaptive refinement) and `run` (the whole diagnosis from a campaign); the [`emulator`],
+//! the [`next_test`] planner (the tests that would separate the leading candidates) and the
+//! `bench` are rooms of their own.
 
 pub mod bench;
 pub mod budget;
@@ -51,6 +52,7 @@ mod interaction_tests;
 mod joint_spread;
 pub mod location;
 pub mod measured;
+pub mod next_test;
 pub mod noise;
 mod one_group;
 pub mod options;
@@ -68,9 +70,11 @@ pub mod truth_fit;
 mod verdict;
 
 pub use fit_problem::FitProblem;
+pub use next_test::propose as propose_next_tests;
 pub use options::{
-    check_options, DiagnoseOptions, Simulating, MIN_EXPLAINED_SHARE, MIN_EXPLAINED_SHRINK,
-    MIN_HELD_OUT_GAIN, PROFILE_95, REFINE_CONTENDERS, REFINE_ROUNDS, SECONDARY_CONTENDERS,
+    check_effects, check_options, DiagnoseOptions, Simulating, MIN_EXPLAINED_SHARE,
+    MIN_EXPLAINED_SHRINK, MIN_HELD_OUT_GAIN, PROFILE_95, REFINE_CONTENDERS, REFINE_ROUNDS,
+    SECONDARY_CONTENDERS,
 };
 pub use refine::diagnose_refining;
 pub use report::*;

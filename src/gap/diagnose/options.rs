@@ -159,6 +159,88 @@ pub fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
         o.k_rel_uncertainty.is_finite() && (0.0..=2.0).contains(&o.k_rel_uncertainty),
         "must lie in [0, 2]",
     )?;
+    if let Some(effects) = &o.emulator.effects {
+        each_once(effects)?;
+    }
+    Ok(())
+}
+
+/// The effects asked for, each once: the same effect twice is a typing error, not a pair.
+fn each_once(effects: &[String]) -> Result<(), GapError> {
+    for (i, name) in effects.iter().enumerate() {
+        if let Some(first) = effects[..i].iter().position(|e| e == name) {
+            return Err(GapError::field(
+                format!("effects[{i}]"),
+                format!("`{name}` is asked for twice (effects[{first}] names it already)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn model_name(m: crate::models::spec::ModelKind) -> &'static str {
+    use crate::models::spec::ModelKind;
+    match m {
+        ModelKind::PersistentContact => "persistent_contact",
+        ModelKind::RattleBox => "rattle_box",
+        ModelKind::Launcher => "launcher",
+    }
+}
+
+/// The effects asked for against the campaign they would diagnose: each a library effect,
+/// asked for once, and applying to the model of every test (a launcher's spring preload loss
+/// is not a candidate on a rattle-box campaign: the data cannot contradict a term the model
+/// does not have, so it could only be dropped unseen). An error names `effects[i]`.
+pub fn check_effects(
+    campaign: &Campaign,
+    effects: &[String],
+    configs_dir: &Path,
+) -> Result<(), GapError> {
+    each_once(effects)?;
+    let models: Vec<crate::models::spec::ModelKind> = campaign
+        .tests
+        .iter()
+        .enumerate()
+        .map(|(ti, t)| t.case(ti, configs_dir).map(|c| c.model))
+        .collect::<Result<_, _>>()?;
+    for (i, name) in effects.iter().enumerate() {
+        let field = format!("effects[{i}]");
+        let info = crate::gap::effects::info(name).ok_or_else(|| {
+            let known: Vec<&str> = crate::gap::effects::LIBRARY
+                .iter()
+                .map(|e| e.name)
+                .collect();
+            GapError::field(
+                field.clone(),
+                format!("unknown effect `{name}` (known: {})", known.join(", ")),
+            )
+        })?;
+        if let Some((ti, model)) = models
+            .iter()
+            .enumerate()
+            .find(|(_, m)| !info.models.contains(m))
+        {
+            let applies: Vec<&str> = crate::gap::effects::LIBRARY
+                .iter()
+                .filter(|e| models.iter().all(|m| e.models.contains(m)))
+                .map(|e| e.name)
+                .collect();
+            return Err(GapError::field(
+                field,
+                format!(
+                    "`{name}` does not apply to test {}'s {} model (it models {}); effects that apply to this campaign: {}",
+                    campaign.tests[ti].id,
+                    model_name(*model),
+                    info.models
+                        .iter()
+                        .map(|m| model_name(*m))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    applies.join(", ")
+                ),
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -180,5 +262,14 @@ mod option_tests {
             check_options(&o).unwrap_err().field_path(),
             Some("grid_points")
         );
+        let mut o = DiagnoseOptions::default();
+        o.emulator.effects = Some(vec![
+            "third_body".into(),
+            "cross_axis".into(),
+            "third_body".into(),
+        ]);
+        let e = check_options(&o).unwrap_err();
+        assert_eq!(e.field_path(), Some("effects[2]"), "{e}");
+        assert!(e.to_string().contains("twice"), "{e}");
     }
 }

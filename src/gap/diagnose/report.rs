@@ -165,6 +165,10 @@ pub struct RankEntry {
     pub name: String,
     /// Fitted magnitudes (full data), in the order of the names.
     pub magnitudes: Vec<f64>,
+    /// Each member's secondary parameters where its fit took a variant table (other values
+    /// than the library defaults), in the order of the names; empty maps for the defaults.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub secondary: Vec<std::collections::BTreeMap<String, f64>>,
     /// Parameters fitted.
     pub parameters: usize,
     /// Held-out log-likelihood (sum over held-out groups).
@@ -264,6 +268,11 @@ pub struct Report {
     /// it cannot predict (None for the other verdicts).
     #[serde(default)]
     pub partly_explained: Option<PartlyExplained>,
+    /// The tests that would best separate the leading candidate from its rivals, cheapest
+    /// decisive first (docs/results/diagnosis.md, "The next test"); empty when the verdict is
+    /// `no_gap` or `explained` without indistinguishable candidates.
+    #[serde(default)]
+    pub next_tests: Vec<ProposedTest>,
     /// railwear version.
     pub code_version: String,
 }
@@ -350,4 +359,72 @@ pub struct HeldOutPrediction {
     /// observation about it, mg.
     #[serde(default)]
     pub interval_mg: [f64; 2],
+}
+
+/// A test the diagnosis proposes to run next.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProposedTest {
+    /// The campaign test entry (specimens with empty increments): what the rig runs and the
+    /// campaign appends.
+    pub test: crate::gap::campaign::CampaignTest,
+    /// Case (config and rattle space).
+    pub case: String,
+    /// What it changes from the campaign, in words.
+    pub change: String,
+    /// Axis of the drive tone (`x`, `y`, `z`), when the drive is one sine tone.
+    pub drive_axis: Option<String>,
+    /// Peak level of the tone, g.
+    pub level_g: Option<f64>,
+    /// Frequency of the tone, Hz.
+    pub frequency_hz: Option<f64>,
+    /// Increments per specimen.
+    pub increments: usize,
+    /// Excited duration of each increment, s.
+    pub increment_duration_s: f64,
+    /// Specimens.
+    pub repeats: usize,
+    /// Input and response accelerometer records asked for.
+    pub accelerometers: bool,
+    /// Test hours: increments x length x repeats.
+    pub cost_h: f64,
+    /// The leading candidate, then the rivals it is told from.
+    pub separates: Vec<String>,
+    /// The smallest expected log-likelihood ratio between the leading candidate and a rival,
+    /// nats.
+    pub separation_nats: f64,
+    /// The ratio exceeds ln 20 against every rival.
+    pub decisive: bool,
+    /// Per rival: the expected log-likelihood ratio.
+    pub rivals: Vec<RivalSeparation>,
+    /// What each candidate predicts the test reads.
+    pub predictions: Vec<CandidateReading>,
+    /// What each outcome would decide, in words.
+    pub decides: Vec<String>,
+}
+
+/// How well a proposed test tells the leading candidate from one rival.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RivalSeparation {
+    /// The rival (`none`: the nominal model).
+    pub candidate: String,
+    /// Expected log-likelihood ratio, nats.
+    pub expected_log_lr: f64,
+    /// Above ln 20.
+    pub decisive: bool,
+}
+
+/// A candidate's prediction of a proposed test: the first weighed component's mass per
+/// increment with its 95 % interval (the mean of the repeats).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateReading {
+    /// Candidate (`none`: the nominal model).
+    pub candidate: String,
+    /// Quantity (`mass cube`).
+    pub quantity: String,
+    /// Per increment, mg.
+    pub mass_mg: Vec<f64>,
+    /// 95 % interval per increment, mg: plus or minus 1.96 standard uncertainties of the
+    /// reading (scatter of the repeats' mean, the simulator's numerical and parameter
+    /// uncertainty, quantisation).
+    pub interval_mg: Vec<[f64; 2]>,
 }

@@ -1,9 +1,10 @@
 //! The whole diagnosis of a campaign: its options checked, the emulator built, then refined
-//! where the candidates' fits land and judged.
+//! where the candidates' fits land and judged, and the next tests proposed.
 
 use super::emulator::Emulator;
+use super::next_test::propose;
 use super::noise;
-use super::options::{check_options, DiagnoseOptions};
+use super::options::{check_effects, check_options, DiagnoseOptions, Simulating};
 use super::refine::diagnose_refining;
 use super::report::Report;
 use super::verdict::no_measurement;
@@ -24,6 +25,9 @@ pub fn diagnose(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Report, Emulator), GapError> {
     check_options(options)?;
+    if let Some(effects) = &options.emulator.effects {
+        check_effects(campaign, effects, configs_dir)?;
+    }
     // Refused before anything is simulated.
     if noise::observations(campaign).is_empty() {
         return Err(no_measurement());
@@ -42,7 +46,7 @@ pub fn diagnose(
     )?;
     // Refinement's simulations count on from the emulator's, so progress never goes back.
     let offset = built.into_inner();
-    let report = diagnose_refining(
+    let mut report = diagnose_refining(
         campaign,
         &mut emulator,
         options,
@@ -51,5 +55,13 @@ pub fn diagnose(
         cache,
         &|done, total| progress(offset + done, offset + total),
     )?;
+    let sim = Simulating {
+        campaign,
+        options,
+        configs_dir,
+        control,
+        cache,
+    };
+    report.next_tests = propose(campaign, &report, sim)?;
     Ok((report, emulator))
 }

@@ -155,6 +155,18 @@ pub(super) fn judge(
     let entry = |c: &Candidate, i: usize| RankEntry {
         name: problem.name_of(&c.families),
         magnitudes: c.magnitudes(),
+        secondary: {
+            let values: Vec<_> = c
+                .spec
+                .iter()
+                .map(|(t, _)| problem.emulator.effects[*t].parameters.clone())
+                .collect();
+            if values.iter().all(|v| v.is_empty()) {
+                Vec::new()
+            } else {
+                values
+            }
+        },
         parameters: c.k.round() as usize,
         held_out_log_likelihood: c.held_ll(),
         held_out_gain: c.held_ll() - nominal.held_ll(),
@@ -375,6 +387,7 @@ pub(super) fn judge(
         },
         held_out_predictions,
         partly_explained: partly,
+        next_tests: Vec::new(),
         code_version: crate::models::case::code_version().to_string(),
     };
     (report, carried)

@@ -54,6 +54,7 @@
 //!
 //! The emulator only reads the tests' configurations, never their measurements, so one
 //! emulator built on the skeleton serves every campaign drawn on it.
+pub mod confirm;
 mod coverage;
 mod detectability;
 mod run;
@@ -106,6 +107,10 @@ pub struct BenchOptions {
     /// Keep only the campaigns with these rig seeds (empty: all): one campaign re-run as the
     /// full bench draws it.
     pub only_seeds: Vec<u64>,
+    /// Close the loop (module `confirm`): each campaign left partly or not explained while its
+    /// truth is detectable gets its top proposed next test run and appended, and is diagnosed
+    /// again.
+    pub confirm: bool,
     /// Diagnosis options.
     pub diagnose: DiagnoseOptions,
 }
@@ -127,6 +132,7 @@ impl Default for BenchOptions {
             truth_filter: None,
             reports_dir: None,
             only_seeds: Vec::new(),
+            confirm: false,
             diagnose: DiagnoseOptions {
                 emulator: EmulatorOptions {
                     window_s: 0.5,
@@ -217,6 +223,9 @@ pub struct Outcome {
     /// data prefer one member alone, whatever the search.
     #[serde(default)]
     pub best_member_aicc: Option<f64>,
+    /// The confirm mode's next test and the verdict with it appended (None when not run).
+    #[serde(default)]
+    pub next_test: Option<confirm::NextTestOutcome>,
 }
 
 /// One parameter of a named effect.

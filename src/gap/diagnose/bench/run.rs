@@ -1,6 +1,7 @@
 //! The bench's run: one emulator on the skeleton, each campaign drawn by the rig, diagnosed
 //! without its truth, its truth's own fit and detectability measured, then scored.
 
+use super::confirm;
 use super::detectability::{closest_alone, detectability, detectable_tests};
 use super::scenarios::{rig_options, scenarios};
 use super::scores::{score, Scores};
@@ -205,7 +206,7 @@ pub fn run(
             write_report(dir, s, &report)?;
         }
         let chosen = report.best_effect.as_ref().map(|b| b.name.clone());
-        outcomes.push(Outcome {
+        let mut outcome = Outcome {
             scenario: s.clone(),
             detectability: det,
             detectable,
@@ -256,7 +257,29 @@ pub fn run(
                         .min_by(f64::total_cmp)
                 })
                 .flatten(),
-        });
+            next_test: None,
+        };
+        if o.confirm && confirm::eligible(&outcome) {
+            let next = confirm::confirm(
+                skeleton,
+                &noisy,
+                &report,
+                s,
+                o,
+                configs_dir,
+                control,
+                &cache,
+            )?;
+            progress(format!(
+                "  next test {} -> {:?} {:?}{}",
+                next.test,
+                next.verdict,
+                next.chosen,
+                if next.confirmed { " (confirmed)" } else { "" }
+            ));
+            outcome.next_test = Some(next);
+        }
+        outcomes.push(outcome);
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
         progress(format!(
             "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows; the truth's own lack-of-fit p {truth_p})",

@@ -111,6 +111,9 @@ pub struct Scores {
     /// Of those, the share whose best effect is the true one.
     #[serde(default)]
     pub top1_weighed_only: f64,
+    /// The confirm mode's scores (`diagnose-bench --confirm`; None otherwise).
+    #[serde(default)]
+    pub next_test: Option<super::confirm::ConfirmScores>,
     /// Truth -> answer -> count.
     pub confusion: BTreeMap<String, BTreeMap<String, usize>>,
     /// Every outcome.
@@ -332,6 +335,7 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         ),
         detectable_weighed_only: weighed_only.len(),
         top1_weighed_only: share(weighed_only_right, weighed_only.len()),
+        next_test: super::confirm::score(&outcomes),
         confusion,
         outcomes,
     }
@@ -443,6 +447,11 @@ impl Scores {
             }
             s.push('\n');
         }
+        if let Some(c) = &self.next_test {
+            s.push_str("Confirm by next test:\n\n| score | value | target |\n|---|---|---|\n");
+            s.push_str(&c.rows());
+            s.push('\n');
+        }
         let mut cols: Vec<String> = vec!["no_gap".into()];
         cols.extend(LIBRARY.iter().map(|e| e.name.to_string()));
         for row in self.confusion.values() {
@@ -507,6 +516,7 @@ mod tests {
             flagged: Vec::new(),
             truth_fit: None,
             best_member_aicc: None,
+            next_test: None,
         }
     }
 

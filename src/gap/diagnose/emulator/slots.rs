@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// A task's simulated increments.
-pub(super) type TaskResult = Result<Vec<ModelIncrement>, GapError>;
+pub(in crate::gap::diagnose) type TaskResult = Result<Vec<ModelIncrement>, GapError>;
 
 /// One simulation task: (what, effects, tolerance scale, friction step, test).
 pub(super) struct Task {
@@ -28,10 +28,10 @@ pub(super) struct Task {
 
 /// One simulation slot: the effects on, the tolerance scale, the friction step and the settle
 /// shift of its run of every test.
-pub(super) type Slot = (Vec<Effect>, f64, f64, f64);
+pub(in crate::gap::diagnose) type Slot = (Vec<Effect>, f64, f64, f64);
 
 /// Every test's case and the number of increments simulated for it.
-pub(super) fn plan(
+pub(in crate::gap::diagnose) fn plan(
     campaign: &Campaign,
     configs_dir: &Path,
 ) -> Result<(Vec<CaseSpec>, Vec<usize>), GapError> {
@@ -59,7 +59,7 @@ pub(super) fn plan(
 /// `[slot][test]`. `progress(done, total)` is called after every test simulated, counting from
 /// `done_before` of `total`.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn simulate_slots(
+pub(in crate::gap::diagnose) fn simulate_slots(
     slots: &[Slot],
     campaign: &Campaign,
     (cases, increments): (&[CaseSpec], &[usize]),
@@ -136,7 +136,7 @@ pub(super) fn simulate_slots(
 }
 
 /// Predictions `[test][increment]` of one slot's simulated increments.
-pub(super) fn predictions_of(slot: &[Vec<ModelIncrement>]) -> TestPredictions {
+pub(in crate::gap::diagnose) fn predictions_of(slot: &[Vec<ModelIncrement>]) -> TestPredictions {
     slot.iter()
         .map(|t| t.iter().map(Prediction::from_increment).collect())
         .collect()

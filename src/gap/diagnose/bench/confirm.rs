@@ -1,0 +1,205 @@
+//! The loop closed on the bench (`diagnose-bench --confirm`): a campaign whose answer is
+//! `partly_explained` or `not_explained` while its in-library truth is detectable gets its top
+//! proposed next test run by the rig under the same hidden truth; the test is appended and the
+//! campaign diagnosed again on an emulator built for the longer campaign. **Confirmed** is
+//! `explained` with the right name (a pair: both members) after that one test.
+
+use super::scenarios::rig_options;
+use super::{BenchOptions, Outcome, Scenario};
+use crate::gap::campaign::Campaign;
+use crate::gap::diagnose::emulator::Emulator;
+use crate::gap::diagnose::{diagnose_refining, propose_next_tests, Report, Simulating, Verdict};
+use crate::gap::rig::run_cached;
+use crate::gap::window::WindowCache;
+use crate::gap::GapError;
+use crate::pipeline::RunControl;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Offset of the proposed test's rig seed from the campaign's: its scatter and noise are drawn
+/// apart from the campaign's own.
+const SEED_OFFSET: u64 = 1_000_003;
+
+/// What one proposed next test did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NextTestOutcome {
+    /// The test run (`next-1: rattle-box-b, ...; 1 x 8.0 h x 3`), or why none was.
+    pub test: String,
+    /// Its test hours.
+    pub cost_h: f64,
+    /// Its expected separation, nats.
+    pub separation_nats: f64,
+    /// The verdict with it appended.
+    pub verdict: Verdict,
+    /// The effect named then.
+    pub chosen: Option<String>,
+    /// `explained` with the right name.
+    pub confirmed: bool,
+}
+
+/// The confirm mode's scores.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConfirmScores {
+    /// Campaigns partly or not explained with a detectable in-library truth.
+    pub eligible: usize,
+    /// Of those, a next test proposed and run.
+    pub run: usize,
+    /// Of those eligible, confirmed after it.
+    pub confirmed: usize,
+    /// Explained naming a wrong effect after it.
+    pub wrong_after: usize,
+}
+
+impl ConfirmScores {
+    /// The table rows.
+    pub fn rows(&self) -> String {
+        let pct = |n: usize| {
+            if self.eligible == 0 {
+                "n/a".to_string()
+            } else {
+                format!("{:.0} %", 100.0 * n as f64 / self.eligible as f64)
+            }
+        };
+        format!(
+            "| confirmed (explained, right name) after one proposed next test ({} partly or not explained, detectable; {} with a test proposed) | {} | >= 80 % |\n| wrong names after the next test | {} | <= 5 % |\n",
+            self.eligible,
+            self.run,
+            pct(self.confirmed),
+            pct(self.wrong_after)
+        )
+    }
+}
+
+/// Whether a campaign's outcome asks for the confirm step.
+pub(super) fn eligible(o: &Outcome) -> bool {
+    o.scenario.in_library
+        && o.scenario.truth != "control"
+        && o.detectable
+        && matches!(o.verdict, Verdict::PartlyExplained | Verdict::NotExplained)
+}
+
+/// The confirm mode's scores over `outcomes` (None when no campaign ran it).
+pub(super) fn score(outcomes: &[Outcome]) -> Option<ConfirmScores> {
+    if !outcomes.iter().any(|o| o.next_test.is_some()) {
+        return None;
+    }
+    let eligible: Vec<&Outcome> = outcomes.iter().filter(|o| eligible(o)).collect();
+    let ran: Vec<&NextTestOutcome> = eligible
+        .iter()
+        .filter_map(|o| o.next_test.as_ref())
+        .collect();
+    let chosen_wrong =
+        |n: &NextTestOutcome| n.verdict == Verdict::Explained && !n.confirmed && n.chosen.is_some();
+    Some(ConfirmScores {
+        eligible: eligible.len(),
+        run: ran.iter().filter(|n| n.cost_h > 0.0).count(),
+        confirmed: ran.iter().filter(|n| n.confirmed).count(),
+        wrong_after: ran.iter().filter(|n| chosen_wrong(n)).count(),
+    })
+}
+
+/// Same effects, in any order: `a+b` and `b+a` name one pair.
+fn same_name(a: &str, b: &str) -> bool {
+    fn sorted(s: &str) -> Vec<&str> {
+        let mut v: Vec<&str> = s.split('+').collect();
+        v.sort_unstable();
+        v
+    }
+    sorted(a) == sorted(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_name;
+
+    #[test]
+    fn a_pair_is_one_name_in_either_order() {
+        assert!(same_name(
+            "cross_axis+severe_wear",
+            "severe_wear+cross_axis"
+        ));
+        assert!(same_name("third_body", "third_body"));
+        assert!(!same_name("cross_axis+severe_wear", "cross_axis"));
+        assert!(!same_name("third_body", "impact_wear"));
+    }
+}
+
+/// The confirm step of one campaign: its top proposed next test run by the rig under the
+/// truth of `s`, appended to `noisy`, diagnosed again.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn confirm(
+    skeleton: &Campaign,
+    noisy: &Campaign,
+    report: &Report,
+    s: &Scenario,
+    o: &BenchOptions,
+    configs_dir: &Path,
+    control: &RunControl,
+    cache: &WindowCache,
+) -> Result<NextTestOutcome, GapError> {
+    let sim = Simulating {
+        campaign: noisy,
+        options: &o.diagnose,
+        configs_dir,
+        control,
+        cache,
+    };
+    let proposed = propose_next_tests(noisy, report, sim)?;
+    let Some(top) = proposed.first() else {
+        return Ok(NextTestOutcome {
+            test: "none proposed".into(),
+            cost_h: 0.0,
+            separation_nats: 0.0,
+            verdict: report.verdict,
+            chosen: report.best_effect.as_ref().map(|b| b.name.clone()),
+            confirmed: false,
+        });
+    };
+    let one = Campaign {
+        tests: vec![top.test.clone()],
+        ..skeleton.clone()
+    };
+    let scenario = Scenario {
+        accelerometers: top.accelerometers,
+        ..s.clone()
+    };
+    let mut rig = rig_options(&scenario, o, true)?;
+    rig.seed = s.seed.wrapping_add(SEED_OFFSET);
+    let (ran, _) = run_cached(&one, configs_dir, &rig, control, cache)?;
+    let mut extended = noisy.clone();
+    extended.tests.extend(ran.tests);
+    let mut emulator = Emulator::build(
+        &extended,
+        configs_dir,
+        &o.diagnose.emulator,
+        control,
+        cache,
+        &|_, _| {},
+    )?;
+    let after = diagnose_refining(
+        &extended,
+        &mut emulator,
+        &o.diagnose,
+        configs_dir,
+        control,
+        cache,
+        &|_, _| {},
+    )?;
+    let chosen = after.best_effect.as_ref().map(|b| b.name.clone());
+    Ok(NextTestOutcome {
+        test: format!(
+            "{}: {}; {} x {:.1} h x {}",
+            top.test.id,
+            top.change,
+            top.increments,
+            top.increment_duration_s / crate::units::S_PER_H,
+            top.repeats
+        ),
+        cost_h: top.cost_h,
+        separation_nats: top.separation_nats,
+        verdict: after.verdict,
+        confirmed: after.verdict == Verdict::Explained
+            && chosen.as_deref().is_some_and(|c| same_name(c, &s.truth)),
+        chosen,
+    })
+}
