@@ -108,22 +108,6 @@ fn same_name(a: &str, b: &str) -> bool {
     sorted(a) == sorted(b)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::same_name;
-
-    #[test]
-    fn a_pair_is_one_name_in_either_order() {
-        assert!(same_name(
-            "cross_axis+severe_wear",
-            "severe_wear+cross_axis"
-        ));
-        assert!(same_name("third_body", "third_body"));
-        assert!(!same_name("cross_axis+severe_wear", "cross_axis"));
-        assert!(!same_name("third_body", "impact_wear"));
-    }
-}
-
 /// The confirm step of one campaign: its top proposed next test run by the rig under the
 /// truth of `s`, appended to `noisy`, diagnosed again.
 #[allow(clippy::too_many_arguments)]
@@ -202,4 +186,20 @@ pub(super) fn confirm(
             && chosen.as_deref().is_some_and(|c| same_name(c, &s.truth)),
         chosen,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_name;
+
+    #[test]
+    fn a_pair_is_one_name_in_either_order() {
+        assert!(same_name(
+            "cross_axis+severe_wear",
+            "severe_wear+cross_axis"
+        ));
+        assert!(same_name("third_body", "third_body"));
+        assert!(!same_name("cross_axis+severe_wear", "cross_axis"));
+        assert!(!same_name("third_body", "impact_wear"));
+    }
 }
