@@ -2,9 +2,9 @@
 //! `explained` (or whose leading candidates are indistinguishable), the tests that would best
 //! separate the leading candidate from its rivals, cheapest decisive first.
 //!
-//! 1. **Who** ([`leaders`]): the candidate the verdict leans on, at its fitted values, and up
+//! 1. **Who** (`leaders`): the candidate the verdict leans on, at its fitted values, and up
 //!    to [`leaders::MAX_RIVALS`] rivals besides the nominal model.
-//! 2. **What could be run** ([`setups`]): the campaign's cases and the reference configs of its
+//! 2. **What could be run** (`setups`): the campaign's cases and the reference configs of its
 //!    model, each under its own drive, a louder one and the two other axes (at most
 //!    [`setups::MAX_SETUPS`] setups), read under a few schedules (increments, repeats,
 //!    accelerometer records).
