@@ -699,14 +699,24 @@ async function showDiagnosis(job) {
         out.appendChild(text("div", "Not explained in full: " + p.reasons.join("; ") + ". It cannot predict " +
           p.cannot_predict + " (held-out RMS error " + fmt.sigma(p.cannot_predict_error[0]) + " nominal, " +
           fmt.sigma(p.cannot_predict_error[1]) + " with it).", "partly-explained"));
+        const unpredicted = p.unpredicted || [];
+        if (unpredicted.length > 0) {
+          out.appendChild(text("div", "Withheld groups it does not predict within their noise: " +
+            unpredicted.map(g => g.group + " (held-out error " + fmt.sigma(g.after) + " against a bound of " +
+              fmt.sigma(g.bound) + ")").join("; ") + ".", "partly-explained"));
+        }
       }
       out.appendChild(text("div", "Held-out RMS standardized error: " + fmt.sigma(b.held_out_error_before) +
         " before, " + fmt.sigma(b.held_out_error_after) + " after; the gap shrinks by " + fmt.percent(b.shrink) +
         " (90 % interval " + fmt.percent(b.shrink_interval[0]) + " to " + fmt.percent(b.shrink_interval[1]) +
         "); lack-of-fit p-value of what is left " + fmt.p(b.residual_p_value) + ".", "best-effect"));
+      // A parameter the data do not identify shows no point value; an interval that reaches a
+      // physical bound says so.
       const params = b.parameters.map(p => row([
-        p.effect, p.name, fmt.withUnit(p.value, p.unit),
-        p.fitted ? interval(p.interval, p.unit) : "held at default",
+        p.effect, p.name,
+        p.fitted && p.identified === false ? "not identified by the data" : fmt.withUnit(p.value, p.unit),
+        (p.fitted ? interval(p.interval, p.unit) : "held at default") +
+          (p.bounds_reached && p.bounds_reached.length > 0 ? " (reaches its " + p.bounds_reached.join(" and ") + " bound)" : ""),
         interval(p.bounds, p.unit),
       ]));
       const paramTable = captioned(table(["Effect", "Parameter", "Value", "Interval", "Physical bounds"], params),
