@@ -231,12 +231,16 @@ impl Observed {
             normal: self.normal_int.clone(),
             normal_slip: self.power_int.clone(),
             friction: self.friction_now.clone(),
-            volume: self
-                .accs
-                .iter()
-                .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
-                .collect(),
+            volume: self.volumes(),
         }
+    }
+
+    /// Wear volume per contact so far, m³.
+    fn volumes(&self) -> Vec<f64> {
+        self.accs
+            .iter()
+            .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
+            .collect()
     }
 
     /// True when the accumulators are shaped for `sys`'s contacts.
@@ -549,11 +553,7 @@ fn run_whole(
         }
         if v.t >= st.next_history {
             st.next_history = v.t + history_dt;
-            let vols = st
-                .accs
-                .iter()
-                .map(|l| l.iter().flatten().map(|a| a.acc.volume_m3()).sum())
-                .collect();
+            let vols = st.volumes();
             st.wear_history.push((v.t, vols));
         }
         // Track samples for export.
@@ -619,11 +619,7 @@ fn run_whole(
         ..
     } = st;
     let friction_window: Vec<f64> = match &friction_at_window_start {
-        Some(start) => friction_now
-            .iter()
-            .zip(start)
-            .map(|(now, start)| now - start)
-            .collect(),
+        Some(start) => rate_window::difference(&friction_now, start),
         None => vec![0.0; ncontacts],
     };
     // A broken run fails here rather than report zeros (`soundness`).

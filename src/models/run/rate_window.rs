@@ -59,6 +59,11 @@ impl Cumulative {
     }
 }
 
+/// `now - base`, entry by entry: a cumulative quantity's growth since its base.
+pub(super) fn difference(now: &[f64], base: &[f64]) -> Vec<f64> {
+    now.iter().zip(base).map(|(n, b)| n - b).collect()
+}
+
 /// Where a run's rates were taken.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RateWindow {

@@ -2,7 +2,7 @@
 //! excited window, rates and means over the rate window ([`super::RateWindow`]), per contact
 //! and per body, from what the run's observer accumulated.
 
-use super::rate_window::Cumulative;
+use super::rate_window::{difference, Cumulative};
 use super::{BodyReport, BuiltModel, ContactReport, RateWindow, RunOptions, TrackAcc};
 use crate::units::{MG_PER_KG, S_PER_H};
 use crate::wear::integrate::{WearAccumulator, WearTotals};
@@ -69,23 +69,19 @@ pub(super) fn window_reports(
         },
     };
     let rate_span = rate_window.length_s.max(f64::MIN_POSITIVE);
-    let over_rate_window = |now: &[f64], base: fn(&Cumulative) -> &Vec<f64>| -> Vec<f64> {
-        match &rate_base {
-            Some(b) => now.iter().zip(base(b)).map(|(n, b)| n - b).collect(),
-            None => now.to_vec(),
-        }
-    };
-    let normal_rate_window = over_rate_window(t.normal_int, |b| &b.normal);
-    let normal_slip_rate_window = over_rate_window(t.normal_slip_int, |b| &b.normal_slip);
-    let friction_rate_window = match &rate_base {
-        Some(b) => t
-            .friction_now
-            .iter()
-            .zip(&b.friction)
-            .map(|(n, b)| n - b)
-            .collect(),
-        None => t.friction_window.to_vec(),
-    };
+    // A cumulative quantity over the rate window: now less its base, or its value over the
+    // whole excited window when there is no base.
+    let over_rate_window =
+        |now: &[f64], base: fn(&Cumulative) -> &Vec<f64>, whole: &[f64]| -> Vec<f64> {
+            match &rate_base {
+                Some(b) => difference(now, base(b)),
+                None => whole.to_vec(),
+            }
+        };
+    let normal_rate_window = over_rate_window(t.normal_int, |b| &b.normal, t.normal_int);
+    let normal_slip_rate_window =
+        over_rate_window(t.normal_slip_int, |b| &b.normal_slip, t.normal_slip_int);
+    let friction_rate_window = over_rate_window(t.friction_now, |b| &b.friction, t.friction_window);
     let mut body_rate = vec![0.0; sys.bodies.len()];
     let mut contacts = Vec::with_capacity(sys.contacts.len());
     let mut body_mass = vec![0.0; sys.bodies.len()];
