@@ -171,16 +171,8 @@ fn the_reduced_laws_damping_and_friction_only_dissipate() {
     let mut loaded = 0;
     for _ in 0..200 {
         let pose = random_pose(&mut rng, 4e-4);
-        let v = Vector3::new(
-            rng.gen_range(-0.05..0.05),
-            rng.gen_range(-0.005..0.005),
-            rng.gen_range(-0.05..0.05),
-        );
-        let omega = Vector3::new(
-            rng.gen_range(-0.5..0.5),
-            rng.gen_range(-0.5..0.5),
-            rng.gen_range(-0.5..0.5),
-        );
+        let (v, omega) =
+            super::face_contact::random_motion(&mut rng, [0.05, 0.005, 0.05], [0.5, 0.5, 0.5]);
         let (_, f, t, tracks) = evaluate(&red, &pose, v, omega);
         if tracks.is_empty() {
             continue;
@@ -245,19 +237,7 @@ fn the_reduced_laws_jacobian_equals_central_differences() {
     let n = sys.state_len();
     let (analytic, fd) = super::face_contact::jacobians(&sys, &y);
     super::face_contact::assert_columns_agree(&analytic, &fd, n, 7..13, 2e-2);
-    for j in [7, 9] {
-        let scale = (7..13).map(|i| fd[j * n + i].abs()).fold(0.0_f64, f64::max);
-        assert!(scale > 0.0, "column {j} must feel the friction");
-        for i in 7..13 {
-            let err = (fd[j * n + i] - analytic[j * n + i]).abs();
-            assert!(
-                err <= 1e-5 * scale,
-                "d f[{i}] / d y[{j}]: central {:e}, analytic {:e}",
-                fd[j * n + i],
-                analytic[j * n + i]
-            );
-        }
-    }
+    super::face_contact::assert_each_column_agrees(&analytic, &fd, n, &[7, 9], 1e-5);
     assert!(sys.contacts[0].reduced_census.snapshot().closed_parts > 0);
     let (sys, y) = with_reduced(false);
     let (analytic, fd) = super::face_contact::jacobians(&sys, &y);
