@@ -373,9 +373,9 @@ impl CampaignTest {
             return Err(GapError::field(f("overrides"), "must be a table"));
         }
         let mut adjust_error: Option<GapError> = None;
-        let source = crate::pipeline::CaseSource::Reference(&self.config);
+        let source = crate::cases::CaseSource::Reference(&self.config);
         let overrides = Some(&self.overrides);
-        let case = crate::pipeline::resolve_model(source, overrides, None, configs_dir, |case| {
+        let case = crate::cases::resolve_model(source, overrides, None, configs_dir, |case| {
             if let Err(e) = self.adjust(ti, case, configs_dir) {
                 adjust_error = Some(e);
                 return Err(RunError::InvalidConfig {

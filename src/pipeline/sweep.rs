@@ -2,8 +2,8 @@
 //! law), one point's run, and the sequential sweep.
 
 use super::{
-    check_keys, design_rattle_space, merge_json, replica_seed, resolve_case, Progress, RunControl,
-    RunError, SweepRange, SWEEP_KEYS,
+    check_keys, design_rattle_space, merge_json, replica_seed, resolve_case_seeded, Progress,
+    RunControl, RunError, SweepRange, SWEEP_KEYS,
 };
 use crate::analysis::penalization::SweepPoint;
 use crate::field_error::FieldError;
@@ -251,7 +251,7 @@ impl SweepPlan {
         if p.get("config").is_none() {
             merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
         }
-        let base = resolve_case(&p, configs_dir, |case| {
+        let base = resolve_case_seeded(&p, configs_dir, seed, |case| {
             if case.launcher.is_none() {
                 return Err(FieldError::new(
                     "config",
@@ -259,9 +259,6 @@ impl SweepPlan {
                      (launcher-tight, launcher-design, launcher-loose or an inline launcher)",
                 )
                 .into());
-            }
-            if let Some(seed) = seed {
-                case.simulation.seed = seed;
             }
             case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
             match (&diagnosed, case.launcher.as_ref()) {
