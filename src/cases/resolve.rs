@@ -111,11 +111,10 @@ fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
 /// Checks every number and text of the case against [`super::bounds`], including the
 /// excitation a profile name stands for.
 fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunError> {
-    let profile = case
-        .excitation
-        .get("kind")
-        .and_then(serde_json::Value::as_str)
-        == Some("profile");
+    let profile = matches!(
+        case.excitation.kind(),
+        crate::models::spec::Excitation::Profile(_)
+    );
     let resolved = if profile {
         let spec = crate::models::case::resolve_excitation(case, configs_dir)?;
         Some(

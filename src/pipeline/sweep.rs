@@ -260,7 +260,7 @@ impl SweepPlan {
                 )
                 .into());
             }
-            case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
+            case.excitation = crate::models::spec::CaseExcitation::profile(&profile_file);
             match (&diagnosed, case.launcher.as_ref()) {
                 (Some(d), Some(launcher)) => {
                     // A legacy law is refused by the case's own rule (`wear.mechanism`).
