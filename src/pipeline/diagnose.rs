@@ -39,13 +39,13 @@ pub struct DiagnosePlan {
     pub campaign_id: uuid::Uuid,
     /// SHA-256 of the campaign's stored canonical JSON, lower-case hex.
     pub campaign_sha256: String,
-    /// Simulated excitation per increment, s ([`check_window_s`]).
+    /// Simulated excitation per increment, s ([`super::check_window_s`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window_s: Option<f64>,
-    /// Settle time before each window, s ([`check_settle_s`]).
+    /// Settle time before each window, s ([`super::check_settle_s`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_s: Option<f64>,
-    /// Grid points per effect parameter ([`check_grid_points`]).
+    /// Grid points per effect parameter ([`super::check_grid_points`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid_points: Option<usize>,
     /// Library effects to consider (all when absent); at least one.

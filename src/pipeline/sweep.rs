@@ -171,7 +171,7 @@ impl SweepPlan {
     /// (default `launcher-design`, must be a launcher case), `overrides`, `seed`, `points`
     /// (default 5, [`super::limits::SWEEP_POINTS`]), `vehicle_profile` (selects the excitation: a
     /// profile in `configs/profiles`, see [`vehicle_profile_file`]), `environment`
-    /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`resolve_case`]
+    /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`super::resolve_case`]
     /// applies to the base case.
     pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
         Self::from_params_seeded(params, configs_dir, None)
