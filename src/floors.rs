@@ -31,15 +31,22 @@ pub(crate) const FLOORS: &[&[&str]] = &[
     &["models"],
     &["report"],
     &["service_life"],
-    &["pipeline"],
+    &["cases"],
     &["validation"],
     &["gap"],
+    &["pipeline"],
     &["store"],
     &["jobs"],
     &["config"],
     &["http"],
     &["cli"],
 ];
+
+/// Rooms that reach the rooms below them only through named ones, each with the rooms it may
+/// import: the job queue reaches the simulation library (models, gap, physics, wear,
+/// analysis, ...) only through `pipeline`, its one door, besides the store it keeps its jobs
+/// in and the lowest utility rooms.
+const DOORS: &[(&str, &[&str])] = &[("jobs", &["units", "field_error", "store", "pipeline"])];
 
 /// Lines a source file may have before it must say why at its top.
 const LONG_FILE_LINES: usize = 700;
@@ -335,6 +342,30 @@ mod tests {
             "arrows against the floors:\n{}",
             wrong.join("\n")
         );
+    }
+
+    #[test]
+    fn a_room_with_doors_imports_only_through_them() {
+        let arrows = import_graph(&src());
+        for (room, doors) in DOORS {
+            assert!(
+                doors
+                    .iter()
+                    .any(|door| arrows.contains_key(&(room.to_string(), door.to_string()))),
+                "the scan found no arrow from {room} through its doors: it no longer reads the \
+                 tree"
+            );
+            let wrong: Vec<String> = arrows
+                .iter()
+                .filter(|((from, to), _)| from == room && !doors.contains(&to.as_str()))
+                .map(|((from, to), files)| format!("{from} -> {to} in {files:?}"))
+                .collect();
+            assert!(
+                wrong.is_empty(),
+                "{room} imports past its doors {doors:?}:\n{}",
+                wrong.join("\n")
+            );
+        }
     }
 
     #[test]

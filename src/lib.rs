@@ -1,8 +1,8 @@
 //! railwear: wear of missile-launcher rails and missile shoes in captive carry.
 //!
 //! The modules are floors that follow the data (see ARCHITECTURE.md, "Floors"): geometry ->
-//! physics -> wear -> models -> report -> pipeline -> jobs -> http, each importing only the
-//! floors below it.
+//! physics -> wear -> models -> report -> cases -> gap -> pipeline -> jobs -> http, each
+//! importing only the floors below it.
 //!
 //! Units: SI inside the engine (m, kg, s, N, Pa). See [`units`] for the
 //! conversions from the thesis' ADAMS units (mm, kg, s, N).
@@ -15,6 +15,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod analysis;
+pub mod cases;
 pub mod cli;
 pub mod config;
 pub mod contact_models;

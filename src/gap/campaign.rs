@@ -373,9 +373,9 @@ impl CampaignTest {
             return Err(GapError::field(f("overrides"), "must be a table"));
         }
         let mut adjust_error: Option<GapError> = None;
-        let source = crate::pipeline::CaseSource::Reference(&self.config);
+        let source = crate::cases::CaseSource::Reference(&self.config);
         let overrides = Some(&self.overrides);
-        let case = crate::pipeline::resolve_model(source, overrides, None, configs_dir, |case| {
+        let case = crate::cases::resolve_model(source, overrides, None, configs_dir, |case| {
             if let Err(e) = self.adjust(ti, case, configs_dir) {
                 adjust_error = Some(e);
                 return Err(RunError::InvalidConfig {
@@ -416,7 +416,7 @@ impl CampaignTest {
             return Ok(());
         };
         if let Some(p) = &drive.profile {
-            case.excitation = serde_json::json!({"kind": "profile", "profile": p});
+            case.excitation = crate::models::spec::CaseExcitation::profile(p);
         }
         if drive.level_g.is_none() && drive.frequency_hz.is_none() {
             return Ok(());
@@ -471,8 +471,8 @@ impl CampaignTest {
             settle_s,
             ramp,
         };
-        case.excitation =
-            serde_json::to_value(&spec).map_err(|e| GapError::field(f("drive"), e.to_string()))?;
+        case.excitation = crate::models::spec::CaseExcitation::motion(spec)
+            .map_err(|e| GapError::field(f("drive"), e.to_string()))?;
         Ok(())
     }
 

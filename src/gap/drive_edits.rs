@@ -22,8 +22,8 @@ pub(super) fn set_excitation(
     spec: &ExcitationSpec,
     field: &str,
 ) -> Result<(), GapError> {
-    case.excitation =
-        serde_json::to_value(spec).map_err(|e| GapError::field(field, e.to_string()))?;
+    case.excitation = crate::models::spec::CaseExcitation::motion(spec.clone())
+        .map_err(|e| GapError::field(field, e.to_string()))?;
     Ok(())
 }
 

@@ -205,8 +205,8 @@ fn check_options(o: &RigOptions) -> Result<(), GapError> {
         "must lie in [0, 2]",
     )?;
     // A diagnosis' window and settle bounds: the rig makes the campaigns a diagnosis reads.
-    crate::pipeline::check_window_s(o.window_s)?;
-    crate::pipeline::check_settle_s(o.settle_s)?;
+    crate::cases::check_window_s(o.window_s)?;
+    crate::cases::check_settle_s(o.settle_s)?;
     rule(
         "segments_per_increment",
         (1..=100).contains(&o.segments_per_increment),

@@ -63,7 +63,7 @@ impl Jobs {
         &self,
         id: uuid::Uuid,
         attempt: i64,
-        cp: crate::models::outcome::Checkpoint,
+        cp: crate::pipeline::Checkpoint,
     ) -> Option<f64> {
         let t = cp.simulated_time_s;
         let new = NewCheckpoint {

@@ -7,7 +7,7 @@
 //! and hands it over as [`JobInputs`].
 
 use crate::field_error::FieldError;
-use crate::models::outcome::RunError;
+use crate::pipeline::RunError;
 use crate::store::Store;
 use sha2::{Digest, Sha256};
 use uuid::Uuid;

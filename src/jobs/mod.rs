@@ -29,7 +29,7 @@ use std::time::Duration;
 use tokio::sync::Notify;
 use uuid::Uuid;
 
-pub use crate::models::case::code_version;
+pub use crate::pipeline::code_version;
 
 /// Key of a penalization curve: vehicle profile, environment and wear law.
 pub fn curve_key(vehicle_profile: &str, environment: &str, wear_law: &str) -> String {
@@ -322,7 +322,7 @@ impl Jobs {
                 ));
             }
         };
-        let carried = crate::gap::diagnose::carry::carried_wear_law(id, result)
+        let carried = crate::pipeline::carried_wear_law(id, result)
             .map_err(|e| SubmitError::Invalid(e.at("params")))?;
         if let Some(submitted) = submitted_record {
             if let Some(field) = differing_field(&submitted, &carried) {

@@ -1,17 +1,14 @@
 //! What the job queue runs: [`CaseRunner`], the trait between the queue and a computation (the
 //! queue never looks inside one; it hands over kind + params + [`RunControl`] and stores what
-//! comes back), and [`LibraryRunner`], the production computation: `pipeline` for simulate,
-//! sweep and calibrate jobs, `gap::diagnose` for diagnoses (`gap` stands above `pipeline`, so
-//! a diagnosis cannot run behind it).
+//! comes back), and [`LibraryRunner`], the production computation: every job kind through
+//! `pipeline`, the library's one door.
 
 pub use super::inputs::{JobInputs, StoredInput};
 use super::model::JobKind;
-use crate::analysis::penalization::PenalizationCurve;
 use crate::field_error::FieldError;
-use crate::physics::track::TrackSample;
 use crate::pipeline::{
-    plan_from_json, plan_to_json, CalibrateParams, DiagnosePlan, RunControl, RunError, SavedRun,
-    SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary,
+    plan_from_json, plan_to_json, CalibrateParams, DiagnosePlan, PenalizationCurve, RunControl,
+    RunError, SavedRun, SimulatePlan, SweepOutcome, SweepPlan, SweepPointSummary, TrackSample,
 };
 use std::path::PathBuf;
 
@@ -213,27 +210,6 @@ impl JobPlan {
     }
 }
 
-/// A diagnosis's options: the defaults with what its plan sets (bounded in the plan).
-pub fn diagnose_options(plan: &DiagnosePlan) -> crate::gap::diagnose::DiagnoseOptions {
-    let mut options = crate::gap::diagnose::DiagnoseOptions::default();
-    let emulator = &mut options.emulator;
-    emulator.window_s = plan.window_s.unwrap_or(emulator.window_s);
-    emulator.settle_s = plan.settle_s.unwrap_or(emulator.settle_s);
-    emulator.grid_points = plan.grid_points.unwrap_or(emulator.grid_points);
-    if let Some(effects) = &plan.effects {
-        emulator.effects = Some(effects.clone());
-    }
-    options
-}
-
-/// Names of the gap library's effects, which a diagnosis may name.
-fn library_effects() -> Vec<&'static str> {
-    crate::gap::effects::LIBRARY
-        .iter()
-        .map(|e| e.name)
-        .collect()
-}
-
 /// The production runner: calls `railwear::pipeline` with reference configs from `configs_dir`.
 pub struct LibraryRunner {
     /// Directory of the reference model configs (`configs/`).
@@ -294,7 +270,6 @@ impl LibraryRunner {
             )?))),
             JobKind::Diagnose => Ok(JobPlan::Diagnose(Box::new(DiagnosePlan::from_params(
                 params,
-                &library_effects(),
             )?))),
         }
     }
@@ -396,15 +371,13 @@ impl CaseRunner for LibraryRunner {
                          stored campaign",
                     )
                 })?;
-                // Validated on upload and pinned by its SHA-256: parsed, not checked again.
-                let campaign = crate::gap::Campaign::from_json_str(content).map_err(|e| {
-                    FieldError::new(
-                        "campaign_id",
-                        format!("names a stored campaign that does not parse: {e}"),
-                    )
-                })?;
-                let options = diagnose_options(&plan);
-                run_diagnosis(&campaign, &options, &self.configs_dir, control)
+                let done =
+                    crate::pipeline::run_diagnosis(&plan, content, &self.configs_dir, control)?;
+                Ok(JobOutput {
+                    summary: done.report,
+                    plots: done.plots,
+                    ..JobOutput::default()
+                })
             }
         }
     }
@@ -515,182 +488,27 @@ impl CaseRunner for LibraryRunner {
     }
 }
 
-/// Runs a diagnosis: progress is the fraction of its test simulations done (reported as
-/// `simulated_time_s` = simulations done of `end_time_s` = simulations in all); the summary is
-/// the report, the plots its figures.
-pub fn run_diagnosis(
-    campaign: &crate::gap::Campaign,
-    options: &crate::gap::diagnose::DiagnoseOptions,
-    configs_dir: &std::path::Path,
-    control: &RunControl,
-) -> Result<JobOutput, RunError> {
-    // The window simulations see the cancel flag but not the progress sink: the job's progress
-    // counts simulations, not one window's simulated time.
-    // Its windows keep no checkpoint: a request stops the diagnosis as cancelled.
-    let inner = RunControl::new(control.cancel.clone(), std::sync::Arc::new(|_| {}));
-    // The stage after the last simulation (fits, ranking, held-out tests, report and plots)
-    // counts as one more unit, so the job reads 100 % only once the report is made.
-    let units = std::sync::atomic::AtomicUsize::new(1);
-    let report_progress = |done: usize, total: usize| {
-        let total = total.max(1) + 1;
-        units.fetch_max(total, std::sync::atomic::Ordering::SeqCst);
-        (control.progress)(diagnosis_progress(done.min(total - 1), total));
-    };
-    let cache = crate::gap::window::WindowCache::new();
-    let (report, _) = crate::gap::diagnose::diagnose(
-        campaign,
-        configs_dir,
-        options,
-        &inner,
-        &cache,
-        &report_progress,
-    )
-    .map_err(|e| {
-        if control.is_cancelled() {
-            RunError::Cancelled
-        } else {
-            match e {
-                crate::gap::GapError::Field { field, rule } => {
-                    RunError::InvalidConfig { field, rule }
-                }
-                other => RunError::Diverged(other.to_string()),
-            }
-        }
-    })?;
-    let summary = serde_json::to_value(&report).map_err(|e| RunError::InvalidConfig {
-        field: "report".into(),
-        rule: format!("could not be serialized: {e}"),
-    })?;
-    let plots = crate::gap::diagnose::plots::plots(&report);
-    let total = units.load(std::sync::atomic::Ordering::SeqCst);
-    (control.progress)(diagnosis_progress(total, total));
-    Ok(JobOutput {
-        summary,
-        plots,
-        ..JobOutput::default()
-    })
-}
-
-/// A diagnosis' progress: `done` of `total` units (its simulations, then the final stage).
-fn diagnosis_progress(done: usize, total: usize) -> crate::physics::control::Progress {
-    crate::physics::control::Progress {
-        simulated_time_s: done as f64,
-        end_time_s: total as f64,
-        fraction: (done as f64 / total as f64).clamp(0.0, 1.0),
-    }
-}
-
 /// A sweep job's output from its outcome (sequential or assembled): the outcome as summary, the
 /// penalization curve (eq. 6.4) with the rates of each seed, its plot, fidelity and
-/// provenance.
+/// provenance ([`crate::pipeline::sweep_curve`]).
 pub fn sweep_output(
     plan: &SweepPlan,
     params: &serde_json::Value,
     sweep: &SweepOutcome,
 ) -> Result<JobOutput, RunError> {
-    let ks: Vec<f64> = sweep.points.iter().map(|p| p.rattle_space).collect();
-    let rates: Vec<Vec<f64>> = if sweep.rate_by_seed_mg_per_h.len() == ks.len() {
-        sweep.rate_by_seed_mg_per_h.clone()
-    } else {
-        sweep
-            .points
-            .iter()
-            .map(|p| vec![p.rail_wear_rate_mg_per_h])
-            .collect()
-    };
-    let curve =
-        PenalizationCurve::from_seeds(&ks, &rates, sweep.design_rattle_space).map_err(|e| {
-            RunError::Diverged(format!("sweep produced no usable penalization curve: {e}"))
-        })?;
-    let (k_min, k_max) = plan.range.rattle_space_bounds();
-    let config = match params.get("config") {
-        None => serde_json::Value::from("launcher-design"),
-        Some(serde_json::Value::String(name)) => serde_json::Value::from(name.as_str()),
-        Some(_) => serde_json::Value::from("inline"),
-    };
-    // Which face contact the runs used (`face_contact`, with the lattice its points per edge):
-    // the launcher's default changed from the lattice to the exact contact, and a curve must
-    // say which one its rates come from.
-    let contact = crate::models::case::face_contact_record(&plan.base)?;
-    let mut provenance = serde_json::json!({
-        "config": config,
-        "overrides": params.get("overrides").cloned().unwrap_or(serde_json::Value::Null),
-        "vehicle_profile": plan.vehicle_profile,
-        "environment": plan.environment,
-        "wear_law": plan.wear_law,
-        "diagnosed_wear_law": plan.diagnosed,
-        "points": plan.len(),
-        "duration_per_point_s": plan.duration_per_point_s(),
-        "settle_s": plan.base.simulation.settle_s,
-        "seeds": plan.seeds,
-        "rattle_space_range": {"min": k_min, "max": k_max},
-        "offsets_mm": plan.offsets_mm,
-        "base_dimensions_mm": plan.range.base,
-        "design_base": plan.range.design_base,
-    });
-    if let (Some(map), serde_json::Value::Object(contact)) = (provenance.as_object_mut(), contact) {
-        map.extend(contact);
-    }
-    let curve_info = CurveInfo {
-        fidelity: crate::store::CurveFidelity {
-            points: plan.len() as i64,
-            duration_per_point_s: Some(plan.duration_per_point_s()),
-            seeds: plan.seeds.len() as i64,
-        },
-        provenance,
-    };
-    let plot = crate::report::curve_plot(&curve);
-    let summary = serde_json::to_value(sweep).map_err(|e| RunError::InvalidConfig {
-        field: "sweep".into(),
-        rule: e.to_string(),
-    })?;
+    let made = crate::pipeline::sweep_curve(plan, params, sweep)?;
     Ok(JobOutput {
-        summary,
+        summary: made.summary,
         tracks: Vec::new(),
-        plots: vec![("penalization.svg".to_string(), plot)],
-        penalization: Some(curve),
-        curve_info: Some(curve_info),
+        plots: vec![made.plot],
+        penalization: Some(made.curve),
+        curve_info: Some(CurveInfo {
+            fidelity: crate::store::CurveFidelity {
+                points: made.points as i64,
+                duration_per_point_s: Some(made.duration_per_point_s),
+                seeds: made.seeds as i64,
+            },
+            provenance: made.provenance,
+        }),
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::analysis::penalization::SweepPoint;
-
-    /// A sweep's curve names the face contact its runs used: the launcher's default (exact)
-    /// when the sweep says nothing, and the lattice with its points per edge when an override
-    /// names it.
-    #[test]
-    fn a_sweeps_curve_records_the_face_contact_its_runs_used() {
-        let configs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
-        let provenance = |params: serde_json::Value| {
-            let plan = SweepPlan::from_params(&params, &configs).expect("plan");
-            // Three points of any wear rates: only the provenance is read here.
-            let points = (0..3)
-                .map(|i| SweepPoint {
-                    offset_mm: None,
-                    rattle_space: 0.2 + 0.1 * i as f64,
-                    rail_wear_rate_mg_per_h: 1.0 + i as f64,
-                })
-                .collect();
-            let outcome = SweepOutcome {
-                design_rattle_space: 0.3,
-                points,
-                seeds: Vec::new(),
-                rate_by_seed_mg_per_h: Vec::new(),
-            };
-            let output = sweep_output(&plan, &params, &outcome).expect("output");
-            output.curve_info.expect("curve info").provenance
-        };
-        let exact = provenance(serde_json::json!({"config": "launcher-design"}));
-        assert_eq!(exact["face_contact"], "exact", "{exact}");
-        assert!(exact.get("contact_points_per_edge").is_none(), "{exact}");
-        let lattice = provenance(serde_json::json!({
-            "config": "launcher-design",
-            "overrides": {"simulation": {"face_contact": "lattice", "contact_points_per_edge": 9}},
-        }));
-        assert_eq!(lattice["face_contact"], "lattice", "{lattice}");
-        assert_eq!(lattice["contact_points_per_edge"], 9, "{lattice}");
-    }
 }

@@ -157,7 +157,7 @@ impl Jobs {
         let sink = Arc::clone(&latest);
         let (chunk_tx, mut chunks) = tokio::sync::mpsc::unbounded_channel::<RecordChunk>();
         let control = RunControl {
-            progress_interval: crate::physics::control::DEFAULT_PROGRESS_INTERVAL,
+            progress_interval: crate::pipeline::DEFAULT_PROGRESS_INTERVAL,
             cancel: Arc::clone(&cancel),
             checkpoint: Arc::clone(&checkpoint),
             progress: Arc::new(move |p: Progress| {
@@ -568,7 +568,7 @@ fn job_progress(p: Progress, elapsed: Duration) -> JobProgress {
 fn new_curve(
     job: &crate::jobs::JobRecord,
     key: &str,
-    curve: &crate::analysis::penalization::PenalizationCurve,
+    curve: &crate::pipeline::PenalizationCurve,
     info: Option<super::runner::CurveInfo>,
 ) -> NewCurve {
     let (fidelity, mut provenance) = match info {

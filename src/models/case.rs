@@ -4,7 +4,7 @@
 
 use super::outcome::RunError;
 use super::run::{BuiltModel, ModelRunError, RunOptions};
-use super::spec::{CaseSpec, ModelSpecRef};
+use super::spec::{CaseSpec, Excitation, ModelSpecRef};
 use super::{launcher, persistent_contact, rattle_box};
 use crate::excitation::profile::ProfileFile;
 use crate::excitation::{BaseMotion, ExcitationSpec};
@@ -64,47 +64,42 @@ pub fn read_case(path: &Path) -> Result<CaseSpec, RunError> {
 /// the case's `simulation.settle_s` becomes the excitation's settle time, and for random
 /// profiles `simulation.seed` replaces the profile's seed (so sweeps and ensembles vary it).
 pub fn resolve_excitation(case: &CaseSpec, configs_dir: &Path) -> Result<ExcitationSpec, RunError> {
-    let mut value = case.excitation.clone();
-    if value.get("kind").and_then(Value::as_str) == Some("profile") {
-        let name = value
-            .get("profile")
-            .and_then(Value::as_str)
-            .ok_or_else(|| {
-                FieldError::new("excitation.profile", "must name a file in configs/profiles")
-            })?;
-        if name.contains('/') || name.contains("..") {
-            return Err(
-                FieldError::new("excitation.profile", "must be a plain profile name").into(),
-            );
-        }
-        let path = configs_dir.join("profiles").join(format!("{name}.toml"));
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            FieldError::new(
-                "excitation.profile",
-                format!(
-                    "cannot read {} (profiles are looked up in the configs directory's \
-                     profiles/, here {}; the CLI's --configs-dir sets it): {e}",
-                    path.display(),
-                    configs_dir.display()
-                ),
-            )
-        })?;
-        let file = ProfileFile::from_toml_str(&text)
-            .map_err(|e| FieldError::new("excitation.profile", e.to_string()))?;
-        value = serde_json::to_value(&file.excitation)
-            .map_err(|e| FieldError::new("excitation", e.to_string()))?;
-        if let Some(obj) = value.as_object_mut() {
-            if obj.contains_key("seed") {
-                obj.insert("seed".into(), json!(case.simulation.seed));
+    let mut spec = match case.excitation.kind() {
+        Excitation::Profile(name) => {
+            if name.contains('/') || name.contains("..") {
+                return Err(
+                    FieldError::new("excitation.profile", "must be a plain profile name").into(),
+                );
             }
+            let path = configs_dir.join("profiles").join(format!("{name}.toml"));
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                FieldError::new(
+                    "excitation.profile",
+                    format!(
+                        "cannot read {} (profiles are looked up in the configs directory's \
+                         profiles/, here {}; the CLI's --configs-dir sets it): {e}",
+                        path.display(),
+                        configs_dir.display()
+                    ),
+                )
+            })?;
+            let mut spec = ProfileFile::from_toml_str(&text)
+                .map_err(|e| FieldError::new("excitation.profile", e.to_string()))?
+                .excitation;
+            if let ExcitationSpec::SineOnRandom { seed, .. } = &mut spec {
+                *seed = case.simulation.seed;
+            }
+            spec
         }
+        Excitation::Motion(spec) => spec.clone(),
+    };
+    match &mut spec {
+        ExcitationSpec::None => {}
+        ExcitationSpec::Sine { settle_s, .. }
+        | ExcitationSpec::SineOnRandom { settle_s, .. }
+        | ExcitationSpec::Measured { settle_s, .. } => *settle_s = case.simulation.settle_s,
     }
-    if let Some(obj) = value.as_object_mut() {
-        if obj.get("kind").and_then(Value::as_str) != Some("none") {
-            obj.insert("settle_s".into(), json!(case.simulation.settle_s));
-        }
-    }
-    serde_json::from_value(value).map_err(|e| FieldError::new("excitation", e.to_string()).into())
+    Ok(spec)
 }
 
 /// Maps the `[simulation]` table to integrator settings. The position tolerance sets the

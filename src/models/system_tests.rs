@@ -426,7 +426,9 @@ fn a_run_with_a_non_finite_base_motion_fails_with_a_diagnostic() {
     case.simulation.settle_s = 0.01;
     case.simulation.duration_s = 0.02;
     case.simulation.record_interval_s = 1e-3;
-    case.excitation["tones"][0]["amplitude_g"] = serde_json::json!(1e308);
+    let mut table = case.excitation.table().clone();
+    table["tones"][0]["amplitude_g"] = serde_json::json!(1e308);
+    case.excitation = crate::models::spec::CaseExcitation::from_table(table).unwrap();
     let model = build(&case, &configs).unwrap();
     let options = run_options(&case).unwrap();
     let control = crate::physics::control::RunControl::silent();

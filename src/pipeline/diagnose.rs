@@ -1,11 +1,17 @@
 //! Diagnose jobs: the params of a diagnosis of a stored campaign (its id, the SHA-256 of its
-//! content and the client's options), parsed and bounded once into [`DiagnosePlan`]. The
-//! options' bounds ([`check_window_s`], [`check_settle_s`], [`check_grid_points`]) are the
-//! ones the CLI's diagnosis and the virtual rig apply too.
+//! content and the client's options), parsed once into [`DiagnosePlan`]; its options built
+//! from the plan in one place ([`DiagnosePlan::options`]) and checked at submission by the
+//! diagnosis' own rules ([`crate::gap::diagnose::check_options`], the ones the CLI's diagnosis
+//! applies, with the window, settle and grid bounds of [`super::limits`]); and the run
+//! ([`run_diagnosis`]): the stored campaign read, the diagnosis run, its report and figures.
 
-use super::{limits, RunError};
+use super::{RunControl, RunError};
+use crate::cases::limits::grid_points_range;
 use crate::field_error::FieldError;
+use crate::gap::diagnose::{check_options, DiagnoseOptions};
+use crate::gap::{Campaign, GapError};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// Params a client may give a diagnosis (`POST /v1/campaigns/{id}/diagnoses`).
 pub const DIAGNOSE_CLIENT_KEYS: &[&str] =
@@ -33,13 +39,13 @@ pub struct DiagnosePlan {
     pub campaign_id: uuid::Uuid,
     /// SHA-256 of the campaign's stored canonical JSON, lower-case hex.
     pub campaign_sha256: String,
-    /// Simulated excitation per increment, s ([`check_window_s`]).
+    /// Simulated excitation per increment, s ([`super::check_window_s`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window_s: Option<f64>,
-    /// Settle time before each window, s ([`check_settle_s`]).
+    /// Settle time before each window, s ([`super::check_settle_s`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_s: Option<f64>,
-    /// Grid points per effect parameter ([`check_grid_points`]).
+    /// Grid points per effect parameter ([`super::check_grid_points`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid_points: Option<usize>,
     /// Library effects to consider (all when absent); at least one.
@@ -47,61 +53,52 @@ pub struct DiagnosePlan {
     pub effects: Option<Vec<String>>,
 }
 
-/// `window_s` within [`limits::WINDOW_S_RANGE`].
-pub fn check_window_s(window_s: f64) -> Result<(), FieldError> {
-    let (lo, hi) = limits::WINDOW_S_RANGE;
-    if window_s.is_finite() && (lo..=hi).contains(&window_s) {
-        Ok(())
-    } else {
-        Err(FieldError::new(
-            "window_s",
-            format!("must lie in [{lo}, {hi}] s"),
-        ))
-    }
-}
-
-/// `settle_s` within [0, [`limits::MAX_SETTLE_S`]].
-pub fn check_settle_s(settle_s: f64) -> Result<(), FieldError> {
-    if settle_s.is_finite() && (0.0..=limits::MAX_SETTLE_S).contains(&settle_s) {
-        Ok(())
-    } else {
-        Err(FieldError::new(
-            "settle_s",
-            format!("must lie in [0, {}] s", limits::MAX_SETTLE_S),
-        ))
-    }
-}
-
-/// `grid_points` within [`limits::GRID_POINTS`].
-pub fn check_grid_points(grid_points: usize) -> Result<(), FieldError> {
-    if limits::GRID_POINTS.contains(&grid_points) {
-        Ok(())
-    } else {
-        Err(FieldError::new(
-            "grid_points",
-            format!("must lie in {}", grid_points_range()),
-        ))
-    }
-}
-
-/// [`limits::GRID_POINTS`] as a rule shows it: `2..=12`.
-fn grid_points_range() -> String {
-    format!(
-        "{}..={}",
-        limits::GRID_POINTS.start(),
-        limits::GRID_POINTS.end()
-    )
-}
-
 /// Lower-case hex of a SHA-256: 64 digits.
 fn is_sha256(s: &str) -> bool {
     s.len() == 64 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'))
 }
 
+/// Names of the gap library's effects, which a diagnosis may name.
+fn library_effects() -> Vec<&'static str> {
+    crate::gap::effects::LIBRARY
+        .iter()
+        .map(|e| e.name)
+        .collect()
+}
+
+/// A diagnosis' error as a job's: a broken rule names its field, anything else is a failed
+/// computation.
+fn job_error(e: GapError) -> RunError {
+    match e {
+        GapError::Field { field, rule } => RunError::InvalidConfig { field, rule },
+        other => RunError::Diverged(other.to_string()),
+    }
+}
+
 impl DiagnosePlan {
     /// Parses a `diagnose` job's params ([`DIAGNOSE_KEYS`]); `effects` must name effects of
-    /// `library` (the gap library's names). Errors name the params field.
-    pub fn from_params(params: &serde_json::Value, library: &[&str]) -> Result<Self, RunError> {
+    /// the gap library, and the options the plan gives ([`DiagnosePlan::options`]) must pass
+    /// the diagnosis' rules. Errors name the params field.
+    pub fn from_params(params: &serde_json::Value) -> Result<Self, RunError> {
+        Self::from_params_in(params, &library_effects())
+    }
+
+    /// The diagnosis' options: its defaults with what the plan sets. The one place a job's
+    /// options are built (at submission to check them, per attempt to run them).
+    pub fn options(&self) -> DiagnoseOptions {
+        let mut options = DiagnoseOptions::default();
+        let emulator = &mut options.emulator;
+        emulator.window_s = self.window_s.unwrap_or(emulator.window_s);
+        emulator.settle_s = self.settle_s.unwrap_or(emulator.settle_s);
+        emulator.grid_points = self.grid_points.unwrap_or(emulator.grid_points);
+        if let Some(effects) = &self.effects {
+            emulator.effects = Some(effects.clone());
+        }
+        options
+    }
+
+    /// [`DiagnosePlan::from_params`] with `effects` names taken from `library`.
+    fn from_params_in(params: &serde_json::Value, library: &[&str]) -> Result<Self, RunError> {
         let known = DIAGNOSE_CLIENT_KEYS.join(", ");
         let map = params
             .as_object()
@@ -154,19 +151,98 @@ impl DiagnosePlan {
             .get("effects")
             .map(|value| parse_effects(value, library))
             .transpose()?;
-        window_s.map(check_window_s).transpose()?;
-        settle_s.map(check_settle_s).transpose()?;
-        grid_points.map(check_grid_points).transpose()?;
-        Ok(Self {
+        let plan = Self {
             campaign_id,
             campaign_sha256,
             window_s,
             settle_s,
             grid_points,
             effects,
-        })
+        };
+        check_options(&plan.options()).map_err(job_error)?;
+        Ok(plan)
     }
 }
+
+/// A finished diagnosis: its report (JSON) and figures (file name, SVG).
+#[derive(Debug, Clone)]
+pub struct DiagnosisOutcome {
+    /// The report.
+    pub report: serde_json::Value,
+    /// Its figures.
+    pub plots: Vec<(String, String)>,
+}
+
+/// Runs the diagnosis `plan` of the stored campaign `campaign_json` (its canonical JSON as the
+/// store holds it: validated on upload and pinned by its SHA-256, so parsed here and not
+/// checked again). Progress is the fraction of its test simulations done (reported as
+/// `simulated_time_s` = simulations done of `end_time_s` = simulations in all, the stage after
+/// the last simulation counting as one more); a checkpoint request is not honoured (its
+/// windows keep none), so `control` should come without one.
+pub fn run_diagnosis(
+    plan: &DiagnosePlan,
+    campaign_json: &str,
+    configs_dir: &Path,
+    control: &RunControl,
+) -> Result<DiagnosisOutcome, RunError> {
+    let campaign = Campaign::from_json_str(campaign_json).map_err(|e| {
+        FieldError::new(
+            "campaign_id",
+            format!("names a stored campaign that does not parse: {e}"),
+        )
+    })?;
+    let options = plan.options();
+    // The window simulations see the cancel flag but not the progress sink: the job's progress
+    // counts simulations, not one window's simulated time.
+    let inner = RunControl::new(control.cancel.clone(), std::sync::Arc::new(|_| {}));
+    // The stage after the last simulation (fits, ranking, held-out tests, report and plots)
+    // counts as one more unit, so the job reads 100 % only once the report is made.
+    let units = std::sync::atomic::AtomicUsize::new(1);
+    let report_progress = |done: usize, total: usize| {
+        let total = total.max(1) + 1;
+        units.fetch_max(total, std::sync::atomic::Ordering::SeqCst);
+        (control.progress)(diagnosis_progress(done.min(total - 1), total));
+    };
+    let cache = crate::gap::window::WindowCache::new();
+    let (report, _) = crate::gap::diagnose::diagnose(
+        &campaign,
+        configs_dir,
+        &options,
+        &inner,
+        &cache,
+        &report_progress,
+    )
+    .map_err(|e| {
+        if control.is_cancelled() {
+            RunError::Cancelled
+        } else {
+            job_error(e)
+        }
+    })?;
+    let summary = serde_json::to_value(&report).map_err(|e| RunError::InvalidConfig {
+        field: "report".into(),
+        rule: format!("could not be serialized: {e}"),
+    })?;
+    let plots = crate::gap::diagnose::plots::plots(&report);
+    let total = units.load(std::sync::atomic::Ordering::SeqCst);
+    (control.progress)(diagnosis_progress(total, total));
+    Ok(DiagnosisOutcome {
+        report: summary,
+        plots,
+    })
+}
+
+/// A diagnosis' progress: `done` of `total` units (its simulations, then the final stage).
+fn diagnosis_progress(done: usize, total: usize) -> super::Progress {
+    super::Progress {
+        simulated_time_s: done as f64,
+        end_time_s: total as f64,
+        fraction: (done as f64 / total as f64).clamp(0.0, 1.0),
+    }
+}
+
+/// The wear law a sweep carries from a diagnosis, read from its stored report.
+pub use crate::gap::diagnose::carry::carried_wear_law;
 
 /// A non-empty list of names of `library` effects.
 fn parse_effects(value: &serde_json::Value, library: &[&str]) -> Result<Vec<String>, FieldError> {
@@ -212,7 +288,7 @@ mod tests {
     #[test]
     fn options_are_bounded_once_naming_the_field() {
         let library = ["third_body", "misalignment"];
-        let ok = DiagnosePlan::from_params(
+        let ok = DiagnosePlan::from_params_in(
             &params(json!({"window_s": 0.1, "grid_points": 2, "effects": ["third_body"]})),
             &library,
         )
@@ -235,7 +311,7 @@ mod tests {
             (json!({"colour": "red"}), "colour"),
         ] {
             let Err(RunError::InvalidConfig { field: got, .. }) =
-                DiagnosePlan::from_params(&params(bad.clone()), &library)
+                DiagnosePlan::from_params_in(&params(bad.clone()), &library)
             else {
                 panic!("{bad} is refused");
             };
@@ -245,7 +321,7 @@ mod tests {
 
     #[test]
     fn a_plan_round_trips_through_its_json() {
-        let plan = DiagnosePlan::from_params(
+        let plan = DiagnosePlan::from_params_in(
             &params(json!({"window_s": 0.1, "settle_s": 0.02})),
             &["third_body"],
         )

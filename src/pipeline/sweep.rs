@@ -2,8 +2,8 @@
 //! law), one point's run, and the sequential sweep.
 
 use super::{
-    check_keys, design_rattle_space, merge_json, replica_seed, resolve_case, Progress, RunControl,
-    RunError, SweepRange, SWEEP_KEYS,
+    check_keys, design_rattle_space, merge_json, replica_seed, resolve_case_seeded, Progress,
+    RunControl, RunError, SweepRange, SWEEP_KEYS,
 };
 use crate::analysis::penalization::SweepPoint;
 use crate::field_error::FieldError;
@@ -171,7 +171,7 @@ impl SweepPlan {
     /// (default `launcher-design`, must be a launcher case), `overrides`, `seed`, `points`
     /// (default 5, [`super::limits::SWEEP_POINTS`]), `vehicle_profile` (selects the excitation: a
     /// profile in `configs/profiles`, see [`vehicle_profile_file`]), `environment`
-    /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`resolve_case`]
+    /// ([`ENVIRONMENTS`]) and `wear_law` ([`WEAR_LAWS`]). Every rule of [`super::resolve_case`]
     /// applies to the base case.
     pub fn from_params(params: &serde_json::Value, configs_dir: &Path) -> Result<Self, RunError> {
         Self::from_params_seeded(params, configs_dir, None)
@@ -251,7 +251,7 @@ impl SweepPlan {
         if p.get("config").is_none() {
             merge_json(&mut p, &serde_json::json!({"config": "launcher-design"}));
         }
-        let base = resolve_case(&p, configs_dir, |case| {
+        let base = resolve_case_seeded(&p, configs_dir, seed, |case| {
             if case.launcher.is_none() {
                 return Err(FieldError::new(
                     "config",
@@ -260,10 +260,7 @@ impl SweepPlan {
                 )
                 .into());
             }
-            if let Some(seed) = seed {
-                case.simulation.seed = seed;
-            }
-            case.excitation = serde_json::json!({"kind": "profile", "profile": profile_file});
+            case.excitation = crate::models::spec::CaseExcitation::profile(&profile_file);
             match (&diagnosed, case.launcher.as_ref()) {
                 (Some(d), Some(launcher)) => {
                     // A legacy law is refused by the case's own rule (`wear.mechanism`).

@@ -234,3 +234,17 @@ fn a_case_resolved_from_its_parts_is_the_case_of_the_same_params() {
     );
     assert_eq!(field_of(e.unwrap_err()), "config");
 }
+
+#[test]
+fn every_reference_case_round_trips_through_its_plan_json() {
+    for name in crate::models::reference::reference_config_names(&configs()) {
+        let path = crate::models::reference::reference_config_path(&configs(), &name).unwrap();
+        let plan = SimulatePlan {
+            case: crate::models::case::load_case(&path).unwrap(),
+        };
+        let json = plan.to_json().unwrap();
+        // Stored as text and read back, as the store does.
+        let stored: serde_json::Value = serde_json::from_str(&json.to_string()).unwrap();
+        assert_eq!(SimulatePlan::from_json(&stored).unwrap(), plan, "{name}");
+    }
+}

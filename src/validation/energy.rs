@@ -48,7 +48,7 @@ pub struct MotionlessTube {
 /// Loads `rattle-box-c.toml` from `configs_dir` and removes its excitation.
 pub fn motionless_tube(configs_dir: &Path) -> Result<MotionlessTube, RunError> {
     let mut case = load_case(&configs_dir.join("rattle-box-c.toml"))?;
-    case.excitation = serde_json::json!({ "kind": "none" });
+    case.excitation = crate::models::spec::CaseExcitation::none();
     case.simulation.settle_s = 0.0;
     case.simulation.duration_s = 1.0;
     let model = build(&case, configs_dir)?;

@@ -1,9 +1,9 @@
 //! Slow anchors of `railwear validate --slow`: whole-model runs.
 
 use super::anchor::Anchor;
+use crate::cases::run_case;
 use crate::models::case::load_case;
 use crate::physics::control::RunControl;
-use crate::pipeline::run_case;
 use std::path::Path;
 
 /// Thesis Table 5.4 (ADAMS) rattle-box wear rates, mg/h.

@@ -331,7 +331,7 @@ fn still_launcher() -> (
 ) {
     let mut case = railwear::models::case::load_case(&configs().join("launcher-design.toml"))
         .expect("launcher loads");
-    case.excitation = serde_json::json!({ "kind": "none" });
+    case.excitation = railwear::models::spec::CaseExcitation::none();
     case.simulation.settle_s = 0.0;
     case.simulation.duration_s = 1.0;
     let model = railwear::models::case::build(&case, configs()).expect("model");

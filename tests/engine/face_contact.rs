@@ -535,7 +535,7 @@ fn the_lattice_converges_to_the_exact_face_contact_on_the_launcher() {
     // a lattice row spacing of 0.27 mm at 33 points.
     let mut case =
         railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
-    case.excitation = serde_json::json!({ "kind": "none" });
+    case.excitation = railwear::models::spec::CaseExcitation::none();
     let model_at = |n: usize, face: FaceContact| {
         let mut case = case.clone();
         case.simulation.contact_points_per_edge = n;
@@ -589,7 +589,7 @@ pub(crate) fn settled_exact_launcher(
 ) {
     let mut case =
         railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
-    case.excitation = serde_json::json!({ "kind": "none" });
+    case.excitation = railwear::models::spec::CaseExcitation::none();
     case.simulation.face_contact = Some(FaceContact::Exact);
     let model = railwear::models::case::build(&case, configs()).expect("model");
     let settings = railwear::models::case::integrator_settings(&case).expect("settings");

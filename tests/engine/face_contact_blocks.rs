@@ -75,7 +75,7 @@ fn assert_round_off(a: &[f64], b: &[f64], n: usize, rel: f64) {
 fn the_exact_face_jacobian_per_track_is_the_sum_over_its_nodes() {
     let mut case =
         railwear::models::case::load_case(&configs().join("launcher-design.toml")).expect("case");
-    case.excitation = serde_json::json!({ "kind": "none" });
+    case.excitation = railwear::models::spec::CaseExcitation::none();
     let lattice = railwear::models::case::build(&case, configs()).expect("model");
     let settings = railwear::models::case::integrator_settings(&case).expect("settings");
     let rest = railwear::validation::energy::energy_run(

@@ -33,7 +33,7 @@ fn launcher(case: &CaseSpec) -> LauncherSpec {
 /// final state.
 fn settle(file: &str, settle_s: f64) -> (CaseSpec, BuiltModel, Vec<f64>) {
     let mut c = case(file);
-    c.excitation = serde_json::json!({ "kind": "none" });
+    c.excitation = railwear::models::spec::CaseExcitation::none();
     c.simulation.settle_s = 0.0;
     c.simulation.duration_s = settle_s;
     let model = build(&c, Path::new(&configs())).unwrap_or_else(|e| panic!("{file}: {e}"));

@@ -24,7 +24,8 @@ fn run_c(
     case.simulation.abs_tolerance_m *= tol_scale;
     case.simulation.record_interval_s = duration;
     if let Some(e) = excitation {
-        case.excitation = e;
+        case.excitation =
+            railwear::models::spec::CaseExcitation::from_table(e).expect("excitation");
     }
     run_case(&case, configs(), &RunControl::silent())
         .expect("runs")

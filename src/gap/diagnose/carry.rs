@@ -14,9 +14,9 @@
 //!   worn-through coating leaves, and the record says so.
 
 use super::report::{Report, Verdict};
+use crate::cases::DiagnosedWearLaw;
 use crate::field_error::FieldError;
 use crate::gap::effects::{info, Acts};
-use crate::pipeline::DiagnosedWearLaw;
 
 /// The record a sweep stores for diagnosis `id` whose job result is `result` (the report's
 /// JSON). Errors name `wear_law.diagnosis` and say why the report cannot be carried.

@@ -2,9 +2,9 @@
 //! rules, with their reasons.
 
 use super::emulator::EmulatorOptions;
+use crate::cases::RunControl;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::path::Path;
 
 /// Held-out log-likelihood gain over the nominal model an effect must exceed to count as an
@@ -126,9 +126,9 @@ pub fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
         "must lie in 10..=100000",
     )?;
     // The service's bounds (one set, with their reasons, in pipeline::limits).
-    crate::pipeline::check_window_s(o.emulator.window_s)?;
-    crate::pipeline::check_settle_s(o.emulator.settle_s)?;
-    crate::pipeline::check_grid_points(o.emulator.grid_points)?;
+    crate::cases::check_window_s(o.emulator.window_s)?;
+    crate::cases::check_settle_s(o.emulator.settle_s)?;
+    crate::cases::check_grid_points(o.emulator.grid_points)?;
     rule(
         "threads",
         (1..=64).contains(&o.emulator.threads),

@@ -8,9 +8,9 @@ use super::options::{check_effects, check_options, DiagnoseOptions, Simulating};
 use super::refine::diagnose_refining;
 use super::report::Report;
 use super::verdict::no_measurement;
+use crate::cases::RunControl;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::path::Path;
 
 /// Runs the diagnosis: builds the emulator (simulations, reported through `progress(done,

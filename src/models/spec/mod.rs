@@ -17,6 +17,7 @@
 //! does not give are engineering estimates, flagged `estimate` in `docs/reference/models.md`.
 
 use crate::field_error::FieldError;
+pub use excitation::{CaseExcitation, Excitation};
 use launcher::LauncherSpec;
 use persistent_contact::PersistentContactSpec;
 use rattle_box::RattleBoxSpec;
@@ -107,6 +108,7 @@ pub(in crate::models) fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Resu
     Ok(())
 }
 
+mod excitation;
 pub mod launcher;
 pub mod persistent_contact;
 pub mod rattle_box;
@@ -163,8 +165,9 @@ pub struct CaseSpec {
     /// Chapter 6 model table.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub launcher: Option<LauncherSpec>,
-    /// Base excitation, kept untyped here (its schema belongs to `crate::excitation`).
-    pub excitation: serde_json::Value,
+    /// Base excitation: a profile by name or a motion given in full, typed when the case is
+    /// read (the schema of its motions belongs to `crate::excitation`).
+    pub excitation: CaseExcitation,
     /// Wear law and the split of wear volume between the bodies of a contact.
     #[serde(default)]
     pub wear: WearSpec,
@@ -277,17 +280,11 @@ impl CaseSpec {
                 ));
             }
         }
+        // The excitation's kind and keys were checked as it was typed (`CaseExcitation`).
         match self.model_spec()? {
-            ModelSpecRef::PersistentContact(s) => s.validate("persistent_contact")?,
-            ModelSpecRef::RattleBox(s) => s.validate("rattle_box")?,
-            ModelSpecRef::Launcher(s) => s.validate("launcher")?,
-        }
-        match self.excitation.get("kind").and_then(|k| k.as_str()) {
-            Some(k) if !k.is_empty() => Ok(()),
-            _ => Err(FieldError::new(
-                "excitation.kind",
-                "the excitation table needs a `kind` string",
-            )),
+            ModelSpecRef::PersistentContact(s) => s.validate("persistent_contact"),
+            ModelSpecRef::RattleBox(s) => s.validate("rattle_box"),
+            ModelSpecRef::Launcher(s) => s.validate("launcher"),
         }
     }
 }

@@ -6,13 +6,13 @@
 
 use super::scenarios::rig_options;
 use super::{BenchOptions, Outcome, Scenario};
+use crate::cases::RunControl;
 use crate::gap::campaign::Campaign;
 use crate::gap::diagnose::emulator::Emulator;
 use crate::gap::diagnose::{diagnose_refining, propose_next_tests, Report, Simulating, Verdict};
 use crate::gap::rig::run_cached;
 use crate::gap::window::WindowCache;
 use crate::gap::GapError;
-use crate::pipeline::RunControl;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

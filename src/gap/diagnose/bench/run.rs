@@ -6,6 +6,7 @@ use super::detectability::{closest_alone, detectability, detectable_tests};
 use super::scenarios::{rig_options, scenarios};
 use super::scores::{score, Scores};
 use super::{BenchOptions, FittedValue, Outcome, Scenario};
+use crate::cases::RunControl;
 use crate::gap::diagnose::emulator::{effect_with, Emulator};
 use crate::gap::diagnose::noise::{observations, NoiseModel, Observation};
 use crate::gap::diagnose::truth_fit::truth_fit;
@@ -13,7 +14,6 @@ use crate::gap::diagnose::{diagnose_refining, Report, Simulating};
 use crate::gap::rig::{run_cached, Truth};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -8,13 +8,13 @@ use super::{
     band_of, Bands, EffectTable, Emulator, EmulatorOptions, FRICTION_STEP, PRESSURE_BANDS,
     SETTLE_SHIFT_S, SLIP_BANDS,
 };
+use crate::cases::RunControl;
 use crate::gap::diagnose::budget::IncrementWork;
 use crate::gap::effects::Acts;
 use crate::gap::rig::ModelIncrement;
 use crate::gap::tracks::WearTerm;
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -5,10 +5,10 @@
 use super::grids::{effect_with, wear_grid};
 use super::slots::{plan, predictions_of, simulate_slots, Slot};
 use super::{EffectTable, Emulator, JointPoint, PairTable, TestPredictions, SETTLE_SHIFT_S};
+use crate::cases::RunControl;
 use crate::gap::effects::{Acts, Effect};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::collections::BTreeMap;
 use std::path::Path;
 

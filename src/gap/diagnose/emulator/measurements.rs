@@ -2,11 +2,11 @@
 //! the tables that agree with it.
 
 use super::Emulator;
+use crate::cases::RunControl;
 use crate::gap::diagnose::measured::{measure, MeasuredValue};
 use crate::gap::effects::{EffectInfo, ParameterInfo};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
-use crate::pipeline::RunControl;
 use std::collections::BTreeMap;
 use std::path::Path;
 

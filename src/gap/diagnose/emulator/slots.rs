@@ -3,12 +3,12 @@
 //! and a slot's increments turned into predictions.
 
 use super::{EmulatorOptions, Prediction, TestPredictions};
+use crate::cases::RunControl;
 use crate::gap::effects::Effect;
 use crate::gap::rig::{simulate_test, ModelIncrement, RigOptions};
 use crate::gap::window::{WindowCache, WindowOptions};
 use crate::gap::{Campaign, GapError};
 use crate::models::spec::CaseSpec;
-use crate::pipeline::RunControl;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;

@@ -1,15 +1,14 @@
-//! Simulate jobs: params (`config`, `overrides`, `seed`) to a validated case, the typed plan a
-//! job stores ([`SimulatePlan`]), and the run.
+//! A case's one parser: a reference config or an inline case object, with overrides and a seed
+//! merged in, to a validated [`CaseSpec`] (unknown keys, the physical bounds of
+//! [`super::bounds`], the run-control limits of [`super::limits`], the model's own rules) and
+//! the model built once to prove it builds. Used by every job kind, the CLI, the campaigns and
+//! the virtual rig.
 
-use super::run::run_case;
-use super::{
-    check_keys, limits, merge_json, parse_seed, CaseOutcome, RunControl, RunError, SIMULATE_KEYS,
-};
+use super::{limits, merge_json, RunError};
 use crate::field_error::FieldError;
 use crate::models::case::read_case;
 use crate::models::run::BuiltModel;
 use crate::models::spec::CaseSpec;
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// True when the dotted `path` (`simulation.duration_s`) is set in `value`.
@@ -112,11 +111,10 @@ fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
 /// Checks every number and text of the case against [`super::bounds`], including the
 /// excitation a profile name stands for.
 fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunError> {
-    let profile = case
-        .excitation
-        .get("kind")
-        .and_then(serde_json::Value::as_str)
-        == Some("profile");
+    let profile = matches!(
+        case.excitation.kind(),
+        crate::models::spec::Excitation::Profile(_)
+    );
     let resolved = if profile {
         let spec = crate::models::case::resolve_excitation(case, configs_dir)?;
         Some(
@@ -138,37 +136,6 @@ pub enum CaseSource<'a> {
     Reference(&'a str),
     /// A case object.
     Inline(&'a serde_json::Value),
-}
-
-/// Resolves job parameters to a validated case: `{"config": "<reference name>" | {inline
-/// case}, "overrides": {...}, "seed": n}` (other keys are the caller's to check), read into
-/// their parts and resolved by [`resolve_config`]. Errors name the params path (`config`,
-/// `config.<path>` or `overrides.<path>`).
-pub fn resolve_case(
-    params: &serde_json::Value,
-    configs_dir: &Path,
-    adjust: impl FnOnce(&mut CaseSpec) -> Result<(), RunError>,
-) -> Result<CaseSpec, RunError> {
-    let source = match params.get("config") {
-        Some(serde_json::Value::String(name)) => CaseSource::Reference(name),
-        Some(obj @ serde_json::Value::Object(_)) => CaseSource::Inline(obj),
-        Some(_) => {
-            return Err(FieldError::new(
-                "config",
-                "must be a reference config name or a config object",
-            )
-            .into())
-        }
-        None => {
-            return Err(FieldError::new(
-                "config",
-                "is required (a reference config name or a config object)",
-            )
-            .into())
-        }
-    };
-    let seed = params.get("seed").map(parse_seed).transpose()?;
-    resolve_config(source, params.get("overrides"), seed, configs_dir, adjust)
 }
 
 /// A case from its `source` with `overrides` deep-merged into it (e.g.
@@ -247,70 +214,4 @@ pub fn resolve_model(
     // Validated above (and not changed since): build without validating again.
     let model = crate::models::case::build_validated(&case, configs_dir).map_err(relocate)?;
     Ok((case, model))
-}
-
-/// [`resolve_case`] without adjustment (the params' other keys are not checked).
-pub fn case_from_params(
-    params: &serde_json::Value,
-    configs_dir: &Path,
-) -> Result<CaseSpec, RunError> {
-    resolve_case(params, configs_dir, |_| Ok(()))
-}
-
-/// A simulate job's params, parsed and checked: [`SIMULATE_KEYS`] only, `config` required.
-pub fn simulate_case(params: &serde_json::Value, configs_dir: &Path) -> Result<CaseSpec, RunError> {
-    check_keys(params, "params", SIMULATE_KEYS)?;
-    case_from_params(params, configs_dir)
-}
-
-/// A simulate job parsed and checked once, at submission: the complete case (reference config,
-/// overrides and seed merged; `simulation.seed` is the job's seed), stored with the job as its
-/// canonical JSON ([`SimulatePlan::to_json`]) and run by the worker from there
-/// ([`SimulatePlan::from_json`]) without reading the params or the reference config again.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SimulatePlan {
-    /// The case to run.
-    pub case: CaseSpec,
-}
-
-impl SimulatePlan {
-    /// Parses and checks a simulate job's params as submitted (the rules of [`simulate_case`],
-    /// and the model built once) for a job run with `seed` (the params' `seed`, or the one
-    /// drawn for the job): the case's `simulation.seed` is set to it before it is checked, as
-    /// the worker sets it for a job planned from its params. Errors name the params path.
-    pub fn from_params(
-        params: &serde_json::Value,
-        configs_dir: &Path,
-        seed: u64,
-    ) -> Result<Self, RunError> {
-        check_keys(params, "params", SIMULATE_KEYS)?;
-        let case = resolve_case(params, configs_dir, |case| {
-            case.simulation.seed = seed;
-            Ok(())
-        })?;
-        Ok(Self { case })
-    }
-
-    /// The plan's canonical JSON (every number round-trips exactly).
-    pub fn to_json(&self) -> Result<serde_json::Value, RunError> {
-        super::plan_to_json(self)
-    }
-
-    /// A stored plan, as [`SimulatePlan::to_json`] wrote it. It was checked at submission; the
-    /// run validates the case once more as it builds the model.
-    pub fn from_json(value: &serde_json::Value) -> Result<Self, RunError> {
-        super::plan_from_json(value, "simulate")
-    }
-}
-
-/// A simulate job: one case end to end.
-pub fn simulate_job(
-    params: &serde_json::Value,
-    configs_dir: &Path,
-    control: &RunControl,
-) -> Result<CaseOutcome, RunError> {
-    let case = simulate_case(params, configs_dir)?;
-    let (_, outcome) = run_case(&case, configs_dir, control)?;
-    Ok(outcome)
 }

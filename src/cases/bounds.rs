@@ -893,7 +893,7 @@ fn check_wear_law(case: &CaseSpec) -> Result<(), FieldError> {
 pub fn check_case(case: &CaseSpec, resolved_excitation: Option<&Value>) -> Result<(), FieldError> {
     let value = serde_json::to_value(case).map_err(|e| FieldError::new("config", e.to_string()))?;
     check_value(&value, "")?;
-    check_excitation_lengths(&case.excitation, "excitation")?;
+    check_excitation_lengths(case.excitation.table(), "excitation")?;
     if let Some(excitation) = resolved_excitation {
         check_value(excitation, "excitation")?;
         check_excitation_lengths(excitation, "excitation")?;
