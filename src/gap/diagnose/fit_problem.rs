@@ -182,11 +182,7 @@ impl<'a> FitProblem<'a> {
     /// ([`Emulator::magnitude_measurement`]), only those within the band, and the band's ends.
     pub(super) fn candidates(&self, e: usize) -> Vec<f64> {
         let all = self.candidates_unbounded(e);
-        let Some([lo, hi]) = self
-            .emulator
-            .magnitude_measurement(e)
-            .and_then(|m| m.band)
-        else {
+        let Some([lo, hi]) = self.emulator.magnitude_measurement(e).and_then(|m| m.band) else {
             return all;
         };
         let (first, last) = (all[0], all[all.len() - 1]);

@@ -207,7 +207,13 @@ pub(super) fn phasor(t: &[f64], x: &[f64], h: &[f64], f: f64) -> (f64, f64) {
 /// Standard deviation of one component of [`phasor`] from the residual after every tone
 /// (`fits` at `freqs`) is removed: white noise of variance `s²` gives `s sqrt(2 Σ h²) / Σ h`
 /// (each component takes half the noise power at the tone's frequency).
-pub(super) fn phasor_sd(t: &[f64], x: &[f64], h: &[f64], freqs: &[f64], fits: &[(f64, f64)]) -> f64 {
+pub(super) fn phasor_sd(
+    t: &[f64],
+    x: &[f64],
+    h: &[f64],
+    freqs: &[f64],
+    fits: &[(f64, f64)],
+) -> f64 {
     let (mut r2, mut sh, mut sh2) = (0.0, 0.0, 0.0);
     for ((ti, xi), hi) in t.iter().zip(x).zip(h) {
         let model: f64 = freqs

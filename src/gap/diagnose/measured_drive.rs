@@ -243,12 +243,15 @@ pub(super) fn fixture_values(
         })
     };
     let band = |k: f64| -> ([f64; 2], [f64; 2]) {
-        let (mut p, mut z) = ([f64::INFINITY, f64::NEG_INFINITY], [f64::INFINITY, f64::NEG_INFINITY]);
+        let (mut p, mut z) = (
+            [f64::INFINITY, f64::NEG_INFINITY],
+            [f64::INFINITY, f64::NEG_INFINITY],
+        );
         for i in 0..PERIOD_STEPS {
             let pm = period.min + (period.max - period.min) * i as f64 / (PERIOD_STEPS - 1) as f64;
             for j in 0..DAMPING_STEPS {
-                let zeta =
-                    damping.min + (damping.max - damping.min) * j as f64 / (DAMPING_STEPS - 1) as f64;
+                let zeta = damping.min
+                    + (damping.max - damping.min) * j as f64 / (DAMPING_STEPS - 1) as f64;
                 if consistent(k, pm, zeta) {
                     p = [p[0].min(pm), p[1].max(pm)];
                     z = [z[0].min(zeta), z[1].max(zeta)];
@@ -271,10 +274,9 @@ pub(super) fn fixture_values(
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let mut out: Vec<MeasuredValue> =
-        band_value(info.name, period.name, p95, p3, source.clone())
-            .into_iter()
-            .collect();
+    let mut out: Vec<MeasuredValue> = band_value(info.name, period.name, p95, p3, source.clone())
+        .into_iter()
+        .collect();
     // The damping only where the gains exclude at least a tenth of its range.
     if z3[1] - z3[0] < 0.9 * (damping.max - damping.min) {
         out.extend(band_value(info.name, damping.name, z95, z3, source));
@@ -313,7 +315,10 @@ fn weighted_mean(readings: &[Reading]) -> Option<Reading> {
     if readings.is_empty() {
         return None;
     }
-    let w: Vec<f64> = readings.iter().map(|r| 1.0 / (r.1 * r.1).max(1e-300)).collect();
+    let w: Vec<f64> = readings
+        .iter()
+        .map(|r| 1.0 / (r.1 * r.1).max(1e-300))
+        .collect();
     let sw: f64 = w.iter().sum();
     let mean = readings.iter().zip(&w).map(|(r, w)| r.0 * w).sum::<f64>() / sw;
     let sd = sw.sqrt().recip();

@@ -249,7 +249,10 @@ fn profile_secondary(
                     .iter()
                     .filter(|(n, v)| {
                         n.as_str() != p.name
-                            && info.parameters.iter().any(|q| q.name == *n && q.default != **v)
+                            && info
+                                .parameters
+                                .iter()
+                                .any(|q| q.name == *n && q.default != **v)
                     })
                     .map(|(n, v)| (n.clone(), *v))
                     .collect()

@@ -111,7 +111,10 @@ mod tests {
         let v = threshold_values(p, 9);
         assert_eq!(v.len(), 9);
         assert_eq!(v[0], 0.0);
-        assert!((v[1] - 1e-4).abs() < 1e-15 && (v[8] - 0.1).abs() < 1e-15, "{v:?}");
+        assert!(
+            (v[1] - 1e-4).abs() < 1e-15 && (v[8] - 0.1).abs() < 1e-15,
+            "{v:?}"
+        );
         for w in v[1..].windows(2) {
             assert!((w[1] / w[0] - 10f64.powf(3.0 / 7.0)).abs() < 1e-9, "{v:?}");
         }
