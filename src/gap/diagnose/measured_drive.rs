@@ -126,58 +126,85 @@ pub(super) fn record_drive(samples: &[[f64; 4]], tones: &[Tone]) -> DriveReading
 
 /// Amplitude of the `f` Hz tone in `x` over the record's trailing steady whole cycles (from
 /// the end back while each cycle's amplitude agrees with the mean of those after it) and its
-/// standard deviation; None with fewer than [`MIN_STEADY_CYCLES`] cycles.
+/// standard deviation; None with fewer than [`MIN_STEADY_CYCLES`] cycles. Each cycle is the
+/// last `round(1 / (f dt))` samples before the next, fitted by least squares with a constant,
+/// a cosine and a sine (exact for a pure tone whatever the sample count).
 fn steady_amplitude(t: &[f64], x: &[f64], f: f64) -> Option<Reading> {
-    let period = 1.0 / f;
-    let end = *t.last()?;
-    let cycles = ((end - t[0]) / period).floor() as usize;
+    let n = t.len();
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let per = (1.0 / (f * dt)).round() as usize;
+    if per < 8 {
+        return None;
+    }
+    let cycles = n / per;
     if cycles < MIN_STEADY_CYCLES {
         return None;
     }
-    // Cycle j (counted from the end) spans [end - (j + 1) T, end - j T).
     let w = 2.0 * PI * f;
     let mut amps = Vec::with_capacity(cycles);
     let mut resid = (0.0, 0usize);
     for j in 0..cycles {
-        let (lo, hi) = (end - (j + 1) as f64 * period, end - j as f64 * period);
-        let idx: Vec<usize> = (0..t.len()).filter(|&i| t[i] > lo && t[i] <= hi).collect();
-        if idx.len() < 8 {
-            return None;
-        }
-        let n = idx.len() as f64;
-        let mean = idx.iter().map(|&i| x[i]).sum::<f64>() / n;
-        let (mut re, mut im) = (0.0, 0.0);
-        for &i in &idx {
-            re += (x[i] - mean) * (w * t[i]).cos();
-            im += (x[i] - mean) * (w * t[i]).sin();
-        }
-        let (re, im) = (2.0 * re / n, 2.0 * im / n);
-        for &i in &idx {
-            let r = x[i] - mean - re * (w * t[i]).cos() - im * (w * t[i]).sin();
+        let idx = n - (j + 1) * per..n - j * per;
+        let (re, im, c0) = fit_tone(&t[idx.clone()], &x[idx.clone()], w)?;
+        for i in idx {
+            let r = x[i] - c0 - re * (w * t[i]).cos() - im * (w * t[i]).sin();
             resid.0 += r * r;
             resid.1 += 1;
         }
-        amps.push((re.hypot(im), n));
+        amps.push(re.hypot(im));
     }
-    let sigma = (resid.0 / resid.1.max(1) as f64).sqrt();
+    let sigma = (resid.0 / resid.1.saturating_sub(3 * cycles).max(1) as f64).sqrt();
     // One cycle's amplitude deviation: the noise's projection on the tone, sqrt(2/n) sigma.
-    let cycle_sd = |n: f64| sigma * (2.0 / n).sqrt();
+    let cycle_sd = sigma * (2.0 / per as f64).sqrt();
     let mut kept = 1;
-    let mut sum = amps[0].0;
+    let mut sum = amps[0];
     while kept < amps.len() {
         let mean = sum / kept as f64;
-        let (a, n) = amps[kept];
-        if (a - mean).abs() > (3.0 * cycle_sd(n)).max(STEADY_REL * mean) {
+        if (amps[kept] - mean).abs() > (3.0 * cycle_sd).max(STEADY_REL * mean) {
             break;
         }
-        sum += a;
+        sum += amps[kept];
         kept += 1;
     }
     if kept < MIN_STEADY_CYCLES {
         return None;
     }
-    let n_mean = amps[..kept].iter().map(|a| a.1).sum::<f64>() / kept as f64;
-    Some((sum / kept as f64, cycle_sd(n_mean) / (kept as f64).sqrt()))
+    Some((sum / kept as f64, cycle_sd / (kept as f64).sqrt()))
+}
+
+/// Least-squares `x ≈ c0 + a cos ωt + b sin ωt` over the samples: `(a, b, c0)`; None when the
+/// normal equations are singular.
+fn fit_tone(t: &[f64], x: &[f64], w: f64) -> Option<(f64, f64, f64)> {
+    // Normal equations of the basis [cos, sin, 1], solved by Cramer's rule.
+    let mut m = [[0.0; 3]; 3];
+    let mut v = [0.0; 3];
+    for (ti, xi) in t.iter().zip(x) {
+        let b = [(w * ti).cos(), (w * ti).sin(), 1.0];
+        for r in 0..3 {
+            v[r] += b[r] * xi;
+            for c in 0..3 {
+                m[r][c] += b[r] * b[c];
+            }
+        }
+    }
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&m);
+    if d.abs() < 1e-12 * (t.len() as f64).powi(3) {
+        return None;
+    }
+    let mut out = [0.0; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut mk = m;
+        for r in 0..3 {
+            mk[r][k] = v[r];
+        }
+        *o = det(&mk) / d;
+    }
+    Some((out[0], out[1], out[2]))
 }
 
 /// The cross-axis share the readings allow, as a measured band (None without readings).
