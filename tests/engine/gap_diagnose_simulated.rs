@@ -329,7 +329,7 @@ fn an_exact_pair_is_the_simulator() {
 /// amplitudes only.
 #[test]
 fn the_input_records_measure_a_cross_axis_phase() {
-    use railwear::gap::diagnose::measured::{measure, wrap_deg};
+    use railwear::gap::diagnose::measured::{measure, wrap_deg, MeasuredValue};
     use railwear::gap::rig::{parse_effects, run, RigOptions};
     let rig = |effects: &[&str]| {
         let args: Vec<String> = effects.iter().map(|s| s.to_string()).collect();
@@ -353,27 +353,37 @@ fn the_input_records_measure_a_cross_axis_phase() {
             &RunControl::silent(),
         )
         .unwrap();
-        measure(&campaign, &configs()).unwrap()
+        measure(&campaign, &configs(), 0.05).unwrap()
     };
-    for effects in [
-        vec!["cross_axis=0.05,phase_deg=-123"],
-        vec![
-            "cross_axis=0.05,phase_deg=-123",
-            "fixture_compliance=5,damping_ratio=0.1",
-        ],
+    // Beside the phase, the records bound the share (holding the drawn 0.05) and the mount's
+    // period (holding the drawn one); without cross motion the share stays below 0.01.
+    let find = |m: &[MeasuredValue], p: &str| m.iter().find(|v| v.parameter == p).cloned();
+    for (effects, period_ms) in [
+        (vec!["cross_axis=0.05,phase_deg=-123"], 0.0),
+        (
+            vec![
+                "cross_axis=0.05,phase_deg=-123",
+                "fixture_compliance=5,damping_ratio=0.1",
+            ],
+            5.0,
+        ),
     ] {
         let m = rig(&effects);
-        assert_eq!(m.len(), 1, "{effects:?}: {m:?}");
-        assert_eq!(
-            (m[0].effect.as_str(), m[0].parameter.as_str()),
-            ("cross_axis", "phase_deg")
-        );
+        let phase = find(&m, "phase_deg").expect("phase measured");
         assert!(
-            wrap_deg(m[0].value + 123.0).abs() <= m[0].tolerance,
+            wrap_deg(phase.value + 123.0).abs() <= phase.tolerance,
             "{effects:?}: {m:?}"
         );
+        assert!(find(&m, "share").unwrap().agrees(0.05), "{m:?}");
+        assert!(
+            find(&m, "natural_period_ms").unwrap().agrees(period_ms),
+            "{m:?}"
+        );
     }
-    assert!(rig(&["none"]).is_empty());
+    let m = rig(&["none"]);
+    assert!(find(&m, "phase_deg").is_none(), "{m:?}");
+    let share = find(&m, "share").unwrap();
+    assert!(share.agrees(0.0) && !share.agrees(0.01), "{share:?}");
 }
 
 /// A fixture compliance drawn at 15 ms / damping 0.1 (a 67 Hz mount under a 20 Hz drive: |T|
