@@ -177,8 +177,29 @@ impl<'a> FitProblem<'a> {
         self.totals(spec, &mask).nll
     }
 
-    /// Magnitudes to try for table `e`: the table's points and four between each pair.
+    /// Magnitudes to try for table `e`: the table's points and four between each pair; where
+    /// the campaign's records bound the effect's magnitude
+    /// ([`Emulator::magnitude_measurement`]), only those within the band, and the band's ends.
     pub(super) fn candidates(&self, e: usize) -> Vec<f64> {
+        let all = self.candidates_unbounded(e);
+        let Some([lo, hi]) = self.emulator.magnitude_measurement(e).and_then(|m| m.band) else {
+            return all;
+        };
+        let (first, last) = (all[0], all[all.len() - 1]);
+        let mut out: Vec<f64> = all.into_iter().filter(|m| lo <= *m && *m <= hi).collect();
+        out.extend([lo, hi].into_iter().filter(|m| first <= *m && *m <= last));
+        out.sort_by(f64::total_cmp);
+        out.dedup();
+        if out.is_empty() {
+            // A band outside the table's range: the table's end nearest to it.
+            out.push(if hi < first { first } else { last });
+        }
+        out
+    }
+
+    /// [`FitProblem::candidates`] without the records' bound: what the masses alone would
+    /// choose from.
+    pub(super) fn candidates_unbounded(&self, e: usize) -> Vec<f64> {
         let m = &self.emulator.effects[e].magnitudes;
         let mut out = Vec::with_capacity(m.len() * 5);
         for w in m.windows(2) {
@@ -201,6 +222,38 @@ impl<'a> FitProblem<'a> {
             .into_iter()
             .filter(|c| *c >= lo && *c <= hi)
             .collect()
+    }
+
+    /// Why the records refuse what the masses alone would fit, if they do: for each member of
+    /// `spec` (full-data fit) whose magnitude the records bound, the best magnitude over the
+    /// unbounded candidates (the other members held) when it lies outside the band and fits
+    /// the data better by more than [`PROFILE_95`].
+    pub(super) fn refused_by_records(&self, spec: &[(usize, f64)]) -> Option<String> {
+        let all = |_: usize| true;
+        let at_fit = self.nll_of(spec, all);
+        let reasons: Vec<String> = (0..spec.len())
+            .filter_map(|i| {
+                let (t, _) = spec[i];
+                let mv = self.emulator.magnitude_measurement(t)?;
+                let [lo, hi] = mv.band?;
+                let mut trial = spec.to_vec();
+                let (m, nll) = self
+                    .candidates_unbounded(t)
+                    .into_iter()
+                    .map(|m| {
+                        trial[i].1 = m;
+                        (m, self.nll_of(&trial, all))
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))?;
+                (!(lo..=hi).contains(&m) && nll < at_fit - PROFILE_95).then(|| {
+                    format!(
+                        "{}.{} = {m:.4} (what the masses alone fit) is refused: {} allow [{lo:.4}, {hi:.4}]",
+                        mv.effect, mv.parameter, mv.source
+                    )
+                })
+            })
+            .collect();
+        (!reasons.is_empty()).then(|| reasons.join("; "))
     }
 
     /// The family (effect) of table `t`.

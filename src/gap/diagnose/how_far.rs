@@ -107,7 +107,11 @@ pub(super) fn best_effect(
                     interval: Some(interval),
                     bounds: [p.min, p.max],
                     fitted: true,
-                    measured_from: None,
+                    // Fitted within what the records allow (`FitProblem::candidates`).
+                    measured_from: problem.emulator.magnitude_measurement(t).map(|mv| {
+                        let [lo, hi] = mv.band.unwrap_or([mv.value, mv.value]);
+                        format!("{}; fitted within [{lo:.4}, {hi:.4}]", mv.source)
+                    }),
                     identified: identification::identified(p, interval),
                     bounds_reached: reached(p, interval),
                 });

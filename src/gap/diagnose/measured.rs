@@ -14,6 +14,7 @@
 //! the input records see that relative phase. A compliant fixture (`fixture_compliance`)
 //! shifts every axis' tone by the same transmissibility phase and leaves the relative phase.
 
+use super::measured_drive::{fixture_values, record_drive, share_value, DriveReadings};
 use crate::analysis::spectra::{window_values, Window};
 use crate::excitation::{ExcitationSpec, Tone};
 use crate::gap::accel::AccelLocation;
@@ -47,12 +48,21 @@ pub struct MeasuredValue {
     pub tolerance: f64,
     /// Where it comes from.
     pub source: String,
+    /// For a magnitude or a ratio (not an angle): the values the records allow (3 standard
+    /// deviations, calibration included), which a table's value or a fitted magnitude must keep
+    /// to; None for an angle (`value` ± `tolerance`, modulo 360°).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub band: Option<[f64; 2]>,
 }
 
 impl MeasuredValue {
-    /// Whether `v` agrees with the measurement (angles compared modulo 360°).
+    /// Whether `v` agrees with the measurement (within `band` when given, else angles
+    /// compared modulo 360°).
     pub fn agrees(&self, v: f64) -> bool {
-        wrap_deg(v - self.value).abs() <= self.tolerance
+        match self.band {
+            Some([lo, hi]) => lo <= v && v <= hi,
+            None => wrap_deg(v - self.value).abs() <= self.tolerance,
+        }
     }
 }
 
@@ -64,11 +74,19 @@ pub fn wrap_deg(d: f64) -> f64 {
 /// One phase reading: degrees and its standard deviation.
 type Reading = (f64, f64);
 
-/// The secondary values `campaign`'s input records measure (empty without input records or
-/// without cross-axis motion). An error only when a test's case cannot be resolved.
-pub fn measure(campaign: &Campaign, configs_dir: &Path) -> Result<Vec<MeasuredValue>, GapError> {
+/// What `campaign`'s input records measure (empty without input records): the cross-axis
+/// phase where the records show cross-axis motion, the cross-axis share the records allow, and
+/// the fixture compliance's period (and damping, where constrained) from the drive-axis gain
+/// (module `measured_drive`); `calibration_rel` is each accelerometer's relative calibration
+/// error (1σ). An error only when a test's case cannot be resolved.
+pub fn measure(
+    campaign: &Campaign,
+    configs_dir: &Path,
+    calibration_rel: f64,
+) -> Result<Vec<MeasuredValue>, GapError> {
     let mut readings: Vec<Reading> = Vec::new();
-    let mut records = 0;
+    let mut drive = DriveReadings::default();
+    let (mut records, mut drive_records) = (0, 0);
     for (ti, test) in campaign.tests.iter().enumerate() {
         let inputs: Vec<_> = test
             .specimens
@@ -92,9 +110,12 @@ pub fn measure(campaign: &Campaign, configs_dir: &Path) -> Result<Vec<MeasuredVa
             let before = readings.len();
             readings.extend(record_readings(&r.samples, &tones));
             records += usize::from(readings.len() > before);
+            let d = record_drive(&r.samples, &tones);
+            drive_records += usize::from(!d.share2.is_empty() || !d.gains.is_empty());
+            drive.extend(d);
         }
     }
-    Ok(combine(&readings)
+    let mut out: Vec<MeasuredValue> = combine(&readings)
         .map(|(value, sd)| MeasuredValue {
             effect: "cross_axis".into(),
             parameter: "phase_deg".into(),
@@ -105,9 +126,19 @@ pub fn measure(campaign: &Campaign, configs_dir: &Path) -> Result<Vec<MeasuredVa
                 "input accelerometer records ({records} records, {} readings: drive tones x moving cross axes)",
                 readings.len()
             ),
+            band: None,
         })
         .into_iter()
-        .collect())
+        .collect();
+    out.extend(share_value(&drive.share2, calibration_rel, drive_records));
+    out.extend(fixture_values(&drive.gains, calibration_rel, drive_records));
+    for m in &out {
+        tracing::info!(
+            effect = %m.effect, parameter = %m.parameter, value = m.value, band = ?m.band,
+            "measured from the input records"
+        );
+    }
+    Ok(out)
 }
 
 /// The cross-axis phase readings of one record `[t, ax, ay, az]` at each drive tone whose
@@ -162,7 +193,7 @@ fn record_readings(samples: &[[f64; 4]], tones: &[Tone]) -> Vec<Reading> {
 /// Complex amplitude `(re, im)` of the zero-mean samples `x` at times `t` at `f` Hz:
 /// `x(t) ≈ re cos ωt - im sin ωt` (a projection weighted by the window `h`), so its argument
 /// is the tone's phase.
-fn phasor(t: &[f64], x: &[f64], h: &[f64], f: f64) -> (f64, f64) {
+pub(super) fn phasor(t: &[f64], x: &[f64], h: &[f64], f: f64) -> (f64, f64) {
     let w = 2.0 * PI * f;
     let (mut re, mut im) = (0.0, 0.0);
     for ((ti, xi), hi) in t.iter().zip(x).zip(h) {
@@ -176,7 +207,13 @@ fn phasor(t: &[f64], x: &[f64], h: &[f64], f: f64) -> (f64, f64) {
 /// Standard deviation of one component of [`phasor`] from the residual after every tone
 /// (`fits` at `freqs`) is removed: white noise of variance `s²` gives `s sqrt(2 Σ h²) / Σ h`
 /// (each component takes half the noise power at the tone's frequency).
-fn phasor_sd(t: &[f64], x: &[f64], h: &[f64], freqs: &[f64], fits: &[(f64, f64)]) -> f64 {
+pub(super) fn phasor_sd(
+    t: &[f64],
+    x: &[f64],
+    h: &[f64],
+    freqs: &[f64],
+    fits: &[(f64, f64)],
+) -> f64 {
     let (mut r2, mut sh, mut sh2) = (0.0, 0.0, 0.0);
     for ((ti, xi), hi) in t.iter().zip(x).zip(h) {
         let model: f64 = freqs

@@ -52,6 +52,7 @@ mod interaction_tests;
 mod joint_spread;
 pub mod location;
 pub mod measured;
+mod measured_drive;
 pub mod next_test;
 pub mod noise;
 mod one_group;

@@ -18,10 +18,12 @@ use super::fit_problem::{FitProblem, Model};
 use super::options::{DiagnoseOptions, Simulating, REFINE_CONTENDERS, SECONDARY_CONTENDERS};
 use super::pair_search;
 use super::report::Report;
-use super::secondary_values::{midpoints_beside, profile_values};
+use super::secondary_values::{
+    midpoints_beside, profile_values, threshold_midpoints_beside, threshold_values,
+};
 use super::verdict::{diagnose_with, singles_if_gap};
 use crate::gap::diagnose::emulator::Emulator;
-use crate::gap::effects::Acts;
+use crate::gap::effects::{Acts, ParameterInfo};
 use crate::gap::window::WindowCache;
 use crate::gap::{Campaign, GapError};
 use crate::physics::control::RunControl;
@@ -44,7 +46,13 @@ pub fn diagnose_refining(
     // done before it, so the count never goes back (the total grows by what a round adds).
     let mut done_before = 0;
     if options.refine_rounds > 0 {
-        emulator.take_measurements(campaign, configs_dir, control, cache)?;
+        emulator.take_measurements(
+            campaign,
+            configs_dir,
+            control,
+            cache,
+            options.accelerometer_calibration_rel,
+        )?;
     }
     for _ in 0..options.refine_rounds {
         let requests = refinement_requests(campaign, emulator, options);
@@ -200,7 +208,7 @@ fn profile_secondary(
     default_table: usize,
     m: f64,
 ) -> Result<(), GapError> {
-    let (campaign, options, configs_dir, control, cache) = sim.parts();
+    let (campaign, _, configs_dir, control, cache) = sim.parts();
     let info = emulator.effects[default_table].info;
     let magnitudes: Vec<f64> = match info.acts {
         Acts::WearLaw => Vec::new(),
@@ -223,37 +231,42 @@ fn profile_secondary(
         Acts::Dynamics => (5, 1),
     };
     let mut bests: BTreeMap<String, f64> = BTreeMap::new();
-    for p in emulator.unmeasured_secondaries(info) {
-        let mut values = profile_values(p, first);
-        let mut tables = Vec::new();
-        let add = |emulator: &mut Emulator, v: f64| {
-            emulator.add_variant(
-                campaign,
-                configs_dir,
-                default_table,
-                BTreeMap::from([(p.name.to_string(), v)]),
-                &magnitudes,
-                control,
-                cache,
-            )
-        };
-        for &v in &values {
-            tables.push(add(emulator, v)?);
-        }
-        let mut best = best_value(campaign, emulator, options, &tables, p.name);
-        // Further passes: midway to the best value's neighbours among the values tried.
-        for _ in 0..bisections {
-            values.sort_by(f64::total_cmp);
-            let Some(i) = values.iter().position(|v| *v == best) else {
-                break;
+    let secondaries = emulator.unmeasured_secondaries(info);
+    // A wear law with two thresholds (third body's pressure and slip speed) can hide behind
+    // either: one profiled with the other at its default finds nothing when both must be
+    // lowered. A second pass profiles each with the others at their bests from the first.
+    let passes = if info.acts == Acts::WearLaw && secondaries.len() > 1 {
+        2
+    } else {
+        1
+    };
+    for pass in 0..passes {
+        for &p in &secondaries {
+            let others: BTreeMap<String, f64> = if pass == 0 {
+                BTreeMap::new()
+            } else {
+                bests
+                    .iter()
+                    .filter(|(n, v)| {
+                        n.as_str() != p.name
+                            && info
+                                .parameters
+                                .iter()
+                                .any(|q| q.name == *n && q.default != **v)
+                    })
+                    .map(|(n, v)| (n.clone(), *v))
+                    .collect()
             };
-            for v in midpoints_beside(p, &values, i) {
-                tables.push(add(emulator, v)?);
-                values.push(v);
-            }
-            best = best_value(campaign, emulator, options, &tables, p.name);
+            let best = profile_one(
+                sim,
+                emulator,
+                default_table,
+                (p, others),
+                &magnitudes,
+                (first, bisections),
+            )?;
+            bests.insert(p.name.to_string(), best);
         }
-        bests.insert(p.name.to_string(), best);
     }
     let non_default: BTreeMap<String, f64> = bests
         .into_iter()
@@ -276,6 +289,63 @@ fn profile_secondary(
         )?;
     }
     Ok(())
+}
+
+/// One secondary parameter `p` of the effect of `default_table` profiled with the other
+/// secondary values `others` held: variants at its first values, then `bisections` passes
+/// midway to the best value's neighbours; its best value. A wear law's threshold from 0 is
+/// profiled over its whole range on a log scale ([`threshold_values`]).
+fn profile_one(
+    sim: Simulating,
+    emulator: &mut Emulator,
+    default_table: usize,
+    (p, others): (&ParameterInfo, BTreeMap<String, f64>),
+    magnitudes: &[f64],
+    (first, bisections): (usize, usize),
+) -> Result<f64, GapError> {
+    let (campaign, options, configs_dir, control, cache) = sim.parts();
+    let wear_law = emulator.effects[default_table].info.acts == Acts::WearLaw;
+    let mut values = if wear_law {
+        threshold_values(p, first)
+    } else {
+        profile_values(p, first)
+    };
+    let mut tables = Vec::new();
+    let add = |emulator: &mut Emulator, v: f64| {
+        let mut values = others.clone();
+        values.insert(p.name.to_string(), v);
+        emulator.add_variant(
+            campaign,
+            configs_dir,
+            default_table,
+            values,
+            magnitudes,
+            control,
+            cache,
+        )
+    };
+    for &v in &values {
+        tables.push(add(emulator, v)?);
+    }
+    let mut best = best_value(campaign, emulator, options, &tables, p.name);
+    // Further passes: midway to the best value's neighbours among the values tried.
+    for _ in 0..bisections {
+        values.sort_by(f64::total_cmp);
+        let Some(i) = values.iter().position(|v| *v == best) else {
+            break;
+        };
+        let more = if wear_law {
+            threshold_midpoints_beside(p, &values, i)
+        } else {
+            midpoints_beside(p, &values, i)
+        };
+        for v in more {
+            tables.push(add(emulator, v)?);
+            values.push(v);
+        }
+        best = best_value(campaign, emulator, options, &tables, p.name);
+    }
+    Ok(best)
 }
 
 /// The value of parameter `name` among `tables` whose best full-data fit is best.

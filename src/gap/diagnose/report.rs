@@ -194,6 +194,10 @@ pub struct RankEntry {
     /// Explains the gap: gain > MIN_HELD_OUT_GAIN, residual p-value >= alpha and at least
     /// [`MIN_EXPLAINED_SHARE`](super::MIN_EXPLAINED_SHARE) of the excess removed.
     pub explains: bool,
+    /// Where the campaign's records bound a magnitude and the masses alone would fit one
+    /// outside that band: the value refused and why (the candidate is judged within the band).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refused_by_records: Option<String>,
 }
 
 /// Fit of the nominal model.

@@ -178,6 +178,7 @@ pub(super) fn judge(
         p_first: p_first(i),
         explained_share: c.explained_share(&nominal),
         explains: c.explains(&nominal),
+        refused_by_records: problem.refused_by_records(&c.spec),
     };
     let ranking: Vec<RankEntry> = order.iter().map(|&i| entry(&singles[i], 1 + i)).collect();
     let pair_entries: Vec<RankEntry> = pairs
@@ -274,9 +275,19 @@ pub(super) fn judge(
     let partly = chosen
         .as_ref()
         .zip(best_effect.as_ref())
-        .and_then(|((c, _), b)| {
+        .and_then(|((c, others), b)| {
+            // Candidates that predict the withheld data alike: the data do not tell them
+            // apart, so none of them is named `explained` (a pair member named because its
+            // partner is not identified says so already).
+            let alike = (unidentified.is_none() && !others.is_empty()).then(|| {
+                format!(
+                    "indistinguishable held out from {}: the data do not tell them apart",
+                    others.join(", ")
+                )
+            });
             let also: Vec<&str> = unidentified
                 .iter()
+                .chain(alike.iter())
                 .map(String::as_str)
                 .chain(scope)
                 .collect();

@@ -12,6 +12,7 @@
 //! effects, calibration and pooling; `secondary` secondary parameters, identification, bounds
 //! and pairs.
 
+mod records;
 mod secondary;
 mod verdicts;
 

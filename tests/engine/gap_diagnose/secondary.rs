@@ -99,6 +99,7 @@ fn a_measured_phase_is_held_not_fitted() {
         sd: 0.5,
         tolerance: 3.0 * 0.5f64.hypot(2.0),
         source: "input accelerometer records".into(),
+        band: None,
     });
     let cross: Vec<usize> = (0..em.effects.len())
         .filter(|&t| em.effects[t].info.name == "cross_axis")

@@ -18,6 +18,14 @@ impl Emulator {
             .find(|m| m.effect == effect && m.parameter == parameter)
     }
 
+    /// The measurement that bounds table `t`'s magnitude (its effect's first parameter), if
+    /// the campaign's records gave one: a fit keeps to its `band`.
+    pub fn magnitude_measurement(&self, t: usize) -> Option<&MeasuredValue> {
+        let info = self.effects.get(t)?.info;
+        self.measured_value(info.name, info.parameters[0].name)
+            .filter(|m| m.band.is_some())
+    }
+
     /// The secondary parameters of `info` that no measurement fixes (a fit's to choose).
     pub fn unmeasured_secondaries(&self, info: &'static EffectInfo) -> Vec<&'static ParameterInfo> {
         info.parameters[1..]
@@ -46,8 +54,9 @@ impl Emulator {
         configs_dir: &Path,
         control: &RunControl,
         cache: &WindowCache,
+        calibration_rel: f64,
     ) -> Result<(), GapError> {
-        let measured = measure(campaign, configs_dir)?;
+        let measured = measure(campaign, configs_dir, calibration_rel)?;
         self.measured.clear();
         for mv in measured {
             let Some(default) = (0..self.effects.len()).find(|&t| {
@@ -60,7 +69,12 @@ impl Emulator {
                 "measured from the campaign's records"
             );
             let (value, parameter) = (mv.value, mv.parameter.clone());
+            let primary = self.effects[default].info.parameters[0].name == parameter;
             self.measured.push(mv);
+            // A magnitude's measurement bounds the fits (`magnitude_measurement`), no table.
+            if primary {
+                continue;
+            }
             if !self
                 .family(default)
                 .iter()
@@ -86,12 +100,13 @@ impl Emulator {
         Ok(())
     }
 
-    /// Whether table `t`'s secondary values agree with every measurement of its effect.
+    /// Whether table `t`'s secondary values agree with every measurement of its effect's
+    /// secondary parameters.
     pub fn agrees_with_measurements(&self, t: usize) -> bool {
         let table = &self.effects[t];
         self.measured
             .iter()
-            .filter(|m| m.effect == table.info.name)
+            .filter(|m| m.effect == table.info.name && m.parameter != table.info.parameters[0].name)
             .all(|m| m.agrees(table.parameter(&m.parameter)))
     }
 }
