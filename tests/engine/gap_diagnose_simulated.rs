@@ -389,7 +389,7 @@ fn the_input_records_measure_a_cross_axis_phase() {
 /// A fixture compliance drawn at 15 ms / damping 0.1 (a 67 Hz mount under a 20 Hz drive: |T|
 /// 1.0985), with input and response records at a 2 % calibration, diagnosed with
 /// fixture_compliance and cross_axis as candidates. The records bound the period: its 95 %
-/// interval holds the drawn 15 ms, its band excludes the rigid mount and the 20 ms bound; they
+/// interval holds the drawn 15 ms, its band excludes the rigid mount; they
 /// do not measure the damping (far below resonance |T| moves 0.3 % between damping 0.1 and
 /// 0.3); they allow no cross-axis share of 0.01. Every fit of either effect keeps to its band,
 /// and where the report names the fixture its intervals hold the drawn period and damping.
@@ -422,7 +422,9 @@ fn the_input_records_bound_a_fixture_and_refuse_a_cross_axis_drive() {
         period.value + 1.96 * period.sd,
     );
     assert!(lo < 15.0 && 15.0 < hi, "[{lo}, {hi}]: {period:?}");
-    assert!(!period.agrees(0.0) && !period.agrees(20.0), "{period:?}");
+    // The rigid mount is excluded. The library's 20 ms is not: at 20 Hz a 20 ms mount with
+    // damping 0.3 transmits |T| = 1.177, within 3σ of a gain read at 2 % calibration.
+    assert!(!period.agrees(0.0), "{period:?}");
     assert!(find("damping_ratio").is_none(), "{:?}", em.measured);
     let share = find("share").expect("share bounded");
     assert!(share.agrees(0.0) && !share.agrees(0.01), "{share:?}");

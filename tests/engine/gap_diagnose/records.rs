@@ -3,20 +3,15 @@
 
 use super::*;
 
-/// Masses drawn with a cross-axis drive at 0.4 of its bound (a share of 0.12: the wear
-/// pattern alone, the records left out so that no mean square speaks against it) are
-/// `explained` by cross_axis at that share. With the input records' measurement that the
-/// share lies within [0, 0.002] (what records without cross-axis motion give), the fit keeps
-/// to the band, the ranking entry says which value the masses wanted and why it is refused,
-/// and no verdict names cross_axis.
+/// A campaign drawn with a cross-axis drive at 0.4 of its bound (a share of 0.12; in the
+/// hand-built emulator the drive shows in the response records' mean squares, not in the
+/// masses) is `explained` by cross_axis at that share. With an input-record measurement that
+/// the share lies within [0, 0.002] (what input records without cross-axis motion give), the
+/// fit keeps to the band, the ranking entry says which value the data wanted and why it is
+/// refused, and the verdict is not `explained`.
 #[test]
 fn a_cross_axis_drive_the_records_do_not_show_is_refused() {
-    let mut c = campaign(|t, k| truth(t, k, 0.0, 0.0, 0.4), 7);
-    for t in &mut c.tests {
-        for s in &mut t.specimens {
-            s.accelerometers.clear();
-        }
-    }
+    let c = campaign(|t, k| truth(t, k, 0.0, 0.0, 0.4), 7);
     let free = diagnose_with(&c, &emulator(), &options()).unwrap();
     assert_eq!(free.verdict, Verdict::Explained, "{}", free.summary);
     let best = free.best_effect.as_ref().unwrap();
@@ -46,13 +41,13 @@ fn a_cross_axis_drive_the_records_do_not_show_is_refused() {
         .unwrap_or(f64::NAN);
     assert!((wanted - 0.12).abs() < 0.012, "{why}");
     assert!(why.contains("[0.0000, 0.0020]"), "{why}");
-    assert!(
-        r.best_effect
-            .as_ref()
-            .is_none_or(|b| !b.name.contains("cross_axis")),
-        "{}",
-        r.summary
-    );
+    // The response's cross-axis motion is still there and nothing else in the library makes
+    // it, so a partial verdict may lead with cross_axis, but only within the records' band and
+    // never `explained`.
+    assert_ne!(r.verdict, Verdict::Explained, "{}", r.summary);
+    if let Some(b) = r.best_effect.as_ref().filter(|b| b.name == "cross_axis") {
+        assert!(b.parameters[0].value <= 0.002, "{b:?}");
+    }
     // Effects the records do not bound carry no refusal.
     assert!(r
         .ranking
