@@ -52,7 +52,6 @@ mod interaction_tests;
 mod joint_spread;
 pub mod location;
 pub mod measured;
-mod measured_drive;
 pub mod next_test;
 pub mod noise;
 mod one_group;

@@ -14,11 +14,13 @@
 //! the input records see that relative phase. A compliant fixture (`fixture_compliance`)
 //! shifts every axis' tone by the same transmissibility phase and leaves the relative phase.
 
-use super::measured_drive::{fixture_values, record_drive, share_value, DriveReadings};
+mod drive;
+
 use crate::analysis::spectra::{window_values, Window};
 use crate::excitation::{ExcitationSpec, Tone};
 use crate::gap::accel::AccelLocation;
 use crate::gap::{Campaign, GapError};
+use drive::{fixture_values, record_drive, share_value, DriveReadings};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -77,7 +79,7 @@ type Reading = (f64, f64);
 /// What `campaign`'s input records measure (empty without input records): the cross-axis
 /// phase where the records show cross-axis motion, the cross-axis share the records allow, and
 /// the fixture compliance's period (and damping, where constrained) from the drive-axis gain
-/// (module `measured_drive`); `calibration_rel` is each accelerometer's relative calibration
+/// (module `drive`); `calibration_rel` is each accelerometer's relative calibration
 /// error (1σ). An error only when a test's case cannot be resolved.
 pub fn measure(
     campaign: &Campaign,

@@ -20,7 +20,7 @@
 //! Only the drive of a sine excitation is read (its tones and levels are known); the damping is
 //! reported as measured only when the records exclude part of its range.
 
-use super::measured::{phasor, phasor_sd, MeasuredValue, MIN_SNR};
+use super::{phasor, phasor_sd, MeasuredValue, MIN_SNR};
 use crate::excitation::Tone;
 use crate::gap::effects::{self, transmissibility};
 use crate::units::STANDARD_GRAVITY;
