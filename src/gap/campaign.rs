@@ -460,7 +460,7 @@ impl CampaignTest {
                     f("drive.frequency_hz"),
                     format!(
                         "must lie in [{lo}, {hi}] Hz (the bound of every tone: \
-                         pipeline::bounds), got {hz}"
+                         cases::bounds), got {hz}"
                     ),
                 ));
             }

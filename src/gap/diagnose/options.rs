@@ -125,7 +125,7 @@ pub fn check_options(o: &DiagnoseOptions) -> Result<(), GapError> {
         (10..=100_000).contains(&o.bootstrap_rounds),
         "must lie in 10..=100000",
     )?;
-    // The service's bounds (one set, with their reasons, in pipeline::limits).
+    // The service's bounds (one set, with their reasons, in cases::limits).
     crate::cases::check_window_s(o.emulator.window_s)?;
     crate::cases::check_settle_s(o.emulator.settle_s)?;
     crate::cases::check_grid_points(o.emulator.grid_points)?;
