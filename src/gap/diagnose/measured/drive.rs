@@ -372,36 +372,9 @@ mod tests {
     /// `zeta` (its closed-form gain), ramped in over 3 cycles (raised cosine), with `share` of
     /// it on x and z 40° later, white noise of `noise` m/s² per axis (fixed-seed generator).
     fn record(period_ms: f64, zeta: f64, share: f64, noise: f64, seed: u64) -> Vec<[f64; 4]> {
-        let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-        let mut gauss = move || {
-            let mut u = || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-            };
-            let (a, b) = (u(), u());
-            (-2.0 * a.ln()).sqrt() * (2.0 * PI * b).cos()
-        };
         let gain = transmissibility(20.0, period_ms * 1e-3, zeta).0;
-        let (a, w) = (15.0 * STANDARD_GRAVITY * gain, 2.0 * PI * 20.0);
-        (0..1000)
-            .map(|i| {
-                let t = i as f64 / 2000.0;
-                let ramp = if t < 0.15 {
-                    0.5 - 0.5 * (PI * t / 0.15).cos()
-                } else {
-                    1.0
-                };
-                let cross = ramp * share * a * (w * t + 0.4 + 40f64.to_radians()).sin();
-                [
-                    t,
-                    cross + noise * gauss(),
-                    ramp * a * (w * t + 0.4).sin() + noise * gauss(),
-                    cross + noise * gauss(),
-                ]
-            })
-            .collect()
+        let amplitude = 15.0 * STANDARD_GRAVITY * gain;
+        super::super::tests::synthetic_record(amplitude, 0.4, share, 40.0, 0.15, noise, seed)
     }
 
     fn tones() -> Vec<Tone> {

@@ -268,9 +268,20 @@ mod tests {
     use super::*;
     use crate::excitation::Axis;
 
-    /// A record of a 20 Hz drive on y with a cross-axis share on x and z at `phase` degrees
-    /// later, white noise of `noise` m/s² on every axis (a fixed-seed generator).
-    fn record(phase: f64, share: f64, noise: f64, seed: u64) -> Vec<[f64; 4]> {
+    /// A record at 2 kHz, 1000 samples, of a 20 Hz drive on y of amplitude `amplitude` m/s²
+    /// at phase `phase_rad`, with `share` of it on x and z `cross_deg` degrees later, the whole
+    /// ramped in over `ramp_s` (raised cosine; 0: none), and white noise of `noise` m/s² on
+    /// every axis (a fixed-seed generator). The drive tests (`drive.rs`) use it too.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn synthetic_record(
+        amplitude: f64,
+        phase_rad: f64,
+        share: f64,
+        cross_deg: f64,
+        ramp_s: f64,
+        noise: f64,
+        seed: u64,
+    ) -> Vec<[f64; 4]> {
         let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
         let mut gauss = move || {
             let mut u = || {
@@ -282,19 +293,30 @@ mod tests {
             let (a, b) = (u(), u());
             (-2.0 * a.ln()).sqrt() * (2.0 * PI * b).cos()
         };
-        let (a, w, th) = (147.0, 2.0 * PI * 20.0, 0.3);
+        let (a, w) = (amplitude, 2.0 * PI * 20.0);
         (0..1000)
             .map(|i| {
                 let t = i as f64 / 2000.0;
-                let cross = share * a * (w * t + th + phase.to_radians()).sin();
+                let ramp = if t < ramp_s {
+                    0.5 - 0.5 * (PI * t / ramp_s).cos()
+                } else {
+                    1.0
+                };
+                let cross = ramp * share * a * (w * t + phase_rad + cross_deg.to_radians()).sin();
                 [
                     t,
                     cross + noise * gauss(),
-                    a * (w * t + th).sin() + noise * gauss(),
+                    ramp * a * (w * t + phase_rad).sin() + noise * gauss(),
                     cross + noise * gauss(),
                 ]
             })
             .collect()
+    }
+
+    /// A record of a 20 Hz drive on y with a cross-axis share on x and z at `phase` degrees
+    /// later, white noise of `noise` m/s² on every axis.
+    fn record(phase: f64, share: f64, noise: f64, seed: u64) -> Vec<[f64; 4]> {
+        synthetic_record(147.0, 0.3, share, phase, 0.0, noise, seed)
     }
 
     fn tones() -> Vec<Tone> {
