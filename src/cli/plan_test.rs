@@ -83,8 +83,21 @@ pub(crate) fn next_tests_text(tests: &[ProposedTest]) -> String {
     let Some(first) = tests.first() else {
         return "next tests: none (nothing left to separate)".to_string();
     };
+    let repeated: Vec<&str> = tests
+        .iter()
+        .filter_map(|t| t.repeats_test.as_deref())
+        .collect();
+    let repeats = if repeated.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "first repeats of {} (held out, {} cannot be confirmed without them), then ",
+            repeated.join(", "),
+            first.separates[0]
+        )
+    };
     let mut out = format!(
-        "next tests (to tell {} from {}; decisive: expected log-likelihood ratio above ln 20 against each):",
+        "next tests ({repeats}to tell {} from {}; decisive: expected log-likelihood ratio above ln 20 against each):",
         first.separates[0],
         first.separates[1..].join(", ")
     );

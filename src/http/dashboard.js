@@ -764,7 +764,8 @@ async function showDiagnosis(job) {
       out.appendChild(predictionTable);
     }
 
-    // The next tests: what would best tell the leading candidate from its rivals, cheapest
+    // The next tests: repeats of the tests the leading candidate cannot be confirmed on held
+    // out ("What changes" says so), then what would best tell it from its rivals, cheapest
     // decisive first (expected log-likelihood ratio above ln 20 against every rival).
     const next = r.next_tests || [];
     if (next.length > 0) {

@@ -1,7 +1,7 @@
 //! The next test, on the simulator: a campaign in which one test carries the effect (third-body
 //! abrasion, which the default thresholds keep out of case A at 15 g, weighed finely only in
-//! case C) is `partly_explained` and proposes a test that would carry it too; the rig runs that
-//! test under the same hidden truth, the campaign appends it, and the diagnosis then names the
+//! case C) is `partly_explained` and proposes first a repeat of C, the test that carries it;
+//! the rig runs that test under the same hidden truth, the campaign appends it, and the diagnosis then names the
 //! effect `explained`, with no next test left to propose.
 
 use railwear::gap::campaign::{Campaign, CampaignTest};
@@ -151,8 +151,13 @@ fn a_one_test_effect_gets_a_next_test_that_confirms_it() {
         // Weighed on the campaign's finest scale.
         assert_eq!(t.test.scale_resolution_mg, 0.001);
     }
-    // The first proposal carries the effect: decisive against the nominal model.
+    // Held out by test, nothing but C informs the effect's fit: the first proposal repeats C
+    // as it was run, and it carries the effect: decisive against the nominal model.
+    assert_eq!(first.to_repeat, vec!["C".to_string()], "{}", first.summary);
     let proposed = &next[0];
+    assert_eq!(proposed.repeats_test.as_deref(), Some("C"), "{proposed:#?}");
+    assert_eq!(proposed.test.config, "rattle-box-c");
+    assert_eq!((proposed.increments, proposed.repeats), (2, 3));
     let against_nominal = proposed
         .rivals
         .iter()

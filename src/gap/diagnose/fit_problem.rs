@@ -43,7 +43,15 @@ pub(super) enum Model {
     Pair(usize, usize),
 }
 
+/// The hold-out scheme by test, as reports name it.
+const LEAVE_ONE_TEST_OUT: &str = "leave-one-test-out";
+
 impl<'a> FitProblem<'a> {
+    /// Held out by test: each group is one test, labelled by its id.
+    pub(super) fn by_test(&self) -> bool {
+        self.held_out == LEAVE_ONE_TEST_OUT
+    }
+
     pub(super) fn new(
         campaign: &Campaign,
         emulator: &'a Emulator,
@@ -66,7 +74,7 @@ impl<'a> FitProblem<'a> {
                 obs.iter().map(|o| o.test).collect(),
                 campaign.tests.len(),
                 campaign.tests.iter().map(|t| t.id.clone()).collect(),
-                "leave-one-test-out".to_string(),
+                LEAVE_ONE_TEST_OUT.to_string(),
             )
         } else {
             let n = obs.iter().map(|o| o.increment + 1).max().unwrap_or(1);

@@ -272,9 +272,16 @@ pub struct Report {
     /// it cannot predict (None for the other verdicts).
     #[serde(default)]
     pub partly_explained: Option<PartlyExplained>,
-    /// The tests that would best separate the leading candidate from its rivals, cheapest
-    /// decisive first (docs/results/diagnosis.md, "The next test"); empty when the verdict is
-    /// `no_gap` or `explained` without indistinguishable candidates.
+    /// The campaign tests whose repetition would let held-out data confirm the leading
+    /// candidate (held out by test only): the tests it cannot predict held out, worst first,
+    /// else the one test that carries what it explains. The next tests start with their
+    /// repeats (docs/results/diagnosis.md, "The next test").
+    #[serde(default)]
+    pub to_repeat: Vec<String>,
+    /// The tests that would best confirm the leading candidate or separate it from its
+    /// rivals: the repeats of `to_repeat` first, then cheapest decisive first
+    /// (docs/results/diagnosis.md, "The next test"); empty when the verdict is `no_gap` or
+    /// `explained` without indistinguishable candidates.
     #[serde(default)]
     pub next_tests: Vec<ProposedTest>,
     /// railwear version.
@@ -375,6 +382,11 @@ pub struct ProposedTest {
     pub case: String,
     /// What it changes from the campaign, in words.
     pub change: String,
+    /// The campaign test it repeats as it was run (its case, drive, increments, specimens and
+    /// records), when it is proposed to confirm the leading candidate where held-out data
+    /// cannot (`Report::to_repeat`); None for a test chosen by its separation.
+    #[serde(default)]
+    pub repeats_test: Option<String>,
     /// Axis of the drive tone (`x`, `y`, `z`), when the drive is one sine tone.
     pub drive_axis: Option<String>,
     /// Peak level of the tone, g.

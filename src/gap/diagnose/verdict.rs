@@ -10,7 +10,7 @@ use super::how_far::{best_effect, held_out_predictions, partly_explained};
 use super::one_group::{carried_by_one_group, one_group_single, seen_in_one_group, OneGroup};
 use super::options::{DiagnoseOptions, MIN_HELD_OUT_GAIN};
 use super::report::{
-    BestEffect, EmulatorReport, NominalFit, PartlyExplained, RankEntry, Report, Verdict,
+    BestEffect, EmulatorReport, GroupError, NominalFit, PartlyExplained, RankEntry, Report, Verdict,
 };
 use super::{location, stats};
 use crate::gap::{Campaign, GapError};
@@ -76,6 +76,9 @@ pub fn diagnose_with(
         return Ok(report);
     }
     within.held_out = format!("leave-one-increment-out, as {carried}");
+    // Increments name no test to repeat; the tests held out by test could not confirm are
+    // still the ones to repeat.
+    within.to_repeat = report.to_repeat;
     Ok(within)
 }
 
@@ -322,6 +325,10 @@ pub(super) fn judge(
                 problem.name_of(&c.families)
             )
         });
+    let carrier = one_group
+        .filter(|_| verdict == Verdict::NotExplained || unidentified.is_none())
+        .map(|(_, g, _)| g);
+    let to_repeat = tests_to_repeat(campaign, problem, partly.as_ref(), carrier);
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
         Verdict::NoGap => format!(
@@ -398,6 +405,7 @@ pub(super) fn judge(
         },
         held_out_predictions,
         partly_explained: partly,
+        to_repeat,
         next_tests: Vec::new(),
         code_version: crate::models::case::code_version().to_string(),
     };
@@ -473,6 +481,36 @@ pub(super) fn singles_unexplained(
         .iter()
         .any(|c| c.explains_cleanly(&nominal, emulator));
     (!clean).then_some((nominal, singles))
+}
+
+/// The campaign tests whose repeats would let held-out data confirm the leading candidate
+/// (`Report::to_repeat`), held out by test only: the tests it cannot predict held out, the
+/// furthest above its bound first; else the test that carries what it explains (`carrier`,
+/// a group index). A test is its own group when held out by test; an increment group names
+/// no test to repeat.
+fn tests_to_repeat(
+    campaign: &Campaign,
+    problem: &FitProblem,
+    partly: Option<&PartlyExplained>,
+    carrier: Option<usize>,
+) -> Vec<String> {
+    let is_test = |label: &str| campaign.tests.iter().any(|t| t.id == label);
+    if !problem.by_test() {
+        return Vec::new();
+    }
+    let mut unpredicted: Vec<&GroupError> = partly
+        .map(|p| p.unpredicted.iter().filter(|g| is_test(&g.group)).collect())
+        .unwrap_or_default();
+    unpredicted.sort_by(|a, b| (b.after / b.bound).total_cmp(&(a.after / a.bound)));
+    let mut out: Vec<String> = unpredicted.iter().map(|g| g.group.clone()).collect();
+    if out.is_empty() {
+        out.extend(
+            carrier
+                .map(|g| problem.group_labels[g].clone())
+                .filter(|label| is_test(label)),
+        );
+    }
+    out
 }
 
 #[cfg(test)]

@@ -13,8 +13,12 @@
 //! 4. **How well it separates** ([`separation`]): the expected log-likelihood ratio between
 //!    the leading candidate and each rival under the campaign's noise model; a test is
 //!    *decisive* when it exceeds [`DECISIVE_NATS`] against every rival.
-//! 5. **Ranking**: the best schedule of each setup (decisive and cheapest, else the most
-//!    separating), then the setups in the same order; the first [`MAX_PROPOSED`] are proposed.
+//! 5. **Ranking**: first the repeats of the report's `to_repeat` tests (the tests the
+//!    leading candidate cannot predict held out, else the one test that carries what it
+//!    explains), each as it was run: held out by test, an effect can only be confirmed where
+//!    another test informs the fit; then the best schedule of each setup (decisive and
+//!    cheapest, else the most separating), the setups in the same order; the first
+//!    [`MAX_PROPOSED`] are proposed.
 
 pub mod leaders;
 pub mod separation;
@@ -28,7 +32,7 @@ use crate::gap::campaign::Campaign;
 use crate::gap::GapError;
 use leaders::{leaders, Leader};
 use separation::{expected_log_lr, Readings, TestNoise};
-use setups::{schedules, setups, test_entry, Schedule, Setup};
+use setups::{repeat_of, schedules, setups, test_entry, Schedule, Setup};
 
 /// Expected log-likelihood ratio a test must give the true candidate over each rival to be
 /// decisive: ln 20 (odds of 20 to 1, a 5 % error), in nats.
@@ -62,8 +66,7 @@ pub fn propose(
     let most = schedules.iter().map(|s| s.increments).max().unwrap_or(1);
     let components = components(campaign);
     let noise = test_noise(campaign, report, options);
-    let mut best: Vec<Ranked> = Vec::new();
-    for setup in setups(campaign, configs_dir) {
+    let simulate = |setup: &Setup| -> Result<Option<Vec<Vec<Prediction>>>, GapError> {
         let skeleton = Schedule {
             increments: most,
             repeats: 1,
@@ -71,7 +74,7 @@ pub fn propose(
         };
         let one = Campaign {
             tests: vec![test_entry(
-                &setup,
+                setup,
                 &skeleton,
                 "next",
                 &components,
@@ -93,16 +96,44 @@ pub fn propose(
                 (0, slots.len()),
             )
         });
-        let by_candidate: Vec<Vec<Prediction>> = match simulated {
-            Ok(by_slot) => by_slot
-                .iter()
-                .map(|s| predictions_of(s).into_iter().next().unwrap_or_default())
-                .collect(),
-            Err(e) if control.is_cancelled() => return Err(e),
+        match simulated {
+            Ok(by_slot) => Ok(Some(
+                by_slot
+                    .iter()
+                    .map(|s| predictions_of(s).into_iter().next().unwrap_or_default())
+                    .collect(),
+            )),
+            Err(e) if control.is_cancelled() => Err(e),
             Err(e) => {
                 tracing::warn!(setup = %setup.change, error = %e, "next test: setup left out");
-                continue;
+                Ok(None)
             }
+        }
+    };
+    // Repeats first: where held-out data cannot confirm the leading candidate, the tests that
+    // would let them.
+    let mut repeats: Vec<Ranked> = Vec::new();
+    for id in &report.to_repeat {
+        let Some((setup, schedule)) = repeat_of(campaign, id, configs_dir) else {
+            continue;
+        };
+        if let Some(by_candidate) = simulate(&setup)? {
+            let mut r = rank(
+                &setup,
+                &schedule,
+                &by_candidate,
+                &candidates,
+                &components,
+                &noise,
+            );
+            r.repeats_test = Some(id.clone());
+            repeats.push(r);
+        }
+    }
+    let mut best: Vec<Ranked> = Vec::new();
+    for setup in setups(campaign, configs_dir) {
+        let Some(by_candidate) = simulate(&setup)? else {
+            continue;
         };
         let ranked = schedules
             .iter()
@@ -111,8 +142,9 @@ pub fn propose(
         best.extend(ranked);
     }
     best.sort_by(Ranked::order);
-    let ids = fresh_ids(campaign, best.len().min(MAX_PROPOSED));
-    Ok(best
+    repeats.extend(best);
+    let ids = fresh_ids(campaign, repeats.len().min(MAX_PROPOSED));
+    Ok(repeats
         .into_iter()
         .zip(ids)
         .map(|(r, id)| r.proposed(&id, &components, &noise))
@@ -128,6 +160,8 @@ struct Ranked {
     predictions: Vec<Vec<Prediction>>,
     /// Per rival.
     separations: Vec<f64>,
+    /// The campaign test it repeats (`Report::to_repeat`).
+    repeats_test: Option<String>,
 }
 
 impl Ranked {
@@ -163,12 +197,20 @@ impl Ranked {
         let separation = self.separation();
         let decisive = self.decisive();
         let s = self.schedule;
-        let description = format!(
-            "Proposed by the diagnosis to tell {} from {} ({}; expected log-likelihood ratio {separation:.1} nats)",
-            self.names[0],
-            self.names[1..].join(", "),
-            self.setup.change
-        );
+        let description = match &self.repeats_test {
+            Some(id) => format!(
+                "Proposed by the diagnosis to confirm {} where held-out data cannot: test {id} repeated ({}; expected log-likelihood ratio {separation:.1} nats against {})",
+                self.names[0],
+                self.setup.change,
+                self.names[1..].join(", ")
+            ),
+            None => format!(
+                "Proposed by the diagnosis to tell {} from {} ({}; expected log-likelihood ratio {separation:.1} nats)",
+                self.names[0],
+                self.names[1..].join(", "),
+                self.setup.change
+            ),
+        };
         let test = test_entry(
             &self.setup,
             &s,
@@ -202,6 +244,7 @@ impl Ranked {
             test,
             case: self.setup.case.clone(),
             change: self.setup.change.clone(),
+            repeats_test: self.repeats_test,
             drive_axis: self.setup.drive_axis.clone(),
             level_g: self.setup.level_g,
             frequency_hz: self.setup.frequency_hz,
@@ -248,6 +291,7 @@ fn rank(
         names: candidates.iter().map(|c| c.name.clone()).collect(),
         predictions,
         separations,
+        repeats_test: None,
     }
 }
 

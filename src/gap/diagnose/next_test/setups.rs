@@ -174,6 +174,31 @@ pub fn setups(campaign: &Campaign, configs_dir: &Path) -> Vec<Setup> {
     out.into_iter().map(|(_, s)| s).take(MAX_SETUPS).collect()
 }
 
+/// Campaign test `id` as it was run: its case and drive as a setup, and its schedule (its
+/// increments, their length, its specimens up to the most [`REPEATS`] allows, its records).
+/// None when no test has that id or its case does not read.
+pub fn repeat_of(campaign: &Campaign, id: &str, configs_dir: &Path) -> Option<(Setup, Schedule)> {
+    let t = campaign.tests.iter().find(|t| t.id == id)?;
+    let case = t.case(0, configs_dir).ok()?;
+    let label = case_label(t, &case);
+    let tone = single_tone(&case, configs_dir);
+    let most_repeats = REPEATS.iter().copied().max().unwrap_or(1);
+    let schedule = Schedule {
+        increments: t
+            .specimens
+            .iter()
+            .map(|s| s.increments.len())
+            .max()
+            .unwrap_or(1)
+            .max(1),
+        increment_duration_s: t.increment_duration_s,
+        repeats: t.specimens.len().clamp(1, most_repeats),
+        accelerometers: t.specimens.iter().any(|s| !s.accelerometers.is_empty()),
+    };
+    let change = format!("a repeat of test {id} as it was run");
+    Some((setup(bare(t), &label, change, tone.as_ref()), schedule))
+}
+
 /// The schedules every setup is read under: the campaign's longest increment, one increment
 /// or the campaign's most, [`REPEATS`], records off or on.
 pub fn schedules(campaign: &Campaign) -> Vec<Schedule> {
@@ -294,5 +319,51 @@ fn axis_name(a: Axis) -> &'static str {
         Axis::X => "x",
         Axis::Y => "y",
         Axis::Z => "z",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn configs() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+    }
+
+    /// Two tests; B has four specimens of two one-hour increments at 25 g.
+    fn campaign() -> Campaign {
+        let specimen =
+            |id: &str| format!("[[tests.specimens]]\nid = \"{id}\"\nincrements = [{{}}, {{}}]\n");
+        let text = format!(
+            "format_version = 1\nname = \"repeat\"\n\
+             [[tests]]\nid = \"A\"\nconfig = \"rattle-box-a\"\nincrement_duration_s = 28800.0\n\
+             scale_resolution_mg = 0.05\ncomponents = [\"cube\"]\n{}\
+             [[tests]]\nid = \"B\"\nconfig = \"rattle-box-b\"\n\
+             drive = {{ level_g = 25.0, frequency_hz = 20.0 }}\nincrement_duration_s = 3600.0\n\
+             scale_resolution_mg = 0.05\ncomponents = [\"cube\"]\n{}{}{}{}",
+            specimen("A-1"),
+            specimen("B-1"),
+            specimen("B-2"),
+            specimen("B-3"),
+            specimen("B-4"),
+        );
+        Campaign::from_toml_str(&text, Path::new(".")).unwrap()
+    }
+
+    #[test]
+    fn a_repeat_is_the_test_as_it_was_run() {
+        let c = campaign();
+        let (setup, schedule) = repeat_of(&c, "B", &configs()).unwrap();
+        assert_eq!(setup.template.config, "rattle-box-b");
+        assert_eq!(setup.template.drive, c.tests[1].drive);
+        assert!(setup.template.specimens.is_empty());
+        assert_eq!(setup.level_g, Some(25.0));
+        assert_eq!(schedule.increments, 2);
+        assert_eq!(schedule.increment_duration_s, 3600.0);
+        // Four specimens were run; a repeat asks for at most three.
+        assert_eq!(schedule.repeats, 3);
+        assert!(!schedule.accelerometers);
+        assert_eq!(schedule.cost_h(), 6.0);
+        assert!(repeat_of(&c, "Z", &configs()).is_none());
     }
 }
