@@ -273,9 +273,9 @@ pub struct Report {
     #[serde(default)]
     pub partly_explained: Option<PartlyExplained>,
     /// The campaign tests whose repetition would let held-out data confirm the leading
-    /// candidate (held out by test only): the tests it cannot predict held out, worst first,
-    /// else the one test that carries what it explains. The next tests start with their
-    /// repeats (docs/results/diagnosis.md, "The next test").
+    /// candidate (held out by test only): the tests it cannot predict held out, furthest
+    /// above its bound first. The next tests start with their repeats
+    /// (docs/results/diagnosis.md, "The next test").
     #[serde(default)]
     pub to_repeat: Vec<String>,
     /// The tests that would best confirm the leading candidate or separate it from its

@@ -325,10 +325,7 @@ pub(super) fn judge(
                 problem.name_of(&c.families)
             )
         });
-    let carrier = one_group
-        .filter(|_| verdict == Verdict::NotExplained || unidentified.is_none())
-        .map(|(_, g, _)| g);
-    let to_repeat = tests_to_repeat(campaign, problem, partly.as_ref(), carrier);
+    let to_repeat = tests_to_repeat(campaign, problem, partly.as_ref());
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
         Verdict::NoGap => format!(
@@ -485,32 +482,24 @@ pub(super) fn singles_unexplained(
 
 /// The campaign tests whose repeats would let held-out data confirm the leading candidate
 /// (`Report::to_repeat`), held out by test only: the tests it cannot predict held out, the
-/// furthest above its bound first; else the test that carries what it explains (`carrier`,
-/// a group index). A test is its own group when held out by test; an increment group names
-/// no test to repeat.
+/// furthest above its bound first. A test is its own group when held out by test; an
+/// increment group names no test to repeat. A test that carries what a candidate explains
+/// while every test is predicted is not among them: a test that carries the effect in
+/// another case or drive confirms it as well and tells more (the separating tests).
 fn tests_to_repeat(
     campaign: &Campaign,
     problem: &FitProblem,
     partly: Option<&PartlyExplained>,
-    carrier: Option<usize>,
 ) -> Vec<String> {
-    let is_test = |label: &str| campaign.tests.iter().any(|t| t.id == label);
     if !problem.by_test() {
         return Vec::new();
     }
+    let is_test = |label: &str| campaign.tests.iter().any(|t| t.id == label);
     let mut unpredicted: Vec<&GroupError> = partly
         .map(|p| p.unpredicted.iter().filter(|g| is_test(&g.group)).collect())
         .unwrap_or_default();
     unpredicted.sort_by(|a, b| (b.after / b.bound).total_cmp(&(a.after / a.bound)));
-    let mut out: Vec<String> = unpredicted.iter().map(|g| g.group.clone()).collect();
-    if out.is_empty() {
-        out.extend(
-            carrier
-                .map(|g| problem.group_labels[g].clone())
-                .filter(|label| is_test(label)),
-        );
-    }
-    out
+    unpredicted.iter().map(|g| g.group.clone()).collect()
 }
 
 #[cfg(test)]

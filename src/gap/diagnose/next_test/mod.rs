@@ -14,9 +14,8 @@
 //!    the leading candidate and each rival under the campaign's noise model; a test is
 //!    *decisive* when it exceeds [`DECISIVE_NATS`] against every rival.
 //! 5. **Ranking**: first the repeats of the report's `to_repeat` tests (the tests the
-//!    leading candidate cannot predict held out, else the one test that carries what it
-//!    explains), each as it was run: held out by test, an effect can only be confirmed where
-//!    another test informs the fit; then the best schedule of each setup (decisive and
+//!    leading candidate cannot predict held out), each as it was run: held out by test, a
+//!    test is predicted only from what the other tests inform; then the best schedule of each setup (decisive and
 //!    cheapest, else the most separating), the setups in the same order; the first
 //!    [`MAX_PROPOSED`] are proposed.
 
