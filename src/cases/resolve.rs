@@ -161,10 +161,8 @@ fn value_path(case: &serde_json::Value, path: &str, message: &str) -> String {
         }
     }
     let mut found = path.to_string();
-    if table.is_object() || table.is_array() {
-        if go(table, &mut found, message) {
-            return found;
-        }
+    if (table.is_object() || table.is_array()) && go(table, &mut found, message) {
+        return found;
     }
     path.to_string()
 }
