@@ -119,10 +119,13 @@ fn value_path(case: &serde_json::Value, path: &str, message: &str) -> String {
     // The value a type error quotes (`floating point `1e+308``, `string "NaN"`, `boolean
     // `true``), numbers compared by value (serde_json prints them its own way).
     fn quotes(message: &str, scalar: &Value) -> bool {
-        let Some(quoted) = ["invalid type: ", "invalid value: "].iter().find_map(|head| {
-            let rest = &message[message.find(head)? + head.len()..];
-            Some(rest.split(", expected").next().unwrap_or(rest))
-        }) else {
+        let Some(quoted) = ["invalid type: ", "invalid value: "]
+            .iter()
+            .find_map(|head| {
+                let rest = &message[message.find(head)? + head.len()..];
+                Some(rest.split(", expected").next().unwrap_or(rest))
+            })
+        else {
             return false;
         };
         match scalar {
