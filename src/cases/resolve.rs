@@ -1,8 +1,8 @@
 //! A case's one parser: a reference config or an inline case object, with overrides and a seed
 //! merged in, to a validated [`CaseSpec`] (unknown keys, the physical bounds of
-//! [`super::bounds`], the run-control limits of [`super::limits`], the model's own rules) and
-//! the model built once to prove it builds. Used by every job kind, the CLI, the campaigns and
-//! the virtual rig.
+//! [`super::bounds`] on the typed case, the run-control limits of [`super::limits`], the
+//! model's own rules) and the model built once to prove it builds. Used by every job kind, the
+//! CLI, the campaigns and the virtual rig.
 
 use super::{limits, merge_json, RunError};
 use crate::field_error::FieldError;
@@ -41,51 +41,13 @@ fn locate(case_field: &str, overrides: Option<&serde_json::Value>) -> String {
     format!("config.{field}")
 }
 
-/// Checks the run-control bounds of [`limits`]; the error's field is a case path.
+/// Checks the run-control limits between fields of [`limits`] (each field's own range is its
+/// bound, checked with the others); the error's field is a case path.
 fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     let s = &case.simulation;
     let bad = |field: &str, rule: String| Err(FieldError::new(field, rule).at("simulation"));
-    if !(s.duration_s.is_finite()
-        && s.duration_s >= limits::MIN_RECORD_INTERVAL_S
-        && s.duration_s <= limits::MAX_DURATION_S)
-    {
-        return bad(
-            "duration_s",
-            format!(
-                "must be > 0 (at least one record interval, {:e} s) and <= {} s (24 h of \
-                 simulated time), got {}",
-                limits::MIN_RECORD_INTERVAL_S,
-                limits::MAX_DURATION_S,
-                s.duration_s
-            ),
-        );
-    }
-    if !(s.settle_s.is_finite() && s.settle_s >= 0.0 && s.settle_s <= limits::MAX_SETTLE_S) {
-        return bad(
-            "settle_s",
-            format!(
-                "must be >= 0 and <= {} s (past the contact creep time constant), got {}",
-                limits::MAX_SETTLE_S,
-                s.settle_s
-            ),
-        );
-    }
-    let (lo, hi) = limits::REL_TOLERANCE_RANGE;
-    if !(s.rel_tolerance >= lo && s.rel_tolerance <= hi) {
-        return bad(
-            "rel_tolerance",
-            format!("must lie in [{lo:e}, {hi}], got {}", s.rel_tolerance),
-        );
-    }
-    let (lo, hi) = limits::ABS_TOLERANCE_M_RANGE;
-    if !(s.abs_tolerance_m >= lo && s.abs_tolerance_m <= hi) {
-        return bad(
-            "abs_tolerance_m",
-            format!("must lie in [{lo:e}, {hi:e}] m, got {}", s.abs_tolerance_m),
-        );
-    }
     let dt = s.record_interval_s;
-    if !(dt.is_finite() && dt >= limits::MIN_RECORD_INTERVAL_S && dt <= s.duration_s) {
+    if dt > s.duration_s {
         return bad(
             "record_interval_s",
             format!(
@@ -108,24 +70,104 @@ fn check_simulation_bounds(case: &CaseSpec) -> Result<(), FieldError> {
     Ok(())
 }
 
-/// Checks every number and text of the case against [`super::bounds`], including the
-/// excitation a profile name stands for.
+/// Checks every number and text of the typed case against its bound ([`super::bounds`]),
+/// including the motion an excitation profile stands for.
 fn check_physical_bounds(case: &CaseSpec, configs_dir: &Path) -> Result<(), RunError> {
-    let profile = matches!(
-        case.excitation.kind(),
-        crate::models::spec::Excitation::Profile(_)
-    );
-    let resolved = if profile {
-        let spec = crate::models::case::resolve_excitation(case, configs_dir)?;
-        Some(
-            serde_json::to_value(&spec)
-                .map_err(|e| FieldError::new("excitation", e.to_string()))?,
-        )
-    } else {
-        None
+    let resolved = match case.excitation.kind() {
+        crate::models::spec::Excitation::Profile(_) => {
+            Some(crate::models::case::resolve_excitation(case, configs_dir)?)
+        }
+        crate::models::spec::Excitation::Motion(_) => None,
     };
     super::bounds::check_case(case, resolved.as_ref())?;
     Ok(())
+}
+
+/// The path of the value a type error of serde's names, when serde read the table at `path`
+/// whole (a tagged wear law, the excitation) and so reports the table: the first scalar below
+/// it that is the value the `message` quotes (`invalid type: string "NaN", expected f64`).
+/// Otherwise `path` itself.
+fn value_path(case: &serde_json::Value, path: &str, message: &str) -> String {
+    use serde::de::Unexpected;
+    use serde_json::Value;
+    fn go(value: &Value, path: &mut String, message: &str) -> bool {
+        match value {
+            Value::Object(map) => map.iter().any(|(k, v)| {
+                let len = path.len();
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(k);
+                let found = go(v, path, message);
+                if !found {
+                    path.truncate(len);
+                }
+                found
+            }),
+            Value::Array(items) => items.iter().enumerate().any(|(i, v)| {
+                let len = path.len();
+                path.push_str(&format!("[{i}]"));
+                let found = go(v, path, message);
+                if !found {
+                    path.truncate(len);
+                }
+                found
+            }),
+            scalar => quotes(message, scalar),
+        }
+    }
+    // The value a type error quotes (`floating point `1e+308``, `string "NaN"`, `boolean
+    // `true``), numbers compared by value (serde_json prints them its own way).
+    fn quotes(message: &str, scalar: &Value) -> bool {
+        let Some(quoted) = ["invalid type: ", "invalid value: "]
+            .iter()
+            .find_map(|head| {
+                let rest = &message[message.find(head)? + head.len()..];
+                Some(rest.split(", expected").next().unwrap_or(rest))
+            })
+        else {
+            return false;
+        };
+        match scalar {
+            Value::Number(n) => {
+                let kind = if n.is_f64() {
+                    "floating point `"
+                } else {
+                    "integer `"
+                };
+                quoted
+                    .strip_prefix(kind)
+                    .and_then(|q| q.strip_suffix('`'))
+                    .and_then(|q| q.parse::<f64>().ok())
+                    .is_some_and(|q| n.as_f64() == Some(q))
+            }
+            Value::String(s) => quoted == Unexpected::Str(s).to_string(),
+            Value::Bool(b) => quoted == Unexpected::Bool(*b).to_string(),
+            _ => false,
+        }
+    }
+    let path = path.trim_start_matches('.');
+    let mut table = case;
+    for part in path.split('.').filter(|p| !p.is_empty()) {
+        let (key, indices) = part.split_once('[').unwrap_or((part, ""));
+        let next = table.get(key).and_then(|v| {
+            indices
+                .split('[')
+                .filter(|i| !i.is_empty())
+                .try_fold(v, |v, i| {
+                    v.get(i.trim_end_matches(']').parse::<usize>().ok()?)
+                })
+        });
+        match next {
+            Some(v) => table = v,
+            None => return path.to_string(),
+        }
+    }
+    let mut found = path.to_string();
+    if (table.is_object() || table.is_array()) && go(table, &mut found, message) {
+        return found;
+    }
+    path.to_string()
 }
 
 /// Where a case comes from: a reference config by name (`configs/<name>.toml`) or a whole case
@@ -188,13 +230,12 @@ pub fn resolve_model(
             &serde_json::json!({"simulation": {"seed": seed}}),
         );
     }
-    // Bounds on the JSON first: a value of the wrong type or out of range is named at its
-    // own path, also inside tables serde reads whole (the tagged wear law).
-    super::bounds::check_value(&value, "")
-        .map_err(|e| RunError::from(FieldError::new(locate(&e.field, overrides), e.rule)))?;
-    let mut case: CaseSpec = serde_path_to_error::deserialize(value).map_err(|e| {
-        let path = e.path().to_string();
-        FieldError::new(locate(&path, overrides), e.into_inner().to_string())
+    // A value of the wrong type is named at its own path, also inside tables serde reads
+    // whole (the tagged wear law, the excitation).
+    let mut case: CaseSpec = serde_path_to_error::deserialize(&value).map_err(|e| {
+        let rule = e.inner().to_string();
+        let path = value_path(&value, &e.path().to_string(), &rule);
+        FieldError::new(locate(&path, overrides), rule)
     })?;
     adjust(&mut case)?;
     let relocate = |e: RunError| match e {
@@ -204,11 +245,11 @@ pub fn resolve_model(
         },
         other => other,
     };
-    // The bounds first: a value out of its physical range is named itself, not through a
-    // rule between two fields that it happens to break as well (a cube of 1e308 m is too
-    // large, not a tube too small).
-    check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
+    // The bounds first, on the typed case: a value out of its physical range is named itself,
+    // not through a rule between two fields that it happens to break as well (a cube of 1e308
+    // m is too large, not a tube too small).
     check_physical_bounds(&case, configs_dir).map_err(relocate)?;
+    check_simulation_bounds(&case).map_err(|e| relocate(e.into()))?;
     case.validate().map_err(|e| relocate(e.into()))?;
     crate::models::case::run_options(&case).map_err(relocate)?;
     // Validated above (and not changed since): build without validating again.

@@ -265,8 +265,8 @@ impl LibraryRunner {
             JobKind::SweepPoint => {
                 JobPlan::sweep_point(SweepPlan::from_params_seeded(params, dir, seed)?)
             }
-            JobKind::Calibrate => Ok(JobPlan::Calibrate(Box::new(CalibrateParams::parse(
-                params,
+            JobKind::Calibrate => Ok(JobPlan::Calibrate(Box::new(CalibrateParams::parse_seeded(
+                params, seed,
             )?))),
             JobKind::Diagnose => Ok(JobPlan::Diagnose(Box::new(DiagnosePlan::from_params(
                 params,

@@ -1,15 +1,17 @@
 //! Calibrate jobs: friction and wear-law data sets, parsed and checked, and the fits.
 
 use super::{check_keys, limits, parse_seed, RunError, CALIBRATE_KEYS};
+use crate::analysis::calibration::{Fixture, TorqueRecord, WearTestRecord};
 use crate::field_error::FieldError;
+use crate::parameters::{Bound, Bounded, FieldPath};
 use serde::{Deserialize, Serialize};
 
 /// Friction data of a calibrate job (thesis 4.3): the fixture and its torque records.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrictionData {
-    pub fixture: crate::analysis::calibration::Fixture,
-    pub records: Vec<crate::analysis::calibration::TorqueRecord>,
+    pub fixture: Fixture,
+    pub records: Vec<TorqueRecord>,
 }
 
 /// Wear-law data of a calibrate job (thesis 4.4): material density, cutoff and wear tests.
@@ -20,7 +22,102 @@ pub struct WearLawData {
     pub density_kg_m3: f64,
     /// Pa (default 870e6, 2 S_y of 7075-T73), in (0, [`limits::MAX_CUTOFF_PRESSURE_PA`]].
     pub cutoff_pressure_pa: f64,
-    pub records: Vec<crate::analysis::calibration::WearTestRecord>,
+    pub records: Vec<WearTestRecord>,
+}
+
+const POLAR_INERTIA: Bound = Bound::new(
+    1.0e-9,
+    1.0e3,
+    "kg·m²",
+    "a fixture's rotating parts, from a 1 g cup to a 1 t turntable",
+);
+const MEAN_RADIUS: Bound = Bound::new(1.0e-5, 10.0, "m", "contact radii from 10 µm to 10 m");
+const TIME: Bound = Bound::new(
+    0.0,
+    limits::MAX_DURATION_S,
+    "s",
+    "a test record within 24 h",
+);
+const ANGLE: Bound = Bound::new(-1.0e7, 1.0e7, "rad", "1.6 million turns: a day at 20 rev/s");
+const ANGULAR_VELOCITY: Bound = Bound::new(
+    -1.0e4,
+    1.0e4,
+    "rad/s",
+    "up to 95 000 rpm, past any friction rig's spindle",
+);
+const NORMAL_LOAD: Bound = Bound::new(
+    0.0,
+    1.0e6,
+    "N",
+    "a compressive load up to 1 MN, a large press",
+);
+const INPUT_TORQUE: Bound = Bound::new(
+    -1.0e5,
+    1.0e5,
+    "N·m",
+    "torques up to 100 kN·m, past any friction rig's drive",
+);
+const CONTACT_PRESSURE: Bound = Bound::new(
+    0.0,
+    limits::MAX_CUTOFF_PRESSURE_PA,
+    "Pa",
+    "compressive pressures up to 10 GPa, above any engineering alloy's hardness",
+);
+const SLIDING_DISTANCE: Bound = Bound::new(0.0, 1.0e7, "m", "up to 10 000 km of sliding");
+const WEAR_MASS: Bound = Bound::new(0.0, 1.0, "kg", "wear of a test specimen, up to 1 kg");
+
+/// The rotating-cup fixture of the friction test (thesis 4.3).
+impl Bounded for Fixture {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number(
+            "polar_inertia_kg_m2",
+            self.polar_inertia_kg_m2,
+            &POLAR_INERTIA,
+        )?;
+        at.number("mean_radius_m", self.mean_radius_m, &MEAN_RADIUS)
+    }
+}
+
+/// One torque record of the friction test.
+impl Bounded for TorqueRecord {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("time_s", self.time_s, &TIME)?;
+        at.number("angle_rad", self.angle_rad, &ANGLE)?;
+        at.number(
+            "angular_velocity_rad_s",
+            self.angular_velocity_rad_s,
+            &ANGULAR_VELOCITY,
+        )?;
+        at.number("normal_load_n", self.normal_load_n, &NORMAL_LOAD)?;
+        at.number("input_torque_n_m", self.input_torque_n_m, &INPUT_TORQUE)
+    }
+}
+
+/// One wear test's record (thesis 4.4).
+impl Bounded for WearTestRecord {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("normal_load_n", self.normal_load_n, &NORMAL_LOAD)?;
+        at.number(
+            "contact_pressure_pa",
+            self.contact_pressure_pa,
+            &CONTACT_PRESSURE,
+        )?;
+        at.number(
+            "sliding_distance_m",
+            self.sliding_distance_m,
+            &SLIDING_DISTANCE,
+        )?;
+        at.number("wear_mass_kg", self.wear_mass_kg, &WEAR_MASS)
+    }
+}
+
+/// Each record inside its bounds, named `field[i].<name>`.
+fn check_records<T: Bounded>(records: &[T], field: &str) -> Result<(), FieldError> {
+    let mut at = FieldPath::new(field);
+    records
+        .iter()
+        .enumerate()
+        .try_for_each(|(i, record)| at.item(i, |at| record.check_bounds(at)))
 }
 
 /// A calibrate job's params, parsed and checked ([`CALIBRATE_KEYS`]): the plan a calibrate
@@ -89,15 +186,21 @@ impl CalibrateParams {
     /// any level are refused, numbers bounded ([`limits`]), friction records checked as the
     /// fit reads them (eq. 4.1-4.4) and at least 8 of them (the fit's minimum).
     pub fn parse(params: &serde_json::Value) -> Result<Self, RunError> {
+        Self::parse_seeded(params, None)
+    }
+
+    /// [`CalibrateParams::parse`] for a job whose seed the caller has parsed already
+    /// (`job_seed`: the params' own `seed`, or the one drawn for a job that names none), so
+    /// the params' `seed` is not read again (a calibration draws nothing from it). Without
+    /// one, the params' `seed` is checked here.
+    pub fn parse_seeded(
+        params: &serde_json::Value,
+        job_seed: Option<u64>,
+    ) -> Result<Self, RunError> {
         use crate::analysis::calibration as cal;
         let map = check_keys(params, "params", CALIBRATE_KEYS)?;
-        if let Some(seed) = map.get("seed") {
+        if let (None, Some(seed)) = (job_seed, map.get("seed")) {
             parse_seed(seed)?;
-        }
-        for key in ["friction", "wear_law"] {
-            if let Some(data) = map.get(key) {
-                super::bounds::check_calibration_value(data, key)?;
-            }
         }
         let friction = match map.get("friction") {
             None => None,
@@ -113,6 +216,7 @@ impl CalibrateParams {
                 )?;
                 let fixture: cal::Fixture = serde_json::from_value(fixture_value.clone())
                     .map_err(|e| FieldError::new("friction.fixture", e.to_string()))?;
+                fixture.check_bounds(&mut FieldPath::new("friction.fixture"))?;
                 let records: Vec<cal::TorqueRecord> = parse_records(
                     f.get("records"),
                     "friction.records",
@@ -124,6 +228,7 @@ impl CalibrateParams {
                         "input_torque_n_m",
                     ],
                 )?;
+                check_records(&records, "friction.records")?;
                 if records.len() < 8 {
                     return Err(FieldError::new(
                         "friction.records",
@@ -159,7 +264,7 @@ impl CalibrateParams {
                     (1.0, limits::MAX_CUTOFF_PRESSURE_PA),
                     "Pa, up to 10 GPa, above any engineering alloy's hardness",
                 )?;
-                let records = parse_records(
+                let records: Vec<WearTestRecord> = parse_records(
                     w.get("records"),
                     "wear_law.records",
                     &[
@@ -169,6 +274,7 @@ impl CalibrateParams {
                         "wear_mass_kg",
                     ],
                 )?;
+                check_records(&records, "wear_law.records")?;
                 Some(WearLawData {
                     density_kg_m3,
                     cutoff_pressure_pa,

@@ -186,7 +186,6 @@ impl SweepRange {
                     )
                     .into());
                 }
-                super::bounds::check_value(v, "base_dimensions_mm")?;
                 let dims: LauncherDimensions = serde_path_to_error::deserialize(v.clone())
                     .map_err(|e| {
                         let path = e.path().to_string();
@@ -197,6 +196,10 @@ impl SweepRange {
                         };
                         FieldError::new(&field, e.into_inner().to_string())
                     })?;
+                crate::parameters::Bounded::check_bounds(
+                    &dims,
+                    &mut crate::parameters::FieldPath::new("base_dimensions_mm"),
+                )?;
                 dims.rattle_space().map_err(
                     |crate::analysis::rattle_space::RattleSpaceError::InvalidDimension(e)| {
                         e.at("base_dimensions_mm")

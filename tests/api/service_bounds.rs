@@ -1,11 +1,11 @@
-//! Issue 29 over HTTP, against an in-process service with the production runner and no
+//! Physical bounds over HTTP, against an in-process service with the production runner and no
 //! workers (nothing runs): every numeric field of a case out of its physical bounds is a 422
 //! naming it and stores nothing; unknown query parameters are refused on every route; the role
 //! comes before the body's size; whoever started a job may cancel it.
 
 use crate::helpers::{Api, Runner, TestApp};
 use crate::support::{ENGINEER, PLANNER, TEST_ENGINEER};
-use railwear::pipeline::bounds::{bound_for, walk_leaves};
+use railwear::pipeline::bounds::{check_case_at, FieldPath};
 use serde_json::{json, Value};
 
 /// The smallest campaign that runs a real diagnosis (tests/fixtures, shared).
@@ -17,11 +17,34 @@ fn stored_jobs(api: &Api) -> usize {
     r.json()["items"].as_array().map_or(0, Vec::len)
 }
 
-/// Rattle box C as an inline config, as the service would load it.
-fn rattle_box_c() -> Value {
+/// Rattle box C as an inline config, as the service would load it, and the typed case.
+fn rattle_box_c() -> (Value, railwear::models::spec::CaseSpec) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/rattle-box-c.toml");
     let case = railwear::models::case::load_case(&path).unwrap();
-    serde_json::to_value(&case).unwrap()
+    (serde_json::to_value(&case).unwrap(), case)
+}
+
+/// The path of every number in `value` (`a.b[2].c`).
+fn number_paths(value: &Value, path: String, out: &mut Vec<String>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                let sub = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                number_paths(v, sub, out);
+            }
+        }
+        Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                number_paths(v, format!("{path}[{i}]"), out);
+            }
+        }
+        Value::Number(_) => out.push(path),
+        _ => {}
+    }
 }
 
 /// `a.b[2].c` as a JSON pointer.
@@ -37,18 +60,25 @@ async fn every_numeric_field_out_of_bounds_is_422_naming_it() {
     let app = TestApp::spawn_with(Runner::Library, false, |_| {}).await;
     let api = app.api.clone();
     tokio::task::spawn_blocking(move || {
-        let case = rattle_box_c();
-        // The table is generated from the case's own fields, with the bound of each.
-        let mut leaves = Vec::new();
-        walk_leaves::<()>(&case, "", &mut |leaf| {
-            if leaf.value.is_number() {
-                let bound = bound_for(leaf.key, leaf.component, leaf.kind)
-                    .unwrap_or_else(|| panic!("{} has no bound", leaf.path));
-                leaves.push((leaf.path.to_string(), *bound));
-            }
-            Ok(())
-        })
-        .unwrap();
+        let (case, typed) = rattle_box_c();
+        // The table is generated from the case's own fields, with the bound the typed checker
+        // holds each to.
+        let mut at = FieldPath::recording("");
+        check_case_at(&typed, None, &mut at).unwrap();
+        let mut paths = Vec::new();
+        number_paths(&case, String::new(), &mut paths);
+        let leaves: Vec<_> = paths
+            .into_iter()
+            .map(|path| {
+                let bound = at
+                    .checked()
+                    .iter()
+                    .find(|(p, _)| *p == path)
+                    .map(|(_, b)| *b)
+                    .unwrap_or_else(|| panic!("{path} has no bound"));
+                (path, bound)
+            })
+            .collect();
         assert!(leaves.len() >= 25, "{} numeric fields", leaves.len());
         let mut refused = 0;
         for (path, bound) in &leaves {

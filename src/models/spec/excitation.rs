@@ -6,11 +6,14 @@
 //! The table is also kept as written, for the record only: a result's `config`, a job's stored
 //! plan and a checkpoint's case hash carry the case as it was written (an omitted default stays
 //! omitted, `15` stays an integer), so typing the table changes no stored result and no
-//! refactor hash. Every reader of the excitation takes the typed form ([`CaseExcitation::kind`]);
-//! the physical bounds read the written one ([`CaseExcitation::table`]), as they read every
-//! table by its field paths.
+//! refactor hash. Every reader of the excitation takes the typed form ([`CaseExcitation::kind`]),
+//! the physical bounds too (declared here, beside the schema's use in a case).
 
-use crate::excitation::ExcitationSpec;
+use super::shared::{DURATION, SEED, SETTLE};
+use super::{FREQUENCY, MAX_TEXT_CHARS};
+use crate::excitation::{ExcitationSpec, RampSpec, Tone};
+use crate::field_error::FieldError;
+use crate::parameters::{Bound, Bounded, FieldPath};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_json::Value;
 
@@ -22,6 +25,196 @@ pub enum Excitation {
     Profile(String),
     /// A base motion given in full (its settle time is the case's).
     Motion(ExcitationSpec),
+}
+
+/// Most tones of one excitation: a rotorcraft profile has its 1P tone and a dozen harmonics.
+pub const MAX_TONES: usize = 64;
+/// Most PSD breakpoints: MIL-STD-810G's tables have fewer than 20.
+pub const MAX_PSD_BREAKPOINTS: usize = 256;
+
+const AMPLITUDE: Bound = Bound::new(
+    0.0,
+    200.0,
+    "g",
+    "shakers reach about 100 g sine and captive-carry profiles stay below 10 g (thesis: 15 g \
+     on the rattle box); above 200 g is shock, not vibration",
+);
+const PHASE: Bound = Bound::new(-360.0, 360.0, "°", "one turn either way");
+const RAMP_SECONDS: Bound = Bound::new(
+    0.0,
+    super::MAX_SETTLE_S,
+    "s",
+    "a ramp-in no longer than the longest settle",
+);
+const RAMP_CYCLES: Bound = Bound::new(
+    0.0,
+    1000.0,
+    "cycles",
+    "a ramp-in of up to 1000 cycles of the lowest frequency (default 3)",
+);
+const PSD_LEVEL: Bound = Bound::new(
+    0.0,
+    10.0,
+    "g²/Hz",
+    "PSD levels above 0 and up to 10 g²/Hz (140 g rms over 2 kHz); MIL-STD-810G helicopter \
+     levels stay below 0.1 g²/Hz",
+)
+.open_min();
+const SAMPLE_RATE: Bound = Bound::new(
+    1.0,
+    1.0e6,
+    "Hz",
+    "a record sampled at 1 Hz to 1 MHz (4x the highest frequency is enough)",
+);
+const CUTOFF_FREQUENCY: Bound = Bound::new(
+    0.01,
+    1000.0,
+    "Hz",
+    "a drift cutoff between 0.01 Hz and 1 kHz: it must sit below the content it keeps",
+);
+const SAMPLE_TIME: Bound = Bound::new(
+    0.0,
+    super::MAX_DURATION_S + super::MAX_SETTLE_S,
+    "s",
+    "sample times within the longest run",
+);
+const ACCELERATION: Bound = Bound::new(
+    -1.0e4,
+    1.0e4,
+    "g or m/s²",
+    "measured accelerations up to 1e4 in either unit: beyond it a record is a unit error or a \
+     shock",
+);
+
+/// A list field `name` of at most `max` entries.
+fn at_most(at: &FieldPath, name: &str, len: usize, max: usize) -> Result<(), FieldError> {
+    if len > max {
+        Err(FieldError::new(
+            format!("{}.{name}", at.as_str()),
+            format!("has {len} entries; at most {max}"),
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+impl Bounded for Tone {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("frequency_hz", self.frequency_hz, &FREQUENCY)?;
+        at.number("amplitude_g", self.amplitude_g, &AMPLITUDE)?;
+        at.number("phase_deg", self.phase_deg, &PHASE)
+    }
+}
+
+impl Bounded for RampSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        match *self {
+            RampSpec::Seconds(s) => at.number("seconds", s, &RAMP_SECONDS),
+            RampSpec::Cycles(c) => at.number("cycles", c, &RAMP_CYCLES),
+        }
+    }
+}
+
+fn tones(at: &mut FieldPath, tones: &[Tone]) -> Result<(), FieldError> {
+    at_most(at, "tones", tones.len(), MAX_TONES)?;
+    at.field("tones", |at| {
+        tones
+            .iter()
+            .enumerate()
+            .try_for_each(|(i, tone)| at.item(i, |at| tone.check_bounds(at)))
+    })
+}
+
+/// A base motion (`crate::excitation::ExcitationSpec`), as a case gives it or a profile
+/// resolves to.
+impl Bounded for ExcitationSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        let (settle_s, ramp) = match self {
+            ExcitationSpec::None => return Ok(()),
+            ExcitationSpec::Sine {
+                tones: t,
+                settle_s,
+                ramp,
+            } => {
+                tones(at, t)?;
+                (settle_s, ramp)
+            }
+            ExcitationSpec::SineOnRandom {
+                tones: t,
+                psd_breakpoints,
+                duration_s,
+                sample_rate_hz,
+                seed,
+                low_cutoff_hz,
+                settle_s,
+                ramp,
+                ..
+            } => {
+                tones(at, t)?;
+                at_most(
+                    at,
+                    "psd_breakpoints",
+                    psd_breakpoints.len(),
+                    MAX_PSD_BREAKPOINTS,
+                )?;
+                at.field("psd_breakpoints", |at| {
+                    psd_breakpoints
+                        .iter()
+                        .enumerate()
+                        .try_for_each(|(i, (f, level))| {
+                            at.item(i, |at| {
+                                at.item(0, |at| at.this(*f, &FREQUENCY))?;
+                                at.item(1, |at| at.this(*level, &PSD_LEVEL))
+                            })
+                        })
+                })?;
+                at.number("duration_s", *duration_s, &DURATION)?;
+                at.number("sample_rate_hz", *sample_rate_hz, &SAMPLE_RATE)?;
+                at.number("seed", *seed as f64, &SEED)?;
+                at.number("low_cutoff_hz", *low_cutoff_hz, &CUTOFF_FREQUENCY)?;
+                (settle_s, ramp)
+            }
+            ExcitationSpec::Measured {
+                csv_path,
+                samples,
+                highpass_hz,
+                settle_s,
+                ramp,
+                ..
+            } => {
+                if let Some(csv_path) = csv_path {
+                    at.text("csv_path", csv_path, MAX_TEXT_CHARS, false)?;
+                }
+                if let Some(samples) = samples {
+                    at.field("samples", |at| {
+                        samples.iter().enumerate().try_for_each(|(i, sample)| {
+                            at.item(i, |at| {
+                                at.item(0, |at| at.this(sample[0], &SAMPLE_TIME))?;
+                                (1..4).try_for_each(|j| {
+                                    at.item(j, |at| at.this(sample[j], &ACCELERATION))
+                                })
+                            })
+                        })
+                    })?;
+                }
+                at.number("highpass_hz", *highpass_hz, &CUTOFF_FREQUENCY)?;
+                (settle_s, ramp)
+            }
+        };
+        at.number("settle_s", *settle_s, &SETTLE)?;
+        at.child("ramp", ramp)
+    }
+}
+
+/// A profile's name as a text field; a motion given in full by its bounds. The motion a
+/// profile stands for is checked where it is resolved (`cases::bounds::check_case`).
+impl Bounded for CaseExcitation {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        match &self.kind {
+            Excitation::Profile(name) => at.text("profile", name, MAX_TEXT_CHARS, false),
+            Excitation::Motion(spec) => spec.check_bounds(at),
+        }
+    }
 }
 
 /// A case's `[excitation]` table: its typed form and the table as written.
@@ -88,7 +281,7 @@ impl CaseExcitation {
         &self.kind
     }
 
-    /// The table as written (what the case records and the bounds read).
+    /// The table as written (what the case records).
     pub fn table(&self) -> &Value {
         &self.written
     }

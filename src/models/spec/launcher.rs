@@ -7,8 +7,10 @@ use crate::analysis::rattle_space::{LauncherDimensions, RattleSpaceError};
 use crate::field_error::FieldError;
 use crate::models::spec::{
     finite, finite3, inertia3, non_negative, path, positive, unit3, validate_friction,
-    validate_material, ContactSpec, RoundedBoxSpec,
+    validate_material, ContactSpec, RoundedBoxSpec, EDGE_RADIUS, LENGTH, MAX_TEXT_CHARS, POSITION,
+    UNIT_COMPONENT,
 };
+use crate::parameters::{Bound, Bounded, FieldPath};
 use crate::physics::friction::{in_mm_per_s, FrictionParams};
 use crate::physics::step::StepKind;
 use crate::units;
@@ -245,6 +247,220 @@ fn default_stations() -> Vec<[f64; 3]> {
 
 fn is_single_station(s: &[[f64; 3]]) -> bool {
     s == [[0.0; 3]]
+}
+
+/// Rail and shoe section letters, mm (eq. 6.1-6.2).
+const LAUNCHER_DIMENSION: Bound = Bound::new(
+    0.01,
+    1000.0,
+    "mm",
+    "rail and shoe section letters (eq. 6.1-6.2) from 10 µm (a machining tolerance) to 1 m; \
+     the thesis' are 9.5-38 mm",
+);
+/// The missile's and the latch's mass, kg.
+const MASS: Bound = Bound::new(
+    1.0e-4,
+    1.0e4,
+    "kg",
+    "from 0.1 g (a chip, not a body) to 10 t (the heaviest air-launched stores; the Hellfire \
+     is 45 kg)",
+);
+/// Principal moments of inertia, kg·m².
+const INERTIA: Bound = Bound::new(
+    1.0e-12,
+    1.0e5,
+    "kg·m²",
+    "from a 1 mm part to a 10 t store 10 m long (m L²/12 = 8e4 kg·m²)",
+);
+/// Spring stiffness, N/m.
+const SPRING_STIFFNESS: Bound = Bound::new(
+    0.0,
+    1.0e9,
+    "N/m",
+    "springs up to 1 GN/m, stiffer than the rail's own aluminium section; 0 is no spring",
+);
+/// Spring damping, N·s/m.
+const SPRING_DAMPING: Bound = Bound::new(
+    0.0,
+    1.0e6,
+    "N·s/m",
+    "spring damping up to 1 MN·s/m, which locks a 45 kg missile within 50 µs",
+);
+/// Spring preloads and point forces, N.
+const FORCE: Bound = Bound::new(
+    0.0,
+    1.0e5,
+    "N",
+    "spring and point forces up to 100 kN: 226 g on a 45 kg missile",
+);
+
+/// The lettered cross-section dimensions (`analysis::rattle_space::LauncherDimensions`).
+impl Bounded for LauncherDimensions {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        for (name, v) in [
+            ("a_shoe_mm", self.a_shoe_mm),
+            ("f_shoe_mm", self.f_shoe_mm),
+            ("g_shoe_mm", self.g_shoe_mm),
+            ("h_shoe_mm", self.h_shoe_mm),
+            ("i_shoe_mm", self.i_shoe_mm),
+            ("j_shoe_mm", self.j_shoe_mm),
+            ("k_shoe_mm", self.k_shoe_mm),
+            ("l_shoe_mm", self.l_shoe_mm),
+            ("m_shoe_mm", self.m_shoe_mm),
+            ("n_shoe_mm", self.n_shoe_mm),
+            ("o_shoe_mm", self.o_shoe_mm),
+            ("b_rail_mm", self.b_rail_mm),
+            ("n_rail_mm", self.n_rail_mm),
+            ("q_rail_mm", self.q_rail_mm),
+        ] {
+            at.number(name, v, &LAUNCHER_DIMENSION)?;
+        }
+        Ok(())
+    }
+}
+
+impl Bounded for RailSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("channel_length_m", self.channel_length_m, &LENGTH)?;
+        at.number("channel_centre_z_m", self.channel_centre_z_m, &POSITION)?;
+        at.number("lip_top_y_m", self.lip_top_y_m, &POSITION)?;
+        at.number("lip_thickness_m", self.lip_thickness_m, &LENGTH)?;
+        at.number("bottom_half_width_m", self.bottom_half_width_m, &LENGTH)
+    }
+}
+
+impl Bounded for MissileSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("mass_kg", self.mass_kg, &MASS)?;
+        at.number("length_m", self.length_m, &LENGTH)?;
+        at.number("diameter_m", self.diameter_m, &LENGTH)?;
+        if let Some(inertia) = &self.inertia_kg_m2 {
+            at.numbers("inertia_kg_m2", inertia, &INERTIA)?;
+        }
+        at.number("com_z_in_rail_m", self.com_z_in_rail_m, &POSITION)
+    }
+}
+
+impl Bounded for ShoeSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.numbers(
+            "head_base_in_missile_m",
+            &self.head_base_in_missile_m,
+            &POSITION,
+        )?;
+        at.number("length_m", self.length_m, &LENGTH)?;
+        at.number("edge_radius_m", self.edge_radius_m, &EDGE_RADIUS)?;
+        if let Some(protrusion) = &self.protrusion {
+            at.child("protrusion", protrusion)?;
+        }
+        Ok(())
+    }
+}
+
+impl Bounded for LatchSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("mass_kg", self.mass_kg, &MASS)?;
+        at.numbers("inertia_kg_m2", &self.inertia_kg_m2, &INERTIA)?;
+        at.numbers("com_in_rail_m", &self.com_in_rail_m, &POSITION)?;
+        at.numbers(
+            "hinge_point_in_rail_m",
+            &self.hinge_point_in_rail_m,
+            &POSITION,
+        )?;
+        at.numbers("hinge_axis", &self.hinge_axis, &UNIT_COMPONENT)?;
+        at.child("tooth", &self.tooth)
+    }
+}
+
+impl Bounded for CoilSpringSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number(
+            "stiffness_n_per_m",
+            self.stiffness_n_per_m,
+            &SPRING_STIFFNESS,
+        )?;
+        at.number("damping_ns_per_m", self.damping_ns_per_m, &SPRING_DAMPING)?;
+        at.number("preload_n", self.preload_n, &FORCE)?;
+        at.numbers("point_on_rail_m", &self.point_on_rail_m, &POSITION)?;
+        at.numbers("point_on_latch_m", &self.point_on_latch_m, &POSITION)
+    }
+}
+
+impl Bounded for ConstantForceSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.text("name", &self.name, MAX_TEXT_CHARS, false)?;
+        at.number("force_n", self.force_n, &FORCE)?;
+        at.numbers("point_in_missile_m", &self.point_in_missile_m, &POSITION)?;
+        at.numbers(
+            "direction_in_rail",
+            &self.direction_in_rail,
+            &UNIT_COMPONENT,
+        )
+    }
+}
+
+impl Bounded for LeafSpringSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number(
+            "stiffness_n_per_m",
+            self.stiffness_n_per_m,
+            &SPRING_STIFFNESS,
+        )?;
+        at.number("preload_n", self.preload_n, &FORCE)?;
+        at.number("reach_below_roof_m", self.reach_below_roof_m, &POSITION)?;
+        at.number("z_in_rail_m", self.z_in_rail_m, &POSITION)?;
+        at.number(
+            "engagement_smoothing_m",
+            self.engagement_smoothing_m,
+            &LENGTH,
+        )
+    }
+}
+
+impl Bounded for LauncherContacts {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.child("missile_rail", &self.missile_rail)?;
+        at.child("latch_rail", &self.latch_rail)?;
+        at.child("mid_shoe_rail", &self.mid_shoe_rail)?;
+        at.child("mid_shoe_latch", &self.mid_shoe_latch)?;
+        at.child("rear_shoe_rail", &self.rear_shoe_rail)
+    }
+}
+
+impl Bounded for LauncherSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.child("material", &self.material)?;
+        at.child("dimensions", &self.dimensions)?;
+        at.child("rail", &self.rail)?;
+        at.child("missile", &self.missile)?;
+        at.child("mid_shoe", &self.mid_shoe)?;
+        at.child("rear_shoe", &self.rear_shoe)?;
+        at.child("front_pad", &self.front_pad)?;
+        at.child("latch", &self.latch)?;
+        at.child("latch_spring", &self.latch_spring)?;
+        at.field("double_barrel_springs", |at| {
+            self.double_barrel_springs
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, spring)| at.item(i, |at| spring.check_bounds(at)))
+        })?;
+        at.child("rear_leaf_spring", &self.rear_leaf_spring)?;
+        at.child("contacts", &self.contacts)?;
+        at.child("friction", &self.friction)?;
+        at.field("stations", |at| {
+            self.stations
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, station)| {
+                    at.item(i, |at| {
+                        station
+                            .iter()
+                            .enumerate()
+                            .try_for_each(|(j, v)| at.item(j, |at| at.this(*v, &POSITION)))
+                    })
+                })
+        })
+    }
 }
 
 /// Most rail stations on one launcher.

@@ -15,8 +15,17 @@
 //! engine's own [`FrictionParams`](crate::physics::friction::FrictionParams), read from and
 //! written to mm/s by [`in_mm_per_s`](crate::physics::friction::in_mm_per_s). Values the thesis
 //! does not give are engineering estimates, flagged `estimate` in `docs/reference/models.md`.
+//!
+//! Every number of a case has a physical range ([`Bound`], with its unit and reason), declared
+//! beside the field it bounds, in the file of its struct, and checked on the typed case
+//! ([`Bounded::check_bounds`]) so a typing error (a friction coefficient of 1e6, an amplitude
+//! of 1e308 g) is refused at submit naming the field instead of running into NaN. The ranges
+//! are deliberately wide: they bound what is physically possible for a captive-carry launcher
+//! or a shaker test, not what is usual; the thesis' values sit well inside every one of them.
+//! The ranges shared by many fields (a length, a position) are the constants below.
 
 use crate::field_error::FieldError;
+use crate::parameters::{Bound, Bounded, FieldPath};
 pub use excitation::{CaseExcitation, Excitation};
 use launcher::LauncherSpec;
 use persistent_contact::PersistentContactSpec;
@@ -108,6 +117,48 @@ pub(in crate::models) fn inertia3(prefix: &str, name: &str, i: [f64; 3]) -> Resu
     Ok(())
 }
 
+/// Sizes of parts and bodies, m.
+pub(in crate::models) const LENGTH: Bound = Bound::new(
+    1.0e-6,
+    10.0,
+    "m",
+    "sizes from 1 µm (below the roughness of machined aluminium) to 10 m (longer than any \
+     air-launched store; the Hellfire is 1.63 m)",
+);
+/// Positions and offsets in a body's or the rail's frame, m.
+pub(in crate::models) const POSITION: Bound = Bound::new(
+    -10.0,
+    10.0,
+    "m",
+    "positions within 10 m of their frame's origin: the launcher and its missile span under \
+     2 m",
+);
+/// The components of a unit vector (its length is the model's rule).
+pub(in crate::models) const UNIT_COMPONENT: Bound =
+    Bound::new(-1.0, 1.0, "", "the components of a unit vector");
+/// Edge and corner roundovers, m.
+pub(in crate::models) const EDGE_RADIUS: Bound = Bound::new(
+    0.0,
+    0.1,
+    "m",
+    "roundovers are fractions of a millimetre (thesis 5.4: 0.508 mm); a 10 cm radius is a \
+     piece, not a roundover",
+);
+/// Frequencies of a base motion, Hz.
+pub(in crate::models) const FREQUENCY: Bound = Bound::new(
+    0.1,
+    5000.0,
+    "Hz",
+    "vibration between 0.1 Hz (below it a tone is a manoeuvre) and 5 kHz (above it the rail's \
+     structural modes, not rigid contact, decide; MIL-STD-810G 514.6 stops at 2 kHz)",
+);
+
+/// Longest text field of a case (names, labels, paths), characters: a name is read on a plot
+/// or in a list; 256 characters hold any path in `configs/`.
+pub const MAX_TEXT_CHARS: usize = 256;
+/// Longest case description, characters: one paragraph with its thesis source.
+pub const MAX_DESCRIPTION_CHARS: usize = 2000;
+
 mod excitation;
 pub mod launcher;
 pub mod persistent_contact;
@@ -115,10 +166,15 @@ pub mod rattle_box;
 mod shared;
 #[cfg(test)]
 pub(in crate::models) mod tests;
+mod wear;
 
+pub use excitation::{MAX_PSD_BREAKPOINTS, MAX_TONES};
 pub use shared::{
     validate_friction, validate_material, ContactSpec, PlanarFace, RoundedBoxSpec, SimulationSpec,
+    ABS_TOLERANCE_M_RANGE, DENSITY_KG_M3_RANGE, MAX_DURATION_S, MAX_SEED, MAX_SETTLE_S,
+    MIN_RECORD_INTERVAL_S, REL_TOLERANCE_RANGE,
 };
+pub use wear::{MAX_CUTOFF_PRESSURE_PA, MAX_WEAR_COEFFICIENT_M2_PER_N};
 
 /// Which model a case file describes (its top-level `model` key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -198,6 +254,33 @@ impl Default for WearSpec {
             volume_split: crate::wear::allocation::VolumeSplit::default(),
             mechanism: None,
         }
+    }
+}
+
+/// The case's texts within their lengths and every number inside its bound: run control, the
+/// model table, the excitation as written (a profile's motion is checked where it is resolved,
+/// `cases::bounds::check_case`) and the wear law.
+impl Bounded for CaseSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.text("name", &self.name, MAX_TEXT_CHARS, false)?;
+        at.text(
+            "description",
+            &self.description,
+            MAX_DESCRIPTION_CHARS,
+            true,
+        )?;
+        at.child("simulation", &self.simulation)?;
+        if let Some(spec) = &self.persistent_contact {
+            at.child("persistent_contact", spec)?;
+        }
+        if let Some(spec) = &self.rattle_box {
+            at.child("rattle_box", spec)?;
+        }
+        if let Some(spec) = &self.launcher {
+            at.child("launcher", spec)?;
+        }
+        at.child("excitation", &self.excitation)?;
+        at.child("wear", &self.wear)
     }
 }
 

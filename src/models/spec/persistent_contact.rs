@@ -4,6 +4,7 @@ use crate::field_error::FieldError;
 use crate::models::spec::{
     finite, non_negative, path, positive, validate_friction, validate_material, ContactSpec,
 };
+use crate::parameters::{Bounded, FieldPath};
 use crate::physics::friction::{in_mm_per_s, FrictionParams};
 use crate::wear::material::Material;
 use serde::{Deserialize, Serialize};
@@ -25,6 +26,22 @@ pub enum PrescribedRotation {
         /// Angular rate, degrees per second.
         rate_deg_per_s: f64,
     },
+}
+
+/// The persistent-contact block runs in no job (it is not a dynamic case), so only what it
+/// shares with the dynamic models is bounded: its material, contact, friction and the
+/// oscillation's frequency.
+impl Bounded for PersistentContactSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.child("material", &self.material)?;
+        if let PrescribedRotation::Oscillating { frequency_hz, .. } = self.rotation {
+            at.field("rotation", |at| {
+                at.number("frequency_hz", frequency_hz, &super::FREQUENCY)
+            })?;
+        }
+        at.child("contact", &self.contact)?;
+        at.child("friction", &self.friction)
+    }
 }
 
 impl PrescribedRotation {

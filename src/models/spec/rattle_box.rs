@@ -3,8 +3,10 @@
 use crate::analysis::rattle_space::{self, RattleSpaceError};
 use crate::field_error::FieldError;
 use crate::models::spec::{
-    non_negative, path, positive, validate_friction, validate_material, ContactSpec,
+    non_negative, path, positive, validate_friction, validate_material, ContactSpec, EDGE_RADIUS,
+    LENGTH, MAX_TEXT_CHARS,
 };
+use crate::parameters::{Bound, Bounded, FieldPath};
 use crate::physics::friction::{in_mm_per_s, FrictionParams};
 use crate::units;
 use crate::wear::material::Material;
@@ -45,6 +47,28 @@ pub struct RattleBoxSpec {
     /// Cube-tube friction, Table 5.2.
     #[serde(with = "in_mm_per_s")]
     pub friction: FrictionParams,
+}
+
+/// The cube's mass, kg.
+const MASS: Bound = Bound::new(
+    1.0e-4,
+    1.0e4,
+    "kg",
+    "from 0.1 g (a chip, not a body) to 10 t (the heaviest air-launched stores)",
+);
+
+impl Bounded for RattleBoxSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.text("case", &self.case, MAX_TEXT_CHARS, false)?;
+        at.child("material", &self.material)?;
+        at.number("cube_side_m", self.cube_side_m, &LENGTH)?;
+        at.optional("cube_mass_kg", self.cube_mass_kg, &MASS)?;
+        at.number("tube_inner_side_m", self.tube_inner_side_m, &LENGTH)?;
+        at.number("tube_length_m", self.tube_length_m, &LENGTH)?;
+        at.number("edge_radius_m", self.edge_radius_m, &EDGE_RADIUS)?;
+        at.child("contact", &self.contact)?;
+        at.child("friction", &self.friction)
+    }
 }
 
 fn default_true() -> bool {

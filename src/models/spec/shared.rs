@@ -1,7 +1,8 @@
 //! Specs shared by every model: material, contact and friction (ADAMS units), rounded boxes, the simulation settings.
 
-use super::{finite3, non_negative, path, positive};
+use super::{finite3, non_negative, path, positive, EDGE_RADIUS, LENGTH, POSITION};
 use crate::field_error::FieldError;
+use crate::parameters::{Bound, Bounded, FieldPath};
 use crate::physics::friction::FrictionParams;
 use crate::physics::impact::ImpactParams;
 use crate::physics::step::StepKind;
@@ -79,6 +80,142 @@ pub fn validate_material(material: &Material, prefix: &str) -> Result<(), FieldE
         .map_err(|crate::wear::WearError::Invalid(e)| e.at(prefix))
 }
 
+/// IMPACT stiffness k, N/mm^e.
+const CONTACT_STIFFNESS: Bound = Bound::new(
+    1.0e-3,
+    1.0e8,
+    "N/mm^e",
+    "IMPACT stiffness from 1e-3 to 1e8 N/mm^e: the thesis uses 1e3-1e4; stiffer laws put \
+     contact time constants below 1 ns",
+);
+/// IMPACT force exponent e.
+const CONTACT_EXPONENT: Bound = Bound::new(
+    1.0,
+    4.0,
+    "",
+    "force exponents of contact laws lie between 1 (flat punch) and about 3 (rough surfaces, \
+     Kogut-Etsion fits); Hertz gives 1.5, the thesis 2; at 4 the force at the 0.01 mm damping \
+     depth is 1e-8 of the linear law's",
+);
+/// IMPACT maximum damping, N·s/mm.
+const CONTACT_DAMPING: Bound = Bound::new(
+    0.0,
+    1.0e5,
+    "N·s/mm",
+    "up to 200 times the thesis' 500 N·s/mm; more makes every impact plastic",
+);
+/// IMPACT full-damping penetration, mm.
+const CONTACT_PENETRATION: Bound = Bound::new(
+    0.0,
+    1.0,
+    "mm",
+    "full damping within 1 mm of penetration (thesis: 0.01 mm); deeper than the tight rail's \
+     whole clearance is no ramp",
+)
+.open_min();
+
+impl Bounded for ContactSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number(
+            "stiffness_n_per_mm_e",
+            self.stiffness_n_per_mm_e,
+            &CONTACT_STIFFNESS,
+        )?;
+        at.number("exponent", self.exponent, &CONTACT_EXPONENT)?;
+        at.number(
+            "damping_ns_per_mm",
+            self.damping_ns_per_mm,
+            &CONTACT_DAMPING,
+        )?;
+        at.number(
+            "penetration_depth_mm",
+            self.penetration_depth_mm,
+            &CONTACT_PENETRATION,
+        )
+    }
+}
+
+/// Friction coefficients (eq. 4.5, Tables 4.2, 5.2, 6.1).
+const MU: Bound = Bound::new(
+    0.0,
+    2.0,
+    "",
+    "friction coefficients of dry engineering pairs lie below 1.3 (clean aluminium); 2 bounds \
+     every real pair, Table 5.2 gives 0.18",
+);
+/// Friction transition speeds, mm/s (as case files write them).
+const TRANSITION_SPEED: Bound = Bound::new(
+    1.0e-3,
+    1.0e3,
+    "mm/s",
+    "friction transition speeds from 1 µm/s to 1 m/s (Table 5.2: 6.46 and 12 mm/s); above \
+     1 m/s every slip of a rattle is stiction",
+);
+
+/// A case's friction, at the names and units case files write (the speeds in mm/s).
+impl Bounded for FrictionParams {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("mu_static", self.mu_static, &MU)?;
+        at.number("mu_dynamic", self.mu_dynamic, &MU)?;
+        at.number(
+            "stiction_transition_speed_mm_per_s",
+            crate::units::to_mm(self.stiction_transition_speed),
+            &TRANSITION_SPEED,
+        )?;
+        at.number(
+            "friction_transition_speed_mm_per_s",
+            crate::units::to_mm(self.friction_transition_speed),
+            &TRANSITION_SPEED,
+        )
+    }
+}
+
+/// Material density range, kg/m³: from polymers to the densest metals (osmium 22 590). A
+/// wear calibration's density is held to it too.
+pub const DENSITY_KG_M3_RANGE: (f64, f64) = (500.0, 25_000.0);
+const DENSITY: Bound = Bound::new(
+    DENSITY_KG_M3_RANGE.0,
+    DENSITY_KG_M3_RANGE.1,
+    "kg/m³",
+    "from polymers to the densest metals (osmium 22 590 kg/m³)",
+);
+const YIELD_STRENGTH: Bound = Bound::new(
+    1.0e6,
+    1.0e10,
+    "Pa",
+    "from soft polymers (1 MPa) to above the strongest steels (maraging 2.5 GPa)",
+);
+const YOUNGS_MODULUS: Bound = Bound::new(
+    1.0e7,
+    1.2e12,
+    "Pa",
+    "from elastomers (10 MPa) to diamond (1.2 TPa)",
+);
+const POISSON_RATIO: Bound = Bound::new(
+    -1.0,
+    0.5,
+    "",
+    "an isotropic solid is stable only for -1 < ν <= 0.5",
+)
+.open_min();
+const BRINELL_HARDNESS: Bound = Bound::new(
+    1.0,
+    1000.0,
+    "HB",
+    "from lead (about 5 HB) to above hardened tool steel (about 700 HB)",
+);
+
+/// The material of a case's contacting parts (`wear::material::Material`).
+impl Bounded for Material {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("density_kg_per_m3", self.density_kg_per_m3, &DENSITY)?;
+        at.number("yield_strength_pa", self.yield_strength_pa, &YIELD_STRENGTH)?;
+        at.number("youngs_modulus_pa", self.youngs_modulus_pa, &YOUNGS_MODULUS)?;
+        at.number("poisson_ratio", self.poisson_ratio, &POISSON_RATIO)?;
+        at.number("brinell_hardness", self.brinell_hardness, &BRINELL_HARDNESS)
+    }
+}
+
 /// A box with rounded edges and corners (a convex contact piece, SPEC 2), given by its centre
 /// in a stated frame, its outer half extents (including the roundover) along that frame's axes,
 /// and its edge radius.
@@ -123,6 +260,14 @@ impl RoundedBoxSpec {
     }
 }
 
+impl Bounded for RoundedBoxSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.numbers("centre_m", &self.centre_m, &POSITION)?;
+        at.numbers("half_extents_m", &self.half_extents_m, &LENGTH)?;
+        at.number("edge_radius_m", self.edge_radius_m, &EDGE_RADIUS)
+    }
+}
+
 /// A bounded planar face (a rectangle) of a kinematic body, derived from a spec.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlanarFace {
@@ -139,6 +284,82 @@ pub struct PlanarFace {
     /// Half size along `normal x tangent`, m.
     pub half_width_m: f64,
 }
+
+/// Longest excited duration of a job, s: 24 h of simulated time. The thesis' longest run is
+/// the 12 h launcher validation (6.7); beyond a day a run is a typing error (1e308 s was
+/// once accepted and grew memory without end).
+pub const MAX_DURATION_S: f64 = 86_400.0;
+/// Longest settle phase, s: ten minutes, well past the tens-of-seconds creep time constant
+/// of a body resting on a face (SPEC 8); the thesis settles for 2 s (6.6.1).
+pub const MAX_SETTLE_S: f64 = 600.0;
+/// Shortest track-record interval, s: 1 us resolves a 500 Hz excitation 2000 times over;
+/// finer only multiplies stored samples.
+pub const MIN_RECORD_INTERVAL_S: f64 = 1.0e-6;
+/// Relative error tolerance range: looser than 10 % is no error control; tighter than
+/// 1e-10 is below what double precision holds over a run.
+pub const REL_TOLERANCE_RANGE: (f64, f64) = (1.0e-10, 0.1);
+/// Absolute position tolerance range, m: coarser than 0.1 mm does not resolve the 0.2 mm
+/// clearance of the tight rail; finer than 1e-15 m is below double precision on metres.
+pub const ABS_TOLERANCE_M_RANGE: (f64, f64) = (1.0e-15, 1.0e-4);
+/// Largest seed, 2^53 - 1: every seed a JSON reader parses into a double (JavaScript, jq)
+/// is then exact, so a run can be reproduced from what a dashboard shows.
+pub const MAX_SEED: u64 = (1 << 53) - 1;
+
+/// A settle phase, s (the case's and a base motion's).
+pub(in crate::models) const SETTLE: Bound = Bound::new(
+    0.0,
+    MAX_SETTLE_S,
+    "s",
+    "a settle of up to ten minutes, past the contact creep time constant (thesis: 2 s)",
+);
+/// An excited duration, s (the case's and a synthesised random record's).
+pub(in crate::models) const DURATION: Bound = Bound::new(
+    MIN_RECORD_INTERVAL_S,
+    MAX_DURATION_S,
+    "s",
+    "from one record interval (1 µs) to 24 h of simulated time (thesis: 12 h at most); also \
+     the length of a synthesised random record",
+);
+/// A seed (the case's and a random base motion's).
+pub(in crate::models) const SEED: Bound = Bound::new(
+    0.0,
+    MAX_SEED as f64,
+    "",
+    "seeds below 2^53 read back exactly from JSON (see limits::MAX_SEED)",
+);
+const REL_TOLERANCE: Bound = Bound::new(
+    REL_TOLERANCE_RANGE.0,
+    REL_TOLERANCE_RANGE.1,
+    "",
+    "looser than 10 % is no error control; tighter than 1e-10 is below double precision",
+);
+const ABS_TOLERANCE: Bound = Bound::new(
+    ABS_TOLERANCE_M_RANGE.0,
+    ABS_TOLERANCE_M_RANGE.1,
+    "m",
+    "coarser than 0.1 mm misses the tight rail's 0.2 mm clearance; finer than 1e-15 m is below \
+     double precision on metres",
+);
+const RECORD_INTERVAL: Bound = Bound::new(
+    MIN_RECORD_INTERVAL_S,
+    MAX_DURATION_S,
+    "s",
+    "1 µs resolves a 500 Hz excitation 2000 times over",
+);
+const ENERGY_REL_TOLERANCE: Bound = Bound::new(
+    0.0,
+    0.5,
+    "",
+    "above 50 % the energy account's quadrature error is as large as the work it checks; 0 \
+     switches the check off",
+);
+const POINTS_PER_EDGE: Bound = Bound::new(
+    crate::geometry::lattice::POINTS_PER_EDGE_RANGE.0 as f64,
+    crate::geometry::lattice::POINTS_PER_EDGE_RANGE.1 as f64,
+    "",
+    "2 points per edge are the corners; beyond 33 the cost grows with no change in the \
+     resolved face law",
+);
 
 /// Run-control settings shared by all models.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -224,6 +445,32 @@ fn default_abs_tolerance_m() -> f64 {
 }
 fn default_record_interval_s() -> f64 {
     1.0e-4
+}
+
+impl Bounded for SimulationSpec {
+    fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
+        at.number("settle_s", self.settle_s, &SETTLE)?;
+        at.number("duration_s", self.duration_s, &DURATION)?;
+        at.text("integrator", &self.integrator, super::MAX_TEXT_CHARS, false)?;
+        at.number("rel_tolerance", self.rel_tolerance, &REL_TOLERANCE)?;
+        at.number("abs_tolerance_m", self.abs_tolerance_m, &ABS_TOLERANCE)?;
+        at.number("seed", self.seed as f64, &SEED)?;
+        at.number(
+            "record_interval_s",
+            self.record_interval_s,
+            &RECORD_INTERVAL,
+        )?;
+        at.optional(
+            "energy_rel_tolerance",
+            self.energy_rel_tolerance,
+            &ENERGY_REL_TOLERANCE,
+        )?;
+        at.number(
+            "contact_points_per_edge",
+            self.contact_points_per_edge as f64,
+            &POINTS_PER_EDGE,
+        )
+    }
 }
 
 impl SimulationSpec {
