@@ -18,7 +18,7 @@ use super::point::{friction_derivatives, penetration_rate, Lump, PointOutputs};
 use super::reduced::ClosedPart;
 use super::Contact;
 use super::{JacobianScope, TrackLinearization};
-use crate::geometry::{inner_box_faces, FacePatch, PlacedFace, QuadratureOrder};
+use crate::geometry::{inner_box_faces, FacePatch, GradedStrip, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use crate::physics::step::StepKind;
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
@@ -434,13 +434,24 @@ impl Contact {
             // matrix takes the strip's derivatives on the side rule's nodes instead
             // ([`STRIP_JACOBIAN_RULE`]); the force stays the fine rule's.
             let order = QuadratureOrder::ROUNDED_EDGE;
+            // The damping's ramp `w < d`, where the graded rule cuts a column.
+            let ramp = if self.impact.max_damping > 0.0 {
+                self.impact.full_damping_depth
+            } else {
+                0.0
+            };
             let coarse = out.scope == JacobianScope::NewtonMatrix
                 && out.linearizing()
                 && self.friction_rule == FrictionRule::PerNode;
             let kept = coarse.then(|| (out.linearizations.take(), out.moments.take()));
-            strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
-                visit(x, fine * share, out)
-            });
+            strip.for_each_node_graded(
+                order,
+                ROUNDED_EDGE_SLICES,
+                radius,
+                ramp,
+                GradedStrip::ROUNDED_EDGE,
+                &mut |x, share| visit(x, fine * share, out),
+            );
             if let Some((linearizations, moments)) = kept {
                 out.linearizations = linearizations;
                 out.moments = moments;
