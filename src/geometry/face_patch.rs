@@ -28,7 +28,9 @@
 //! energy, which is continuous across the side: the region boundary terms of the two parts'
 //! gradients cancel, so no force acts on the cut line, and a shoe sliding off a lip unloads
 //! continuously even when a whole face crosses the edge at once. `w` is not polynomial there;
-//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/reference/models.md gives the measured error).
+//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it, along the edge graded by the density's
+//! smoothness ([`FacePatch::for_each_node_graded`]; docs/reference/models.md gives the
+//! measured error).
 //!
 //! Hot path: fixed-size arrays only, no heap allocation.
 
@@ -371,11 +373,6 @@ impl FacePatch {
                 keep = patch.clip(&within(reach));
             }
             if keep {
-                // Sliced exactly across the side's edge (`u` along the gradient of `g`): the
-                // strip's lines `g = 0` and `g = −reach` are then slice boundaries, the strip
-                // one vertex interval (a face's axis only nearly across the edge cut thin
-                // end slices off it, each with the whole rule), and the integrand's kink at
-                // `w = 0` lies in few slices.
                 // The strip's edge line, kept when no vertex lies beyond another side (the
                 // distance is then `√(h⁺² + q²)` with `q = −g` alone); turned with the strip
                 // below, `g` depends on `u` alone.
@@ -387,6 +384,11 @@ impl FacePatch {
                     _ => true,
                 });
                 patch.edge = lone.then_some(g);
+                // Sliced exactly across the side's edge (`u` along the gradient of `g`): the
+                // strip's lines `g = 0` and `g = −reach` are then slice boundaries, the strip
+                // one vertex interval (a face's axis only nearly across the edge cut thin
+                // end slices off it, each with the whole rule), and the integrand's kink at
+                // `w = 0` lies in few slices.
                 each(k, &patch.aligned_with(&g));
             }
         }
@@ -607,9 +609,9 @@ impl FacePatch {
     /// fixed distance `q` beyond the edge) the balls at height `h(v) = r − w_plane(v)` (affine)
     /// touch the rounded edge where `h⁺² + q² < r²`: one interval `[a, b]`, found in closed
     /// form, on which `w = r − √(h⁺² + q²)` is analytic but at `h = 0`. With `x` the distance of
-    /// `h = 0` from the interval's middle in half-lengths, `ρ = x + √(x² − 1)` is the largest
-    /// Bernstein ellipse the density is analytic in, and a Gauss rule of `m` nodes errs by
-    /// about `ρ^(−2m)`. Columns with `ρ >= graded.full` take `graded.along_edge` nodes on
+    /// `h = 0` from the interval's middle in half-lengths, the density is analytic inside the
+    /// Bernstein ellipse through it, `ρ = x + √(x² − 1)`, and a Gauss rule of `m` nodes errs
+    /// by about `ρ^(−2m)`. Columns with `ρ >= graded.full` take `graded.along_edge` nodes on
     /// `[a, b]`; with `ρ <= graded.from`, `order.across` nodes on the whole column (the fixed
     /// rule); between, both, their shares blended by a smooth step in `ρ`, so the rule and
     /// the stored energy it integrates are continuous in the pose. The coarse rule's interval
@@ -684,7 +686,7 @@ impl FacePatch {
                 // Cut where `w = ramp` (`h⁺² + q² = (r − ramp)²`) when that is inside
                 // [a, b]: the damping's STEP(w) ends there, each piece its own rule.
                 let core = (radius - ramp) * (radius - ramp) - q * q;
-                let cut = if ramp > 0.0 && core > 0.0 && s != 0.0 {
+                let cut = if ramp > 0.0 && ramp < radius && core > 0.0 && s != 0.0 {
                     Some((core.sqrt() - h0) / s).filter(|c| *c > a && *c < b)
                 } else {
                     None
