@@ -32,6 +32,10 @@
 //! smoothness ([`FacePatch::for_each_node_graded`]; docs/reference/models.md gives the
 //! measured error).
 //!
+//! Over 700 lines: the patch's cutting (clip, split, strips) and its rules (sliced, clamped,
+//! graded along a strip's edge) all walk the same private vertex array and columns, which
+//! a second file would have to open up.
+//!
 //! Hot path: fixed-size arrays only, no heap allocation.
 
 use super::bounded_face::PlacedFace;
