@@ -28,7 +28,13 @@
 //! energy, which is continuous across the side: the region boundary terms of the two parts'
 //! gradients cancel, so no force acts on the cut line, and a shoe sliding off a lip unloads
 //! continuously even when a whole face crosses the edge at once. `w` is not polynomial there;
-//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it (docs/reference/models.md gives the measured error).
+//! [`QuadratureOrder::ROUNDED_EDGE`] integrates it, along the edge graded by the density's
+//! smoothness ([`FacePatch::for_each_node_graded`]; docs/reference/models.md gives the
+//! measured error).
+//!
+//! Over 700 lines: the patch's cutting (clip, split, strips) and its rules (sliced, clamped,
+//! graded along a strip's edge) all walk the same private vertex array and columns, which
+//! a second file would have to open up.
 //!
 //! Hot path: fixed-size arrays only, no heap allocation.
 
@@ -123,6 +129,45 @@ impl QuadratureOrder {
     }
 }
 
+/// The rule along the edge of a strip beyond a bounded face's side
+/// ([`FacePatch::for_each_node_graded`]): a column whose density is analytic in the Bernstein
+/// ellipse of parameter `ρ` around its touching interval takes `along_edge` Gauss nodes
+/// there when `ρ >= full`, the fixed rule's when `ρ <= from`, and both, blended, between.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GradedStrip {
+    /// Gauss nodes along the edge on a smooth column's touching interval (1 to 5).
+    pub along_edge: usize,
+    /// At or below this `ρ` the fixed rule alone.
+    pub from: f64,
+    /// At or above this `ρ` the coarse rule alone.
+    pub full: f64,
+}
+
+impl GradedStrip {
+    /// The contact's rule on a facing face's strips (with [`QuadratureOrder::ROUNDED_EDGE`]
+    /// on two slices across the edge): 3 nodes along the edge from `ρ = 8` (a Gauss rule of
+    /// `m` nodes errs by about `ρ^(−2m)`: 4e-6), the fixed rule's 5 on the whole column up to
+    /// `ρ = 4`, both blended between.
+    pub const ROUNDED_EDGE: Self = Self {
+        along_edge: 3,
+        from: 4.0,
+        full: 8.0,
+    };
+
+    /// The coarse rule's share at `ρ`: 0 up to `from`, 1 from `full`, a smoothstep
+    /// `3t² − 2t³` between (continuous with its derivative).
+    pub fn share(&self, rho: f64) -> f64 {
+        if rho >= self.full {
+            1.0
+        } else if rho <= self.from {
+            0.0
+        } else {
+            let t = (rho - self.from) / (self.full - self.from);
+            t * t * (3.0 - 2.0 * t)
+        }
+    }
+}
+
 /// An affine function `alpha + beta · ξ` of a patch's material coordinates (a clip keeps its
 /// `>= 0` side).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,6 +205,10 @@ pub struct FacePatch {
     axis_u: Vector3<f64>,
     axis_v: Vector3<f64>,
     depth: Line,
+    /// On a strip beyond one side only ([`FacePatch::beyond_sides`]): that side's line `g`
+    /// (positive over the face's extent), so `q = −g` is the distance beyond the edge; `None`
+    /// on a pressed polygon and on a strip that also reaches beyond another side.
+    edge: Option<Line>,
     verts: [[f64; 2]; MAX_VERTICES],
     len: usize,
 }
@@ -188,6 +237,7 @@ impl FacePatch {
             axis_u,
             axis_v,
             depth,
+            edge: None,
             verts: [[0.0; 2]; MAX_VERTICES],
             len: 4,
         };
@@ -327,6 +377,17 @@ impl FacePatch {
                 keep = patch.clip(&within(reach));
             }
             if keep {
+                // The strip's edge line, kept when no vertex lies beyond another side (the
+                // distance is then `√(h⁺² + q²)` with `q = −g` alone); turned with the strip
+                // below, `g` depends on `u` alone.
+                let lone = sides.iter().enumerate().all(|(j, other)| match other {
+                    Some(other) if j != k => {
+                        let h = patch.side_line(other);
+                        patch.vertices().iter().all(|&p| h.at(p) >= 0.0)
+                    }
+                    _ => true,
+                });
+                patch.edge = lone.then_some(g);
                 // Sliced exactly across the side's edge (`u` along the gradient of `g`): the
                 // strip's lines `g = 0` and `g = −reach` are then slice boundaries, the strip
                 // one vertex interval (a face's axis only nearly across the edge cut thin
@@ -374,8 +435,11 @@ impl FacePatch {
         let mut out = *self;
         out.axis_u = self.axis_u * e1[0] + self.axis_v * e1[1];
         out.axis_v = self.axis_u * e2[0] + self.axis_v * e2[1];
-        let b = self.depth.beta;
-        out.depth.beta = [b[0] * e1[0] + b[1] * e1[1], b[0] * e2[0] + b[1] * e2[1]];
+        let turn = |b: [f64; 2]| [b[0] * e1[0] + b[1] * e1[1], b[0] * e2[0] + b[1] * e2[1]];
+        out.depth.beta = turn(self.depth.beta);
+        if let Some(edge) = &mut out.edge {
+            edge.beta = turn(edge.beta);
+        }
         for (o, p) in out.verts[..self.len]
             .iter_mut()
             .zip(&self.verts[..self.len])
@@ -539,6 +603,112 @@ impl FacePatch {
             for (xv, wv) in xs_v.iter().zip(ws_v) {
                 let v = vm + half_v * xv;
                 visit(base + self.axis_v * v, 0.25 * half_u * wu * half_v * wv);
+            }
+        });
+    }
+
+    /// [`FacePatch::for_each_node_sliced`] on a strip beyond one side of a bounded face
+    /// ([`FacePatch::beyond_sides`]), each column along the edge on a rule sized by how
+    /// smooth the balls' penetration is there ([`GradedStrip`]). On a column (fixed `u`, so
+    /// fixed distance `q` beyond the edge) the balls at height `h(v) = r − w_plane(v)` (affine)
+    /// touch the rounded edge where `h⁺² + q² < r²`: one interval `[a, b]`, found in closed
+    /// form, on which `w = r − √(h⁺² + q²)` is analytic but at `h = 0`. With `x` the distance of
+    /// `h = 0` from the interval's middle in half-lengths, the density is analytic inside the
+    /// Bernstein ellipse through it, `ρ = x + √(x² − 1)`, and a Gauss rule of `m` nodes errs
+    /// by about `ρ^(−2m)`. Columns with `ρ >= graded.full` take `graded.along_edge` nodes on
+    /// `[a, b]`; with `ρ <= graded.from`, `order.across` nodes on the whole column (the fixed
+    /// rule); between, both, their shares blended by a smooth step in `ρ`, so the rule and
+    /// the stored energy it integrates are continuous in the pose. The coarse rule's interval
+    /// is cut where `w = ramp` (the damping's STEP ends there; 0: no cut) when that lies
+    /// inside it, each piece with `graded.along_edge` nodes. A column no ball of which
+    /// touches gets no node (the fixed rule's would all add zero). A patch without an edge
+    /// (a pressed polygon, a strip also beyond another side) takes the fixed rule.
+    pub fn for_each_node_graded(
+        &self,
+        order: QuadratureOrder,
+        parts: usize,
+        radius: f64,
+        ramp: f64,
+        graded: GradedStrip,
+        visit: &mut impl FnMut(Point3<f64>, f64),
+    ) {
+        let Some(edge) = self.edge else {
+            self.for_each_node_sliced(order, parts, visit);
+            return;
+        };
+        let (xs_v, ws_v) = rule(order.across);
+        let (xs_c, ws_c) = rule(graded.along_edge);
+        // The height over the plane, `h0 + s v` on a column.
+        let slope = self.depth.beta[1];
+        self.for_each_column(order.along, parts, |u, half_u, wu, lo, hi| {
+            let q = (-edge.at([u, 0.5 * (lo + hi)])).max(0.0);
+            let room = radius * radius - q * q;
+            if room <= 0.0 {
+                return;
+            }
+            let top = room.sqrt();
+            let h0 = radius - self.depth.at([u, 0.0]);
+            let s = -slope;
+            // Where h(v) < top: the touching interval [a, b].
+            let (a, b) = if s > 0.0 {
+                (lo, hi.min((top - h0) / s))
+            } else if s < 0.0 {
+                (lo.max((top - h0) / s), hi)
+            } else if h0 < top {
+                (lo, hi)
+            } else {
+                return;
+            };
+            if b <= a {
+                return;
+            }
+            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+            let coarse = if s == 0.0 {
+                1.0
+            } else {
+                let x = (-h0 / s - mid).abs() / half;
+                let rho = if x > 1.0 {
+                    x + (x * x - 1.0).sqrt()
+                } else {
+                    1.0
+                };
+                graded.share(rho)
+            };
+            let base = self.column_base(u);
+            let column = 0.25 * half_u * wu;
+            if coarse < 1.0 {
+                let (vm, half_v) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+                for (xv, wv) in xs_v.iter().zip(ws_v) {
+                    let v = vm + half_v * xv;
+                    visit(
+                        base + self.axis_v * v,
+                        (1.0 - coarse) * column * half_v * wv,
+                    );
+                }
+            }
+            if coarse > 0.0 {
+                // Cut where `w = ramp` (`h⁺² + q² = (r − ramp)²`) when that is inside
+                // [a, b]: the damping's STEP(w) ends there, each piece its own rule.
+                let core = (radius - ramp) * (radius - ramp) - q * q;
+                let cut = if ramp > 0.0 && ramp < radius && core > 0.0 && s != 0.0 {
+                    Some((core.sqrt() - h0) / s).filter(|c| *c > a && *c < b)
+                } else {
+                    None
+                };
+                let mut piece = |a: f64, b: f64| {
+                    let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+                    for (xv, wv) in xs_c.iter().zip(ws_c) {
+                        let v = mid + half * xv;
+                        visit(base + self.axis_v * v, coarse * column * half * wv);
+                    }
+                };
+                match cut {
+                    Some(c) => {
+                        piece(a, c);
+                        piece(c, b);
+                    }
+                    None => piece(a, b),
+                }
             }
         });
     }

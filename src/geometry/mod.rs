@@ -37,7 +37,7 @@ mod steiner_pieces;
 mod tests;
 
 pub use bounded_face::{FaceExtent, PlacedFace};
-pub use face_patch::{inner_box_faces, FacePatch, Line, QuadratureOrder};
+pub use face_patch::{inner_box_faces, FacePatch, GradedStrip, Line, QuadratureOrder};
 pub use halfspace_overlap::{shape_halfspace_depth, shape_halfspace_overlap, PlaneOverlap};
 pub use lattice::{contact_points, ContactPoint, DEFAULT_POINTS_PER_EDGE};
 pub use polygon_moments::PolygonMoments;

@@ -210,8 +210,9 @@ pub(crate) fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
 }
 
 /// Relative bound on `F + ∂U/∂x` and on the power balance: the pressed polygons are
-/// integrated exactly; the strips beyond the lip's edge (at most a roundover wide) by a 5 × 5
-/// Gauss rule on a non-polynomial `w`, whose error is what is left (measured worst 1.6e-4 of
+/// integrated exactly; the strips beyond the lip's edge (at most a roundover wide) by Gauss
+/// rules (5 nodes across the edge, graded along it) on a non-polynomial `w`, whose error is
+/// what is left (measured worst 1.6e-4 of
 /// the contact's power over these poses; docs/reference/models.md "Exact face contact").
 const GRADIENT_TOLERANCE: f64 = 5e-4;
 

@@ -13,6 +13,7 @@ mod face_contact_blocks;
 mod face_contact_closed_form;
 mod face_contact_reduced;
 mod face_contact_rules;
+mod face_contact_strips;
 mod face_friction_rule;
 mod gap_campaign;
 mod gap_diagnose;

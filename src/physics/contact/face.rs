@@ -18,7 +18,7 @@ use super::point::{friction_derivatives, penetration_rate, Lump, PointOutputs};
 use super::reduced::ClosedPart;
 use super::Contact;
 use super::{JacobianScope, TrackLinearization};
-use crate::geometry::{inner_box_faces, FacePatch, PlacedFace, QuadratureOrder};
+use crate::geometry::{inner_box_faces, FacePatch, GradedStrip, PlacedFace, QuadratureOrder};
 use crate::physics::body::BodyFrame;
 use crate::physics::step::StepKind;
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
@@ -33,7 +33,8 @@ pub enum FaceContact {
     Lattice,
     /// Each face integrated over its pressed polygon with a Gauss rule exact for the IMPACT
     /// law's force, torque and stored energy (integer exponent), and over the strips beyond a
-    /// bounded face's sides with a 5 × 5 rule: the lattice's limit of infinitely many points
+    /// bounded face's sides with 5 nodes across the edge and a rule along it graded by the
+    /// density's smoothness ([`GradedStrip`]): the lattice's limit of infinitely many points
     /// (docs/reference/models.md "Exact face contact").
     Exact,
     /// The exact face contact with the clamp-free parts of each pressed polygon (the closing
@@ -60,8 +61,10 @@ pub enum FrictionRule {
     PerPart,
 }
 
-/// Slices per strip beyond a bounded face's side (each with the 5 × 5 rule): the strip's
-/// integrand has a kink where `w = 0` crosses it on a tilted face.
+/// Slices per strip beyond a bounded face's side (each with 5 nodes across the edge, and
+/// along it the 5 of [`QuadratureOrder::ROUNDED_EDGE`] or fewer where
+/// [`GradedStrip::ROUNDED_EDGE`] allows): the strip's integrand has a kink where `w = 0`
+/// crosses it on a tilted face.
 const ROUNDED_EDGE_SLICES: usize = 2;
 
 /// Which inner faces take the side rules, by `|n_F · n|`, the cosine between the inner
@@ -93,7 +96,8 @@ const SIDE_SHARE_MAX: f64 = 0.02;
 /// The rule a Newton matrix takes a facing face's strip beyond a bounded face's side on
 /// ([`JacobianScope::NewtonMatrix`]): one slice of 3 × 3 nodes (the side faces' strips' rule)
 /// for the derivatives, where the force takes [`QuadratureOrder::ROUNDED_EDGE`] on
-/// [`ROUNDED_EDGE_SLICES`] slices (50 nodes).
+/// [`ROUNDED_EDGE_SLICES`] slices, graded along the edge ([`GradedStrip::ROUNDED_EDGE`]: 50
+/// nodes on the fixed rule, 30 on smooth columns).
 const STRIP_JACOBIAN_RULE: QuadratureOrder = QuadratureOrder::SIDE_EDGE;
 
 /// The ramp rule of the faces that do not face the plane ([`FACING`]): 3 nodes across the
@@ -434,13 +438,24 @@ impl Contact {
             // matrix takes the strip's derivatives on the side rule's nodes instead
             // ([`STRIP_JACOBIAN_RULE`]); the force stays the fine rule's.
             let order = QuadratureOrder::ROUNDED_EDGE;
+            // The damping's ramp `w < d`, where the graded rule cuts a column.
+            let ramp = if self.impact.max_damping > 0.0 {
+                self.impact.full_damping_depth
+            } else {
+                0.0
+            };
             let coarse = out.scope == JacobianScope::NewtonMatrix
                 && out.linearizing()
                 && self.friction_rule == FrictionRule::PerNode;
             let kept = coarse.then(|| (out.linearizations.take(), out.moments.take()));
-            strip.for_each_node_sliced(order, ROUNDED_EDGE_SLICES, &mut |x, share| {
-                visit(x, fine * share, out)
-            });
+            strip.for_each_node_graded(
+                order,
+                ROUNDED_EDGE_SLICES,
+                radius,
+                ramp,
+                GradedStrip::ROUNDED_EDGE,
+                &mut |x, share| visit(x, fine * share, out),
+            );
             if let Some((linearizations, moments)) = kept {
                 out.linearizations = linearizations;
                 out.moments = moments;
