@@ -46,7 +46,8 @@ pub struct ConfirmScores {
     pub run: usize,
     /// Of those eligible, confirmed after it.
     pub confirmed: usize,
-    /// Explained naming a wrong effect after it.
+    /// Explained naming an effect the rig did not inject after it (one member of an injected
+    /// pair named alone is incomplete, not wrong).
     pub wrong_after: usize,
 }
 
@@ -84,18 +85,30 @@ pub(super) fn score(outcomes: &[Outcome]) -> Option<ConfirmScores> {
         return None;
     }
     let eligible: Vec<&Outcome> = outcomes.iter().filter(|o| eligible(o)).collect();
-    let ran: Vec<&NextTestOutcome> = eligible
+    let ran: Vec<(&Outcome, &NextTestOutcome)> = eligible
         .iter()
-        .filter_map(|o| o.next_test.as_ref())
+        .filter_map(|o| o.next_test.as_ref().map(|n| (*o, n)))
         .collect();
-    let chosen_wrong =
-        |n: &NextTestOutcome| n.verdict == Verdict::Explained && !n.confirmed && n.chosen.is_some();
     Some(ConfirmScores {
         eligible: eligible.len(),
-        run: ran.iter().filter(|n| n.cost_h > 0.0).count(),
-        confirmed: ran.iter().filter(|n| n.confirmed).count(),
-        wrong_after: ran.iter().filter(|n| chosen_wrong(n)).count(),
+        run: ran.iter().filter(|(_, n)| n.cost_h > 0.0).count(),
+        confirmed: ran.iter().filter(|(_, n)| n.confirmed).count(),
+        wrong_after: ran
+            .iter()
+            .filter(|(o, n)| named_wrong_after(&o.scenario.truth, n))
+            .count(),
     })
+}
+
+/// `explained` after the next test naming an effect the rig did not inject: the bench's own
+/// rule for a wrong name ("wrong names" in its scores). One member of an injected pair named
+/// alone is incomplete, not wrong: it is counted neither confirmed nor wrong.
+fn named_wrong_after(truth: &str, n: &NextTestOutcome) -> bool {
+    n.verdict == Verdict::Explained
+        && n.chosen.as_deref().is_some_and(|c| {
+            c.split('+')
+                .any(|name| !truth.split('+').any(|t| t == name))
+        })
 }
 
 /// Same effects, in any order: `a+b` and `b+a` name one pair.
@@ -190,7 +203,43 @@ pub(super) fn confirm(
 
 #[cfg(test)]
 mod tests {
-    use super::same_name;
+    use super::{named_wrong_after, same_name, NextTestOutcome, Verdict};
+
+    #[test]
+    fn a_wrong_name_is_one_the_rig_did_not_inject() {
+        let after = |verdict: Verdict, chosen: Option<&str>| NextTestOutcome {
+            test: "next-1".into(),
+            cost_h: 8.0,
+            separation_nats: 5.0,
+            verdict,
+            chosen: chosen.map(str::to_string),
+            confirmed: false,
+        };
+        let truth = "fixture_compliance+cross_axis";
+        // One member of the injected pair: incomplete, not wrong.
+        assert!(!named_wrong_after(
+            truth,
+            &after(Verdict::Explained, Some("cross_axis"))
+        ));
+        // An effect the rig did not inject.
+        assert!(named_wrong_after(
+            truth,
+            &after(Verdict::Explained, Some("third_body"))
+        ));
+        assert!(named_wrong_after(
+            truth,
+            &after(Verdict::Explained, Some("cross_axis+severe_wear"))
+        ));
+        // Only `explained` names anything.
+        assert!(!named_wrong_after(
+            truth,
+            &after(Verdict::PartlyExplained, Some("third_body"))
+        ));
+        assert!(!named_wrong_after(
+            "cross_axis",
+            &after(Verdict::NotExplained, None)
+        ));
+    }
 
     #[test]
     fn a_pair_is_one_name_in_either_order() {
