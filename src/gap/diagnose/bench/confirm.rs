@@ -40,7 +40,8 @@ pub struct NextTestOutcome {
 /// The confirm mode's scores.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConfirmScores {
-    /// Campaigns partly or not explained with a detectable in-library truth.
+    /// Campaigns partly or not explained with a detectable in-library truth (a pair only
+    /// when identifiable).
     pub eligible: usize,
     /// Of those, a next test proposed and run.
     pub run: usize,
@@ -62,7 +63,7 @@ impl ConfirmScores {
             }
         };
         format!(
-            "| confirmed (explained, right name) after one proposed next test ({} partly or not explained, detectable; {} with a test proposed) | {} | >= 80 % |\n| wrong names after the next test | {} | <= 5 % |\n",
+            "| confirmed (explained, right name) after one proposed next test ({} partly or not explained, detectable, pairs identifiable; {} with a test proposed) | {} | >= 80 % |\n| wrong names after the next test | {} | <= 5 % |\n",
             self.eligible,
             self.run,
             pct(self.confirmed),
@@ -71,11 +72,15 @@ impl ConfirmScores {
     }
 }
 
-/// Whether a campaign's outcome asks for the confirm step.
+/// Whether a campaign's outcome asks for the confirm step: partly or not explained with a
+/// detectable in-library truth, a pair only where the data can name both members (the bench
+/// scores pairs over identifiable ones; one whose member alone fits better by AICc cannot be
+/// confirmed as a pair by one more test of the same kind).
 pub(super) fn eligible(o: &Outcome) -> bool {
     o.scenario.in_library
         && o.scenario.truth != "control"
         && o.detectable
+        && (!o.scenario.truth.contains('+') || o.pair_identifiable())
         && matches!(o.verdict, Verdict::PartlyExplained | Verdict::NotExplained)
 }
 
@@ -203,7 +208,48 @@ pub(super) fn confirm(
 
 #[cfg(test)]
 mod tests {
-    use super::{named_wrong_after, same_name, NextTestOutcome, Verdict};
+    use super::super::test_outcome::outcome;
+    use super::{eligible, named_wrong_after, same_name, NextTestOutcome, Outcome, Verdict};
+    use crate::gap::diagnose::truth_fit::TruthFit;
+
+    /// The confirm step asks for a partly or not explained campaign with a detectable truth,
+    /// a pair only when the data can name both members (the rule the pair scores use).
+    #[test]
+    fn the_confirm_step_takes_pairs_only_where_identifiable() {
+        let pair = |truth_aicc: f64, member_aicc: f64| Outcome {
+            truth_fit: Some(TruthFit {
+                chi2: 0.0,
+                dof: 84.0,
+                parameters: 4,
+                p_value: 0.5,
+                nll: 0.0,
+                aicc: truth_aicc,
+                fits: true,
+                by_group: Vec::new(),
+                worst: Vec::new(),
+            }),
+            best_member_aicc: Some(member_aicc),
+            ..outcome(
+                "fixture_compliance+cross_axis",
+                true,
+                Verdict::PartlyExplained,
+                Some("cross_axis"),
+            )
+        };
+        assert!(eligible(&pair(-40.0, -31.0)));
+        // The member alone fits better: no test of the same kind names both.
+        assert!(!eligible(&pair(-31.2, -38.2)));
+        let single = |verdict| outcome("cross_axis", true, verdict, Some("cross_axis"));
+        assert!(eligible(&single(Verdict::PartlyExplained)));
+        assert!(eligible(&single(Verdict::NotExplained)));
+        assert!(!eligible(&single(Verdict::Explained)));
+        assert!(!eligible(&outcome(
+            "surface_oxide",
+            false,
+            Verdict::NotExplained,
+            None
+        )));
+    }
 
     #[test]
     fn a_wrong_name_is_one_the_rig_did_not_inject() {

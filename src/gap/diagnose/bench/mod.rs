@@ -228,6 +228,58 @@ pub struct Outcome {
     pub next_test: Option<confirm::NextTestOutcome>,
 }
 
+impl Outcome {
+    /// A pair whose truth fits and beats each member alone by AICc: the data can name both.
+    pub(super) fn pair_identifiable(&self) -> bool {
+        self.truth_fit
+            .as_ref()
+            .zip(self.best_member_aicc)
+            .is_some_and(|(t, single)| t.fits && t.aicc < single)
+    }
+}
+
+/// An outcome for the scoring tests: the campaign's truth, whether it is in the library, the
+/// verdict and the name chosen; detectable in four tests, nothing else set.
+#[cfg(test)]
+pub(super) mod test_outcome {
+    use super::{Outcome, Scenario, Verdict};
+
+    pub(in crate::gap::diagnose::bench) fn outcome(
+        truth: &str,
+        in_library: bool,
+        verdict: Verdict,
+        chosen: Option<&str>,
+    ) -> Outcome {
+        Outcome {
+            scenario: Scenario {
+                truth: truth.into(),
+                in_library,
+                magnitude: 1.0,
+                effects: Vec::new(),
+                noise_rel: 0.03,
+                seed: 0,
+                accelerometers: true,
+            },
+            detectability: 10.0,
+            detectable: true,
+            member_detectability: Vec::new(),
+            member_distinguishable: Vec::new(),
+            detectable_at_drawn: true,
+            detectable_tests: 4,
+            verdict,
+            chosen: chosen.map(str::to_string),
+            shrink: chosen.map(|_| 0.9),
+            fitted_magnitude: None,
+            fitted: Vec::new(),
+            nominal_p_value: 0.0,
+            flagged: Vec::new(),
+            truth_fit: None,
+            best_member_aicc: None,
+            next_test: None,
+        }
+    }
+}
+
 /// One parameter of a named effect.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FittedValue {

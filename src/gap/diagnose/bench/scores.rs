@@ -177,10 +177,7 @@ fn truth_fits(o: &Outcome) -> bool {
 
 /// A pair whose truth fits and beats each member alone by AICc.
 fn identifiable(o: &Outcome) -> bool {
-    o.truth_fit
-        .as_ref()
-        .zip(o.best_member_aicc)
-        .is_some_and(|(t, single)| t.fits && t.aicc < single)
+    o.pair_identifiable()
 }
 
 fn named_wrong(o: &Outcome) -> bool {
@@ -485,40 +482,11 @@ impl Scores {
 #[cfg(test)]
 mod tests {
     use super::super::coverage::holds;
-    use super::super::{FittedValue, Scenario};
+    use super::super::test_outcome::outcome;
+    use super::super::FittedValue;
     use super::*;
     use crate::gap::diagnose::truth_fit::TruthFit;
     use crate::gap::effects::Effect;
-
-    fn outcome(truth: &str, in_library: bool, verdict: Verdict, chosen: Option<&str>) -> Outcome {
-        Outcome {
-            scenario: Scenario {
-                truth: truth.into(),
-                in_library,
-                magnitude: 1.0,
-                effects: Vec::new(),
-                noise_rel: 0.03,
-                seed: 0,
-                accelerometers: true,
-            },
-            detectability: 10.0,
-            detectable: true,
-            member_detectability: Vec::new(),
-            member_distinguishable: Vec::new(),
-            detectable_at_drawn: true,
-            detectable_tests: 4,
-            verdict,
-            chosen: chosen.map(str::to_string),
-            shrink: chosen.map(|_| 0.9),
-            fitted_magnitude: None,
-            fitted: Vec::new(),
-            nominal_p_value: 0.0,
-            flagged: Vec::new(),
-            truth_fit: None,
-            best_member_aicc: None,
-            next_test: None,
-        }
-    }
 
     /// A pair is both named whatever the order of its names; naming one member is neither
     /// both named nor wrong; naming an effect the rig did not inject is wrong, and so is any
