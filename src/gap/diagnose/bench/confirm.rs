@@ -1,8 +1,10 @@
 //! The loop closed on the bench (`diagnose-bench --confirm`): a campaign whose answer is
-//! `partly_explained` or `not_explained` while its in-library truth is detectable gets its top
-//! proposed next test run by the rig under the same hidden truth; the test is appended and the
-//! campaign diagnosed again on an emulator built for the longer campaign. **Confirmed** is
-//! `explained` with the right name (a pair: both members) after that one test.
+//! `partly_explained` or `not_explained` while its in-library truth is detectable (a pair only
+//! where identifiable, `eligible`) gets its top proposed next test run by the rig under the
+//! same hidden truth; the test is appended and the campaign diagnosed again on an emulator
+//! built for the longer campaign. **Confirmed** is `explained` with the right name (a pair:
+//! both members) after that one test; **wrong** is `explained` naming an effect the rig did not
+//! inject.
 
 use super::scenarios::rig_options;
 use super::{BenchOptions, Outcome, Scenario};
