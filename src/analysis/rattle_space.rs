@@ -215,7 +215,7 @@ impl LauncherDimensions {
     }
 
     /// All fields with their names, in declaration order.
-    fn named_fields(&self) -> [(&'static str, f64); 14] {
+    pub fn named_fields(&self) -> [(&'static str, f64); 14] {
         [
             ("a_shoe_mm", self.a_shoe_mm),
             ("f_shoe_mm", self.f_shoe_mm),

@@ -297,22 +297,7 @@ const FORCE: Bound = Bound::new(
 /// The lettered cross-section dimensions (`analysis::rattle_space::LauncherDimensions`).
 impl Bounded for LauncherDimensions {
     fn check_bounds(&self, at: &mut FieldPath) -> Result<(), FieldError> {
-        for (name, v) in [
-            ("a_shoe_mm", self.a_shoe_mm),
-            ("f_shoe_mm", self.f_shoe_mm),
-            ("g_shoe_mm", self.g_shoe_mm),
-            ("h_shoe_mm", self.h_shoe_mm),
-            ("i_shoe_mm", self.i_shoe_mm),
-            ("j_shoe_mm", self.j_shoe_mm),
-            ("k_shoe_mm", self.k_shoe_mm),
-            ("l_shoe_mm", self.l_shoe_mm),
-            ("m_shoe_mm", self.m_shoe_mm),
-            ("n_shoe_mm", self.n_shoe_mm),
-            ("o_shoe_mm", self.o_shoe_mm),
-            ("b_rail_mm", self.b_rail_mm),
-            ("n_rail_mm", self.n_rail_mm),
-            ("q_rail_mm", self.q_rail_mm),
-        ] {
+        for (name, v) in self.named_fields() {
             at.number(name, v, &LAUNCHER_DIMENSION)?;
         }
         Ok(())
