@@ -177,8 +177,81 @@ fn a_uniformly_pressed_face_carries_k_w_e_times_its_pressed_share() {
 }
 
 /// Stored energy of the head at `pose` (no velocity).
-fn stored(contact: &Contact, pose: &Isometry3<f64>) -> f64 {
+pub(crate) fn stored(contact: &Contact, pose: &Isometry3<f64>) -> f64 {
     evaluate(contact, pose, Vector3::zeros(), Vector3::zeros()).0
+}
+
+/// Lever of the rotational central differences, m: a turn of `h / LEVER` moves the head's
+/// faces by about `h`, and a torque residual is compared with the force's times it.
+pub(crate) const LEVER: f64 = 0.05;
+
+/// `∂U/∂x` and `∂U/∂θ` of the stored energy at `pose` by central differences: a translation
+/// step `h` along each axis and a turn of `h / LEVER` about it.
+pub(crate) fn energy_gradient(
+    contact: &Contact,
+    pose: &Isometry3<f64>,
+    h: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let (mut along, mut about) = (Vector3::zeros(), Vector3::zeros());
+    let angle = h / LEVER;
+    for i in 0..3 {
+        let moved = |s: f64| {
+            Isometry3::from_parts(
+                Translation3::from(pose.translation.vector + Vector3::ith(i, s * h)),
+                pose.rotation,
+            )
+        };
+        along[i] = (stored(contact, &moved(1.0)) - stored(contact, &moved(-1.0))) / (2.0 * h);
+        let turn = |s: f64| {
+            let r = UnitQuaternion::from_scaled_axis(Vector3::ith(i, s * angle));
+            Isometry3::from_parts(pose.translation, r * pose.rotation)
+        };
+        about[i] = (stored(contact, &turn(1.0)) - stored(contact, &turn(-1.0))) / (2.0 * angle);
+    }
+    (along, about)
+}
+
+/// The power account of the head moving at `(v, omega)` from `pose`: the power its motion
+/// takes from the contact `F·v + τ·ω`, the elastic `dU/dt` (central differences along the
+/// motion over 1 ns) and the damping and friction power the tracks report.
+pub(crate) fn power_account(
+    contact: &Contact,
+    pose: &Isometry3<f64>,
+    (v, omega): (Vector3<f64>, Vector3<f64>),
+    (force, torque, tracks): (Vector3<f64>, Vector3<f64>, &[TrackState]),
+) -> PowerAccount {
+    let dt = 1e-9;
+    let moved = |s: f64| {
+        Isometry3::from_parts(
+            Translation3::from(pose.translation.vector + v * (s * dt)),
+            UnitQuaternion::from_scaled_axis(omega * (s * dt)) * pose.rotation,
+        )
+    };
+    PowerAccount {
+        power: force.dot(&v) + torque.dot(&omega),
+        du_dt: (stored(contact, &moved(1.0)) - stored(contact, &moved(-1.0))) / (2.0 * dt),
+        damping: tracks.iter().map(|t| t.damping_power).sum(),
+        friction: tracks.iter().map(|t| t.friction_power).sum(),
+    }
+}
+
+/// What [`power_account`] measures, W.
+pub(crate) struct PowerAccount {
+    pub power: f64,
+    pub du_dt: f64,
+    pub damping: f64,
+    pub friction: f64,
+}
+
+impl PowerAccount {
+    /// `power + dU/dt + damping + friction` (zero for a passive contact) and the scale it is
+    /// judged against (the sum of the terms' sizes).
+    pub(crate) fn residual_and_scale(&self) -> (f64, f64) {
+        (
+            self.power + self.du_dt + self.damping + self.friction,
+            self.power.abs() + self.du_dt.abs() + self.damping + self.friction,
+        )
+    }
 }
 
 /// Height of the head's centre above its lowest point when turned by `rot`: the inner box's
@@ -198,6 +271,16 @@ pub(crate) fn random_pose(rng: &mut ChaCha8Rng, max_w: f64) -> Isometry3<f64> {
         rng.gen_range(-0.3..0.3),
         rng.gen_range(-0.01..0.01),
     );
+    placed_over_lip(rng, rot, max_w)
+}
+
+/// The head turned by `rot`, placed over the lip's edge (x from -0.03 to 0.02 m, z within
+/// 0.01 m) with its lowest point `0..max_w` deep.
+pub(crate) fn placed_over_lip(
+    rng: &mut ChaCha8Rng,
+    rot: UnitQuaternion<f64>,
+    max_w: f64,
+) -> Isometry3<f64> {
     let lowest = lowest_point_depth(&rot);
     Isometry3::from_parts(
         Translation3::new(
@@ -239,37 +322,21 @@ fn the_elastic_force_is_minus_the_gradient_of_the_stored_energy_across_a_lip_edg
         let scale = force.norm();
         // Central differences: truncation (h/w)², round-off ε w / h.
         let h = (1e-3 * depth).min(1e-8);
+        let (along, about) = energy_gradient(&contact, &pose, h);
         for i in 0..3 {
-            let e = Vector3::ith(i, h);
-            let plus = Isometry3::from_parts(
-                Translation3::from(pose.translation.vector + e),
-                pose.rotation,
-            );
-            let minus = Isometry3::from_parts(
-                Translation3::from(pose.translation.vector - e),
-                pose.rotation,
-            );
-            let grad = (stored(&contact, &plus) - stored(&contact, &minus)) / (2.0 * h);
-            worst = worst.max((force[i] + grad).abs() / scale);
+            worst = worst.max((force[i] + along[i]).abs() / scale);
             assert!(
-                (force[i] + grad).abs() <= GRADIENT_TOLERANCE * scale,
+                (force[i] + along[i]).abs() <= GRADIENT_TOLERANCE * scale,
                 "force {i}: {} vs −∂U = {} at {pose:?}",
                 force[i],
-                -grad
+                -along[i]
             );
-            let angle = h / 0.05;
-            let turn = |s: f64| {
-                let r = UnitQuaternion::from_scaled_axis(Vector3::ith(i, s * angle));
-                Isometry3::from_parts(pose.translation, r * pose.rotation)
-            };
-            let grad =
-                (stored(&contact, &turn(1.0)) - stored(&contact, &turn(-1.0))) / (2.0 * angle);
-            worst = worst.max((torque[i] + grad).abs() / (scale * 0.05));
+            worst = worst.max((torque[i] + about[i]).abs() / (scale * LEVER));
             assert!(
-                (torque[i] + grad).abs() <= GRADIENT_TOLERANCE * scale * 0.05,
+                (torque[i] + about[i]).abs() <= GRADIENT_TOLERANCE * scale * LEVER,
                 "torque {i}: {} vs −∂U = {} at {pose:?}",
                 torque[i],
-                -grad
+                -about[i]
             );
         }
     }
@@ -293,21 +360,17 @@ fn damping_and_friction_only_dissipate_node_by_node() {
             continue;
         }
         loaded += 1;
-        let power = force.dot(&v) + torque.dot(&omega);
-        let dt = 1e-9;
-        let moved = |s: f64| {
-            Isometry3::from_parts(
-                Translation3::from(pose.translation.vector + v * (s * dt)),
-                UnitQuaternion::from_scaled_axis(omega * (s * dt)) * pose.rotation,
-            )
-        };
-        let du_dt = (stored(&contact, &moved(1.0)) - stored(&contact, &moved(-1.0))) / (2.0 * dt);
-        let damping: f64 = tracks.iter().map(|t| t.damping_power).sum();
-        let friction: f64 = tracks.iter().map(|t| t.friction_power).sum();
+        let account = power_account(&contact, &pose, (v, omega), (force, torque, &tracks));
+        let PowerAccount {
+            power,
+            du_dt,
+            damping,
+            friction,
+        } = account;
         assert!(damping >= 0.0 && friction >= 0.0);
-        let scale = power.abs() + du_dt.abs() + damping + friction;
+        let (residual, scale) = account.residual_and_scale();
         assert!(
-            (power + du_dt + damping + friction).abs() <= GRADIENT_TOLERANCE * scale,
+            residual.abs() <= GRADIENT_TOLERANCE * scale,
             "power {power} dU/dt {du_dt} damping {damping} friction {friction}"
         );
     }

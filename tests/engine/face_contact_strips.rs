@@ -6,9 +6,12 @@
 //! contact's elastic force as minus the gradient of the stored energy, and its power balance,
 //! on the nearly level poses, where the coarse rule and its blend with the fixed one act.
 
-use super::face_contact::{evaluate, lip_contact, lip_plane, random_motion, table_6_2};
+use super::face_contact::{
+    energy_gradient, evaluate, lip_contact, lip_plane, power_account, random_motion, table_6_2,
+    LEVER,
+};
 use super::face_contact::{HALF, ROUNDOVER};
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use railwear::geometry::{inner_box_faces, FacePatch, GradedStrip, PlacedFace, QuadratureOrder};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -38,15 +41,7 @@ fn pose(rng: &mut ChaCha8Rng, max_tilt: f64, max_w: f64) -> Isometry3<f64> {
         rng.gen_range(-0.3..0.3),
         tilt(rng, max_tilt),
     );
-    let lowest = super::face_contact::lowest_point_depth(&rot);
-    Isometry3::from_parts(
-        Translation3::new(
-            rng.gen_range(-0.03..0.02),
-            lowest - rng.gen_range(0.0..max_w),
-            rng.gen_range(-0.01..0.01),
-        ),
-        rot,
-    )
+    super::face_contact::placed_over_lip(rng, rot, max_w)
 }
 
 /// The strips of the head's bottom inner face (the one facing the lip) at `pose`.
@@ -200,10 +195,6 @@ fn graded_strips_keep_the_fixed_rules_accuracy_on_fewer_nodes() {
 /// Relative bound on `F + ∂U/∂x` and on the power balance (face_contact.rs's).
 const GRADIENT_TOLERANCE: f64 = 5e-4;
 
-fn stored(contact: &railwear::physics::contact::Contact, pose: &Isometry3<f64>) -> f64 {
-    evaluate(contact, pose, Vector3::zeros(), Vector3::zeros()).0
-}
-
 #[test]
 fn on_nearly_level_heads_the_force_is_minus_the_gradient_and_the_power_balances() {
     // Where the graded rule acts (a head nearly level over the lip's edge, its height over the
@@ -225,41 +216,17 @@ fn on_nearly_level_heads_the_force_is_minus_the_gradient_and_the_power_balances(
         checked += 1;
         let scale = force.norm();
         let h = (1e-3 * depth).min(1e-8);
+        let (along, about) = energy_gradient(&contact, &pose, h);
         for i in 0..3 {
-            let e = Vector3::ith(i, h);
-            let moved = |s: f64| {
-                Isometry3::from_parts(
-                    Translation3::from(pose.translation.vector + e * s),
-                    pose.rotation,
-                )
-            };
-            let grad = (stored(&contact, &moved(1.0)) - stored(&contact, &moved(-1.0))) / (2.0 * h);
-            worst = worst.max((force[i] + grad).abs() / scale);
-            let angle = h / 0.05;
-            let turn = |s: f64| {
-                let r = UnitQuaternion::from_scaled_axis(Vector3::ith(i, s * angle));
-                Isometry3::from_parts(pose.translation, r * pose.rotation)
-            };
-            let grad =
-                (stored(&contact, &turn(1.0)) - stored(&contact, &turn(-1.0))) / (2.0 * angle);
-            worst = worst.max((torque[i] + grad).abs() / (scale * 0.05));
+            worst = worst.max((force[i] + along[i]).abs() / scale);
+            worst = worst.max((torque[i] + about[i]).abs() / (scale * LEVER));
         }
         let (v, omega) = random_motion(&mut rng, [0.05, 0.01, 0.05], [0.5, 2.0, 0.5]);
         let (_, force, torque, tracks) = evaluate(&contact, &pose, v, omega);
-        let power = force.dot(&v) + torque.dot(&omega);
-        let dt = 1e-9;
-        let moved = |s: f64| {
-            Isometry3::from_parts(
-                Translation3::from(pose.translation.vector + v * (s * dt)),
-                UnitQuaternion::from_scaled_axis(omega * (s * dt)) * pose.rotation,
-            )
-        };
-        let du_dt = (stored(&contact, &moved(1.0)) - stored(&contact, &moved(-1.0))) / (2.0 * dt);
-        let damping: f64 = tracks.iter().map(|t| t.damping_power).sum();
-        let friction: f64 = tracks.iter().map(|t| t.friction_power).sum();
-        assert!(damping >= 0.0 && friction >= 0.0);
-        let scale = power.abs() + du_dt.abs() + damping + friction;
-        worst_power = worst_power.max((power + du_dt + damping + friction).abs() / scale);
+        let account = power_account(&contact, &pose, (v, omega), (force, torque, &tracks));
+        assert!(account.damping >= 0.0 && account.friction >= 0.0);
+        let (residual, scale) = account.residual_and_scale();
+        worst_power = worst_power.max(residual.abs() / scale);
     }
     eprintln!("{checked} poses: worst |F + ∂U| / |F| {worst:.2e}, power balance {worst_power:.2e}");
     assert!(checked >= 100, "{checked} poses over the edge");
