@@ -220,6 +220,10 @@ enum Command {
         /// code version match (it depends on no measurement).
         #[arg(long)]
         emulator_file: Option<PathBuf>,
+        /// Diagnose nothing: score together the outcomes of earlier runs' `--out` files (a
+        /// seed run in parts with `--only`, or several seeds), print the table, write `--out`.
+        #[arg(long, value_delimiter = ',')]
+        rescore: Vec<PathBuf>,
         /// Directory of reference configs and profiles.
         #[arg(long, env = "RAILWEAR_CONFIGS_DIR", default_value = "configs")]
         configs_dir: PathBuf,
@@ -662,9 +666,13 @@ async fn run(cli: Cli) -> Result<()> {
             only,
             out,
             emulator_file,
+            rescore,
             configs_dir,
         } => {
             init_logging(false);
+            if !rescore.is_empty() {
+                return railwear::cli::rescore_bench(rescore, out.as_deref());
+            }
             let mut options = railwear::gap::diagnose::bench::BenchOptions {
                 campaigns: *campaigns,
                 seed: *seed,

@@ -640,6 +640,42 @@ pub fn diagnose_bench(
     Ok(())
 }
 
+/// `railwear diagnose-bench --rescore`: the outcomes of earlier runs' `--out` files scored
+/// together (each campaign once: a campaign in two files is an error, not counted twice).
+pub fn rescore_bench(files: &[std::path::PathBuf], out: Option<&Path>) -> Result<()> {
+    use crate::gap::diagnose::bench::{score, Scores};
+    let mut outcomes = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for path in files {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let scores: Scores = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a diagnose-bench --out file", path.display()))?;
+        for o in scores.outcomes {
+            if !seen.insert(o.scenario.seed) {
+                anyhow::bail!(
+                    "{}: campaign {} is already in an earlier file",
+                    path.display(),
+                    o.scenario.seed
+                );
+            }
+            outcomes.push(o);
+        }
+    }
+    let scores = score(outcomes);
+    println!(
+        "diagnose-bench: {} campaigns from {} files\n",
+        scores.campaigns,
+        files.len()
+    );
+    println!("{}", scores.table());
+    if let Some(path) = out {
+        std::fs::write(path, serde_json::to_string_pretty(&scores)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
