@@ -643,13 +643,19 @@ pub fn diagnose_bench(
 /// `railwear diagnose-bench --rescore`: the outcomes of earlier runs' `--out` files scored
 /// together (each campaign once: a campaign in two files is an error, not counted twice).
 pub fn rescore_bench(files: &[std::path::PathBuf], out: Option<&Path>) -> Result<()> {
-    use crate::gap::diagnose::bench::{score, Scores};
+    use crate::gap::diagnose::bench::{score, Outcome};
+    /// The part of a `--out` file read back: its scores are recomputed (a share over no
+    /// campaign was written as `null`).
+    #[derive(serde::Deserialize)]
+    struct OutFile {
+        outcomes: Vec<Outcome>,
+    }
     let mut outcomes = Vec::new();
     let mut seen = std::collections::BTreeSet::new();
     for path in files {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        let scores: Scores = serde_json::from_str(&text)
+        let scores: OutFile = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a diagnose-bench --out file", path.display()))?;
         for o in scores.outcomes {
             if !seen.insert(o.scenario.seed) {
@@ -679,6 +685,25 @@ pub fn rescore_bench(files: &[std::path::PathBuf], out: Option<&Path>) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rescore_refuses_a_file_that_is_not_a_bench_output_and_names_it() {
+        let dir = std::env::temp_dir().join(format!("railwear-rescore-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let empty = dir.join("empty.json");
+        let scores = crate::gap::diagnose::bench::score(Vec::new());
+        std::fs::write(&empty, serde_json::to_string(&scores).unwrap()).unwrap();
+        let other = dir.join("other.json");
+        std::fs::write(&other, "{\"verdict\": \"no_gap\"}").unwrap();
+        let out = dir.join("merged.json");
+        rescore_bench(&[empty.clone(), empty.clone()], Some(&out)).unwrap();
+        let merged: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        assert_eq!(merged["campaigns"], 0);
+        let e = rescore_bench(&[empty, other.clone()], None).unwrap_err();
+        assert!(format!("{e:#}").contains("other.json"), "{e:#}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn steps_follow_the_1_2_5_series() {
