@@ -52,6 +52,14 @@ pub struct ConfirmScores {
     /// Explained naming an effect the rig did not inject after it (one member of an injected
     /// pair named alone is incomplete, not wrong).
     pub wrong_after: usize,
+    /// Of those eligible, the ones whose truth, simulated in the emulator at its drawn values,
+    /// fits the campaign within its noise (`Outcome::truth_fit`): the ones any diagnosis
+    /// through this emulator could confirm (a pair's eligibility already asks it).
+    #[serde(default)]
+    pub truth_fits: usize,
+    /// Of those, confirmed after the next test.
+    #[serde(default)]
+    pub truth_fits_confirmed: usize,
 }
 
 impl ConfirmScores {
@@ -64,11 +72,21 @@ impl ConfirmScores {
                 format!("{:.0} %", 100.0 * n as f64 / self.eligible as f64)
             }
         };
+        let fits = if self.truth_fits == 0 {
+            "n/a".to_string()
+        } else {
+            format!(
+                "{:.0} %",
+                100.0 * self.truth_fits_confirmed as f64 / self.truth_fits as f64
+            )
+        };
         format!(
-            "| confirmed (explained, right name) after one proposed next test ({} partly or not explained, detectable, pairs identifiable; {} with a test proposed) | {} | >= 80 % |\n| wrong names after the next test | {} | <= 5 % |\n",
+            "| confirmed (explained, right name) after one proposed next test ({} partly or not explained, detectable, pairs identifiable; {} with a test proposed) | {} | >= 80 % |\n| of them, those whose truth the emulator fits within the noise ({}) | {} | |\n| wrong names after the next test | {} | <= 5 % |\n",
             self.eligible,
             self.run,
             pct(self.confirmed),
+            self.truth_fits,
+            fits,
             pct(self.wrong_after)
         )
     }
@@ -104,7 +122,17 @@ pub(super) fn score(outcomes: &[Outcome]) -> Option<ConfirmScores> {
             .iter()
             .filter(|(o, n)| named_wrong_after(&o.scenario.truth, n))
             .count(),
+        truth_fits: eligible.iter().filter(|o| truth_fits(o)).count(),
+        truth_fits_confirmed: ran
+            .iter()
+            .filter(|(o, n)| n.confirmed && truth_fits(o))
+            .count(),
     })
+}
+
+/// The truth's own fit passes the lack-of-fit test.
+fn truth_fits(o: &Outcome) -> bool {
+    o.truth_fit.as_ref().is_some_and(|t| t.fits)
 }
 
 /// `explained` after the next test naming an effect the rig did not inject: the bench's own
@@ -211,7 +239,7 @@ pub(super) fn confirm(
 #[cfg(test)]
 mod tests {
     use super::super::test_outcome::outcome;
-    use super::{eligible, named_wrong_after, same_name, NextTestOutcome, Outcome, Verdict};
+    use super::{eligible, named_wrong_after, same_name, score, NextTestOutcome, Outcome, Verdict};
     use crate::gap::diagnose::truth_fit::TruthFit;
 
     /// The confirm step asks for a partly or not explained campaign with a detectable truth,
@@ -287,6 +315,48 @@ mod tests {
             "cross_axis",
             &after(Verdict::NotExplained, None)
         ));
+    }
+
+    /// The confirm score counts apart the campaigns whose truth the emulator itself fits: a
+    /// truth it cannot reproduce no next test can confirm.
+    #[test]
+    fn the_confirm_score_counts_apart_the_truths_the_emulator_fits() {
+        let fit = |fits: bool| TruthFit {
+            chi2: 0.0,
+            dof: 84.0,
+            parameters: 1,
+            p_value: if fits { 0.5 } else { 3e-22 },
+            nll: 0.0,
+            aicc: 0.0,
+            fits,
+            by_group: Vec::new(),
+            worst: Vec::new(),
+        };
+        let ran = |fits: bool, confirmed: bool| Outcome {
+            truth_fit: Some(fit(fits)),
+            next_test: Some(NextTestOutcome {
+                test: "next-1".into(),
+                cost_h: 8.0,
+                separation_nats: 5.0,
+                verdict: if confirmed {
+                    Verdict::Explained
+                } else {
+                    Verdict::NotExplained
+                },
+                chosen: confirmed.then(|| "friction_drift".to_string()),
+                confirmed,
+            }),
+            ..outcome(
+                "friction_drift",
+                true,
+                Verdict::PartlyExplained,
+                Some("friction_drift"),
+            )
+        };
+        let scores = score(&[ran(true, true), ran(true, false), ran(false, false)]).unwrap();
+        assert_eq!((scores.eligible, scores.run, scores.confirmed), (3, 3, 1));
+        assert_eq!((scores.truth_fits, scores.truth_fits_confirmed), (2, 1));
+        assert!(scores.rows().contains("(2) | 50 %"), "{}", scores.rows());
     }
 
     #[test]
