@@ -220,8 +220,7 @@ enum Command {
         /// code version match (it depends on no measurement).
         #[arg(long)]
         emulator_file: Option<PathBuf>,
-        /// Diagnose nothing: score together the outcomes of earlier runs' `--out` files (a
-        /// seed run in parts with `--only`, or several seeds), print the table, write `--out`.
+        /// Score the outcomes of earlier runs' `--out` files together instead of diagnosing.
         #[arg(long, value_delimiter = ',')]
         rescore: Vec<PathBuf>,
         /// Directory of reference configs and profiles.
@@ -670,9 +669,6 @@ async fn run(cli: Cli) -> Result<()> {
             configs_dir,
         } => {
             init_logging(false);
-            if !rescore.is_empty() {
-                return railwear::cli::rescore_bench(rescore, out.as_deref());
-            }
             let mut options = railwear::gap::diagnose::bench::BenchOptions {
                 campaigns: *campaigns,
                 seed: *seed,
@@ -690,6 +686,7 @@ async fn run(cli: Cli) -> Result<()> {
                 &options,
                 out.as_deref(),
                 emulator_file.as_deref(),
+                rescore,
                 configs_dir,
             )
         }
