@@ -38,12 +38,7 @@ pub fn diagnose_bench(
         options.rig_window_s,
         started.elapsed().as_secs_f64()
     );
-    println!("{}", scores.table());
-    if let Some(path) = out {
-        std::fs::write(path, serde_json::to_string_pretty(&scores)?)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
-    Ok(())
+    print_and_write(&scores, out)
 }
 
 /// `railwear diagnose-bench --rescore`: the outcomes of earlier runs' `--out` files scored
@@ -80,9 +75,14 @@ pub fn rescore_bench(files: &[std::path::PathBuf], out: Option<&Path>) -> Result
         scores.campaigns,
         files.len()
     );
+    print_and_write(&scores, out)
+}
+
+/// The scores' table on stdout, and the scores with every outcome as JSON in `out` if given.
+fn print_and_write(scores: &crate::gap::diagnose::bench::Scores, out: Option<&Path>) -> Result<()> {
     println!("{}", scores.table());
     if let Some(path) = out {
-        std::fs::write(path, serde_json::to_string_pretty(&scores)?)
+        std::fs::write(path, serde_json::to_string_pretty(scores)?)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())

@@ -248,21 +248,19 @@ pub fn compare_rattle_box(
     // What the closing paragraph says is read off the rows, so the generated text cannot
     // contradict its own table: the measured rates' orders of magnitude above railwear's and
     // the share of the friction work done above the cutoff, lowest and highest over the cases.
-    let range = |values: &mut dyn Iterator<Item = f64>| {
+    fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
         values
             .filter(|x| x.is_finite())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
                 (lo.min(x), hi.max(x))
             })
-    };
+    }
     let (above_lo, above_hi) = range(
-        &mut rows
-            .iter()
+        rows.iter()
             .map(|((_, measured, _), _, _, c, ..)| (measured / c.mass_rate_mg_per_h).log10()),
     );
     let (cut_lo, cut_hi) = range(
-        &mut rows
-            .iter()
+        rows.iter()
             .map(|(_, _, _, c, ..)| 100.0 * c.work_share_above_cutoff),
     );
     let span = |lo: f64, hi: f64| {

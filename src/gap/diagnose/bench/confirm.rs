@@ -122,17 +122,12 @@ pub(super) fn score(outcomes: &[Outcome]) -> Option<ConfirmScores> {
             .iter()
             .filter(|(o, n)| named_wrong_after(&o.scenario.truth, n))
             .count(),
-        truth_fits: eligible.iter().filter(|o| truth_fits(o)).count(),
+        truth_fits: eligible.iter().filter(|o| o.truth_fits()).count(),
         truth_fits_confirmed: ran
             .iter()
-            .filter(|(o, n)| n.confirmed && truth_fits(o))
+            .filter(|(o, n)| n.confirmed && o.truth_fits())
             .count(),
     })
-}
-
-/// The truth's own fit passes the lack-of-fit test.
-fn truth_fits(o: &Outcome) -> bool {
-    o.truth_fit.as_ref().is_some_and(|t| t.fits)
 }
 
 /// `explained` after the next test naming an effect the rig did not inject: the bench's own

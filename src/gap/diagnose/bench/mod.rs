@@ -229,6 +229,12 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// The truth, simulated in the emulator at its drawn values, passes the lack-of-fit test:
+    /// the library's model of the truth itself fits within the noise.
+    pub(super) fn truth_fits(&self) -> bool {
+        self.truth_fit.as_ref().is_some_and(|t| t.fits)
+    }
+
     /// A pair whose truth fits and beats each member alone by AICc: the data can name both.
     pub(super) fn pair_identifiable(&self) -> bool {
         self.truth_fit

@@ -171,15 +171,6 @@ fn led_right(o: &Outcome) -> bool {
 }
 
 /// A confident name that is not the truth: explained by an effect the rig did not inject.
-fn truth_fits(o: &Outcome) -> bool {
-    o.truth_fit.as_ref().is_some_and(|t| t.fits)
-}
-
-/// A pair whose truth fits and beats each member alone by AICc.
-fn identifiable(o: &Outcome) -> bool {
-    o.pair_identifiable()
-}
-
 fn named_wrong(o: &Outcome) -> bool {
     if o.verdict != Verdict::Explained {
         return false;
@@ -221,7 +212,8 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
         .filter(|o| o.scenario.truth.contains('+') && o.detectable_at_drawn)
         .collect();
     let conf_pairs: Vec<&&&Outcome> = det_pairs.iter().filter(|o| confirmable(o)).collect();
-    let identifiable: Vec<&&&Outcome> = det_pairs.iter().filter(|o| identifiable(o)).collect();
+    let identifiable: Vec<&&&Outcome> =
+        det_pairs.iter().filter(|o| o.pair_identifiable()).collect();
     let conf: Vec<&&&&Outcome> = det_lib.iter().filter(|o| confirmable(o)).collect();
     let one_test: Vec<&&&&Outcome> = det_lib.iter().filter(|o| !confirmable(o)).collect();
     let undet: Vec<&&&Outcome> = singles.iter().filter(|o| !o.detectable).collect();
@@ -284,13 +276,13 @@ pub fn score(outcomes: Vec<Outcome>) -> Scores {
             drawn_pairs.iter().filter(|o| named_right(o)).count(),
             drawn_pairs.len(),
         ),
-        pairs_truth_fits: det_pairs.iter().filter(|o| truth_fits(o)).count(),
+        pairs_truth_fits: det_pairs.iter().filter(|o| o.truth_fits()).count(),
         identifiable_pairs: identifiable.len(),
         identifiable_pairs_both_named: share(
             identifiable.iter().filter(|o| named_right(o)).count(),
             identifiable.len(),
         ),
-        singles_truth_fits: det_lib.iter().filter(|o| truth_fits(o)).count(),
+        singles_truth_fits: det_lib.iter().filter(|o| o.truth_fits()).count(),
         wrong_names: wrong,
         wrong_name_rate: share(wrong, outcomes.len()),
         partly_explained: outcomes
