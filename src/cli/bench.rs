@@ -29,6 +29,15 @@ pub fn diagnose_bench(
         &RunControl::silent(),
         emulator_file,
         &|m| eprintln!("[{:>6.0} s] {m}", started.elapsed().as_secs_f64()),
+        &|outcomes| {
+            // The finished campaigns' scores after each one, so a run stopped part way keeps them.
+            if let Some(path) = out {
+                let partial = crate::gap::diagnose::bench::score(outcomes.to_vec());
+                if let Err(e) = write_scores(&partial, path) {
+                    tracing::warn!(error = %format!("{e:#}"), "diagnose-bench: partial --out not written");
+                }
+            }
+        },
     )?;
     println!(
         "diagnose-bench: {} campaigns on {} (seed {}, window {} s), {:.0} s\n",
@@ -81,11 +90,19 @@ pub fn rescore_bench(files: &[std::path::PathBuf], out: Option<&Path>) -> Result
 /// The scores' table on stdout, and the scores with every outcome as JSON in `out` if given.
 fn print_and_write(scores: &crate::gap::diagnose::bench::Scores, out: Option<&Path>) -> Result<()> {
     println!("{}", scores.table());
-    if let Some(path) = out {
-        std::fs::write(path, serde_json::to_string_pretty(scores)?)
-            .with_context(|| format!("writing {}", path.display()))?;
+    match out {
+        Some(path) => write_scores(scores, path),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// The scores with every outcome as JSON in `path`, replaced whole (written beside it, then
+/// renamed, so a run stopped while writing leaves the previous file).
+fn write_scores(scores: &crate::gap::diagnose::bench::Scores, path: &Path) -> Result<()> {
+    let partial = path.with_extension("json.part");
+    std::fs::write(&partial, serde_json::to_string_pretty(scores)?)
+        .with_context(|| format!("writing {}", partial.display()))?;
+    std::fs::rename(&partial, path).with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]

@@ -87,15 +87,24 @@ pub(crate) fn next_tests_text(tests: &[ProposedTest]) -> String {
         .iter()
         .filter_map(|t| t.repeats_test.as_deref())
         .collect();
-    let repeats = if repeated.is_empty() {
+    let mut repeats = if repeated.is_empty() {
         String::new()
     } else {
         format!(
-            "first repeats of {} (held out, {} cannot be confirmed without them), then ",
+            "repeats of {} (held out, {} cannot be confirmed without them), then ",
             repeated.join(", "),
             first.separates[0]
         )
     };
+    if let Some(alone) = first.second_to.as_deref() {
+        repeats = format!(
+            "{} a second test that carries {} (test {alone} alone carries it), then {repeats}",
+            first.test.id, first.separates[0]
+        );
+    }
+    if !repeats.is_empty() {
+        repeats = format!("first {repeats}");
+    }
     let mut out = format!(
         "next tests ({repeats}to tell {} from {}; decisive: expected log-likelihood ratio above ln 20 against each):",
         first.separates[0],

@@ -60,6 +60,12 @@ pub(super) struct Candidate {
     pub(super) fold_specs: Vec<Vec<(usize, f64)>>,
     pub(super) held_nll: Vec<f64>,
     pub(super) held_r2: Vec<f64>,
+    /// Per group, the held-out chi-square at the training fold's fit that predicts the group
+    /// best among those the training groups do not refuse (within [`PROFILE_95`](super::options::PROFILE_95) of the
+    /// fold's best: other values of parameters the training data leave open); `held_r2` at
+    /// most. What the group test uses: a prediction carries the spread of what the data
+    /// do not identify.
+    pub(super) held_r2_spread: Vec<f64>,
     pub(super) held_w: Vec<f64>,
     pub(super) aicc: f64,
     pub(super) bic: f64,
@@ -98,9 +104,10 @@ impl Candidate {
         }
     }
 
-    /// Each held-out group's test of being predicted within its noise ([`group_tests`]).
+    /// Each held-out group's test of being predicted within its noise ([`group_tests`]), on
+    /// the training fold's fits within [`PROFILE_95`](super::options::PROFILE_95) of its best (`held_r2_spread`).
     pub(super) fn group_tests(&self) -> Vec<GroupTest> {
-        group_tests(&self.held_r2, &self.held_w, self.alpha)
+        group_tests(&self.held_r2_spread, &self.held_w, self.alpha)
     }
 
     /// The held-out groups it does not predict within their noise.

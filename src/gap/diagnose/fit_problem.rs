@@ -296,26 +296,35 @@ impl<'a> FitProblem<'a> {
     ///   points, refined five-fold around the best; both are taken only when they beat the
     ///   better member alone by more than [`PROFILE_95`].
     pub(super) fn fit(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> Fit {
+        let mut fits = self.fits(model, mask);
+        let first = fits.remove(0);
+        unless_beaten(first, fits.into_iter())
+    }
+
+    /// Every fit [`FitProblem::fit`] chooses among on the groups `mask` keeps, the library
+    /// defaults' (or the tables the singles chose) first: one per table of the model's
+    /// secondary values, each at its best magnitudes.
+    pub(super) fn fits(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> Vec<Fit> {
         match model {
-            Model::Nominal => (Vec::new(), self.nll_of(&[], mask)),
-            Model::Single(f) => {
-                let tables = &self.families[f];
-                let (m0, n0) = self.fit_table(tables[0], mask);
-                let variants = tables[1..].iter().map(|&t| {
+            Model::Nominal => vec![(Vec::new(), self.nll_of(&[], mask))],
+            Model::Single(f) => self.families[f]
+                .iter()
+                .map(|&t| {
                     let (m, n) = self.fit_table(t, mask);
                     (vec![(t, m)], n)
-                });
-                unless_beaten((vec![(tables[0], m0)], n0), variants)
-            }
+                })
+                .collect(),
             Model::Pair(a, b) => {
                 // The tables the singles chose first; another combination of the two
                 // effects' tables (their secondary values profiled with the other member on)
                 // only when it beats them by more than [`PROFILE_95`], as for a single.
-                let combinations = self
-                    .pair_combinations(a, b)
-                    .into_iter()
-                    .map(|(ta, tb)| self.fit_pair_tables(ta, tb, mask));
-                unless_beaten(self.fit_pair_tables(a, b, mask), combinations)
+                std::iter::once(self.fit_pair_tables(a, b, mask))
+                    .chain(
+                        self.pair_combinations(a, b)
+                            .into_iter()
+                            .map(|(ta, tb)| self.fit_pair_tables(ta, tb, mask)),
+                    )
+                    .collect()
             }
         }
     }
@@ -325,16 +334,31 @@ impl<'a> FitProblem<'a> {
         let mut held_nll = Vec::with_capacity(self.groups);
         let mut held_r2 = Vec::with_capacity(self.groups);
         let mut held_w = Vec::with_capacity(self.groups);
+        let mut held_r2_spread = Vec::with_capacity(self.groups);
         let mut fold_specs = Vec::with_capacity(self.groups);
         for g in 0..self.groups {
-            let (spec, _) = self.fit(model, &|h| h != g);
+            let mut fits = self.fits(model, &|h| h != g);
+            let first = fits.remove(0);
+            let floor = fits.iter().map(|f| f.1).fold(first.1, f64::min);
+            let (spec, _) = unless_beaten(first.clone(), fits.iter().cloned());
             // Held out: the joint likelihood less the training groups' alone, i.e. group `g`
             // given the training groups (their calibration scales carried over).
-            let p = self.emulator.predict(&spec);
-            let held =
-                self.totals_of(&p, &spec, &|_| true) - self.totals_of(&p, &spec, &|h| h != g);
+            let held_of = |spec: &[(usize, f64)]| {
+                let p = self.emulator.predict(spec);
+                self.totals_of(&p, spec, &|_| true) - self.totals_of(&p, spec, &|h| h != g)
+            };
+            let held = held_of(&spec);
+            // The prediction carries the spread of what the training groups leave open: the
+            // group's chi-square at the fit, among those the training groups do not refuse
+            // (within PROFILE_95 of their best), that predicts it best.
+            let spread = std::iter::once(first)
+                .chain(fits)
+                .filter(|f| f.1 <= floor + PROFILE_95 && f.0 != spec)
+                .map(|f| held_of(&f.0).r2)
+                .fold(held.r2, f64::min);
             held_nll.push(held.nll);
             held_r2.push(held.r2);
+            held_r2_spread.push(spread);
             held_w.push(held.w);
             fold_specs.push(spec);
         }
@@ -360,6 +384,7 @@ impl<'a> FitProblem<'a> {
             fold_specs,
             held_nll,
             held_r2,
+            held_r2_spread,
             held_w,
             aicc: stats::aicc(k, nll_full, n),
             bic: k * n.max(1.0).ln() + 2.0 * nll_full,

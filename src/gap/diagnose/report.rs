@@ -278,6 +278,12 @@ pub struct Report {
     /// (docs/results/diagnosis.md, "The next test").
     #[serde(default)]
     pub to_repeat: Vec<String>,
+    /// The campaign test that carries 90 % or more of what the leading candidate explains
+    /// (held out by test only): held out, nothing else informs it, so the campaign cannot
+    /// confirm the candidate until a second test carries it (docs/results/diagnosis.md, "Seen
+    /// in one test"). None when no one test carries it.
+    #[serde(default)]
+    pub carried_by: Option<String>,
     /// The tests that would best confirm the leading candidate or separate it from its
     /// rivals: the repeats of `to_repeat` first, then cheapest decisive first
     /// (docs/results/diagnosis.md, "The next test"); empty when the verdict is `no_gap` or
@@ -387,6 +393,11 @@ pub struct ProposedTest {
     /// cannot (`Report::to_repeat`); None for a test chosen by its separation.
     #[serde(default)]
     pub repeats_test: Option<String>,
+    /// The campaign test that alone carries the leading candidate (`Report::carried_by`, or a
+    /// test of `to_repeat`) when this test, of another case or drive, is proposed to carry it
+    /// too: then each of the two is predicted held out from the other.
+    #[serde(default)]
+    pub second_to: Option<String>,
     /// Axis of the drive tone (`x`, `y`, `z`), when the drive is one sine tone.
     pub drive_axis: Option<String>,
     /// Peak level of the tone, g.

@@ -212,6 +212,9 @@ pub(super) fn confirm(
         cache,
         &|_, _| {},
     )?;
+    if let Some(dir) = &o.reports_dir {
+        super::run::write_report(dir, s, "-after", &after)?;
+    }
     let chosen = after.best_effect.as_ref().map(|b| b.name.clone());
     Ok(NextTestOutcome {
         test: format!(

@@ -17,7 +17,9 @@ use crate::gap::{Campaign, GapError};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Runs the bench. `progress(message)` reports each step.
+/// Runs the bench. `progress(message)` reports each step; `done(outcomes)` is called with
+/// every outcome so far after each campaign (so a long run's finished campaigns can be kept
+/// before it ends).
 pub fn run(
     skeleton: &Campaign,
     configs_dir: &Path,
@@ -25,6 +27,7 @@ pub fn run(
     control: &RunControl,
     emulator_file: Option<&Path>,
     progress: &(dyn Fn(String) + Sync),
+    done: &(dyn Fn(&[Outcome]) + Sync),
 ) -> Result<Scores, GapError> {
     skeleton.validate(configs_dir)?;
     let cache = WindowCache::new();
@@ -203,7 +206,7 @@ pub fn run(
             .as_ref()
             .map_or_else(|| "n/a".to_string(), |t| format!("{:.2e}", t.p_value));
         if let Some(dir) = &o.reports_dir {
-            write_report(dir, s, &report)?;
+            write_report(dir, s, "", &report)?;
         }
         let chosen = report.best_effect.as_ref().map(|b| b.name.clone());
         let mut outcome = Outcome {
@@ -280,6 +283,7 @@ pub fn run(
             outcome.next_test = Some(next);
         }
         outcomes.push(outcome);
+        done(&outcomes);
         let last = outcomes.last().map(|x| (x.verdict, x.chosen.clone()));
         progress(format!(
             "  -> {:?} {:?} (detectability {det:.1}, {refinements} refinement windows; the truth's own lack-of-fit p {truth_p})",
@@ -290,9 +294,15 @@ pub fn run(
     Ok(score(outcomes))
 }
 
-/// Writes `report` and its scenario as `<dir>/<rig seed>.json`.
-pub(super) fn write_report(dir: &Path, s: &Scenario, report: &Report) -> Result<(), GapError> {
-    let path = dir.join(format!("{}.json", s.seed));
+/// Writes `report` and its scenario as `<dir>/<rig seed><suffix>.json` (the confirm step's
+/// report after its next test: suffix `-after`).
+pub(super) fn write_report(
+    dir: &Path,
+    s: &Scenario,
+    suffix: &str,
+    report: &Report,
+) -> Result<(), GapError> {
+    let path = dir.join(format!("{}{suffix}.json", s.seed));
     let write_error = |x: String| GapError::Write {
         path: path.display().to_string(),
         message: x,

@@ -13,11 +13,17 @@
 //! 4. **How well it separates** ([`separation`]): the expected log-likelihood ratio between
 //!    the leading candidate and each rival under the campaign's noise model; a test is
 //!    *decisive* when it exceeds [`DECISIVE_NATS`] against every rival.
-//! 5. **Ranking**: first the repeats of the report's `to_repeat` tests (the tests the
-//!    leading candidate cannot predict held out), each as it was run: held out by test, a
-//!    test is predicted only from what the other tests inform; then the best schedule of each setup (decisive and
+//! 5. **Ranking**: held out by test, a test is predicted only from what the other tests
+//!    inform, so an effect that one test carries (`Report::carried_by`, or a test of
+//!    `Report::to_repeat`, which the leading candidate cannot predict held out) is confirmed
+//!    only once a second test carries it. First the repeats of the `to_repeat` tests, each
+//!    as it was run; then **a second carrying test**: the best setup of another case or drive
+//!    that carries the leading candidate (decisive against the nominal model, [`carries`])
+//!    under its best such schedule; then the best schedule of each setup (decisive and
 //!    cheapest, else the most separating), the setups in the same order; the first
-//!    [`MAX_PROPOSED`] are proposed.
+//!    [`MAX_PROPOSED`] are proposed. (Led by the second carrying test, the bench lost a
+//!    fixture compliance a repeat of A confirms: a test of D that is decisive against the
+//!    nominal model carries a ten-thousandth of what A does.)
 
 pub mod leaders;
 pub mod separation;
@@ -31,7 +37,7 @@ use crate::gap::campaign::Campaign;
 use crate::gap::GapError;
 use leaders::{leaders, Leader};
 use separation::{expected_log_lr, Readings, TestNoise};
-use setups::{repeat_of, schedules, setups, test_entry, Schedule, Setup};
+use setups::{repeat_of, same_case, schedules, setups, test_entry, Schedule, Setup};
 
 /// Expected log-likelihood ratio a test must give the true candidate over each rival to be
 /// decisive: ln 20 (odds of 20 to 1, a 5 % error), in nats.
@@ -129,28 +135,64 @@ pub fn propose(
             repeats.push(r);
         }
     }
+    // The tests that alone carry the leading candidate: a second test of another case or
+    // drive that carries it lets each be predicted held out from the other.
+    let carrying: Vec<&crate::gap::campaign::CampaignTest> = report
+        .carried_by
+        .iter()
+        .chain(&report.to_repeat)
+        .filter_map(|id| campaign.tests.iter().find(|t| &t.id == id))
+        .collect();
+    let mut second: Vec<Ranked> = Vec::new();
     let mut best: Vec<Ranked> = Vec::new();
     for setup in setups(campaign, configs_dir) {
         let Some(by_candidate) = simulate(&setup)? else {
             continue;
         };
-        let ranked = schedules
+        let ranked: Vec<Ranked> = schedules
             .iter()
             .map(|s| rank(&setup, s, &by_candidate, &candidates, &components, &noise))
-            .min_by(Ranked::order);
-        best.extend(ranked);
+            .collect();
+        if let Some(first) = carrying.first() {
+            if !carrying.iter().any(|t| same_case(&setup, t)) {
+                let carried = ranked
+                    .iter()
+                    .filter(|r| carries(r))
+                    .min_by(|a, b| Ranked::order(a, b));
+                if let Some(r) = carried {
+                    second.push(Ranked {
+                        second_to: Some(first.id.clone()),
+                        ..r.clone()
+                    });
+                }
+            }
+        }
+        best.extend(ranked.into_iter().min_by(Ranked::order));
     }
+    second.sort_by(Ranked::order);
     best.sort_by(Ranked::order);
-    repeats.extend(best);
-    let ids = fresh_ids(campaign, repeats.len().min(MAX_PROPOSED));
-    Ok(repeats
+    // The repeats, then the best second carrying test; the other setups keep their place.
+    let second: Option<Ranked> = second.into_iter().next();
+    let lead = second.as_ref().map(|s| s.setup.clone());
+    let mut ordered: Vec<Ranked> = repeats;
+    ordered.extend(second);
+    ordered.extend(best.into_iter().filter(|b| lead.as_ref() != Some(&b.setup)));
+    let ids = fresh_ids(campaign, ordered.len().min(MAX_PROPOSED));
+    Ok(ordered
         .into_iter()
         .zip(ids)
         .map(|(r, id)| r.proposed(&id, &components, &noise))
         .collect())
 }
 
+/// Whether a ranked test carries the leading candidate: decisive against the nominal model
+/// (the first rival, [`leaders`]), so the test alone would show the effect.
+fn carries(r: &Ranked) -> bool {
+    r.separations.first().is_some_and(|&x| x > DECISIVE_NATS)
+}
+
 /// One setup under one schedule with its separations.
+#[derive(Clone)]
 struct Ranked {
     setup: Setup,
     schedule: Schedule,
@@ -161,6 +203,9 @@ struct Ranked {
     separations: Vec<f64>,
     /// The campaign test it repeats (`Report::to_repeat`).
     repeats_test: Option<String>,
+    /// The campaign test that alone carries the leading candidate, which this test of
+    /// another case or drive carries too.
+    second_to: Option<String>,
 }
 
 impl Ranked {
@@ -196,14 +241,21 @@ impl Ranked {
         let separation = self.separation();
         let decisive = self.decisive();
         let s = self.schedule;
-        let description = match &self.repeats_test {
-            Some(id) => format!(
+        let description = match (&self.repeats_test, &self.second_to) {
+            (_, Some(id)) => format!(
+                "Proposed by the diagnosis so that a second test carries {}: test {id} alone carries it, and held out one carrying test is not predicted from the others ({}; expected log-likelihood ratio {:.1} nats against the nominal model, {separation:.1} against {})",
+                self.names[0],
+                self.setup.change,
+                self.separations.first().copied().unwrap_or(0.0),
+                self.names[1..].join(", ")
+            ),
+            (Some(id), None) => format!(
                 "Proposed by the diagnosis to confirm {} where held-out data cannot: test {id} repeated ({}; expected log-likelihood ratio {separation:.1} nats against {})",
                 self.names[0],
                 self.setup.change,
                 self.names[1..].join(", ")
             ),
-            None => format!(
+            (None, None) => format!(
                 "Proposed by the diagnosis to tell {} from {} ({}; expected log-likelihood ratio {separation:.1} nats)",
                 self.names[0],
                 self.names[1..].join(", "),
@@ -244,6 +296,7 @@ impl Ranked {
             case: self.setup.case.clone(),
             change: self.setup.change.clone(),
             repeats_test: self.repeats_test,
+            second_to: self.second_to,
             drive_axis: self.setup.drive_axis.clone(),
             level_g: self.setup.level_g,
             frequency_hz: self.setup.frequency_hz,
@@ -291,6 +344,7 @@ fn rank(
         predictions,
         separations,
         repeats_test: None,
+        second_to: None,
     }
 }
 

@@ -277,6 +277,12 @@ fn setup(
     }
 }
 
+/// Whether `setup` is campaign test `t`'s case under `t`'s drive (then it is a repeat of `t`,
+/// whatever its schedule).
+pub fn same_case(setup: &Setup, t: &CampaignTest) -> bool {
+    case_key(&setup.template) == case_key(t)
+}
+
 /// The test's configuration without its measurements.
 fn bare(t: &CampaignTest) -> CampaignTest {
     CampaignTest {
