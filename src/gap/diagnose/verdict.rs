@@ -72,7 +72,15 @@ pub fn diagnose_with(
     }
     let (mut within, _) = judge(campaign, emulator, options, &by_increment, Some(&scope));
     tracing::debug!(verdict = ?within.verdict, summary = %within.summary, "judged again by increment");
-    if within.verdict != Verdict::PartlyExplained {
+    // Confirmed by increment means every increment predicted held out; one it does not
+    // predict confirms nothing, and the report held out by test stands (it names the test
+    // that carries the effect).
+    let confirmed = within.verdict == Verdict::PartlyExplained
+        && within
+            .partly_explained
+            .as_ref()
+            .is_none_or(|p| p.unpredicted.is_empty());
+    if !confirmed {
         return Ok(report);
     }
     within.held_out = format!("leave-one-increment-out, as {carried}");

@@ -37,6 +37,11 @@ pub struct NextTestOutcome {
     pub chosen: Option<String>,
     /// `explained` with the right name.
     pub confirmed: bool,
+    /// Lack-of-fit p-value of the truth itself, simulated in the emulator at its drawn
+    /// values, on the campaign with the test appended: below the diagnosis' alpha, no
+    /// diagnosis through this emulator could confirm it (None where the truth is not fitted).
+    #[serde(default)]
+    pub truth_p_after: Option<f64>,
 }
 
 /// The confirm mode's scores.
@@ -180,6 +185,7 @@ pub(super) fn confirm(
             verdict: report.verdict,
             chosen: report.best_effect.as_ref().map(|b| b.name.clone()),
             confirmed: false,
+            truth_p_after: None,
         });
     };
     let one = Campaign {
@@ -216,6 +222,15 @@ pub(super) fn confirm(
         super::run::write_report(dir, s, "-after", &after)?;
     }
     let chosen = after.best_effect.as_ref().map(|b| b.name.clone());
+    let sim = Simulating {
+        campaign: &extended,
+        options: &o.diagnose,
+        configs_dir,
+        control,
+        cache,
+    };
+    let truth_p_after = crate::gap::diagnose::truth_fit::truth_fit(sim, &mut emulator, &s.effects)?
+        .map(|t| t.p_value);
     Ok(NextTestOutcome {
         test: format!(
             "{}: {}; {} x {:.1} h x {}",
@@ -231,6 +246,7 @@ pub(super) fn confirm(
         confirmed: after.verdict == Verdict::Explained
             && chosen.as_deref().is_some_and(|c| same_name(c, &s.truth)),
         chosen,
+        truth_p_after,
     })
 }
 
@@ -288,6 +304,7 @@ mod tests {
             verdict,
             chosen: chosen.map(str::to_string),
             confirmed: false,
+            truth_p_after: None,
         };
         let truth = "fixture_compliance+cross_axis";
         // One member of the injected pair: incomplete, not wrong.
@@ -343,6 +360,7 @@ mod tests {
                 },
                 chosen: confirmed.then(|| "friction_drift".to_string()),
                 confirmed,
+                truth_p_after: None,
             }),
             ..outcome(
                 "friction_drift",

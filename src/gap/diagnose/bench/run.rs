@@ -274,11 +274,13 @@ pub fn run(
                 &cache,
             )?;
             progress(format!(
-                "  next test {} -> {:?} {:?}{}",
+                "  next test {} -> {:?} {:?}{}; the truth's own lack-of-fit p with it {}",
                 next.test,
                 next.verdict,
                 next.chosen,
-                if next.confirmed { " (confirmed)" } else { "" }
+                if next.confirmed { " (confirmed)" } else { "" },
+                next.truth_p_after
+                    .map_or_else(|| "n/a".to_string(), |p| format!("{p:.2e}"))
             ));
             outcome.next_test = Some(next);
         }
