@@ -24,23 +24,30 @@ fn truth_phase(t: usize, k: usize, cross: f64, phase_deg: f64) -> Prediction {
     p
 }
 
-/// The cross-axis table of [`emulator`] at another phase (a variant table).
-fn cross_variant(phase_deg: f64) -> EffectTable {
-    let mut t = table("cross_axis", 2, 41);
+/// Table `name` of [`emulator`] (its `which` effect) with predictions `at(test, increment,
+/// share of the bound)`.
+fn table_with(
+    name: &str,
+    which: usize,
+    at: impl Fn(usize, usize, f64) -> Prediction,
+) -> EffectTable {
+    let mut t = table(name, which, 41);
     let max = t.info.parameters[0].max;
     t.predictions = t
         .magnitudes
         .iter()
         .map(|m| {
             (0..TESTS)
-                .map(|ti| {
-                    (0..INCREMENTS)
-                        .map(|k| truth_phase(ti, k, m / max, phase_deg))
-                        .collect()
-                })
+                .map(|ti| (0..INCREMENTS).map(|k| at(ti, k, m / max)).collect())
                 .collect()
         })
         .collect();
+    t
+}
+
+/// The cross-axis table of [`emulator`] at another phase (a variant table).
+fn cross_variant(phase_deg: f64) -> EffectTable {
+    let mut t = table_with("cross_axis", 2, |ti, k, f| truth_phase(ti, k, f, phase_deg));
     t.parameters = BTreeMap::from([("phase_deg".to_string(), phase_deg)]);
     t
 }
@@ -202,20 +209,10 @@ fn a_withheld_test_that_is_not_predicted_keeps_the_verdict_from_explained() {
 /// false: the library default's table) or lets it act there as on the other tests (a variant
 /// at a low threshold); on T0-T3 the two are the same.
 fn threshold_table(reaches_t4: bool) -> EffectTable {
-    let mut t = table("third_body", 0, 41);
-    let max = t.info.parameters[0].max;
-    t.predictions = t
-        .magnitudes
-        .iter()
-        .map(|m| {
-            (0..TESTS)
-                .map(|ti| {
-                    let f = if ti == 4 && !reaches_t4 { 0.0 } else { m / max };
-                    (0..INCREMENTS).map(|k| truth(ti, k, f, 0.0, 0.0)).collect()
-                })
-                .collect()
-        })
-        .collect();
+    let mut t = table_with("third_body", 0, |ti, k, f| {
+        let f = if ti == 4 && !reaches_t4 { 0.0 } else { f };
+        truth(ti, k, f, 0.0, 0.0)
+    });
     if reaches_t4 {
         t.parameters = BTreeMap::from([("min_slip_m_s".to_string(), 1e-4)]);
     }
