@@ -157,7 +157,8 @@ fn same_name(a: &str, b: &str) -> bool {
 }
 
 /// The confirm step of one campaign: its top proposed next test run by the rig under the
-/// truth of `s`, appended to `noisy`, diagnosed again.
+/// truth of `s`, appended to `noisy`, diagnosed again; with the report after it (None when
+/// no test was proposed).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn confirm(
     skeleton: &Campaign,
@@ -168,7 +169,7 @@ pub(super) fn confirm(
     configs_dir: &Path,
     control: &RunControl,
     cache: &WindowCache,
-) -> Result<NextTestOutcome, GapError> {
+) -> Result<(NextTestOutcome, Option<Report>), GapError> {
     let sim = Simulating {
         campaign: noisy,
         options: &o.diagnose,
@@ -178,7 +179,7 @@ pub(super) fn confirm(
     };
     let proposed = propose_next_tests(noisy, report, sim)?;
     let Some(top) = proposed.first() else {
-        return Ok(NextTestOutcome {
+        let none = NextTestOutcome {
             test: "none proposed".into(),
             cost_h: 0.0,
             separation_nats: 0.0,
@@ -186,7 +187,8 @@ pub(super) fn confirm(
             chosen: report.best_effect.as_ref().map(|b| b.name.clone()),
             confirmed: false,
             truth_p_after: None,
-        });
+        };
+        return Ok((none, None));
     };
     let one = Campaign {
         tests: vec![top.test.clone()],
@@ -218,9 +220,6 @@ pub(super) fn confirm(
         cache,
         &|_, _| {},
     )?;
-    if let Some(dir) = &o.reports_dir {
-        super::run::write_report(dir, s, "-after", &after)?;
-    }
     let chosen = after.best_effect.as_ref().map(|b| b.name.clone());
     let sim = Simulating {
         campaign: &extended,
@@ -231,7 +230,7 @@ pub(super) fn confirm(
     };
     let truth_p_after = crate::gap::diagnose::truth_fit::truth_fit(sim, &mut emulator, &s.effects)?
         .map(|t| t.p_value);
-    Ok(NextTestOutcome {
+    let outcome = NextTestOutcome {
         test: format!(
             "{}: {}; {} x {:.1} h x {}",
             top.test.id,
@@ -247,7 +246,8 @@ pub(super) fn confirm(
             && chosen.as_deref().is_some_and(|c| same_name(c, &s.truth)),
         chosen,
         truth_p_after,
-    })
+    };
+    Ok((outcome, Some(after)))
 }
 
 #[cfg(test)]

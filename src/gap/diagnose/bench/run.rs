@@ -263,7 +263,7 @@ pub fn run(
             next_test: None,
         };
         if o.confirm && confirm::eligible(&outcome) {
-            let next = confirm::confirm(
+            let (next, after) = confirm::confirm(
                 skeleton,
                 &noisy,
                 &report,
@@ -273,6 +273,9 @@ pub fn run(
                 control,
                 &cache,
             )?;
+            if let (Some(dir), Some(after)) = (&o.reports_dir, &after) {
+                write_report(dir, s, "-after", after)?;
+            }
             progress(format!(
                 "  next test {} -> {:?} {:?}{}; the truth's own lack-of-fit p with it {}",
                 next.test,
@@ -298,12 +301,7 @@ pub fn run(
 
 /// Writes `report` and its scenario as `<dir>/<rig seed><suffix>.json` (the confirm step's
 /// report after its next test: suffix `-after`).
-pub(super) fn write_report(
-    dir: &Path,
-    s: &Scenario,
-    suffix: &str,
-    report: &Report,
-) -> Result<(), GapError> {
+fn write_report(dir: &Path, s: &Scenario, suffix: &str, report: &Report) -> Result<(), GapError> {
     let path = dir.join(format!("{}{suffix}.json", s.seed));
     let write_error = |x: String| GapError::Write {
         path: path.display().to_string(),
