@@ -18,7 +18,7 @@
 //!    `Report::to_repeat`, which the leading candidate cannot predict held out) is confirmed
 //!    only once a second test carries it. First the repeats of the `to_repeat` tests, each
 //!    as it was run; then **a second carrying test**: the best setup of another case or drive
-//!    that carries the leading candidate (decisive against the nominal model, [`carries`])
+//!    that carries the leading candidate (decisive against the nominal model, `carries`)
 //!    under its best such schedule; then the best schedule of each setup (decisive and
 //!    cheapest, else the most separating), the setups in the same order; the first
 //!    [`MAX_PROPOSED`] are proposed. (Led by the second carrying test, the bench lost a
