@@ -296,9 +296,7 @@ impl<'a> FitProblem<'a> {
     ///   points, refined five-fold around the best; both are taken only when they beat the
     ///   better member alone by more than [`PROFILE_95`].
     pub(super) fn fit(&self, model: Model, mask: &dyn Fn(usize) -> bool) -> Fit {
-        let mut fits = self.fits(model, mask);
-        let first = fits.remove(0);
-        unless_beaten(first, fits.into_iter())
+        chosen(&self.fits(model, mask))
     }
 
     /// Every fit [`FitProblem::fit`] chooses among on the groups `mask` keeps, the library
@@ -337,10 +335,9 @@ impl<'a> FitProblem<'a> {
         let mut held_r2_spread = Vec::with_capacity(self.groups);
         let mut fold_specs = Vec::with_capacity(self.groups);
         for g in 0..self.groups {
-            let mut fits = self.fits(model, &|h| h != g);
-            let first = fits.remove(0);
-            let floor = fits.iter().map(|f| f.1).fold(first.1, f64::min);
-            let (spec, _) = unless_beaten(first.clone(), fits.iter().cloned());
+            let fits = self.fits(model, &|h| h != g);
+            let floor = fits.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
+            let (spec, _) = chosen(&fits);
             // Held out: the joint likelihood less the training groups' alone, i.e. group `g`
             // given the training groups (their calibration scales carried over).
             let held_of = |spec: &[(usize, f64)]| {
@@ -351,8 +348,8 @@ impl<'a> FitProblem<'a> {
             // The prediction carries the spread of what the training groups leave open: the
             // group's chi-square at the fit, among those the training groups do not refuse
             // (within PROFILE_95 of their best), that predicts it best.
-            let spread = std::iter::once(first)
-                .chain(fits)
+            let spread = fits
+                .iter()
                 .filter(|f| f.1 <= floor + PROFILE_95 && f.0 != spec)
                 .map(|f| held_of(&f.0).r2)
                 .fold(held.r2, f64::min);
@@ -411,6 +408,15 @@ impl<'a> FitProblem<'a> {
 
 /// A fit `(spec, negative log-likelihood)`.
 pub(super) type Fit = (Vec<(usize, f64)>, f64);
+
+/// The fit [`FitProblem::fit`] takes among `fits` ([`FitProblem::fits`]: the defaults' first):
+/// [`unless_beaten`].
+fn chosen(fits: &[Fit]) -> Fit {
+    match fits.split_first() {
+        Some((first, others)) => unless_beaten(first.clone(), others.iter().cloned()),
+        None => (Vec::new(), f64::INFINITY),
+    }
+}
 
 /// `first` (the library defaults, or the tables the singles chose), unless the best of
 /// `others` (other secondary values) beats it by more than [`PROFILE_95`]: a likelihood-ratio

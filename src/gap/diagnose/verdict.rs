@@ -342,10 +342,10 @@ pub(super) fn judge(
             )
         });
     let to_repeat = tests_to_repeat(campaign, problem, partly.as_ref());
+    // Held out by test, the group labels are the tests' ids.
     let carried_by = one_group
         .filter(|_| problem.by_test())
-        .map(|(_, g, _)| problem.group_labels[g].clone())
-        .filter(|label| campaign.tests.iter().any(|t| &t.id == label));
+        .map(|(_, g, _)| problem.group_labels[g].clone());
     let indistinguishable = chosen.map(|(_, o)| o).unwrap_or_default();
     let summary = match verdict {
         Verdict::NoGap => format!(

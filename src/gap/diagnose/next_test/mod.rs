@@ -169,10 +169,9 @@ pub fn propose(
         }
         best.extend(ranked.into_iter().min_by(Ranked::order));
     }
-    second.sort_by(Ranked::order);
     best.sort_by(Ranked::order);
     // The repeats, then the best second carrying test; the other setups keep their place.
-    let second: Option<Ranked> = second.into_iter().next();
+    let second: Option<Ranked> = second.into_iter().min_by(Ranked::order);
     let lead = second.as_ref().map(|s| s.setup.clone());
     let mut ordered: Vec<Ranked> = repeats;
     ordered.extend(second);
